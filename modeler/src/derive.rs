@@ -1,0 +1,341 @@
+//! Symbolic derivation (Symbolica): from a validated [`Model`] to the named
+//! quantities of Lagrange's equations of the first kind, as in the thesis's
+//! `Bicicleta.m`: mass matrix (eq. 32), quadratic-velocity forces (eq. 36),
+//! gravity forces (eq. 38), applied forces, holonomic residuals and their
+//! derivatives, the nonholonomic matrix and its convective term, energies and
+//! point positions. Every derivative here is exact (symbolic).
+
+use crate::expr::Expr;
+use crate::model::{Axis, Force, Holonomic, Model, Nonholonomic, GROUND};
+use std::collections::HashMap;
+use std::time::{Duration, Instant};
+use symbolica::prelude::*;
+
+/// Which inputs a generated function takes (besides the parameters).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Inputs {
+    pub time: bool,
+    pub coordinates: bool,
+    pub rates: bool,
+}
+
+/// How the outputs are returned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// Written into `out` (row-major `rows x cols`).
+    Buffer { rows: usize, cols: usize },
+    /// Returned as a scalar.
+    Scalar,
+}
+
+/// One derived quantity, to become one generated function.
+#[derive(Clone, Debug)]
+pub struct Quantity {
+    /// Function name (e.g. `mass_matrix`).
+    pub name: &'static str,
+    /// One-line description (becomes the doc comment).
+    pub doc: &'static str,
+    pub inputs: Inputs,
+    pub shape: Shape,
+    /// Output expressions (row-major).
+    pub outputs: Vec<Atom>,
+}
+
+/// The symbols standing for the inputs of generated code.
+pub struct Symbols {
+    pub params: Vec<Symbol>,
+    pub coords: Vec<Symbol>,
+    pub rates: Vec<Symbol>,
+    pub time: Symbol,
+}
+
+/// Everything derived for one model.
+pub struct Derived {
+    pub model: Model,
+    pub symbols: Symbols,
+    pub quantities: Vec<Quantity>,
+    /// Wall time of the symbolic derivation.
+    pub elapsed: Duration,
+}
+
+type V3 = [Atom; 3];
+type M3 = [[Atom; 3]; 3];
+
+fn zero() -> Atom {
+    Atom::num(0)
+}
+
+fn mat_mul(a: &M3, b: &M3) -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| (0..3).fold(zero(), |s, k| s + &a[i][k] * &b[k][j])))
+}
+fn mat_vec(a: &M3, v: &V3) -> V3 {
+    std::array::from_fn(|i| (0..3).fold(zero(), |s, k| s + &a[i][k] * &v[k]))
+}
+fn mat_t_vec(a: &M3, v: &V3) -> V3 {
+    std::array::from_fn(|i| (0..3).fold(zero(), |s, k| s + &a[k][i] * &v[k]))
+}
+fn dot(a: &V3, b: &V3) -> Atom {
+    (0..3).fold(zero(), |s, k| s + &a[k] * &b[k])
+}
+fn cross(a: &V3, b: &V3) -> V3 {
+    [
+        &a[1] * &b[2] - &a[2] * &b[1],
+        &a[2] * &b[0] - &a[0] * &b[2],
+        &a[0] * &b[1] - &a[1] * &b[0],
+    ]
+}
+fn identity() -> M3 {
+    std::array::from_fn(|i| std::array::from_fn(|j| Atom::num(if i == j { 1 } else { 0 })))
+}
+
+/// Elementary rotation matrix about `axis` by `angle` (right-handed; the
+/// thesis's A_theta, A_psi, A_gam, ...).
+fn rotation(axis: Axis, angle: &Atom) -> M3 {
+    let c = Symbol::COS.call((angle,));
+    let s = Symbol::SIN.call((angle,));
+    let (o, l) = (zero(), Atom::num(1));
+    match axis {
+        Axis::X => [[l, o.clone(), o.clone()], [o.clone(), c.clone(), -&s], [o, s, c]],
+        Axis::Y => [[c.clone(), o.clone(), s.clone()], [o.clone(), l, o.clone()], [-&s, o, c]],
+        Axis::Z => [[c.clone(), -&s, o.clone()], [s, c, o.clone()], [o.clone(), o, l]],
+    }
+}
+
+struct Deriver<'a> {
+    m: &'a Model,
+    sym: Symbols,
+    param_index: HashMap<&'a str, usize>,
+    coord_index: HashMap<&'a str, usize>,
+}
+
+impl<'a> Deriver<'a> {
+    fn atom(&self, e: &Expr) -> Atom {
+        match e {
+            Expr::Num(n, d) => Atom::num(*n) / Atom::num(*d),
+            Expr::Param(n) => Atom::var(self.sym.params[self.param_index[n.as_str()]]),
+            Expr::Coord(n) => Atom::var(self.sym.coords[self.coord_index[n.as_str()]]),
+            Expr::Rate(n) => Atom::var(self.sym.rates[self.coord_index[n.as_str()]]),
+            Expr::Time => Atom::var(self.sym.time),
+            Expr::Add(v) => v.iter().fold(zero(), |s, e| s + self.atom(e)),
+            Expr::Mul(v) => v.iter().fold(Atom::num(1), |s, e| s * self.atom(e)),
+            Expr::Pow(b, n) => self.atom(b).pow(Atom::num(*n as i64)),
+            Expr::Sin(a) => Symbol::SIN.call((&self.atom(a),)),
+            Expr::Cos(a) => Symbol::COS.call((&self.atom(a),)),
+            Expr::Sqrt(a) => Symbol::SQRT.call((&self.atom(a),)),
+        }
+    }
+    fn vec(&self, v: &[Expr; 3]) -> V3 {
+        std::array::from_fn(|i| self.atom(&v[i]))
+    }
+
+    /// Total time derivative of an expression in (t, q): sum dE/dq_j q'_j + dE/dt.
+    fn time_rate(&self, e: &Atom) -> Atom {
+        let mut s = e.derivative(self.sym.time);
+        for (j, q) in self.sym.coords.iter().enumerate() {
+            s = s + e.derivative(*q) * Atom::var(self.sym.rates[j]);
+        }
+        s
+    }
+}
+
+/// Derive every quantity of a model.
+pub fn derive(model: &Model) -> Derived {
+    let start = Instant::now();
+    let ns = &model.name;
+    let mk = |kind: &str, n: &str| symbol!(&format!("bikedyn_{ns}::{kind}_{n}"));
+    let sym = Symbols {
+        params: model.parameters.iter().map(|p| mk("p", &p.name)).collect(),
+        coords: model.coordinates.iter().map(|c| mk("q", &c.name)).collect(),
+        rates: model.coordinates.iter().map(|c| mk("dq", &c.name)).collect(),
+        time: mk("t", "time"),
+    };
+    let d = Deriver {
+        m: model,
+        param_index: model.parameters.iter().enumerate().map(|(i, p)| (p.name.as_str(), i)).collect(),
+        coord_index: model.coordinates.iter().enumerate().map(|(i, p)| (p.name.as_str(), i)).collect(),
+        sym,
+    };
+    let nq = model.coordinates.len();
+    let q_at = |j: usize| d.sym.coords[j];
+    let dq = |j: usize| Atom::var(d.sym.rates[j]);
+
+    // Kinematics: frame rotation matrices (global) and body-axis angular velocities.
+    let mut rot: Vec<M3> = Vec::with_capacity(d.m.frames.len());
+    let mut omega_local: Vec<V3> = Vec::with_capacity(d.m.frames.len());
+    for (fi, f) in d.m.frames.iter().enumerate() {
+        if fi == GROUND.0 {
+            rot.push(identity());
+            omega_local.push([zero(), zero(), zero()]);
+            continue;
+        }
+        let mut a = rot[f.parent.0].clone();
+        let mut w = omega_local[f.parent.0].clone();
+        for (axis, angle) in &f.rotations {
+            let angle = d.atom(angle);
+            let r = rotation(*axis, &angle);
+            a = mat_mul(&a, &r);
+            // Angular velocity in the new axes: R^T w_prev + e_axis * d(angle)/dt.
+            w = mat_t_vec(&r, &w);
+            let k = axis.index();
+            w[k] = &w[k] + d.time_rate(&angle);
+        }
+        rot.push(a);
+        omega_local.push(w);
+    }
+    let mut points: Vec<V3> = Vec::with_capacity(d.m.points.len());
+    for p in &d.m.points {
+        let mut r = match p.base {
+            Some(b) => points[b.0].clone(),
+            None => [zero(), zero(), zero()],
+        };
+        for (f, v) in &p.offsets {
+            let g = mat_vec(&rot[f.0], &d.vec(v));
+            r = std::array::from_fn(|i| &r[i] + &g[i]);
+        }
+        points.push(r);
+    }
+    // Jacobians H_i = dRG_i/dp (3 x nq) and Gl_i = d(omega_local)/dp' (3 x nq).
+    let jac = |v: &V3, s: &dyn Fn(usize) -> Symbol| -> Vec<V3> {
+        (0..nq).map(|j| std::array::from_fn(|i| v[i].derivative(s(j)))).collect()
+    };
+    let body_h: Vec<Vec<V3>> = d.m.bodies.iter().map(|b| jac(&points[b.mass_centre.0], &|j| q_at(j))).collect();
+    let body_g: Vec<Vec<V3>> = d.m.bodies.iter().map(|b| jac(&omega_local[b.frame.0], &|j| d.sym.rates[j])).collect();
+    let masses: Vec<Atom> = d.m.bodies.iter().map(|b| d.atom(&b.mass)).collect();
+    let inertias: Vec<M3> = d
+        .m
+        .bodies
+        .iter()
+        .map(|b| std::array::from_fn(|i| std::array::from_fn(|j| d.atom(&b.inertia[i][j]))))
+        .collect();
+
+    // Mass matrix, eq. 32: M = sum m H^T H + Gl^T I Gl.
+    let mut mass = vec![zero(); nq * nq];
+    for a in 0..nq {
+        for b in a..nq {
+            let mut s = zero();
+            for i in 0..d.m.bodies.len() {
+                s = s + &masses[i] * dot(&body_h[i][a], &body_h[i][b]);
+                s = s + dot(&body_g[i][a], &mat_vec(&inertias[i], &body_g[i][b]));
+            }
+            mass[a * nq + b] = s.clone();
+            mass[b * nq + a] = s;
+        }
+    }
+    // Kinetic energy and quadratic-velocity forces, eq. 36: Qv = -d(M p')/dp p' + dT/dp.
+    let mdq: Vec<Atom> = (0..nq).map(|a| (0..nq).fold(zero(), |s, b| s + &mass[a * nq + b] * dq(b))).collect();
+    let kinetic = (0..nq).fold(zero(), |s, a| s + dq(a) * &mdq[a]) * Atom::num(1) / Atom::num(2);
+    let qv: Vec<Atom> = (0..nq)
+        .map(|a| {
+            let mut s = zero();
+            for j in 0..nq {
+                s = s - mdq[a].derivative(q_at(j)) * dq(j);
+            }
+            s + kinetic.derivative(q_at(a))
+        })
+        .collect();
+    // Gravity, eq. 38: Qgrav = sum H^T [0 0 -m g]; potential V = sum m g z.
+    let (gravity, potential) = match &d.m.gravity {
+        Some((g, up)) => {
+            let g = Atom::var(d.sym.params[d.param_index[g.as_str()]]);
+            let k = up.index();
+            let pot = (0..d.m.bodies.len()).fold(zero(), |s, i| {
+                s + &masses[i] * &g * &points[d.m.bodies[i].mass_centre.0][k]
+            });
+            let qg = (0..nq)
+                .map(|a| (0..d.m.bodies.len()).fold(zero(), |s, i| s - &masses[i] * &g * &body_h[i][a][k]))
+                .collect();
+            (qg, pot)
+        }
+        None => (vec![zero(); nq], zero()),
+    };
+    // Applied forces.
+    let mut applied = vec![zero(); nq];
+    for f in &d.m.forces {
+        match f {
+            Force::Generalized { coordinate, expr, .. } => {
+                let j = d.coord_index[coordinate.as_str()];
+                applied[j] = &applied[j] + d.atom(expr);
+            }
+            Force::AtMassCentre { body, frame, force, .. } => {
+                let fg = mat_vec(&rot[frame.0], &d.vec(force));
+                for a in 0..nq {
+                    applied[a] = &applied[a] + dot(&body_h[body.0][a], &fg);
+                }
+            }
+        }
+    }
+    // Holonomic constraints: Res, Cq, Ct, dCqdp = d(Cq p')/dp p'.
+    let res: Vec<Atom> = d
+        .m
+        .holonomic
+        .iter()
+        .map(|h| match h {
+            Holonomic::Residual { expr, .. } => d.atom(expr),
+            Holonomic::PointComponent { point, axis, .. } => points[point.0][axis.index()].clone(),
+            Holonomic::PointComponentStationary { point, axis, coordinate, .. } => {
+                points[point.0][axis.index()].derivative(q_at(d.coord_index[coordinate.as_str()]))
+            }
+        })
+        .collect();
+    let nh = res.len();
+    let cq: Vec<Atom> = (0..nh).flat_map(|i| (0..nq).map(|j| res[i].derivative(q_at(j))).collect::<Vec<_>>()).collect();
+    let ct: Vec<Atom> = res.iter().map(|r| r.derivative(d.sym.time)).collect();
+    let convective = |rows: &[Atom], n: usize| -> Vec<Atom> {
+        (0..n)
+            .map(|i| {
+                let bdq = (0..nq).fold(zero(), |s, k| s + &rows[i * nq + k] * dq(k));
+                (0..nq).fold(zero(), |s, j| s + bdq.derivative(q_at(j)) * dq(j))
+            })
+            .collect()
+    };
+    let dcqdp = convective(&cq, nh);
+    // Nonholonomic constraints: velocities, B = d(vel)/dp', dBdp = d(B p')/dp p'.
+    let vel: Vec<Atom> = d
+        .m
+        .nonholonomic
+        .iter()
+        .map(|n| match n {
+            Nonholonomic::ContactVelocity { body, point, axis, .. } => {
+                let b = &d.m.bodies[body.0];
+                let rg = &points[b.mass_centre.0];
+                let vg: V3 = std::array::from_fn(|i| (0..nq).fold(zero(), |s, j| s + &body_h[body.0][j][i] * dq(j)));
+                let w = mat_vec(&rot[b.frame.0], &omega_local[b.frame.0]);
+                let rel: V3 = std::array::from_fn(|i| &points[point.0][i] - &rg[i]);
+                let wxr = cross(&w, &rel);
+                &vg[axis.index()] + &wxr[axis.index()]
+            }
+            Nonholonomic::Linear { expr, .. } => d.atom(expr),
+        })
+        .collect();
+    let nnh = vel.len();
+    let bmat: Vec<Atom> =
+        (0..nnh).flat_map(|i| (0..nq).map(|j| vel[i].derivative(d.sym.rates[j])).collect::<Vec<_>>()).collect();
+    let dbdp = convective(&bmat, nnh);
+    let poi: Vec<Atom> = d.m.points_of_interest.iter().flat_map(|p| points[p.0].clone()).collect();
+
+    let (all, no_t, t_only) = (
+        Inputs { time: true, coordinates: true, rates: true },
+        Inputs { time: false, coordinates: true, rates: true },
+        Inputs { time: true, coordinates: true, rates: false },
+    );
+    let pos = Inputs { time: false, coordinates: true, rates: false };
+    let buf = |rows, cols| Shape::Buffer { rows, cols };
+    let quantities = vec![
+        Quantity { name: "mass_matrix", doc: "Mass matrix M(p), thesis eq. 32 (row-major nq x nq).", inputs: pos, shape: buf(nq, nq), outputs: mass },
+        Quantity { name: "quadratic_velocity_forces", doc: "Quadratic-velocity forces Qv = -d(M p')/dp p' + dT/dp, thesis eq. 36.", inputs: no_t, shape: buf(nq, 1), outputs: qv },
+        Quantity { name: "gravity_forces", doc: "Gravity forces Qgrav = sum H_i^T [0 0 -m_i g], thesis eq. 38.", inputs: pos, shape: buf(nq, 1), outputs: gravity },
+        Quantity { name: "applied_forces", doc: "Applied generalized forces Qext(p, p', t).", inputs: all, shape: buf(nq, 1), outputs: applied },
+        Quantity { name: "holonomic_residuals", doc: "Holonomic constraint residuals Res(p, t).", inputs: t_only, shape: buf(nh, 1), outputs: res },
+        Quantity { name: "holonomic_jacobian", doc: "Holonomic constraint Jacobian Cq = dRes/dp (row-major nh x nq).", inputs: t_only, shape: buf(nh, nq), outputs: cq },
+        Quantity { name: "holonomic_time_derivative", doc: "Ct = dRes/dt.", inputs: t_only, shape: buf(nh, 1), outputs: ct },
+        Quantity { name: "holonomic_convective", doc: "dCqdp = d(Cq p')/dp p'.", inputs: all, shape: buf(nh, 1), outputs: dcqdp },
+        Quantity { name: "nonholonomic_velocities", doc: "Constrained velocities (contact-point velocities), zero when the constraints hold.", inputs: all, shape: buf(nnh, 1), outputs: vel },
+        Quantity { name: "nonholonomic_matrix", doc: "Nonholonomic matrix B = d(velocities)/dp' (row-major nnh x nq).", inputs: t_only, shape: buf(nnh, nq), outputs: bmat },
+        Quantity { name: "nonholonomic_convective", doc: "dBdp = d(B p')/dp p'.", inputs: all, shape: buf(nnh, 1), outputs: dbdp },
+        Quantity { name: "kinetic_energy", doc: "Kinetic energy T = 1/2 p'^T M p' (J).", inputs: no_t, shape: Shape::Scalar, outputs: vec![kinetic] },
+        Quantity { name: "potential_energy", doc: "Gravitational potential energy V (J), Qgrav = -dV/dp.", inputs: pos, shape: Shape::Scalar, outputs: vec![potential] },
+        Quantity { name: "point_positions", doc: "Global positions of the points of interest (x, y, z per point).", inputs: pos, shape: buf(d.m.points_of_interest.len(), 3), outputs: poi },
+    ];
+    let Deriver { sym, .. } = d;
+    Derived { model: model.clone(), symbols: sym, quantities, elapsed: start.elapsed() }
+}

@@ -1,0 +1,453 @@
+//! Code emission: derived expressions -> optimized Rust source.
+//!
+//! Optimisation is our own common-subexpression elimination: every output of
+//! one function is converted into a single hash-consed DAG (identical
+//! subexpressions, including `sin`/`cos` of the same angle, become one node),
+//! and each node is emitted once as a `let`. Tokens are built with `quote`,
+//! checked by `syn::parse2`, and formatted by `prettyplease`, so the output is
+//! stable and diffable. The functions are generic over the runtime's `Scalar`
+//! trait so that dual numbers can flow through them (exact derivatives for the
+//! linearization without emitting derivative code).
+
+use crate::derive::{Derived, Quantity, Shape};
+use crate::model::Role;
+use proc_macro2::{Ident, Span, TokenStream};
+use quote::{format_ident, quote};
+use std::collections::HashMap;
+use std::fmt;
+use symbolica::prelude::*;
+
+/// Emission errors.
+#[derive(Debug)]
+pub enum EmitError {
+    /// An expression uses something generated code cannot evaluate.
+    Unsupported { function: String, what: String },
+    /// The emitted tokens did not parse (a bug in the emitter).
+    Syntax(String),
+}
+impl fmt::Display for EmitError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            EmitError::Unsupported { function, what } => write!(f, "cannot emit {what} in `{function}`"),
+            EmitError::Syntax(s) => write!(f, "emitted code does not parse: {s}"),
+        }
+    }
+}
+impl std::error::Error for EmitError {}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Input {
+    Param(usize),
+    Coord(usize),
+    Rate(usize),
+    Time,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum Node {
+    Input(Input),
+    Const(u64),
+    Add(Vec<usize>),
+    Mul(Vec<usize>),
+    Neg(usize),
+    Recip(usize),
+    Sin(usize),
+    Cos(usize),
+    Sqrt(usize),
+}
+
+/// Operation counts of one function.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCount {
+    /// Additions, subtractions, multiplications, divisions and negations.
+    pub arithmetic: usize,
+    /// Calls of sin, cos, sqrt.
+    pub transcendental: usize,
+}
+impl OpCount {
+    /// Total (each transcendental call counted once).
+    pub fn total(&self) -> usize {
+        self.arithmetic + self.transcendental
+    }
+}
+
+/// Statistics of one emitted function.
+#[derive(Clone, Debug)]
+pub struct FunctionReport {
+    pub name: &'static str,
+    /// Operations of the expression trees as derived (no sharing).
+    pub before: OpCount,
+    /// Operations after common-subexpression elimination.
+    pub after: OpCount,
+}
+
+struct Dag<'a> {
+    nodes: Vec<Node>,
+    index: HashMap<Node, usize>,
+    inputs: &'a HashMap<Symbol, Input>,
+    tree_ops: OpCount,
+    function: &'static str,
+}
+
+impl<'a> Dag<'a> {
+    fn add(&mut self, n: Node) -> usize {
+        if let Some(&i) = self.index.get(&n) {
+            return i;
+        }
+        self.nodes.push(n.clone());
+        self.index.insert(n, self.nodes.len() - 1);
+        self.nodes.len() - 1
+    }
+    fn constant(&mut self, x: f64) -> usize {
+        self.add(Node::Const(x.to_bits()))
+    }
+    fn unsupported(&self, what: String) -> EmitError {
+        EmitError::Unsupported { function: self.function.to_string(), what }
+    }
+    fn number(&self, v: AtomView) -> Result<Option<f64>, EmitError> {
+        if let AtomView::Num(n) = v {
+            match n.get_coeff_view() {
+                CoefficientView::Natural(nr, dr, ni, _) if ni == 0 => Ok(Some(nr as f64 / dr as f64)),
+                _ => Err(self.unsupported(format!("the number {v}"))),
+            }
+        } else {
+            Ok(None)
+        }
+    }
+    fn pow(&mut self, base: usize, n: i64) -> usize {
+        let m = n.unsigned_abs() as usize;
+        let p = if m == 1 { base } else {
+            self.tree_ops.arithmetic += m - 1;
+            self.add(Node::Mul(vec![base; m]))
+        };
+        if n < 0 {
+            self.tree_ops.arithmetic += 1;
+            self.add(Node::Recip(p))
+        } else {
+            p
+        }
+    }
+    fn convert(&mut self, v: AtomView) -> Result<usize, EmitError> {
+        Ok(match v {
+            AtomView::Num(_) => {
+                let x = self.number(v)?.unwrap_or(0.0);
+                self.constant(x)
+            }
+            AtomView::Var(s) => {
+                let input = *self.inputs.get(&s.get_symbol()).ok_or_else(|| self.unsupported(format!("the symbol {v}")))?;
+                self.add(Node::Input(input))
+            }
+            AtomView::Fun(f) => {
+                if f.get_nargs() != 1 {
+                    return Err(self.unsupported(format!("the function {v}")));
+                }
+                let a = self.convert(f.get(0))?;
+                self.tree_ops.transcendental += 1;
+                let s = f.get_symbol();
+                if s == Symbol::SIN {
+                    self.add(Node::Sin(a))
+                } else if s == Symbol::COS {
+                    self.add(Node::Cos(a))
+                } else if s == Symbol::SQRT {
+                    self.add(Node::Sqrt(a))
+                } else {
+                    return Err(self.unsupported(format!("the function {v}")));
+                }
+            }
+            AtomView::Pow(p) => {
+                let (b, e) = p.get_base_exp();
+                let base = self.convert(b)?;
+                let e = self.number(e)?.ok_or_else(|| self.unsupported(format!("the power {v}")))?;
+                if e.fract() == 0.0 {
+                    self.pow(base, e as i64)
+                } else if (2.0 * e).fract() == 0.0 {
+                    // x^(k/2) = sqrt(x)^k
+                    self.tree_ops.transcendental += 1;
+                    let r = self.add(Node::Sqrt(base));
+                    self.pow(r, (2.0 * e) as i64)
+                } else {
+                    return Err(self.unsupported(format!("the power {v}")));
+                }
+            }
+            AtomView::Mul(m) => {
+                let mut factors = Vec::new();
+                let mut coeff = 1.0;
+                for f in m.iter() {
+                    match self.number(f)? {
+                        Some(c) => coeff *= c,
+                        None => factors.push(self.convert(f)?),
+                    }
+                }
+                factors.sort_unstable();
+                if coeff != 1.0 && coeff != -1.0 {
+                    factors.insert(0, self.constant(coeff));
+                }
+                self.tree_ops.arithmetic += factors.len().saturating_sub(1);
+                let prod = if factors.len() == 1 { factors[0] } else { self.add(Node::Mul(factors)) };
+                if coeff == -1.0 {
+                    self.tree_ops.arithmetic += 1;
+                    self.add(Node::Neg(prod))
+                } else {
+                    prod
+                }
+            }
+            AtomView::Add(a) => {
+                let mut terms = Vec::new();
+                for t in a.iter() {
+                    terms.push(self.convert(t)?);
+                }
+                terms.sort_unstable();
+                self.tree_ops.arithmetic += terms.len().saturating_sub(1);
+                self.add(Node::Add(terms))
+            }
+        })
+    }
+}
+
+fn count_dag(nodes: &[Node]) -> OpCount {
+    let mut c = OpCount::default();
+    for n in nodes {
+        match n {
+            Node::Add(v) | Node::Mul(v) => c.arithmetic += v.len() - 1,
+            Node::Neg(_) | Node::Recip(_) => c.arithmetic += 1,
+            Node::Sin(_) | Node::Cos(_) | Node::Sqrt(_) => c.transcendental += 1,
+            Node::Input(_) | Node::Const(_) => {}
+        }
+    }
+    c
+}
+
+fn lit(x: f64) -> TokenStream {
+    let l = proc_macro2::Literal::f64_suffixed(x);
+    quote!(T::cst(#l))
+}
+
+struct Names {
+    params: Vec<Ident>,
+    coords: Vec<Ident>,
+    rates: Vec<Ident>,
+}
+
+fn ident(s: &str) -> Ident {
+    Ident::new(s, Span::call_site())
+}
+
+/// Emit one function; returns its tokens and report.
+fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -> Result<(TokenStream, FunctionReport), EmitError> {
+    let mut dag = Dag { nodes: Vec::new(), index: HashMap::new(), inputs, tree_ops: OpCount::default(), function: q.name };
+    let outs: Vec<usize> = q.outputs.iter().map(|a| dag.convert(a.as_view())).collect::<Result<_, _>>()?;
+    let report = FunctionReport { name: q.name, before: dag.tree_ops, after: count_dag(&dag.nodes) };
+    let var = |i: usize, nodes: &[Node]| -> TokenStream {
+        match &nodes[i] {
+            Node::Input(Input::Param(k)) => { let n = &names.params[*k]; quote!(#n) }
+            Node::Input(Input::Coord(k)) => { let n = &names.coords[*k]; quote!(#n) }
+            Node::Input(Input::Rate(k)) => { let n = &names.rates[*k]; quote!(#n) }
+            Node::Input(Input::Time) => quote!(t),
+            Node::Const(b) => lit(f64::from_bits(*b)),
+            _ => { let n = format_ident!("t{}", i); quote!(#n) }
+        }
+    };
+    let mut body = Vec::new();
+    // Inputs actually used.
+    let mut used = vec![false; dag.nodes.len()];
+    for (i, n) in dag.nodes.iter().enumerate() {
+        if let Node::Input(inp) = n {
+            used[i] = true;
+            let stmt = match inp {
+                Input::Param(k) => { let n = &names.params[*k]; quote!(let #n = param[#k];) }
+                Input::Coord(k) => { let n = &names.coords[*k]; quote!(let #n = p[#k];) }
+                Input::Rate(k) => { let n = &names.rates[*k]; quote!(let #n = dp[#k];) }
+                Input::Time => quote!(),
+            };
+            body.push(stmt);
+        }
+    }
+    for (i, n) in dag.nodes.iter().enumerate() {
+        let t = format_ident!("t{}", i);
+        let e = match n {
+            Node::Input(_) | Node::Const(_) => continue,
+            Node::Add(v) => {
+                let mut it = v.iter().map(|&c| (c, matches!(dag.nodes[c], Node::Neg(_))));
+                let mut pos: Vec<TokenStream> = Vec::new();
+                let mut neg: Vec<TokenStream> = Vec::new();
+                for (c, is_neg) in &mut it {
+                    if is_neg {
+                        if let Node::Neg(inner) = dag.nodes[c] { neg.push(var(inner, &dag.nodes)); }
+                    } else {
+                        pos.push(var(c, &dag.nodes));
+                    }
+                }
+                let first = if pos.is_empty() {
+                    let f = neg.remove(0);
+                    quote!(-#f)
+                } else {
+                    let f = pos.remove(0);
+                    quote!(#f)
+                };
+                quote!(#first #(+ #pos)* #(- #neg)*)
+            }
+            Node::Mul(v) => {
+                let f: Vec<_> = v.iter().map(|&c| var(c, &dag.nodes)).collect();
+                let (h, rest) = f.split_first().expect("products have factors");
+                quote!(#h #(* #rest)*)
+            }
+            Node::Neg(a) => { let a = var(*a, &dag.nodes); quote!(-#a) }
+            Node::Recip(a) => { let a = var(*a, &dag.nodes); quote!(T::one() / #a) }
+            Node::Sin(a) => { let a = var(*a, &dag.nodes); quote!(#a.sin()) }
+            Node::Cos(a) => { let a = var(*a, &dag.nodes); quote!(#a.cos()) }
+            Node::Sqrt(a) => { let a = var(*a, &dag.nodes); quote!(#a.sqrt()) }
+        };
+        body.push(quote!(let #t: T = #e;));
+    }
+    let _ = used;
+    let name = ident(q.name);
+    let doc = q.doc;
+    let t_arg = if q.inputs.time { quote!(t: T) } else { quote!(_t: T) };
+    let dp_arg = if q.inputs.rates { quote!(dp: &[T]) } else { quote!(_dp: &[T]) };
+    let tokens = match q.shape {
+        Shape::Scalar => {
+            let r = var(outs[0], &dag.nodes);
+            let args = if q.inputs.rates { quote!(param: &[T], p: &[T], #dp_arg) } else { quote!(param: &[T], p: &[T]) };
+            quote! {
+                #[doc = #doc]
+                #[allow(unused_variables, clippy::all)]
+                pub fn #name<T: Scalar>(#args) -> T {
+                    #(#body)*
+                    #r
+                }
+            }
+        }
+        Shape::Buffer { .. } => {
+            let n = outs.len();
+            let assigns = outs.iter().enumerate().map(|(k, &o)| { let v = var(o, &dag.nodes); quote!(out[#k] = #v;) });
+            let args = match (q.inputs.time, q.inputs.rates) {
+                _ if q.name == "mass_matrix" || q.name == "gravity_forces" || q.name == "point_positions" => quote!(param: &[T], p: &[T], out: &mut [T]),
+                (_, false) => quote!(param: &[T], #t_arg, p: &[T], out: &mut [T]),
+                (_, true) if q.name == "quadratic_velocity_forces" => quote!(param: &[T], p: &[T], dp: &[T], out: &mut [T]),
+                (_, true) => quote!(param: &[T], #t_arg, p: &[T], dp: &[T], out: &mut [T]),
+            };
+            quote! {
+                #[doc = #doc]
+                #[allow(unused_variables, clippy::all)]
+                pub fn #name<T: Scalar>(#args) {
+                    debug_assert_eq!(out.len(), #n);
+                    #(#body)*
+                    #(#assigns)*
+                }
+            }
+        }
+    };
+    Ok((tokens, report))
+}
+
+/// The emitted source of one model and its statistics.
+pub struct Emitted {
+    /// Formatted Rust source, with header.
+    pub source: String,
+    pub reports: Vec<FunctionReport>,
+}
+
+/// FNV-1a, for the header's model hash (stable across platforms and runs).
+pub fn fnv1a(data: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf29ce484222325;
+    for b in data {
+        h ^= *b as u64;
+        h = h.wrapping_mul(0x100000001b3);
+    }
+    h
+}
+
+fn camel(s: &str) -> String {
+    s.split('_').map(|w| { let mut c = w.chars(); c.next().map(|f| f.to_uppercase().chain(c).collect::<String>()).unwrap_or_default() }).collect()
+}
+
+/// Emit the whole model: one module body with the generated functions, the
+/// model's metadata, and the `MultibodyModel` implementation.
+pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
+    let m = &d.model;
+    let mut inputs = HashMap::new();
+    for (i, s) in d.symbols.params.iter().enumerate() { inputs.insert(*s, Input::Param(i)); }
+    for (i, s) in d.symbols.coords.iter().enumerate() { inputs.insert(*s, Input::Coord(i)); }
+    for (i, s) in d.symbols.rates.iter().enumerate() { inputs.insert(*s, Input::Rate(i)); }
+    inputs.insert(d.symbols.time, Input::Time);
+    let names = Names {
+        params: m.parameters.iter().map(|p| format_ident!("p_{}", p.name)).collect(),
+        coords: m.coordinates.iter().map(|c| format_ident!("q_{}", c.name)).collect(),
+        rates: m.coordinates.iter().map(|c| format_ident!("dq_{}", c.name)).collect(),
+    };
+    let mut fns = Vec::new();
+    let mut reports = Vec::new();
+    for q in &d.quantities {
+        let (t, r) = emit_function(q, &inputs, &names)?;
+        fns.push(t);
+        reports.push(r);
+    }
+    let ty = format_ident!("{}", camel(&m.name));
+    let name = &m.name;
+    let coords: Vec<&str> = m.coordinates.iter().map(|c| c.name.as_str()).collect();
+    let params: Vec<&str> = m.parameters.iter().map(|c| c.name.as_str()).collect();
+    let holo = m.holonomic_names();
+    let nonholo = m.nonholonomic_names();
+    let poi: Vec<&str> = m.points_of_interest.iter().map(|p| m.points[p.0].name.as_str()).collect();
+    let indep: Vec<usize> = m.coordinates.iter().enumerate().filter(|(_, c)| c.role == Role::Independent).map(|(i, _)| i).collect();
+    let dep: Vec<usize> = m.coordinates.iter().enumerate().filter(|(_, c)| c.role == Role::Dependent).map(|(i, _)| i).collect();
+    let guess: Vec<proc_macro2::Literal> = m.coordinates.iter().map(|c| proc_macro2::Literal::f64_suffixed(c.guess)).collect();
+    let flop_names: Vec<&str> = reports.iter().map(|r| r.name).collect();
+    let flop_counts: Vec<usize> = reports.iter().map(|r| r.after.total()).collect();
+    let coord_docs: Vec<String> = m.coordinates.iter().map(|c| format!("`{}`: {}", c.name, c.doc)).collect();
+    let param_docs: Vec<String> = m.parameters.iter().map(|c| format!("`{}`: {}", c.name, c.doc)).collect();
+    let model_doc = format!("Generated model `{}`: {}", m.name, m.doc);
+    let tokens = quote! {
+        use bikedyn_runtime::{MultibodyModel, Scalar};
+
+        #[doc = #model_doc]
+        #[derive(Clone, Copy, Debug, Default)]
+        pub struct #ty;
+
+        /// Generalized coordinates:
+        #(#[doc = #coord_docs])*
+        pub const COORDINATES: &[&str] = &[#(#coords),*];
+        /// Parameters:
+        #(#[doc = #param_docs])*
+        pub const PARAMETERS: &[&str] = &[#(#params),*];
+
+        #(#fns)*
+
+        impl MultibodyModel for #ty {
+            const NAME: &'static str = #name;
+            const COORDINATES: &'static [&'static str] = COORDINATES;
+            const PARAMETERS: &'static [&'static str] = PARAMETERS;
+            const HOLONOMIC: &'static [&'static str] = &[#(#holo),*];
+            const NONHOLONOMIC: &'static [&'static str] = &[#(#nonholo),*];
+            const POINTS: &'static [&'static str] = &[#(#poi),*];
+            const INDEPENDENT: &'static [usize] = &[#(#indep),*];
+            const DEPENDENT: &'static [usize] = &[#(#dep),*];
+            const INITIAL_GUESS: &'static [f64] = &[#(#guess),*];
+            const FLOPS: &'static [(&'static str, usize)] = &[#((#flop_names, #flop_counts)),*];
+            fn mass_matrix<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) { mass_matrix(param, p, out) }
+            fn quadratic_velocity_forces<T: Scalar>(param: &[T], p: &[T], dp: &[T], out: &mut [T]) { quadratic_velocity_forces(param, p, dp, out) }
+            fn gravity_forces<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) { gravity_forces(param, p, out) }
+            fn applied_forces<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) { applied_forces(param, t, p, dp, out) }
+            fn holonomic_residuals<T: Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]) { holonomic_residuals(param, t, p, out) }
+            fn holonomic_jacobian<T: Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]) { holonomic_jacobian(param, t, p, out) }
+            fn holonomic_time_derivative<T: Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]) { holonomic_time_derivative(param, t, p, out) }
+            fn holonomic_convective<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) { holonomic_convective(param, t, p, dp, out) }
+            fn nonholonomic_velocities<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) { nonholonomic_velocities(param, t, p, dp, out) }
+            fn nonholonomic_matrix<T: Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]) { nonholonomic_matrix(param, t, p, out) }
+            fn nonholonomic_convective<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) { nonholonomic_convective(param, t, p, dp, out) }
+            fn kinetic_energy<T: Scalar>(param: &[T], p: &[T], dp: &[T]) -> T { kinetic_energy(param, p, dp) }
+            fn potential_energy<T: Scalar>(param: &[T], p: &[T]) -> T { potential_energy(param, p) }
+            fn point_positions<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) { point_positions(param, p, out) }
+        }
+    };
+    let file = syn::parse2::<syn::File>(tokens).map_err(|e| EmitError::Syntax(e.to_string()))?;
+    let body = prettyplease::unparse(&file);
+    let hash = fnv1a(format!("{:?}", m).as_bytes());
+    let header = format!(
+        "// @generated by bikedyn build.rs from the modeler (model \"{}\", sources: {}, model hash {:016x}).\n// Do not edit: change the model file and rebuild; refresh this snapshot with UPDATE_SNAPSHOTS=1 cargo test.\n\n",
+        m.name,
+        m.sources.join(", "),
+        hash
+    );
+    Ok(Emitted { source: format!("{header}{body}"), reports })
+}

@@ -1,0 +1,12 @@
+//! bikedyn's build-time modeler: declare a multibody model as data
+//! ([`model`]), derive its equations symbolically with Symbolica
+//! ([`derive`]), and emit optimized Rust ([`emit`]).
+//!
+//! Symbolica runs here only, at build time; the generated code and the
+//! runtime do not depend on it. Symbolica's own licence governs its use.
+
+pub mod derive;
+pub mod emit;
+pub mod expr;
+pub mod model;
+pub mod models;

@@ -1,0 +1,489 @@
+//! Declaring a multibody model: coordinates, parameters, frames built from
+//! elementary rotations, points, bodies, constraints and applied forces.
+//!
+//! A [`ModelBuilder`] collects declarations; [`ModelBuilder::build`] validates
+//! the whole model at once and reports every problem it finds
+//! ([`ModelError::Invalid`]), then freezes it into a [`Model`] that the
+//! derivation stage ([`crate::derive`]) consumes.
+
+use crate::expr::{Expr, Tensor3, Vec3};
+use std::collections::BTreeSet;
+use std::fmt;
+
+/// Axis of an elementary rotation, in the frame being rotated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    /// Index 0, 1, 2.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+}
+
+/// Handle of a frame. [`GROUND`] is the inertial frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameId(pub usize);
+/// The inertial (ground) frame.
+pub const GROUND: FrameId = FrameId(0);
+/// Handle of a point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PointId(pub usize);
+/// Handle of a body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BodyId(pub usize);
+
+/// How the runtime treats a coordinate when it reduces the equations
+/// (generalized coordinate partitioning, thesis section 3.8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Role {
+    /// Independent coordinate (e.g. roll, steer).
+    Independent,
+    /// Dependent position, solved from the holonomic constraints.
+    Dependent,
+    /// Ignorable: appears in no equation but is needed for the configuration.
+    Ignorable,
+}
+
+/// A generalized coordinate.
+#[derive(Clone, Debug)]
+pub struct Coordinate {
+    pub name: String,
+    pub doc: String,
+    pub role: Role,
+    /// Initial guess for the constraint solver (rad or m).
+    pub guess: f64,
+}
+
+/// A parameter.
+#[derive(Clone, Debug)]
+pub struct Parameter {
+    pub name: String,
+    pub doc: String,
+}
+
+/// A frame: its parent and the elementary rotations (about the rotated
+/// frame's own axes, applied left to right) that lead from parent to it.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub name: String,
+    pub parent: FrameId,
+    pub rotations: Vec<(Axis, Expr)>,
+}
+
+/// A point: `base + sum_k A_{frame_k} v_k` (global position).
+#[derive(Clone, Debug)]
+pub struct Point {
+    pub name: String,
+    pub base: Option<PointId>,
+    pub offsets: Vec<(FrameId, Vec3)>,
+}
+
+/// A rigid body.
+#[derive(Clone, Debug)]
+pub struct Body {
+    pub name: String,
+    pub frame: FrameId,
+    pub mass: Expr,
+    /// Inertia tensor about the mass centre, in body axes.
+    pub inertia: Tensor3,
+    pub mass_centre: PointId,
+}
+
+/// A holonomic constraint `Res(p, t) = 0`.
+#[derive(Clone, Debug)]
+pub enum Holonomic {
+    /// A general residual expression (scleronomic or rheonomic).
+    Residual { name: String, expr: Expr },
+    /// A global component of a point's position is zero (e.g. contact height).
+    PointComponent { name: String, point: PointId, axis: Axis },
+    /// The derivative of a point's global component with respect to a
+    /// coordinate is zero (e.g. the contact point is the lowest of the rim).
+    PointComponentStationary { name: String, point: PointId, axis: Axis, coordinate: String },
+}
+
+/// A nonholonomic constraint, linear in the velocities.
+#[derive(Clone, Debug)]
+pub enum Nonholonomic {
+    /// A global component of the velocity of the material point of `body`
+    /// that coincides with `point` is zero (rolling without slip).
+    ContactVelocity { name: String, body: BodyId, point: PointId, axis: Axis },
+    /// A general expression linear in the rates.
+    Linear { name: String, expr: Expr },
+}
+
+/// An applied force.
+#[derive(Clone, Debug)]
+pub enum Force {
+    /// A generalized force on one coordinate (e.g. a steer torque or damper).
+    Generalized { name: String, coordinate: String, expr: Expr },
+    /// A force at a body's mass centre, components in `frame`.
+    AtMassCentre { name: String, body: BodyId, frame: FrameId, force: Vec3 },
+}
+
+/// A frozen, validated model.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub doc: String,
+    /// Source files the model is declared in (for the generated header).
+    pub sources: Vec<String>,
+    pub coordinates: Vec<Coordinate>,
+    pub parameters: Vec<Parameter>,
+    pub frames: Vec<Frame>,
+    pub points: Vec<Point>,
+    pub bodies: Vec<Body>,
+    pub holonomic: Vec<Holonomic>,
+    pub nonholonomic: Vec<Nonholonomic>,
+    pub forces: Vec<Force>,
+    /// Points whose global positions are emitted.
+    pub points_of_interest: Vec<PointId>,
+    /// Gravity: parameter name and the global axis it acts against (Z up).
+    pub gravity: Option<(String, Axis)>,
+}
+
+/// One problem found by validation.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Diagnostic {
+    Duplicate { kind: &'static str, name: String },
+    Undeclared { kind: &'static str, name: String, used_in: String },
+    TimeDependentGeometry { item: String },
+    RateInGeometry { item: String },
+    HolonomicCount { dependent: usize, constraints: usize },
+    DegreesOfFreedom { coordinates: usize, independent: usize, constraints: usize },
+    NoBodies,
+    AsymmetricInertia { body: String },
+    NoIndependentCoordinates,
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Diagnostic::Duplicate { kind, name } => write!(f, "{kind} `{name}` is declared twice"),
+            Diagnostic::Undeclared { kind, name, used_in } => {
+                write!(f, "{kind} `{name}` is used in {used_in} but not declared")
+            }
+            Diagnostic::TimeDependentGeometry { item } => {
+                write!(f, "{item} depends on time; only constraints and forces may")
+            }
+            Diagnostic::RateInGeometry { item } => {
+                write!(f, "{item} uses a coordinate rate; positions depend on coordinates only")
+            }
+            Diagnostic::HolonomicCount { dependent, constraints } => write!(
+                f,
+                "{dependent} dependent coordinates but {constraints} holonomic constraints to solve them"
+            ),
+            Diagnostic::DegreesOfFreedom { coordinates, independent, constraints } => write!(
+                f,
+                "{coordinates} coordinates - {independent} independent velocities != {constraints} constraints (holonomic + nonholonomic)"
+            ),
+            Diagnostic::NoBodies => write!(f, "the model has no bodies"),
+            Diagnostic::AsymmetricInertia { body } => {
+                write!(f, "inertia tensor of body `{body}` is not symmetric")
+            }
+            Diagnostic::NoIndependentCoordinates => write!(f, "no independent coordinate declared"),
+        }
+    }
+}
+
+/// Model errors.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ModelError {
+    /// Validation found these problems (all of them, not just the first).
+    Invalid { model: String, problems: Vec<Diagnostic> },
+}
+
+impl fmt::Display for ModelError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ModelError::Invalid { model, problems } => {
+                writeln!(f, "model `{model}` is invalid ({} problems):", problems.len())?;
+                for p in problems {
+                    writeln!(f, "  - {p}")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+impl std::error::Error for ModelError {}
+
+/// Collects declarations; see the module docs.
+#[derive(Clone, Debug)]
+pub struct ModelBuilder {
+    m: Model,
+}
+
+impl Model {
+    /// Start declaring a model.
+    pub fn builder(name: &str) -> ModelBuilder {
+        ModelBuilder {
+            m: Model {
+                name: name.to_string(),
+                doc: String::new(),
+                sources: Vec::new(),
+                coordinates: Vec::new(),
+                parameters: Vec::new(),
+                frames: vec![Frame { name: "ground".into(), parent: GROUND, rotations: vec![] }],
+                points: Vec::new(),
+                bodies: Vec::new(),
+                holonomic: Vec::new(),
+                nonholonomic: Vec::new(),
+                forces: Vec::new(),
+                points_of_interest: Vec::new(),
+                gravity: None,
+            },
+        }
+    }
+
+    /// Index of a coordinate.
+    pub fn coordinate_index(&self, name: &str) -> Option<usize> {
+        self.coordinates.iter().position(|c| c.name == name)
+    }
+
+    /// Names of the holonomic constraints.
+    pub fn holonomic_names(&self) -> Vec<String> {
+        self.holonomic
+            .iter()
+            .map(|h| match h {
+                Holonomic::Residual { name, .. }
+                | Holonomic::PointComponent { name, .. }
+                | Holonomic::PointComponentStationary { name, .. } => name.clone(),
+            })
+            .collect()
+    }
+
+    /// Names of the nonholonomic constraints.
+    pub fn nonholonomic_names(&self) -> Vec<String> {
+        self.nonholonomic
+            .iter()
+            .map(|h| match h {
+                Nonholonomic::ContactVelocity { name, .. } | Nonholonomic::Linear { name, .. } => {
+                    name.clone()
+                }
+            })
+            .collect()
+    }
+}
+
+impl ModelBuilder {
+    /// Documentation line of the model.
+    pub fn doc(mut self, doc: &str) -> Self {
+        self.m.doc = doc.to_string();
+        self
+    }
+    /// A source file the model is declared in (shown in generated headers).
+    pub fn source(mut self, path: &str) -> Self {
+        self.m.sources.push(path.to_string());
+        self
+    }
+    /// Declare a coordinate (and its rate).
+    pub fn coordinate(&mut self, name: &str, role: Role, guess: f64, doc: &str) -> Expr {
+        self.m.coordinates.push(Coordinate {
+            name: name.into(),
+            doc: doc.into(),
+            role,
+            guess,
+        });
+        Expr::Coord(name.into())
+    }
+    /// Declare a parameter.
+    pub fn parameter(&mut self, name: &str, doc: &str) -> Expr {
+        self.m.parameters.push(Parameter { name: name.into(), doc: doc.into() });
+        Expr::Param(name.into())
+    }
+    /// Declare a frame reached from `parent` by elementary rotations.
+    pub fn frame(&mut self, name: &str, parent: FrameId, rotations: Vec<(Axis, Expr)>) -> FrameId {
+        self.m.frames.push(Frame { name: name.into(), parent, rotations });
+        FrameId(self.m.frames.len() - 1)
+    }
+    /// Declare a point `base + sum A_frame v`.
+    pub fn point(&mut self, name: &str, base: Option<PointId>, offsets: Vec<(FrameId, Vec3)>) -> PointId {
+        self.m.points.push(Point { name: name.into(), base, offsets });
+        PointId(self.m.points.len() - 1)
+    }
+    /// Declare a rigid body.
+    pub fn body(&mut self, name: &str, frame: FrameId, mass: Expr, inertia: Tensor3, mass_centre: PointId) -> BodyId {
+        self.m.bodies.push(Body { name: name.into(), frame, mass, inertia, mass_centre });
+        BodyId(self.m.bodies.len() - 1)
+    }
+    /// Move a body's mass centre to another point (for model variants).
+    pub fn move_mass_centre(&mut self, body: BodyId, point: PointId) {
+        self.m.bodies[body.0].mass_centre = point;
+    }
+    /// Replace the documentation line (for model variants).
+    pub fn set_doc(&mut self, doc: &str) {
+        self.m.doc = doc.to_string();
+    }
+    /// Add a holonomic constraint.
+    pub fn holonomic(&mut self, c: Holonomic) {
+        self.m.holonomic.push(c);
+    }
+    /// Add a nonholonomic constraint.
+    pub fn nonholonomic(&mut self, c: Nonholonomic) {
+        self.m.nonholonomic.push(c);
+    }
+    /// Add an applied force.
+    pub fn force(&mut self, f: Force) {
+        self.m.forces.push(f);
+    }
+    /// Emit the global position of this point.
+    pub fn point_of_interest(&mut self, p: PointId) {
+        self.m.points_of_interest.push(p);
+    }
+    /// Uniform gravity of magnitude `param` acting along minus `up`.
+    pub fn gravity(&mut self, param: &str, up: Axis) {
+        self.m.gravity = Some((param.into(), up));
+    }
+
+    /// Validate everything and freeze the model.
+    pub fn build(self) -> Result<Model, ModelError> {
+        let problems = validate(&self.m);
+        if problems.is_empty() {
+            Ok(self.m)
+        } else {
+            Err(ModelError::Invalid { model: self.m.name.clone(), problems })
+        }
+    }
+}
+
+fn duplicates<'a>(kind: &'static str, names: impl Iterator<Item = &'a str>, out: &mut Vec<Diagnostic>) {
+    let mut seen = BTreeSet::new();
+    for n in names {
+        if !seen.insert(n) {
+            out.push(Diagnostic::Duplicate { kind, name: n.to_string() });
+        }
+    }
+}
+
+/// Every problem of the model, in declaration order.
+pub fn validate(m: &Model) -> Vec<Diagnostic> {
+    let mut out = Vec::new();
+    duplicates("coordinate", m.coordinates.iter().map(|c| c.name.as_str()), &mut out);
+    duplicates("parameter", m.parameters.iter().map(|c| c.name.as_str()), &mut out);
+    duplicates("frame", m.frames.iter().map(|c| c.name.as_str()), &mut out);
+    duplicates("point", m.points.iter().map(|c| c.name.as_str()), &mut out);
+    duplicates("body", m.bodies.iter().map(|c| c.name.as_str()), &mut out);
+    let coords: BTreeSet<&str> = m.coordinates.iter().map(|c| c.name.as_str()).collect();
+    let params: BTreeSet<&str> = m.parameters.iter().map(|c| c.name.as_str()).collect();
+
+    // (expression, where it is used, geometry?)
+    let mut uses: Vec<(&Expr, String, bool)> = Vec::new();
+    for f in &m.frames {
+        for (_, e) in &f.rotations {
+            uses.push((e, format!("frame `{}`", f.name), true));
+        }
+    }
+    for p in &m.points {
+        for (_, v) in &p.offsets {
+            for e in v {
+                uses.push((e, format!("point `{}`", p.name), true));
+            }
+        }
+    }
+    for b in &m.bodies {
+        uses.push((&b.mass, format!("mass of body `{}`", b.name), true));
+        for row in &b.inertia {
+            for e in row {
+                uses.push((e, format!("inertia of body `{}`", b.name), true));
+            }
+        }
+        let sym = (0..3).all(|i| (0..3).all(|j| b.inertia[i][j] == b.inertia[j][i]));
+        if !sym {
+            out.push(Diagnostic::AsymmetricInertia { body: b.name.clone() });
+        }
+    }
+    for h in &m.holonomic {
+        match h {
+            Holonomic::Residual { name, expr } => {
+                uses.push((expr, format!("holonomic constraint `{name}`"), false))
+            }
+            Holonomic::PointComponentStationary { name, coordinate, .. } => {
+                if !coords.contains(coordinate.as_str()) {
+                    out.push(Diagnostic::Undeclared {
+                        kind: "coordinate",
+                        name: coordinate.clone(),
+                        used_in: format!("holonomic constraint `{name}`"),
+                    });
+                }
+            }
+            Holonomic::PointComponent { .. } => {}
+        }
+    }
+    for n in &m.nonholonomic {
+        if let Nonholonomic::Linear { name, expr } = n {
+            uses.push((expr, format!("nonholonomic constraint `{name}`"), false));
+        }
+    }
+    for f in &m.forces {
+        match f {
+            Force::Generalized { name, coordinate, expr } => {
+                uses.push((expr, format!("force `{name}`"), false));
+                if !coords.contains(coordinate.as_str()) {
+                    out.push(Diagnostic::Undeclared {
+                        kind: "coordinate",
+                        name: coordinate.clone(),
+                        used_in: format!("force `{name}`"),
+                    });
+                }
+            }
+            Force::AtMassCentre { name, force, .. } => {
+                for e in force {
+                    uses.push((e, format!("force `{name}`"), false));
+                }
+            }
+        }
+    }
+    for (e, used_in, geometry) in uses {
+        let mut names = BTreeSet::new();
+        e.names(&mut names);
+        for (kind, name) in names {
+            let ok = match kind {
+                "parameter" => params.contains(name.as_str()),
+                "coordinate" | "rate" => coords.contains(name.as_str()),
+                _ => true,
+            };
+            if !ok {
+                let kind = if kind == "rate" { "coordinate" } else { kind };
+                out.push(Diagnostic::Undeclared { kind, name, used_in: used_in.clone() });
+            } else if geometry && kind == "time" {
+                out.push(Diagnostic::TimeDependentGeometry { item: used_in.clone() });
+            } else if geometry && kind == "rate" {
+                out.push(Diagnostic::RateInGeometry { item: used_in.clone() });
+            }
+        }
+    }
+    if let Some((g, _)) = &m.gravity {
+        if !params.contains(g.as_str()) {
+            out.push(Diagnostic::Undeclared { kind: "parameter", name: g.clone(), used_in: "gravity".into() });
+        }
+    }
+    if m.bodies.is_empty() {
+        out.push(Diagnostic::NoBodies);
+    }
+    let dependent = m.coordinates.iter().filter(|c| c.role == Role::Dependent).count();
+    if dependent != m.holonomic.len() {
+        out.push(Diagnostic::HolonomicCount { dependent, constraints: m.holonomic.len() });
+    }
+    let independent = m.coordinates.iter().filter(|c| c.role == Role::Independent).count();
+    if independent == 0 {
+        out.push(Diagnostic::NoIndependentCoordinates);
+    }
+    let nc = m.holonomic.len() + m.nonholonomic.len();
+    if m.coordinates.len() != independent + nc {
+        out.push(Diagnostic::DegreesOfFreedom {
+            coordinates: m.coordinates.len(),
+            independent,
+            constraints: nc,
+        });
+    }
+    out
+}

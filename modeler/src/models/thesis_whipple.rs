@@ -1,0 +1,128 @@
+//! The Whipple bicycle of the thesis (Martin Recuero 2009, section 3 and the
+//! listing `Bicicleta.m`): four rigid bodies (2 rear wheel, 3 rear frame,
+//! 4 handlebar + fork, 5 front wheel), knife-edge wheels rolling without slip
+//! on flat ground, nine coordinates `p = [xc yc phi theta psi beta gamma eps xi]`.
+//! Axes: X forward, Y left, Z up.
+
+use crate::expr::{inertia_wheel, inertia_xz, num, time, vec3};
+use crate::model::{Axis, BodyId, FrameId, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, PointId, Role, GROUND};
+use std::f64::consts::PI;
+
+/// Handles a variant of this model needs to modify it.
+pub struct WhippleParts {
+    pub fork_frame: FrameId,
+    /// RG4: the point of the steer axis where the thesis puts the fork's mass centre.
+    pub steer_point: PointId,
+    pub fork: BodyId,
+}
+
+/// Declare the thesis model under `name` (variants start from here).
+pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
+    let mut m = Model::builder(name)
+        .doc("Whipple bicycle of Martin Recuero (2009), section 3: 9 coordinates, driving constraint psi = V t / Rt")
+        .source("modeler/src/models/thesis_whipple.rs");
+    if source != "modeler/src/models/thesis_whipple.rs" {
+        m = m.source(source);
+    }
+
+    // 3.2 Coordinates: rear contact (xc, yc), yaw phi, roll theta, rear wheel
+    // rotation psi, frame pitch beta, steer gamma, front wheel rotation eps,
+    // and xi, the angle locating the front contact on the rim.
+    let xc = m.coordinate("xc", Role::Ignorable, 0.0, "rear contact point, global X (m)");
+    let yc = m.coordinate("yc", Role::Ignorable, 0.0, "rear contact point, global Y (m)");
+    let phi = m.coordinate("phi", Role::Ignorable, 0.0, "yaw (rad)");
+    let theta = m.coordinate("theta", Role::Independent, 0.0, "roll (rad), positive leaning right");
+    let psi = m.coordinate("psi", Role::Dependent, 0.0, "rear wheel rotation (rad)");
+    let beta = m.coordinate("beta", Role::Dependent, -PI / 10.0, "frame pitch (rad); minus the steer-axis tilt when upright");
+    let gamma = m.coordinate("gamma", Role::Independent, 0.0, "steer angle about the steer axis (rad), positive turning left");
+    let eps = m.coordinate("eps", Role::Ignorable, 0.0, "front wheel rotation (rad)");
+    let xi = m.coordinate("xi", Role::Dependent, PI / 2.0, "angle of the front contact point on the rim (rad)");
+
+    // Parameters (section 4.4, Parametros.m).
+    let v = m.parameter("V", "forward speed imposed by the driving constraint (m/s)");
+    let rt = m.parameter("Rt", "rear wheel radius (m)");
+    let rd = m.parameter("Rd", "front wheel radius (m)");
+    let x3 = m.parameter("x3", "rear-frame mass centre from the rear wheel centre, frame x (m)");
+    let z3 = m.parameter("z3", "rear-frame mass centre from the rear wheel centre, frame z (m)");
+    let x4 = m.parameter("x4", "steer-axis point G4 from the rear wheel centre, frame x (m)");
+    let z4 = m.parameter("z4", "steer-axis point G4 from the rear wheel centre, frame z (m)");
+    let x5 = m.parameter("x5", "front wheel centre from G4, fork x (m)");
+    let z5 = m.parameter("z5", "front wheel centre from G4, fork z (m)");
+    let m2 = m.parameter("m2", "rear wheel mass (kg)");
+    let m3 = m.parameter("m3", "rear frame mass (kg)");
+    let m4 = m.parameter("m4", "handlebar + fork mass (kg)");
+    let m5 = m.parameter("m5", "front wheel mass (kg)");
+    let i2x = m.parameter("I2x", "rear wheel moment about a diameter (kg m^2)");
+    let i2y = m.parameter("I2y", "rear wheel moment about its axle (kg m^2)");
+    let i3x = m.parameter("I3x", "rear frame inertia xx, frame axes (kg m^2)");
+    let i3y = m.parameter("I3y", "rear frame inertia yy (kg m^2)");
+    let i3z = m.parameter("I3z", "rear frame inertia zz (kg m^2)");
+    let i3zx = m.parameter("I3zx", "rear frame inertia xz (kg m^2)");
+    let i4x = m.parameter("I4x", "handlebar + fork inertia xx, fork axes (kg m^2)");
+    let i4y = m.parameter("I4y", "handlebar + fork inertia yy (kg m^2)");
+    let i4z = m.parameter("I4z", "handlebar + fork inertia zz (kg m^2)");
+    let i4xz = m.parameter("I4xz", "handlebar + fork inertia xz (kg m^2)");
+    let i5x = m.parameter("I5x", "front wheel moment about a diameter (kg m^2)");
+    let i5y = m.parameter("I5y", "front wheel moment about its axle (kg m^2)");
+    m.parameter("g", "gravitational acceleration (m/s^2)");
+    m.gravity("g", Axis::Z);
+
+    // 3.3 Rotations (eq. 4): Ai1 = A_phi, Ai2 = A_phi A_theta, A2 = Ai2 A_psi,
+    // A3 = Ai2 A_beta, A4 = A3 A_gam, A5 = A4 A_eps.
+    let yaw = m.frame("Ai1", GROUND, vec![(Axis::Z, phi)]);
+    let roll = m.frame("Ai2", yaw, vec![(Axis::X, theta)]);
+    let rear_wheel_frame = m.frame("A2", roll, vec![(Axis::Y, psi.clone())]);
+    let frame = m.frame("A3", roll, vec![(Axis::Y, beta)]);
+    let fork_frame = m.frame("A4", frame, vec![(Axis::Z, gamma)]);
+    let front_wheel_frame = m.frame("A5", fork_frame, vec![(Axis::Y, eps)]);
+
+    // 3.5 Mass centres (eq. 13-19).
+    let g2 = m.point("G2", None, vec![(GROUND, vec3(xc, yc, num(0))), (roll, vec3(num(0), num(0), rt.clone()))]);
+    let g3 = m.point("G3", Some(g2), vec![(frame, vec3(x3, num(0), z3))]);
+    let g4 = m.point("G4", Some(g2), vec![(frame, vec3(x4, num(0), z4))]);
+    let g5 = m.point("G5", Some(g4), vec![(fork_frame, vec3(x5, num(0), z5))]);
+    // Contact points: rear, straight below the rear wheel centre in the roll
+    // frame; front (eq. 21), on the rim at angle xi.
+    let rear_contact = m.point("rear_contact", Some(g2), vec![(roll, vec3(num(0), num(0), -rt.clone()))]);
+    let front_contact = m.point(
+        "front_contact",
+        Some(g5),
+        vec![(front_wheel_frame, vec3(rd.clone() * xi.clone().cos(), num(0), -(rd * xi.sin())))],
+    );
+    m.point_of_interest(rear_contact);
+    m.point_of_interest(front_contact);
+
+    // Bodies: mass, inertia tensor in body axes, mass centre.
+    m.body("rear_wheel", rear_wheel_frame, m2, inertia_wheel(i2x, i2y), g2);
+    m.body("rear_frame", frame, m3, inertia_xz(i3x, i3y, i3z, i3zx), g3);
+    let fork = m.body("fork", fork_frame, m4, inertia_xz(i4x, i4y, i4z, i4xz), g4);
+    let front_wheel = m.body("front_wheel", front_wheel_frame, m5, inertia_wheel(i5x, i5y), g5);
+    let rear_wheel = crate::model::BodyId(0);
+
+    // 3.6 Constraints. Front contact on the ground and lowest point of the rim
+    // (eq. 21-22); driving constraint psi - V t / Rt = 0 (eq. 26, as coded).
+    m.holonomic(Holonomic::PointComponent { name: "front_contact_height".into(), point: front_contact, axis: Axis::Z });
+    m.holonomic(Holonomic::PointComponentStationary {
+        name: "front_contact_lowest".into(),
+        point: front_contact,
+        axis: Axis::Z,
+        coordinate: "xi".into(),
+    });
+    m.holonomic(Holonomic::Residual { name: "driving".into(), expr: psi - v * time() / rt });
+    // Rolling without slip (eq. 23-25).
+    for (name, body, point, axis) in [
+        ("rear_rolling_x", rear_wheel, rear_contact, Axis::X),
+        ("rear_rolling_y", rear_wheel, rear_contact, Axis::Y),
+        ("front_rolling_x", front_wheel, front_contact, Axis::X),
+        ("front_rolling_y", front_wheel, front_contact, Axis::Y),
+    ] {
+        m.nonholonomic(Nonholonomic::ContactVelocity { name: name.into(), body, point, axis });
+    }
+    (m, WhippleParts { fork_frame, steer_point: g4, fork })
+}
+
+/// The thesis model.
+pub fn model() -> Result<Model, ModelError> {
+    declare("thesis_whipple", "modeler/src/models/thesis_whipple.rs").0.build()
+}
+

@@ -1,0 +1,77 @@
+//! TEST ORACLE ONLY: the canonical matrices of the benchmark bicycle from the
+//! closed-form expressions of appendix A of Meijaard, Papadopoulos, Ruina & Schwab
+//! (2007), "Linearized dynamics equations for the balance and steer of a bicycle: a
+//! benchmark and review", Proc. R. Soc. A 463:1955-1982, doi 10.1098/rspa.2007.1857.
+//!
+//! The product computes canonical matrices from the generated multibody equations;
+//! this independent hand-written route exists to check them (and the eigen
+//! analysis) against the paper.
+
+use crate::canonical::CanonicalMatrices;
+use crate::parameters::BenchmarkParameters;
+use nalgebra::Matrix2;
+
+/// `M0`, `C1`, `K0`, `K2` of Meijaard et al. (2007), appendix A (eqs. A 1 - A 27),
+/// benchmark axes (x forward, y right, z down), `q = [phi, delta]`.
+///
+/// Uses the paper's auxiliary quantities: total mass and mass centre
+/// (`mT`, `xT`, `zT`), total inertia about the rear contact point (`ITxx`, `ITxz`,
+/// `ITzz`, with `IRzz = IRxx`, `IFzz = IFxx`), front assembly `A = H + F`
+/// (`mA`, `xA`, `zA`, `IAxx`, `IAxz`, `IAzz`), the perpendicular distance `uA` of its
+/// mass centre from the steer axis, its steer-axis inertias `IAll`, `IAlx`, `IAlz`,
+/// the trail ratio `mu = (c/w) cos(lam)`, gyrostatic coefficients
+/// `SR = IRyy/rR`, `SF = IFyy/rF`, `ST = SR + SF`, and the static moment
+/// `SA = mA uA + mu mT xT`.
+pub fn meijaard_canonical(p: &BenchmarkParameters) -> CanonicalMatrices {
+    let w = p.wheelbase;
+    let c = p.trail;
+    let lam = p.steer_axis_tilt;
+    let (rr, mr, irxx, iryy) = (p.rear_wheel_radius, p.rear_wheel_mass, p.rear_wheel_ixx, p.rear_wheel_iyy);
+    let (xb, zb, mb) = (p.rear_frame_com_x, p.rear_frame_com_z, p.rear_frame_mass);
+    let (ibxx, ibzz, ibxz) = (p.rear_frame_ixx, p.rear_frame_izz, p.rear_frame_ixz);
+    let (xh, zh, mh) = (p.front_frame_com_x, p.front_frame_com_z, p.front_frame_mass);
+    let (ihxx, ihzz, ihxz) = (p.front_frame_ixx, p.front_frame_izz, p.front_frame_ixz);
+    let (rf, mf, ifxx, ifyy) = (p.front_wheel_radius, p.front_wheel_mass, p.front_wheel_ixx, p.front_wheel_iyy);
+
+    // (A 1-3) total mass and mass centre
+    let mt = mr + mb + mh + mf;
+    let xt = (xb * mb + xh * mh + w * mf) / mt;
+    let zt = (-rr * mr + zb * mb + zh * mh - rf * mf) / mt;
+    // (A 4-7) total inertia about the rear contact point
+    let itxx = irxx + ibxx + ihxx + ifxx + mr * rr * rr + mb * zb * zb + mh * zh * zh + mf * rf * rf;
+    let itxz = ibxz + ihxz - mb * xb * zb - mh * xh * zh + mf * w * rf;
+    let irzz = irxx;
+    let ifzz = ifxx;
+    let itzz = irzz + ibzz + ihzz + ifzz + mb * xb * xb + mh * xh * xh + mf * w * w;
+    // (A 8-13) front assembly A = H + F
+    let ma = mh + mf;
+    let xa = (xh * mh + w * mf) / ma;
+    let za = (zh * mh - rf * mf) / ma;
+    let iaxx = ihxx + ifxx + mh * (zh - za) * (zh - za) + mf * (rf + za) * (rf + za);
+    let iaxz = ihxz - mh * (xh - xa) * (zh - za) + mf * (w - xa) * (rf + za);
+    let iazz = ihzz + ifzz + mh * (xh - xa) * (xh - xa) + mf * (w - xa) * (w - xa);
+    // (A 14-17) steer-axis quantities
+    let (sl, cl) = lam.sin_cos();
+    let ua = (xa - w - c) * cl - za * sl;
+    let iall = ma * ua * ua + iaxx * sl * sl + 2.0 * iaxz * sl * cl + iazz * cl * cl;
+    let ialx = -ma * ua * za + iaxx * sl + iaxz * cl;
+    let ialz = ma * ua * xa + iaxz * sl + iazz * cl;
+    // (A 18-21)
+    let mu = c / w * cl;
+    let sr = iryy / rr;
+    let sf = ifyy / rf;
+    let st = sr + sf;
+    let sa = ma * ua + mu * mt * xt;
+    // (A 22-27) canonical matrices
+    let m_pd = ialx + mu * itxz;
+    let m0 = Matrix2::new(itxx, m_pd, m_pd, iall + 2.0 * mu * ialz + mu * mu * itzz);
+    let k0 = Matrix2::new(mt * zt, -sa, -sa, -sa * sl);
+    let k2 = Matrix2::new(0.0, (st - mt * zt) * cl / w, 0.0, (sa + sf * sl) * cl / w);
+    let c1 = Matrix2::new(
+        0.0,
+        mu * st + sf * cl + itxz * cl / w - mu * mt * zt,
+        -(mu * st + sf * cl),
+        ialz * cl / w + mu * (sa + itzz * cl / w),
+    );
+    CanonicalMatrices { m0, c1, k0, k2, g: p.g }
+}

@@ -1,0 +1,618 @@
+//! Eigenvalues, eigenvectors, mode labels and critical speeds of the canonical
+//! linear bicycle `M0 q'' + v C1 q' + (g K0 + v^2 K2) q = 0` (Meijaard et al. 2007),
+//! state `x = [phi, delta, phi', delta']`.
+//!
+//! # Numerics
+//! The eigenvalues are the roots of the characteristic quartic
+//! `det(M0 s^2 + v C1 s + g K0 + v^2 K2) = k4 s^4 + k3 s^3 + k2 s^2 + k1 s + k0`,
+//! whose coefficients are polynomials in `v` computed from the 2x2 entries
+//! ([`CharPoly`]). Roots: Ferrari factorisation into two real quadratics, Newton
+//! refinement of the factorisation, then guarded Newton polish of every root on the
+//! quartic (see `quartic.rs`); conjugate pairs are exactly conjugate, real roots have
+//! imaginary part exactly `0.0`. Negative speeds use the exact symmetry
+//! `roots(-v) = -roots(v)`.
+//!
+//! # Mode classification rule
+//! Labels are attached to continuous root branches, not to sorted positions:
+//! 1. *Anchor.* At the highest requested |speed| (or, if needed, at higher speeds
+//!    `max(v,1) * 1.25^k`, up to ~7500 m/s) find a speed where the spectrum is
+//!    *one complex pair + two real roots*. There the pair is `Weave`, the more
+//!    negative real root is `Castering`, the other real root is `Capsize`. (This is
+//!    the generic high-speed picture of an uncontrolled bicycle: castering goes to
+//!    `-inf` roughly like `-v`, the weave frequency grows like `v`, capsize stays
+//!    small.) If no such speed exists, fall back at the top speed to: four real roots
+//!    sorted descending `[Weave, Weave, Capsize, Castering]`; two complex pairs: the
+//!    pair with the larger imaginary part `Weave`, the other `Other(k)`.
+//! 2. *Continuation.* Labels are carried down in speed by adaptive continuation:
+//!    between consecutive speeds the roots are matched by the permutation of least
+//!    total squared displacement, and the step is halved until the largest
+//!    displacement is below 0.3 times the smallest distance between roots carrying
+//!    *different* labels (roots sharing a label, e.g. the two weave roots at the
+//!    double root `v_d`, may be close or swap freely). Hence labels never swap, even
+//!    when the capsize root and a real weave root pass close to each other (then the
+//!    ordering along the real axis is kept: an avoided crossing). Only at an exact
+//!    collision of two differently-labelled roots (step below `1e-12 max(1,|v|)`) is
+//!    the minimal-displacement matching accepted as is.
+//! 3. Below the merge speed `v_d` the two real roots continuing the weave pair are
+//!    both labelled `Weave` (for the benchmark at `v = 0`: `+5.53` and `+3.13`;
+//!    `-3.13` is capsize and `-5.53` castering).
+//!
+//! In an [`EigenPoint`] the eigenvalues are ordered by label: weave roots first
+//! (upper root of the pair, or the larger real root, first), then capsize, then
+//! castering, then `Other(k)` by `k`. [`eigenvalues`] (unlabelled fast path) sorts by
+//! descending real part, then descending imaginary part.
+
+use nalgebra::{Complex, Matrix2};
+
+use crate::canonical::CanonicalMatrices;
+
+mod critical;
+mod quartic;
+
+pub use critical::critical_speeds;
+use quartic::{quartic_roots, sort_desc, C64};
+
+/// Errors of the eigen analysis. Functions never panic and never return NaN.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum EigenError {
+    /// `M0` is singular (or numerically so): the quartic is not of degree 4.
+    #[error("singular mass matrix M0 (det = {det:e})")]
+    SingularMassMatrix {
+        /// Determinant of `M0`.
+        det: f64,
+    },
+    /// A matrix entry, `g`, or a speed is NaN or infinite.
+    #[error("non-finite input: {what}")]
+    NonFinite {
+        /// What was non-finite.
+        what: String,
+    },
+    /// An iterative step did not converge within its iteration cap.
+    #[error("no convergence: {what}")]
+    NoConvergence {
+        /// Which step failed.
+        what: String,
+    },
+    /// Invalid argument (e.g. `v_min > v_max`).
+    #[error("invalid argument: {what}")]
+    InvalidArgument {
+        /// Description.
+        what: String,
+    },
+}
+
+/// Mode label of an eigenvalue.
+///
+/// * `Weave`: the oscillatory steer/roll mode. Below the merge speed `v_d` the
+///   weave "pair" is two *real* roots (at `v = 0`: one unstable, one stable
+///   inverted-pendulum root); both carry the label `Weave` and
+///   [`EigenPoint::is_oscillatory`] tells the two regimes apart.
+/// * `Capsize`: the real, slow roll mode (unstable above `v_c`).
+/// * `Castering`: the real, fast, strongly stable steer mode.
+/// * `Other(k)`: anything the classification rule could not assign (e.g. a
+///   second complex pair for an unusual bicycle); `k` is the eigenvalue index.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum Mode {
+    /// Weave (complex pair above `v_d`, two real roots below).
+    Weave,
+    /// Capsize (real).
+    Capsize,
+    /// Castering (real).
+    Castering,
+    /// Unclassified.
+    Other(u8),
+}
+
+impl Mode {
+    /// Lower-case name: "weave", "capsize", "castering", "other".
+    pub fn name(&self) -> &'static str {
+        match self {
+            Mode::Weave => "weave",
+            Mode::Capsize => "capsize",
+            Mode::Castering => "castering",
+            Mode::Other(_) => "other",
+        }
+    }
+}
+
+/// Eigen-analysis at one speed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EigenPoint {
+    /// Forward speed (m/s).
+    pub v: f64,
+    /// The four eigenvalues (1/s).
+    pub eigenvalues: [Complex<f64>; 4],
+    /// Mode label of each eigenvalue.
+    pub modes: [Mode; 4],
+    /// Eigenvector `k` belongs to eigenvalue `k`; state `x = [phi, delta, phi', delta']`,
+    /// unit 2-norm, phase fixed so that the largest-modulus component of `[phi, delta]`
+    /// is real and positive.
+    pub eigenvectors: [[Complex<f64>; 4]; 4],
+}
+
+impl EigenPoint {
+    /// Whether eigenvalue `k` is part of a complex-conjugate pair (nonzero imaginary part).
+    pub fn is_oscillatory(&self, k: usize) -> bool {
+        k < 4 && self.eigenvalues[k].im != 0.0
+    }
+
+    /// Index of the first eigenvalue with mode `m`, if any.
+    pub fn index_of(&self, m: Mode) -> Option<usize> {
+        self.modes.iter().position(|x| *x == m)
+    }
+
+    /// Whether all real parts are strictly negative.
+    pub fn is_stable(&self) -> bool {
+        self.eigenvalues.iter().all(|s| s.re < 0.0)
+    }
+}
+
+/// Eigen-analysis over a list of speeds, labels tracked continuously.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct EigenSweep {
+    /// One point per requested speed, in the order given.
+    pub points: Vec<EigenPoint>,
+}
+
+/// Direction of a real-part zero crossing with increasing speed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum CrossingDirection {
+    /// Real part goes from negative to positive (loss of stability).
+    Destabilizing,
+    /// Real part goes from positive to negative (gain of stability).
+    Stabilizing,
+}
+
+/// Kind of a crossing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub enum CrossingKind {
+    /// A complex pair crosses the imaginary axis (Hopf; Hurwitz determinant zero).
+    ComplexPair,
+    /// A real root passes through zero (`det(g K0 + v^2 K2) = 0`).
+    RealRoot,
+}
+
+/// A speed where a real part crosses zero.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Crossing {
+    /// Speed (m/s).
+    pub speed: f64,
+    /// Mode whose real part crosses.
+    pub mode: Mode,
+    /// Direction with increasing speed.
+    pub direction: CrossingDirection,
+    /// Complex pair or real root.
+    pub kind: CrossingKind,
+    /// Imaginary part at the crossing (`0` for a real root; `> 0` for a pair).
+    pub frequency: f64,
+}
+
+/// Critical speeds in a speed range.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct CriticalSpeeds {
+    /// `v_d`: speed where the two real weave roots merge into the weave pair.
+    pub weave_real_pair_merge: Option<f64>,
+    /// `v_w`: weave Hopf speed (first stabilizing weave crossing).
+    pub weave_speed: Option<f64>,
+    /// `v_c`: capsize speed (first destabilizing capsize crossing).
+    pub capsize_speed: Option<f64>,
+    /// Every speed in the range where a real part crosses zero, ascending.
+    pub crossings: Vec<Crossing>,
+    /// Maximal intervals `[lo, hi]` within the range where all real parts are < 0.
+    pub stable_intervals: Vec<[f64; 2]>,
+}
+
+
+/// Characteristic quartic `det(M0 s^2 + v C1 s + g K0 + v^2 K2)` as polynomials in
+/// the speed: with `u = v^2`,
+/// `k4 = det M0`, `k3 = v a3`, `k2 = g b0 + u b2`, `k1 = v (g d0 + u d2)`,
+/// `k0 = g^2 e0 + g u e1 + u^2 e2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CharPoly {
+    /// `g` (m/s^2).
+    pub g: f64,
+    /// `det M0`.
+    pub k4: f64,
+    /// `k3 / v`.
+    pub a3: f64,
+    /// `k2 = g b0 + v^2 b2`.
+    pub b0: f64,
+    /// See `b0`.
+    pub b2: f64,
+    /// `k1 = v (g d0 + v^2 d2)`.
+    pub d0: f64,
+    /// See `d0`.
+    pub d2: f64,
+    /// `k0 = g^2 e0 + g v^2 e1 + v^4 e2` (`e0 = det K0`, `e2 = det K2`).
+    pub e0: f64,
+    /// See `e0`.
+    pub e1: f64,
+    /// See `e0`.
+    pub e2: f64,
+}
+
+/// `x11 y22 + y11 x22 - x12 y21 - y12 x21` (the mixed determinant; `det X` when `X = Y`
+/// counts twice).
+fn mixed(x: &Matrix2<f64>, y: &Matrix2<f64>) -> f64 {
+    x[(0, 0)] * y[(1, 1)] + y[(0, 0)] * x[(1, 1)] - x[(0, 1)] * y[(1, 0)] - y[(0, 1)] * x[(1, 0)]
+}
+
+/// Accurate 2x2 determinant (Kahan's FMA algorithm).
+fn det2(m: &Matrix2<f64>) -> f64 {
+    let w = m[(0, 1)] * m[(1, 0)];
+    let err = (-m[(0, 1)]).mul_add(m[(1, 0)], w);
+    m[(0, 0)].mul_add(m[(1, 1)], -w) + err
+}
+
+impl CharPoly {
+    /// Coefficient polynomials of `c`. Errors on non-finite entries or singular `M0`
+    /// (`|det M0| <= 1e-12 (|m11 m22| + |m12 m21|)`).
+    pub fn new(c: &CanonicalMatrices) -> Result<Self, EigenError> {
+        for (name, m) in [("M0", &c.m0), ("C1", &c.c1), ("K0", &c.k0), ("K2", &c.k2)] {
+            if !m.iter().all(|x| x.is_finite()) {
+                return Err(EigenError::NonFinite { what: format!("matrix {name}") });
+            }
+        }
+        if !c.g.is_finite() {
+            return Err(EigenError::NonFinite { what: "g".into() });
+        }
+        let k4 = det2(&c.m0);
+        let scale = (c.m0[(0, 0)] * c.m0[(1, 1)]).abs() + (c.m0[(0, 1)] * c.m0[(1, 0)]).abs();
+        if !(k4.abs() > 1e-12 * scale) {
+            return Err(EigenError::SingularMassMatrix { det: k4 });
+        }
+        let (m, c1, k0, k2) = (&c.m0, &c.c1, &c.k0, &c.k2);
+        let cp = CharPoly {
+            g: c.g,
+            k4,
+            a3: mixed(m, c1),
+            b0: mixed(m, k0),
+            b2: mixed(m, k2) + det2(c1),
+            d0: mixed(c1, k0),
+            d2: mixed(c1, k2),
+            e0: det2(k0),
+            e1: mixed(k0, k2),
+            e2: det2(k2),
+        };
+        Ok(cp)
+    }
+
+    /// Coefficients `[k0, k1, k2, k3, k4]` (`k[i]` multiplies `s^i`) at speed `v`.
+    pub fn coeffs(&self, v: f64) -> [f64; 5] {
+        let g = self.g;
+        let u = v * v;
+        [
+            g.mul_add(g * self.e0, u * g.mul_add(self.e1, u * self.e2)),
+            v * g.mul_add(self.d0, u * self.d2),
+            g.mul_add(self.b0, u * self.b2),
+            v * self.a3,
+            self.k4,
+        ]
+    }
+
+    /// Derivatives `d k_i / d v` at speed `v`.
+    pub fn dcoeffs(&self, v: f64) -> [f64; 5] {
+        let g = self.g;
+        let u = v * v;
+        [
+            2.0 * v * g.mul_add(self.e1, 2.0 * u * self.e2),
+            g.mul_add(self.d0, 3.0 * u * self.d2),
+            2.0 * v * self.b2,
+            self.a3,
+            0.0,
+        ]
+    }
+
+    /// Roots at speed `v`, sorted by descending real part then imaginary part.
+    pub fn roots(&self, v: f64) -> Result<[Complex<f64>; 4], EigenError> {
+        if !v.is_finite() {
+            return Err(EigenError::NonFinite { what: format!("speed {v}") });
+        }
+        let va = v.abs();
+        let mut z = quartic_roots(&self.coeffs(va))
+            .ok_or_else(|| EigenError::NoConvergence { what: format!("quartic roots at v = {v}") })?;
+        if v < 0.0 {
+            for x in z.iter_mut() {
+                *x = neg(*x);
+            }
+            sort_desc(&mut z);
+        }
+        Ok(z)
+    }
+}
+
+/// `-z` without producing `-0.0` imaginary parts for real roots.
+fn neg(z: C64) -> C64 {
+    C64::new(-z.re, if z.im == 0.0 { 0.0 } else { -z.im })
+}
+
+/// The four eigenvalues at speed `v` (fast path, no vectors, no labels). Sorted by
+/// descending real part, ties by descending imaginary part.
+pub fn eigenvalues(c: &CanonicalMatrices, v: f64) -> Result<[Complex<f64>; 4], EigenError> {
+    CharPoly::new(c)?.roots(v)
+}
+
+// ---------------------------------------------------------------------------
+// Mode tracking
+
+/// All 24 permutations of 0..4, identity first.
+const PERMS: [[usize; 4]; 24] = {
+    let mut out = [[0usize; 4]; 24];
+    let mut n = 0;
+    let mut a = 0;
+    while a < 4 {
+        let mut b = 0;
+        while b < 4 {
+            let mut c = 0;
+            while c < 4 {
+                if a != b && a != c && b != c {
+                    let d = 6 - a - b - c;
+                    out[n] = [a, b, c, d];
+                    n += 1;
+                }
+                c += 1;
+            }
+            b += 1;
+        }
+        a += 1;
+    }
+    out
+};
+
+/// Labelled roots of one branch set: `roots[i]` carries `labels[i]`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Labelled {
+    pub roots: [C64; 4],
+    pub labels: [Mode; 4],
+}
+
+fn rank(m: Mode) -> u16 {
+    match m {
+        Mode::Weave => 0,
+        Mode::Capsize => 1,
+        Mode::Castering => 2,
+        Mode::Other(k) => 3 + k as u16,
+    }
+}
+
+impl Labelled {
+    /// Canonical order: by label rank; within a label, descending imaginary then real part.
+    fn canonical(mut self) -> Self {
+        let mut idx = [0usize, 1, 2, 3];
+        idx.sort_by(|&i, &j| {
+            rank(self.labels[i])
+                .cmp(&rank(self.labels[j]))
+                .then(self.roots[j].im.partial_cmp(&self.roots[i].im).unwrap_or(std::cmp::Ordering::Equal))
+                .then(self.roots[j].re.partial_cmp(&self.roots[i].re).unwrap_or(std::cmp::Ordering::Equal))
+        });
+        let (r, l) = (self.roots, self.labels);
+        for k in 0..4 {
+            self.roots[k] = r[idx[k]];
+            self.labels[k] = l[idx[k]];
+        }
+        self
+    }
+
+    /// Mirror to negative speed: roots negated, labels kept.
+    fn mirrored(self) -> Self {
+        let mut r = self.roots;
+        for x in r.iter_mut() {
+            *x = neg(*x);
+        }
+        Labelled { roots: r, labels: self.labels }.canonical()
+    }
+}
+
+/// Anchor pattern: exactly one complex pair and two real roots (input sorted desc).
+fn classify_anchor(z: &[C64; 4]) -> Option<[Mode; 4]> {
+    let n_real = z.iter().filter(|x| x.im == 0.0).count();
+    if n_real != 2 {
+        return None;
+    }
+    let mut l = [Mode::Weave; 4];
+    let reals: Vec<usize> = (0..4).filter(|&i| z[i].im == 0.0).collect();
+    // sorted descending: reals[0] larger -> capsize, reals[1] -> castering
+    l[reals[0]] = Mode::Capsize;
+    l[reals[1]] = Mode::Castering;
+    Some(l)
+}
+
+/// Fallback classification when no anchor speed exists (input sorted desc).
+fn classify_fallback(z: &[C64; 4]) -> [Mode; 4] {
+    let n_real = z.iter().filter(|x| x.im == 0.0).count();
+    if n_real == 4 {
+        return [Mode::Weave, Mode::Weave, Mode::Capsize, Mode::Castering];
+    }
+    if let Some(l) = classify_anchor(z) {
+        return l;
+    }
+    // two complex pairs: larger |im| is weave
+    let wmax = z.iter().fold(0.0f64, |m, x| m.max(x.im.abs()));
+    let mut l = [Mode::Other(0); 4];
+    let mut k = 2u8;
+    for i in 0..4 {
+        if z[i].im.abs() == wmax {
+            l[i] = Mode::Weave;
+        } else {
+            l[i] = Mode::Other(k);
+            k += 1;
+        }
+    }
+    // keep exactly one label per conjugate pair for the non-weave pair
+    let others: Vec<usize> = (0..4).filter(|&i| l[i] != Mode::Weave).collect();
+    for &i in &others {
+        l[i] = Mode::Other(2);
+    }
+    l
+}
+
+/// Best matching of `new` roots to `prev` branches. Returns the reordered new roots
+/// and whether the matching is unambiguous.
+fn match_roots(prev: &Labelled, new: &[C64; 4]) -> ([C64; 4], bool) {
+    let mut best = (f64::INFINITY, 0usize);
+    for (pi, p) in PERMS.iter().enumerate() {
+        let mut cost = 0.0;
+        for i in 0..4 {
+            cost += (prev.roots[i] - new[p[i]]).norm_sqr();
+        }
+        if cost < best.0 {
+            best = (cost, pi);
+        }
+    }
+    let p = PERMS[best.1];
+    let out = [new[p[0]], new[p[1]], new[p[2]], new[p[3]]];
+    let mut dmax = 0.0f64;
+    let mut sep = f64::INFINITY;
+    for i in 0..4 {
+        dmax = dmax.max((prev.roots[i] - out[i]).norm());
+        for j in i + 1..4 {
+            if prev.labels[i] != prev.labels[j] {
+                sep = sep.min((prev.roots[i] - prev.roots[j]).norm());
+                sep = sep.min((out[i] - out[j]).norm());
+            }
+        }
+    }
+    (out, dmax < 0.3 * sep)
+}
+
+/// Continue labelled roots from `v0` (>= 0) to `v1` (>= 0) adaptively.
+fn continue_to(cp: &CharPoly, start: Labelled, v0: f64, v1: f64) -> Result<Labelled, EigenError> {
+    let mut cur = start;
+    let mut v = v0;
+    if v0 == v1 {
+        return Ok(cur);
+    }
+    let hmin = 1e-12 * v0.abs().max(v1.abs()).max(1.0);
+    let mut h = v1 - v0;
+    let mut guard = 0usize;
+    while v != v1 {
+        guard += 1;
+        if guard > 2_000_000 {
+            return Err(EigenError::NoConvergence { what: "mode continuation".into() });
+        }
+        let vt = if (v1 - v).abs() <= h.abs() * (1.0 + 1e-12) { v1 } else { v + h };
+        let z = cp.roots(vt)?;
+        let (m, ok) = match_roots(&cur, &z);
+        if ok || h.abs() <= hmin {
+            cur = Labelled { roots: m, labels: cur.labels };
+            v = vt;
+            h *= 2.0;
+            if h.abs() > (v1 - v).abs() && v != v1 {
+                h = v1 - v;
+            }
+        } else {
+            h *= 0.5;
+        }
+    }
+    Ok(cur)
+}
+
+/// Labels at every `|v|` of `speeds` (any order, any sign). Returns labelled roots in
+/// canonical order, one per input speed.
+pub(crate) fn track(cp: &CharPoly, speeds: &[f64]) -> Result<Vec<Labelled>, EigenError> {
+    if speeds.is_empty() {
+        return Ok(Vec::new());
+    }
+    for &v in speeds {
+        if !v.is_finite() {
+            return Err(EigenError::NonFinite { what: format!("speed {v}") });
+        }
+    }
+    let mut order: Vec<usize> = (0..speeds.len()).collect();
+    order.sort_by(|&i, &j| speeds[j].abs().partial_cmp(&speeds[i].abs()).unwrap_or(std::cmp::Ordering::Equal));
+    let vtop = speeds[order[0]].abs();
+    // Anchor search.
+    let mut anchor = None;
+    let z = cp.roots(vtop)?;
+    if let Some(l) = classify_anchor(&z) {
+        anchor = Some((vtop, Labelled { roots: z, labels: l }));
+    } else {
+        let mut va = vtop.max(1.0);
+        for _ in 0..40 {
+            va *= 1.25;
+            let z = cp.roots(va)?;
+            if let Some(l) = classify_anchor(&z) {
+                anchor = Some((va, Labelled { roots: z, labels: l }));
+                break;
+            }
+        }
+    }
+    let (mut vcur, mut cur) = match anchor {
+        Some(a) => a,
+        None => (vtop, Labelled { roots: z, labels: classify_fallback(&z) }),
+    };
+    let mut out = vec![cur; speeds.len()];
+    for &i in &order {
+        let va = speeds[i].abs();
+        cur = continue_to(cp, cur, vcur, va)?;
+        vcur = va;
+        let l = cur.canonical();
+        out[i] = if speeds[i] < 0.0 { l.mirrored() } else { l };
+        cur = l;
+    }
+    Ok(out)
+}
+
+// ---------------------------------------------------------------------------
+// Eigenvectors
+
+/// Eigenvector of eigenvalue `s` at speed `v`: `u` spans the null space of
+/// `P(s) = M0 s^2 + v C1 s + g K0 + v^2 K2`; `x = [u, s u]`, unit 2-norm, phase fixed so
+/// that the larger-modulus component of `u` is real and positive.
+pub fn eigenvector(c: &CanonicalMatrices, v: f64, s: Complex<f64>) -> [Complex<f64>; 4] {
+    let s2 = s * s;
+    let kk = c.stiffness(v);
+    let cc = c.damping(v);
+    let p = |i: usize, j: usize| s2 * c.m0[(i, j)] + s * cc[(i, j)] + C64::new(kk[(i, j)], 0.0);
+    let (p11, p12, p21, p22) = (p(0, 0), p(0, 1), p(1, 0), p(1, 1));
+    let n1 = p11.norm_sqr() + p12.norm_sqr();
+    let n2 = p21.norm_sqr() + p22.norm_sqr();
+    let mut u = if n1 >= n2 && n1 > 0.0 {
+        [-p12, p11]
+    } else if n2 > 0.0 {
+        [p22, -p21]
+    } else {
+        [C64::new(1.0, 0.0), C64::new(0.0, 0.0)]
+    };
+    // phase: larger component real positive
+    let k = if u[0].norm() >= u[1].norm() { 0 } else { 1 };
+    let uk = u[k];
+    let nk = uk.norm();
+    if nk > 0.0 && nk.is_finite() {
+        let ph = uk.conj() / nk;
+        u = [u[0] * ph, u[1] * ph];
+        u[k] = C64::new(u[k].re, 0.0);
+    }
+    let x = [u[0], u[1], s * u[0], s * u[1]];
+    let nrm = x.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
+    if !(nrm > 0.0 && nrm.is_finite()) {
+        return [C64::new(1.0, 0.0), C64::new(0.0, 0.0), s, C64::new(0.0, 0.0)];
+    }
+    [x[0] / nrm, x[1] / nrm, x[2] / nrm, x[3] / nrm]
+}
+
+/// Eigen-analysis at each speed in `speeds` (any order, negative speeds allowed), with
+/// labels tracked continuously (see the module docs for the rule).
+pub fn eigen_sweep(c: &CanonicalMatrices, speeds: &[f64]) -> Result<EigenSweep, EigenError> {
+    let cp = CharPoly::new(c)?;
+    let tracked = track(&cp, speeds)?;
+    let points = speeds
+        .iter()
+        .zip(tracked)
+        .map(|(&v, l)| {
+            let mut vecs = [[C64::new(0.0, 0.0); 4]; 4];
+            for k in 0..4 {
+                // conjugate pairs get exactly conjugate vectors
+                let s = l.roots[k];
+                vecs[k] = if s.im < 0.0 {
+                    let v_up = eigenvector(c, v, s.conj());
+                    [v_up[0].conj(), v_up[1].conj(), v_up[2].conj(), v_up[3].conj()]
+                } else {
+                    eigenvector(c, v, s)
+                };
+            }
+            EigenPoint { v, eigenvalues: l.roots, modes: l.labels, eigenvectors: vecs }
+        })
+        .collect();
+    Ok(EigenSweep { points })
+}

@@ -1,0 +1,21 @@
+//! bikedyn runtime: numerics on generated multibody models (nalgebra only; no
+//! Symbolica at run time).
+#![allow(clippy::needless_range_loop)]
+
+pub mod benchmark_oracle;
+pub mod canonical;
+pub mod constraints;
+pub mod linalg;
+pub mod linearize;
+pub mod eigen;
+pub mod model;
+pub mod output;
+pub mod parameters;
+pub mod plot;
+pub mod scalar;
+pub mod sweep;
+pub mod verify;
+
+pub use canonical::CanonicalMatrices;
+pub use model::MultibodyModel;
+pub use scalar::{Dual, Scalar};

@@ -1,0 +1,221 @@
+//! Reduced equations by generalized coordinate partitioning (thesis section
+//! 3.8, eq. 40-47) and their exact linearization about upright straight
+//! running (section 3.9, eq. 48-50).
+//!
+//! The reduced equations are `Ec = Mi q'' - Qi` in the independent coordinates
+//! `q` (roll theta, steer gamma). The linearization differentiates `Ec` with
+//! dual numbers seeded on `q` and `q'`: the derivatives flow exactly through
+//! the constraint solution, the dependent velocities, `E`, `F`, `M` and the
+//! forces. A central-difference version (the thesis's method) exists only to
+//! cross-check it.
+
+use crate::canonical::CanonicalMatrices;
+use crate::constraints::{dependent_velocities, solve_configuration, solve_velocities, ConstraintError, NewtonOptions};
+use crate::linalg::solve_in_place;
+use crate::model::MultibodyModel;
+use crate::scalar::{Dual, Scalar};
+use nalgebra::{DMatrix, Matrix2};
+use thiserror::Error;
+
+/// Linearization failures.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum LinearizeError {
+    #[error(transparent)]
+    Constraint(#[from] ConstraintError),
+    #[error("model `{model}` has no parameter `{name}`")]
+    MissingParameter { model: &'static str, name: String },
+    #[error("the canonical form needs exactly 2 independent coordinates (roll, steer), model `{model}` has {n}")]
+    NotRollSteer { model: &'static str, n: usize },
+    #[error("the reduced mass matrix is singular")]
+    SingularMass,
+}
+
+/// Evaluate the reduced equations `Ec = Mi q'' - Qi` (thesis `EcMov.m`) at
+/// independent coordinates `q`, rates `dq`, accelerations `ddq`, with the
+/// ignorable coordinates at their initial guesses and time `t`. Returns
+/// `(Ec, Mi)` (`Mi` row-major `nind x nind`).
+pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
+    param: &[T],
+    t: T,
+    q: &[T],
+    dq: &[T],
+    ddq: &[T],
+) -> Result<(Vec<T>, Vec<T>), ConstraintError> {
+    let nq = M::nq();
+    let ind = M::INDEPENDENT;
+    let ni = ind.len();
+    let mut p: Vec<T> = M::INITIAL_GUESS.iter().map(|&x| T::cst(x)).collect();
+    for (k, &j) in ind.iter().enumerate() {
+        p[j] = q[k];
+    }
+    solve_configuration::<M, T>(param, t, &mut p, &NewtonOptions::default())?;
+    let mut dp = vec![T::zero(); nq];
+    for (k, &j) in ind.iter().enumerate() {
+        dp[j] = dq[k];
+    }
+    solve_velocities::<M, T>(param, t, &p, &mut dp)?;
+
+    // E = [I; -Ddep^-1 Dind], F = [0; -Ddep^-1 gamma] (eq. 43-45).
+    let nh = M::HOLONOMIC.len();
+    let nnh = M::NONHOLONOMIC.len();
+    let nc = nh + nnh;
+    let mut dmat = vec![T::zero(); nc * nq];
+    M::holonomic_jacobian(param, t, &p, &mut dmat[..nh * nq]);
+    M::nonholonomic_matrix(param, t, &p, &mut dmat[nh * nq..]);
+    let mut gamma = vec![T::zero(); nc];
+    M::holonomic_convective(param, t, &p, &dp, &mut gamma[..nh]);
+    M::nonholonomic_convective(param, t, &p, &dp, &mut gamma[nh..]);
+    let depv = dependent_velocities::<M>();
+    let nd = depv.len();
+    let mut a = vec![T::zero(); nd * nd];
+    // Right-hand sides: columns [Dind (ni columns) | gamma].
+    let mut rhs = vec![T::zero(); nd * (ni + 1)];
+    for i in 0..nc {
+        for (k, &j) in depv.iter().enumerate() {
+            a[i * nd + k] = dmat[i * nq + j];
+        }
+        for (k, &j) in ind.iter().enumerate() {
+            rhs[i * (ni + 1) + k] = dmat[i * nq + j];
+        }
+        rhs[i * (ni + 1) + ni] = gamma[i];
+    }
+    solve_in_place(&mut a, nd, &mut rhs, ni + 1).map_err(|s| ConstraintError::SingularJacobian {
+        what: "coordinate partitioning",
+        column: s.column,
+        pivot: s.pivot,
+    })?;
+    let mut e = vec![T::zero(); nq * ni];
+    let mut f = vec![T::zero(); nq];
+    for (k, &j) in ind.iter().enumerate() {
+        e[j * ni + k] = T::one();
+    }
+    for (r, &j) in depv.iter().enumerate() {
+        for k in 0..ni {
+            e[j * ni + k] = -rhs[r * (ni + 1) + k];
+        }
+        f[j] = -rhs[r * (ni + 1) + ni];
+    }
+
+    let mut mass = vec![T::zero(); nq * nq];
+    M::mass_matrix(param, &p, &mut mass);
+    let mut qv = vec![T::zero(); nq];
+    M::quadratic_velocity_forces(param, &p, &dp, &mut qv);
+    let mut qg = vec![T::zero(); nq];
+    M::gravity_forces(param, &p, &mut qg);
+    let mut qe = vec![T::zero(); nq];
+    M::applied_forces(param, t, &p, &dp, &mut qe);
+    // Q = Qv + Qgrav + Qext - M F; Mi = E^T M E; Qi = E^T Q (eq. 46-47).
+    let mut qtot = vec![T::zero(); nq];
+    for r in 0..nq {
+        let mut s = qv[r] + qg[r] + qe[r];
+        for c in 0..nq {
+            s -= mass[r * nq + c] * f[c];
+        }
+        qtot[r] = s;
+    }
+    let mut me = vec![T::zero(); nq * ni];
+    for r in 0..nq {
+        for k in 0..ni {
+            let mut s = T::zero();
+            for c in 0..nq {
+                s += mass[r * nq + c] * e[c * ni + k];
+            }
+            me[r * ni + k] = s;
+        }
+    }
+    let mut mi = vec![T::zero(); ni * ni];
+    let mut ec = vec![T::zero(); ni];
+    for a_ in 0..ni {
+        let mut qi = T::zero();
+        for r in 0..nq {
+            qi += e[r * ni + a_] * qtot[r];
+        }
+        let mut s = -qi;
+        for b in 0..ni {
+            let mut m = T::zero();
+            for r in 0..nq {
+                m += e[r * ni + a_] * me[r * ni + b];
+            }
+            mi[a_ * ni + b] = m;
+            s += m * ddq[b];
+        }
+        ec[a_] = s;
+    }
+    Ok((ec, mi))
+}
+
+/// `M`, `C`, `K` of `M q'' + C q' + K q = 0` (thesis eq. 48-50) about
+/// upright straight running, in the model's independent coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Linearization {
+    pub mass: DMatrix<f64>,
+    pub damping: DMatrix<f64>,
+    pub stiffness: DMatrix<f64>,
+}
+
+/// Exact linearization (dual numbers) at `param` (which fixes the speed).
+pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, LinearizeError> {
+    const N: usize = 4;
+    let ni = M::INDEPENDENT.len();
+    if ni != 2 {
+        return Err(LinearizeError::NotRollSteer { model: M::NAME, n: ni });
+    }
+    let pd: Vec<Dual<N>> = param.iter().map(|&x| Dual::cst(x)).collect();
+    let q = [Dual::<N>::variable(0.0, 0), Dual::variable(0.0, 1)];
+    let dq = [Dual::<N>::variable(0.0, 2), Dual::variable(0.0, 3)];
+    let ddq = [Dual::<N>::zero(); 2];
+    let (ec, mi) = reduced_equations::<M, Dual<N>>(&pd, Dual::zero(), &q, &dq, &ddq)?;
+    let mass = DMatrix::from_fn(2, 2, |i, j| mi[i * 2 + j].re);
+    let stiffness = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[j]);
+    let damping = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[2 + j]);
+    Ok(Linearization { mass, damping, stiffness })
+}
+
+/// The thesis's finite-difference linearization (forward differences, step
+/// `h`, `CalculaMatricesMCK.m`), kept to cross-check [`linearize`].
+pub fn linearize_finite_difference<M: MultibodyModel>(param: &[f64], h: f64) -> Result<Linearization, LinearizeError> {
+    let eval = |q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]| reduced_equations::<M, f64>(param, 0.0, &q, &dq, &ddq).map(|r| r.0);
+    let e0 = eval([0.0; 2], [0.0; 2], [0.0; 2])?;
+    let mut lin = Linearization { mass: DMatrix::zeros(2, 2), damping: DMatrix::zeros(2, 2), stiffness: DMatrix::zeros(2, 2) };
+    for j in 0..2 {
+        let mut u = [0.0; 2];
+        u[j] = h;
+        let ek = eval(u, [0.0; 2], [0.0; 2])?;
+        let ec = eval([0.0; 2], u, [0.0; 2])?;
+        let em = eval([0.0; 2], [0.0; 2], u)?;
+        for i in 0..2 {
+            lin.stiffness[(i, j)] = (ek[i] - e0[i]) / h;
+            lin.damping[(i, j)] = (ec[i] - e0[i]) / h;
+            lin.mass[(i, j)] = (em[i] - e0[i]) / h;
+        }
+    }
+    Ok(lin)
+}
+
+/// Fill a model's parameter vector by name from `lookup`, with the forward
+/// speed `V`.
+pub fn parameter_vector<M: MultibodyModel>(lookup: impl Fn(&str) -> Option<f64>, speed: f64) -> Result<Vec<f64>, LinearizeError> {
+    M::PARAMETERS
+        .iter()
+        .map(|&n| if n == "V" { Some(speed) } else { lookup(n) }.ok_or_else(|| LinearizeError::MissingParameter { model: M::NAME, name: n.to_string() }))
+        .collect()
+}
+
+/// Canonical matrices of Meijaard et al. (2007) from a generated model:
+/// `M0 = M`, `C1 = C(v=1)`, `K0 = K(v=0)/g`, `K2 = K(v=1) - K(v=0)`, exact
+/// because the reduced equations are quadratic in the forward speed. The
+/// thesis's steer angle gamma is minus the benchmark's delta, so the
+/// off-diagonal entries change sign.
+pub fn canonical_matrices<M: MultibodyModel>(lookup: impl Fn(&str) -> Option<f64>) -> Result<CanonicalMatrices, LinearizeError> {
+    let g = lookup("g").ok_or_else(|| LinearizeError::MissingParameter { model: M::NAME, name: "g".into() })?;
+    let l0 = linearize::<M>(&parameter_vector::<M>(&lookup, 0.0)?)?;
+    let l1 = linearize::<M>(&parameter_vector::<M>(&lookup, 1.0)?)?;
+    let flip = |m: &DMatrix<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);
+    Ok(CanonicalMatrices {
+        m0: flip(&l0.mass),
+        c1: flip(&l1.damping),
+        k0: flip(&l0.stiffness) / g,
+        k2: flip(&(&l1.stiffness - &l0.stiffness)),
+        g,
+    })
+}

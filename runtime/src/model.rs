@@ -1,0 +1,83 @@
+//! The interface every generated multibody model implements.
+//!
+//! Notation follows the thesis (section 3): `p` are the generalized
+//! coordinates, `dp` their time derivatives, `param` the model's parameters in
+//! the order of [`MultibodyModel::PARAMETERS`], `t` time (s). Matrices are
+//! written row-major into caller-provided slices; nothing allocates.
+//!
+//! The equations of motion in Lagrange's first kind are
+//! `M p'' + Cq^T lambda_h + B^T lambda_nh = Qv + Qgrav + Qext`, with the
+//! holonomic constraints `Res(p, t) = 0` (velocity level `Cq p' + Ct = 0`,
+//! acceleration level `Cq p'' + dCqdp + ... = 0`) and the nonholonomic ones
+//! `B p' = 0` (acceleration level `B p'' + dBdp = 0`).
+
+use crate::scalar::Scalar;
+
+/// A generated model. All functions are associated (no `self`): a model is a
+/// type, its code is monomorphised for each scalar.
+pub trait MultibodyModel: Send + Sync + 'static {
+    /// Model name, as declared in the modeler.
+    const NAME: &'static str;
+    /// Generalized coordinates, in order.
+    const COORDINATES: &'static [&'static str];
+    /// Parameters, in the order of the `param` slices.
+    const PARAMETERS: &'static [&'static str];
+    /// Names of the holonomic constraints (rows of `Res`, `Cq`).
+    const HOLONOMIC: &'static [&'static str];
+    /// Names of the nonholonomic constraints (rows of `B`).
+    const NONHOLONOMIC: &'static [&'static str];
+    /// Names of the points of interest (e.g. wheel contacts).
+    const POINTS: &'static [&'static str];
+    /// Indices of the independent coordinates (e.g. roll, steer).
+    const INDEPENDENT: &'static [usize];
+    /// Indices of the dependent positions solved from the holonomic
+    /// constraints (one per constraint, in order).
+    const DEPENDENT: &'static [usize];
+    /// Initial guess of every coordinate for the constraint solver.
+    const INITIAL_GUESS: &'static [f64];
+    /// Floating-point operations per call of each generated function
+    /// (after common-subexpression elimination), by function name.
+    const FLOPS: &'static [(&'static str, usize)];
+
+    /// Number of coordinates.
+    fn nq() -> usize {
+        Self::COORDINATES.len()
+    }
+    /// Index of a coordinate by name.
+    fn coordinate_index(name: &str) -> Option<usize> {
+        Self::COORDINATES.iter().position(|c| *c == name)
+    }
+    /// Index of a parameter by name.
+    fn parameter_index(name: &str) -> Option<usize> {
+        Self::PARAMETERS.iter().position(|c| *c == name)
+    }
+
+    /// Mass matrix `M(p)`, `nq x nq` (thesis eq. 32).
+    fn mass_matrix<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
+    /// Quadratic-velocity forces `Qv(p, p') = -d(M p')/dp p' + dT/dp` (eq. 36).
+    fn quadratic_velocity_forces<T: Scalar>(param: &[T], p: &[T], dp: &[T], out: &mut [T]);
+    /// Gravity forces `Qgrav(p)` (eq. 38).
+    fn gravity_forces<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
+    /// Applied generalized forces `Qext(p, p', t)` (zero for a model without effects).
+    fn applied_forces<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
+    /// Holonomic residuals `Res(p, t)`.
+    fn holonomic_residuals<T: Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]);
+    /// `Cq = dRes/dp`, `nh x nq`.
+    fn holonomic_jacobian<T: Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]);
+    /// `Ct = dRes/dt`, `nh`.
+    fn holonomic_time_derivative<T: Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]);
+    /// `dCqdp = d(Cq p')/dp p'`, `nh`.
+    fn holonomic_convective<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
+    /// Nonholonomic constraint velocities (e.g. contact-point velocities), `nnh`.
+    fn nonholonomic_velocities<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
+    /// `B = d(velocities)/dp'`, `nnh x nq`.
+    fn nonholonomic_matrix<T: Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]);
+    /// `dBdp = d(B p')/dp p'`, `nnh`.
+    fn nonholonomic_convective<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
+    /// Kinetic energy `T = 1/2 p'^T M p'` (J).
+    fn kinetic_energy<T: Scalar>(param: &[T], p: &[T], dp: &[T]) -> T;
+    /// Potential energy of gravity `V` (J), with `Qgrav = -dV/dp`.
+    fn potential_energy<T: Scalar>(param: &[T], p: &[T]) -> T;
+    /// Global positions of the points of interest, `3 x npoints` (x, y, z per point).
+    fn point_positions<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
+}

@@ -1,0 +1,599 @@
+//! Output files: atomic writing, CSV/JSON writers and terminal tables.
+//!
+//! # Atomic writes
+//! Every `save_*` function (and the plots in [`crate::plot`]) writes through
+//! [`write_atomic`] / [`write_atomic_via_path`]: the content goes to a fresh
+//! temporary file in the target's directory (`.<name>.tmp-<pid>-<n>.<ext>`),
+//! is flushed and fsynced, and is then renamed over the target (followed by a
+//! best-effort fsync of the directory). On any error the temporary file is
+//! removed and an existing target is left untouched; a missing directory is
+//! reported as [`OutputError::NoSuchDirectory`] (directories are never created).
+//!
+//! # Eigenvalue order
+//! Within each speed the four eigenvalues are written in the order of
+//! [`ordered_eigenvalues`]: by mode (weave, capsize, castering, other), then by
+//! descending imaginary part, then by descending real part. For a conventional
+//! bicycle slots 1-2 are the weave pair (`+i` first; two real roots below
+//! `v_d`), slot 3 capsize and slot 4 castering; the mode of each slot is
+//! written alongside it, so unusual labelings are never misread.
+//!
+//! # Eigen sweep formats
+//! * JSON ([`eigen_sweep_json`]): a list of
+//!   `{"v": speed, "eigenvalues": [[re, im], x4], "modes": ["weave", x4]}`.
+//! * CSV ([`write_eigen_sweep_csv`]): header
+//!   `v,re_1,im_1,mode_1,re_2,im_2,mode_2,re_3,im_3,mode_3,re_4,im_4,mode_4`,
+//!   one row per speed, in sweep order. Units: `v` m/s, eigenvalues 1/s.
+//!
+//! # Parameter sweep / stability map formats
+//! CSV columns (after the parameter column(s), for a grid also `i,j`):
+//! `weave_speed,capsize_speed,weave_real_pair_merge,stable_width,stable_lo,stable_hi,
+//! n_stable_intervals,stable_intervals,open_ended,error`.
+//! Absent values are empty cells. `stable_lo`/`stable_hi` bound the first
+//! (lowest-speed) stable interval, `stable_intervals` lists all as
+//! `lo:hi` separated by `;`, `error` is empty for successful cells. A grid is
+//! written in long (tidy) format, row-major (`x` outer, `y` inner). JSON holds
+//! the same fields per cell (`null` when absent) plus the axes and speed range.
+//!
+//! Floating-point numbers are written with Rust's shortest round-trip
+//! representation (`{:?}`, e.g. `4.29238253634111`, `1e-20`).
+
+use std::fmt::Write as _;
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use nalgebra::Complex;
+use serde_json::{json, Value};
+
+use crate::eigen::{EigenPoint, EigenSweep, Mode};
+use crate::sweep::{CellResult, ParameterSweep, StabilityMap};
+
+/// Boxed error of a writer callback.
+pub type BoxError = Box<dyn std::error::Error + Send + Sync + 'static>;
+
+/// Error writing an output file; always names the target path.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The directory of the target does not exist (it is not created).
+    #[error("cannot write {}: directory {} does not exist", .path.display(), .dir.display())]
+    NoSuchDirectory {
+        /// Target file.
+        path: PathBuf,
+        /// Its (missing) directory.
+        dir: PathBuf,
+    },
+    /// The path has no file name (e.g. ends in `..` or is a root).
+    #[error("cannot write {}: not a file path", .path.display())]
+    InvalidPath {
+        /// Offending path.
+        path: PathBuf,
+    },
+    /// An I/O step failed.
+    #[error("cannot write {}: {op}: {source}", .path.display())]
+    Io {
+        /// Target file.
+        path: PathBuf,
+        /// Step that failed (e.g. "create temporary file", "rename").
+        op: &'static str,
+        /// Underlying error.
+        source: io::Error,
+    },
+    /// Producing the content failed (encoding or rendering).
+    #[error("cannot write {}: {source}", .path.display())]
+    Content {
+        /// Target file.
+        path: PathBuf,
+        /// Underlying error.
+        source: BoxError,
+    },
+}
+
+impl OutputError {
+    /// The target path of the failed write.
+    pub fn path(&self) -> &Path {
+        match self {
+            OutputError::NoSuchDirectory { path, .. }
+            | OutputError::InvalidPath { path }
+            | OutputError::Io { path, .. }
+            | OutputError::Content { path, .. } => path,
+        }
+    }
+}
+
+static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
+
+/// Reserve a fresh temporary file next to `path`; returns (file, temp path).
+fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
+    let name = match path.file_name() {
+        Some(n) => n.to_string_lossy().into_owned(),
+        None => return Err(OutputError::InvalidPath { path: path.to_path_buf() }),
+    };
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    if !dir.is_dir() {
+        return Err(OutputError::NoSuchDirectory { path: path.to_path_buf(), dir });
+    }
+    // Keep the extension last: some encoders choose the format from it.
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or(name);
+    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+    let mut last_err = None;
+    for _ in 0..16 {
+        let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
+        let tmp = dir.join(format!(".{stem}.tmp-{}-{n}{ext}", std::process::id()));
+        match OpenOptions::new().write(true).create_new(true).open(&tmp) {
+            Ok(f) => return Ok((f, tmp)),
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last_err = Some(e),
+            Err(e) => {
+                return Err(OutputError::Io {
+                    path: path.to_path_buf(),
+                    op: "create temporary file",
+                    source: e,
+                })
+            }
+        }
+    }
+    Err(OutputError::Io {
+        path: path.to_path_buf(),
+        op: "create temporary file",
+        source: last_err.unwrap_or_else(|| io::Error::other("no free temporary name")),
+    })
+}
+
+/// fsync the complete temporary file, rename it over `path`, fsync the directory.
+fn commit(tmp: &Path, path: &Path) -> Result<(), OutputError> {
+    let io_err = |op, source| OutputError::Io { path: path.to_path_buf(), op, source };
+    let f = OpenOptions::new().read(true).write(true).open(tmp).map_err(|e| io_err("reopen temporary file", e))?;
+    f.sync_all().map_err(|e| io_err("fsync", e))?;
+    drop(f);
+    if let Ok(meta) = fs::metadata(path) {
+        // Keep the permissions of the file being replaced (best effort).
+        let _ = fs::set_permissions(tmp, meta.permissions());
+    }
+    fs::rename(tmp, path).map_err(|e| io_err("rename temporary file", e))?;
+    #[cfg(unix)]
+    if let Some(dir) = path.parent() {
+        let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+        // Best effort: some file systems do not support fsync on directories.
+        if let Ok(d) = File::open(dir) {
+            let _ = d.sync_all();
+        }
+    }
+    Ok(())
+}
+
+/// Atomically replace `path` with what `write` writes (see the module docs).
+///
+/// The writer is buffered; `write` need not flush. If `write` fails, nothing
+/// at `path` changes and the temporary file is removed.
+pub fn write_atomic<F, E>(path: impl AsRef<Path>, write: F) -> Result<(), OutputError>
+where
+    F: FnOnce(&mut dyn Write) -> Result<(), E>,
+    E: Into<BoxError>,
+{
+    let path = path.as_ref();
+    let (file, tmp) = create_temp(path)?;
+    let result = (|| {
+        let mut w = BufWriter::new(file);
+        write(&mut w).map_err(|e| OutputError::Content { path: path.to_path_buf(), source: e.into() })?;
+        w.flush().map_err(|e| OutputError::Io { path: path.to_path_buf(), op: "write", source: e })?;
+        drop(w);
+        commit(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Atomically replace `path` with a file that `produce` writes at the given
+/// temporary path (same directory and extension as `path`; the file exists and
+/// is empty when `produce` is called and may be overwritten).
+pub fn write_atomic_via_path<F, E>(path: impl AsRef<Path>, produce: F) -> Result<(), OutputError>
+where
+    F: FnOnce(&Path) -> Result<(), E>,
+    E: Into<BoxError>,
+{
+    let path = path.as_ref();
+    let (file, tmp) = create_temp(path)?;
+    drop(file);
+    let result = produce(&tmp)
+        .map_err(|e| OutputError::Content { path: path.to_path_buf(), source: e.into() })
+        .and_then(|()| commit(&tmp, path));
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// Atomically write `contents` to `path`.
+pub fn write_string_atomic(path: impl AsRef<Path>, contents: &str) -> Result<(), OutputError> {
+    write_atomic(path, |w| w.write_all(contents.as_bytes()))
+}
+
+// ---------------------------------------------------------------------------
+// Eigen sweeps
+
+fn mode_rank(m: Mode) -> u32 {
+    match m {
+        Mode::Weave => 0,
+        Mode::Capsize => 1,
+        Mode::Castering => 2,
+        Mode::Other(k) => 3 + k as u32,
+    }
+}
+
+/// The eigenvalues of a point with their modes, in the stable output order:
+/// by mode (weave, capsize, castering, other), then descending imaginary part,
+/// then descending real part.
+pub fn ordered_eigenvalues(p: &EigenPoint) -> [(Complex<f64>, Mode); 4] {
+    let mut out: [(Complex<f64>, Mode); 4] = std::array::from_fn(|k| (p.eigenvalues[k], p.modes[k]));
+    out.sort_by(|a, b| {
+        mode_rank(a.1)
+            .cmp(&mode_rank(b.1))
+            .then(b.0.im.total_cmp(&a.0.im))
+            .then(b.0.re.total_cmp(&a.0.re))
+    });
+    out
+}
+
+/// JSON value of an eigen sweep:
+/// `[{"v": .., "eigenvalues": [[re, im], ..], "modes": ["weave", ..]}, ..]`.
+pub fn eigen_sweep_json(sweep: &EigenSweep) -> Value {
+    Value::Array(
+        sweep
+            .points
+            .iter()
+            .map(|p| {
+                let ev = ordered_eigenvalues(p);
+                json!({
+                    "v": p.v,
+                    "eigenvalues": ev.iter().map(|(s, _)| [s.re, s.im]).collect::<Vec<_>>(),
+                    "modes": ev.iter().map(|(_, m)| m.name()).collect::<Vec<_>>(),
+                })
+            })
+            .collect(),
+    )
+}
+
+/// Header of the eigen-sweep CSV.
+pub fn eigen_sweep_csv_header() -> Vec<String> {
+    let mut h = vec!["v".to_string()];
+    for k in 1..=4 {
+        h.push(format!("re_{k}"));
+        h.push(format!("im_{k}"));
+        h.push(format!("mode_{k}"));
+    }
+    h
+}
+
+/// Write an eigen sweep as CSV (see the module docs for the columns).
+pub fn write_eigen_sweep_csv<W: Write>(w: W, sweep: &EigenSweep) -> Result<(), csv::Error> {
+    let mut wr = csv::Writer::from_writer(w);
+    wr.write_record(eigen_sweep_csv_header())?;
+    for p in &sweep.points {
+        let mut row = vec![num(p.v)];
+        for (s, m) in ordered_eigenvalues(p) {
+            row.push(num(s.re));
+            row.push(num(s.im));
+            row.push(m.name().to_string());
+        }
+        wr.write_record(&row)?;
+    }
+    wr.flush()?;
+    Ok(())
+}
+
+/// Atomically save an eigen sweep as CSV.
+pub fn save_eigen_sweep_csv(path: impl AsRef<Path>, sweep: &EigenSweep) -> Result<(), OutputError> {
+    write_atomic(path, |w| write_eigen_sweep_csv(w, sweep))
+}
+
+/// Atomically save an eigen sweep as pretty-printed JSON.
+pub fn save_eigen_sweep_json(path: impl AsRef<Path>, sweep: &EigenSweep) -> Result<(), OutputError> {
+    save_json(path, &eigen_sweep_json(sweep))
+}
+
+/// Atomically save a JSON value (pretty-printed, trailing newline).
+pub fn save_json(path: impl AsRef<Path>, value: &Value) -> Result<(), OutputError> {
+    write_atomic(path, |w| -> Result<(), BoxError> {
+        serde_json::to_writer_pretty(&mut *w, value)?;
+        w.write_all(b"\n")?;
+        Ok(())
+    })
+}
+
+/// Aligned plain-text table of an eigen sweep for terminals. Columns are
+/// titled by mode when every row has the same mode sequence, else `lambda_k`
+/// with the mode in each cell.
+pub fn format_eigen_table(sweep: &EigenSweep) -> String {
+    let rows: Vec<[(Complex<f64>, Mode); 4]> = sweep.points.iter().map(ordered_eigenvalues).collect();
+    let uniform = rows.windows(2).all(|w| w[0].iter().zip(&w[1]).all(|(a, b)| a.1 == b.1));
+    let mut header = vec!["v (m/s)".to_string()];
+    for k in 0..4 {
+        header.push(match rows.first() {
+            Some(r) if uniform => r[k].1.name().to_string(),
+            _ => format!("lambda_{} (1/s)", k + 1),
+        });
+    }
+    let body = sweep
+        .points
+        .iter()
+        .zip(&rows)
+        .map(|(p, r)| {
+            let mut row = vec![format!("{:.3}", p.v)];
+            for (s, m) in r {
+                let z = format!("{:+.5} {} {:.5}i", s.re, if s.im < 0.0 { '-' } else { '+' }, s.im.abs());
+                row.push(if uniform { z } else { format!("{z} {}", m.name()) });
+            }
+            row
+        })
+        .collect::<Vec<_>>();
+    format_table(&header, &body)
+}
+
+/// Aligned plain-text table: a header, a rule, then the rows; every column is
+/// right-aligned to its widest entry, two spaces between columns.
+pub fn format_table(header: &[String], rows: &[Vec<String>]) -> String {
+    let ncol = header.len().max(rows.iter().map(Vec::len).max().unwrap_or(0));
+    let mut width = vec![0usize; ncol];
+    for r in std::iter::once(header).chain(rows.iter().map(Vec::as_slice)) {
+        for (k, s) in r.iter().enumerate() {
+            width[k] = width[k].max(s.chars().count());
+        }
+    }
+    let mut out = String::new();
+    let line = |r: &[String], out: &mut String| {
+        let cells: Vec<String> = (0..ncol)
+            .map(|k| {
+                let s = r.get(k).map(String::as_str).unwrap_or("");
+                format!("{s:>w$}", w = width[k])
+            })
+            .collect();
+        let _ = writeln!(out, "{}", cells.join("  ").trim_end());
+    };
+    line(header, &mut out);
+    let rule: Vec<String> = width.iter().map(|w| "-".repeat(*w)).collect();
+    line(&rule, &mut out);
+    for r in rows {
+        line(r, &mut out);
+    }
+    out
+}
+
+// ---------------------------------------------------------------------------
+// Parameter sweeps and stability maps
+
+const CELL_COLUMNS: [&str; 10] = [
+    "weave_speed",
+    "capsize_speed",
+    "weave_real_pair_merge",
+    "stable_width",
+    "stable_lo",
+    "stable_hi",
+    "n_stable_intervals",
+    "stable_intervals",
+    "open_ended",
+    "error",
+];
+
+fn num(x: f64) -> String {
+    format!("{x:?}")
+}
+
+fn opt(x: Option<f64>) -> String {
+    x.map(num).unwrap_or_default()
+}
+
+fn cell_fields(c: &CellResult) -> Vec<String> {
+    match c {
+        Ok(s) => {
+            let first = s.first_stable_interval();
+            vec![
+                opt(s.weave_speed),
+                opt(s.capsize_speed),
+                opt(s.weave_real_pair_merge),
+                num(s.stable_width),
+                opt(first.map(|i| i[0])),
+                opt(first.map(|i| i[1])),
+                s.stable_intervals.len().to_string(),
+                s.stable_intervals.iter().map(|[a, b]| format!("{}:{}", num(*a), num(*b))).collect::<Vec<_>>().join(";"),
+                s.open_ended.to_string(),
+                String::new(),
+            ]
+        }
+        Err(e) => {
+            let mut v = vec![String::new(); CELL_COLUMNS.len()];
+            v[CELL_COLUMNS.len() - 1] = e.to_string();
+            v
+        }
+    }
+}
+
+fn cell_json(c: &CellResult) -> serde_json::Map<String, Value> {
+    let mut m = serde_json::Map::new();
+    match c {
+        Ok(s) => {
+            m.insert("weave_speed".into(), json!(s.weave_speed));
+            m.insert("capsize_speed".into(), json!(s.capsize_speed));
+            m.insert("weave_real_pair_merge".into(), json!(s.weave_real_pair_merge));
+            m.insert("stable_intervals".into(), json!(s.stable_intervals));
+            m.insert("stable_width".into(), json!(s.stable_width));
+            m.insert("open_ended".into(), json!(s.open_ended));
+            m.insert("error".into(), Value::Null);
+        }
+        Err(e) => {
+            for k in ["weave_speed", "capsize_speed", "weave_real_pair_merge", "stable_intervals", "stable_width", "open_ended"] {
+                m.insert(k.into(), Value::Null);
+            }
+            m.insert("error".into(), json!({"stage": e.stage, "message": e.message}));
+        }
+    }
+    m
+}
+
+/// Header of the parameter-sweep CSV: the parameter's name, then the cell columns.
+pub fn parameter_sweep_csv_header(s: &ParameterSweep) -> Vec<String> {
+    std::iter::once(s.param.name.clone()).chain(CELL_COLUMNS.iter().map(|c| c.to_string())).collect()
+}
+
+/// Write a parameter sweep as CSV, one row per parameter value.
+pub fn write_parameter_sweep_csv<W: Write>(w: W, s: &ParameterSweep) -> Result<(), csv::Error> {
+    let mut wr = csv::Writer::from_writer(w);
+    wr.write_record(parameter_sweep_csv_header(s))?;
+    for (p, c) in s.param.values.iter().zip(&s.points) {
+        let mut row = vec![num(*p)];
+        row.extend(cell_fields(c));
+        wr.write_record(&row)?;
+    }
+    wr.flush()?;
+    Ok(())
+}
+
+/// JSON value of a parameter sweep:
+/// `{"parameter": name, "speed_range": [lo, hi], "points": [{"value": p, ...cell fields}]}`.
+pub fn parameter_sweep_json(s: &ParameterSweep) -> Value {
+    let points: Vec<Value> = s
+        .param
+        .values
+        .iter()
+        .zip(&s.points)
+        .map(|(p, c)| {
+            let mut m = serde_json::Map::new();
+            m.insert("value".into(), json!(p));
+            m.extend(cell_json(c));
+            Value::Object(m)
+        })
+        .collect();
+    json!({"parameter": s.param.name, "speed_range": s.speed_range, "points": points})
+}
+
+/// Header of the stability-map CSV: x name, y name, `i`, `j`, then the cell columns.
+pub fn stability_map_csv_header(m: &StabilityMap) -> Vec<String> {
+    [m.x.name.clone(), m.y.name.clone(), "i".into(), "j".into()]
+        .into_iter()
+        .chain(CELL_COLUMNS.iter().map(|c| c.to_string()))
+        .collect()
+}
+
+/// Write a stability map as long-format CSV, one row per cell, row-major.
+pub fn write_stability_map_csv<W: Write>(w: W, m: &StabilityMap) -> Result<(), csv::Error> {
+    let mut wr = csv::Writer::from_writer(w);
+    wr.write_record(stability_map_csv_header(m))?;
+    let (nx, ny) = m.shape();
+    for i in 0..nx {
+        for j in 0..ny {
+            let Some(c) = m.cell(i, j) else { continue };
+            let mut row = vec![num(m.x.values[i]), num(m.y.values[j]), i.to_string(), j.to_string()];
+            row.extend(cell_fields(c));
+            wr.write_record(&row)?;
+        }
+    }
+    wr.flush()?;
+    Ok(())
+}
+
+/// JSON value of a stability map:
+/// `{"x": {"name", "values"}, "y": {..}, "speed_range": [lo, hi], "layout": "row-major",
+///   "cells": [{"i", "j", "x", "y", ...cell fields}]}`.
+pub fn stability_map_json(m: &StabilityMap) -> Value {
+    let (nx, ny) = m.shape();
+    let mut cells = Vec::with_capacity(nx * ny);
+    for i in 0..nx {
+        for j in 0..ny {
+            let Some(c) = m.cell(i, j) else { continue };
+            let mut o = serde_json::Map::new();
+            o.insert("i".into(), json!(i));
+            o.insert("j".into(), json!(j));
+            o.insert("x".into(), json!(m.x.values[i]));
+            o.insert("y".into(), json!(m.y.values[j]));
+            o.extend(cell_json(c));
+            cells.push(Value::Object(o));
+        }
+    }
+    json!({
+        "x": m.x,
+        "y": m.y,
+        "speed_range": m.speed_range,
+        "layout": "row-major: cells[i * len(y.values) + j] is (x.values[i], y.values[j])",
+        "cells": cells,
+    })
+}
+
+/// Atomically save a parameter sweep as CSV.
+pub fn save_parameter_sweep_csv(path: impl AsRef<Path>, s: &ParameterSweep) -> Result<(), OutputError> {
+    write_atomic(path, |w| write_parameter_sweep_csv(w, s))
+}
+
+/// Atomically save a parameter sweep as JSON.
+pub fn save_parameter_sweep_json(path: impl AsRef<Path>, s: &ParameterSweep) -> Result<(), OutputError> {
+    save_json(path, &parameter_sweep_json(s))
+}
+
+/// Atomically save a stability map as CSV.
+pub fn save_stability_map_csv(path: impl AsRef<Path>, m: &StabilityMap) -> Result<(), OutputError> {
+    write_atomic(path, |w| write_stability_map_csv(w, m))
+}
+
+/// Atomically save a stability map as JSON.
+pub fn save_stability_map_json(path: impl AsRef<Path>, m: &StabilityMap) -> Result<(), OutputError> {
+    save_json(path, &stability_map_json(m))
+}
+
+fn short(x: Option<f64>) -> String {
+    x.map(|v| format!("{v:.4}")).unwrap_or_else(|| "-".into())
+}
+
+fn summary_row(c: &CellResult) -> Vec<String> {
+    match c {
+        Ok(s) => vec![
+            short(s.weave_speed),
+            short(s.capsize_speed),
+            format!("{:.4}{}", s.stable_width, if s.open_ended { "+" } else { "" }),
+            if s.stable_intervals.is_empty() {
+                "-".into()
+            } else {
+                s.stable_intervals.iter().map(|[a, b]| format!("[{a:.3}, {b:.3}]")).collect::<Vec<_>>().join(" ")
+            },
+        ],
+        Err(e) => vec!["-".into(), "-".into(), "-".into(), format!("error: {e}")],
+    }
+}
+
+const SUMMARY_HEADER: [&str; 4] = ["v_w (m/s)", "v_c (m/s)", "stable width (m/s)", "stable intervals (m/s)"];
+
+/// Aligned plain-text table of a parameter sweep (`+` marks a width cut off at `speed_max`).
+pub fn format_parameter_table(s: &ParameterSweep) -> String {
+    let header: Vec<String> =
+        std::iter::once(s.param.name.clone()).chain(SUMMARY_HEADER.iter().map(|h| h.to_string())).collect();
+    let rows: Vec<Vec<String>> = s
+        .param
+        .values
+        .iter()
+        .zip(&s.points)
+        .map(|(p, c)| std::iter::once(format!("{p:.6}")).chain(summary_row(c)).collect())
+        .collect();
+    format_table(&header, &rows)
+}
+
+/// Aligned plain-text table of a stability map, one line per cell (row-major).
+pub fn format_stability_map_table(m: &StabilityMap) -> String {
+    let header: Vec<String> = [m.x.name.clone(), m.y.name.clone()]
+        .into_iter()
+        .chain(SUMMARY_HEADER.iter().map(|h| h.to_string()))
+        .collect();
+    let (nx, ny) = m.shape();
+    let mut rows = Vec::with_capacity(nx * ny);
+    for i in 0..nx {
+        for j in 0..ny {
+            if let Some(c) = m.cell(i, j) {
+                let mut r = vec![format!("{:.6}", m.x.values[i]), format!("{:.6}", m.y.values[j])];
+                r.extend(summary_row(c));
+                rows.push(r);
+            }
+        }
+    }
+    format_table(&header, &rows)
+}

@@ -1,0 +1,511 @@
+//! Reading and writing parameter sets: TOML files of either form, and (via
+//! [`MeasuredBenchmark`]) the benchmark text files of BicycleParameters and
+//! HumanControl.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use toml::de::{DeTable, DeValue};
+use toml::Spanned;
+
+use super::{
+    BenchmarkParameters, MeasuredBenchmark, ParameterError, ParameterWarning, ThesisParameters,
+};
+
+/// Which parameterization a set uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Form {
+    /// [`ThesisParameters`] (Martin Recuero 2009).
+    Thesis,
+    /// [`BenchmarkParameters`] (Meijaard et al. 2007, Table 1).
+    Benchmark,
+}
+
+impl Form {
+    /// `"thesis"` or `"benchmark"` (the values of the TOML key `form`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Form::Thesis => "thesis",
+            Form::Benchmark => "benchmark",
+        }
+    }
+
+    /// The symbols of this form.
+    pub fn symbols(self) -> &'static [&'static str] {
+        match self {
+            Form::Thesis => &ThesisParameters::SYMBOLS,
+            Form::Benchmark => &BenchmarkParameters::SYMBOLS,
+        }
+    }
+
+    fn from_name(name: &str) -> Option<Form> {
+        match name {
+            "thesis" => Some(Form::Thesis),
+            "benchmark" => Some(Form::Benchmark),
+            _ => None,
+        }
+    }
+}
+
+/// A parameter set of either form, as read from a file.
+///
+/// # TOML
+///
+/// Keys are the symbols of one form ([`ThesisParameters::SYMBOLS`] or
+/// [`BenchmarkParameters::SYMBOLS`]), either at the top level or inside a
+/// `[parameters]` table. When a `[parameters]` table exists it is used and the
+/// other tables are ignored (so a reference file such as `meijaard2007.toml`,
+/// with `[canonical]` and `[[eigenvalues]]` beside its `[parameters]`, loads).
+/// The form is detected from the keys (thesis-only symbols such as `Rt`, `x3`
+/// against benchmark-only ones such as `w`, `lam`; `g` is shared) or forced
+/// with `form = "thesis"` or `form = "benchmark"`. Values are TOML integers or
+/// floats (`nan` and `inf` parse, then fail validation). Every key must be
+/// known; the thesis `d4` may be omitted (it defaults to 0). Loading validates
+/// the set and returns the warnings beside it.
+///
+/// ```
+/// use bikedyn_runtime::parameters::{ParameterSet, ThesisParameters};
+/// let text = ThesisParameters::thesis_bicycle().to_toml_string();
+/// let (set, warnings) = ParameterSet::from_toml_str(&text, "thesis.toml").unwrap();
+/// assert_eq!(set, ParameterSet::Thesis(ThesisParameters::thesis_bicycle()));
+/// assert_eq!(warnings.len(), 2); // handlebar and front wheel triangle inequality
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParameterSet {
+    /// Thesis form.
+    Thesis(ThesisParameters),
+    /// Benchmark form.
+    Benchmark(BenchmarkParameters),
+}
+
+impl ParameterSet {
+    /// Read and validate a parameter file. Files ending in `.toml` are read as
+    /// TOML ([`from_toml_str`](Self::from_toml_str)), all others as benchmark
+    /// text files ([`from_text_str`](Self::from_text_str)).
+    ///
+    /// Returns the set and its warnings (triangle inequality, extra names of
+    /// text files). To keep the `+/-` uncertainties of a text file, use
+    /// [`MeasuredBenchmark::load`].
+    pub fn load(
+        path: impl AsRef<Path>,
+    ) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
+        let path = path.as_ref();
+        let text = read(path)?;
+        let is_toml = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        if is_toml {
+            Self::from_toml_str(&text, path)
+        } else {
+            Self::from_text_str(&text, path)
+        }
+    }
+
+    /// Parse and validate TOML text (format in [`ParameterSet`]); `path` is
+    /// only used in messages.
+    pub fn from_toml_str(
+        text: &str,
+        path: impl AsRef<Path>,
+    ) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
+        let path = path.as_ref();
+        let fields = parse_toml_fields(text, path)?;
+        let line_of = |f: &str| fields.values.get(f).map(|&(_, line)| line);
+        let set = match fields.form {
+            Form::Thesis => {
+                ParameterSet::Thesis(ThesisParameters::from_lookup(|sym| {
+                    match fields.values.get(sym) {
+                        Some(&(v, _)) => Ok(v),
+                        None if sym == "d4" => Ok(0.0),
+                        None => Err(missing(path, sym)),
+                    }
+                })?)
+            }
+            Form::Benchmark => ParameterSet::Benchmark(BenchmarkParameters::from_lookup(|sym| {
+                fields
+                    .values
+                    .get(sym)
+                    .map(|&(v, _)| v)
+                    .ok_or_else(|| missing(path, sym))
+            })?),
+        };
+        let warnings = set.validate().map_err(|e| e.located(path, line_of))?;
+        Ok((set, warnings))
+    }
+
+    /// Parse and validate a benchmark text file (`name = value` or
+    /// `name = value+/-std` per line, see [`MeasuredBenchmark`]); the
+    /// uncertainties are dropped and the extra names (`v`, ...) are reported as
+    /// [`ParameterWarning::ExtraField`]. `path` is only used in messages.
+    pub fn from_text_str(
+        text: &str,
+        path: impl AsRef<Path>,
+    ) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
+        let (measured, warnings) = MeasuredBenchmark::from_text_str(text, path)?;
+        Ok((ParameterSet::Benchmark(measured.parameters), warnings))
+    }
+
+    /// The form of this set.
+    pub fn form(&self) -> Form {
+        match self {
+            ParameterSet::Thesis(_) => Form::Thesis,
+            ParameterSet::Benchmark(_) => Form::Benchmark,
+        }
+    }
+
+    /// Value by symbol of this set's form.
+    pub fn get(&self, symbol: &str) -> Option<f64> {
+        match self {
+            ParameterSet::Thesis(p) => p.get(symbol),
+            ParameterSet::Benchmark(p) => p.get(symbol),
+        }
+    }
+
+    /// Validate (see [`ThesisParameters::validate`],
+    /// [`BenchmarkParameters::validate`]).
+    pub fn validate(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
+        match self {
+            ParameterSet::Thesis(p) => p.validate(),
+            ParameterSet::Benchmark(p) => p.validate(),
+        }
+    }
+
+    /// The thesis form, converting a benchmark set
+    /// ([`BenchmarkParameters::to_thesis`]).
+    pub fn to_thesis(&self) -> Result<ThesisParameters, ParameterError> {
+        match self {
+            ParameterSet::Thesis(p) => Ok(*p),
+            ParameterSet::Benchmark(p) => p.to_thesis(),
+        }
+    }
+
+    /// The benchmark form, converting a thesis set
+    /// ([`ThesisParameters::to_benchmark`]).
+    pub fn to_benchmark(&self) -> Result<BenchmarkParameters, ParameterError> {
+        match self {
+            ParameterSet::Thesis(p) => p.to_benchmark(),
+            ParameterSet::Benchmark(p) => Ok(*p),
+        }
+    }
+
+    /// TOML text with `form = "..."` and one commented line per symbol; it
+    /// reads back to exactly this set.
+    pub fn to_toml_string(&self) -> String {
+        match self {
+            ParameterSet::Thesis(p) => p.to_toml_string(),
+            ParameterSet::Benchmark(p) => p.to_toml_string(),
+        }
+    }
+}
+
+impl ThesisParameters {
+    /// Parse and validate TOML text that must hold the thesis form (detected
+    /// or forced); a benchmark-form file is [`ParameterError::WrongForm`]
+    /// (convert it with [`ParameterSet::to_thesis`] instead).
+    pub fn from_toml_str(
+        text: &str,
+        path: impl AsRef<Path>,
+    ) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+        let path = path.as_ref();
+        match ParameterSet::from_toml_str(text, path)? {
+            (ParameterSet::Thesis(p), w) => Ok((p, w)),
+            (other, _) => Err(wrong_form(path, Form::Thesis, other.form())),
+        }
+    }
+
+    /// Read and validate a thesis-form TOML file.
+    pub fn load(path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+        let path = path.as_ref();
+        Self::from_toml_str(&read(path)?, path)
+    }
+
+    /// TOML text (`form = "thesis"`, one commented `symbol = value` line per
+    /// symbol, shortest round-trip float representation): reads back exactly.
+    pub fn to_toml_string(&self) -> String {
+        write_toml(
+            Form::Thesis,
+            |s| self.get(s),
+            ThesisParameters::describe,
+            "Thesis-form bicycle parameters (Martin Recuero 2009). Axes X forward, Y left, \
+             Z up; SI units.",
+        )
+    }
+}
+
+impl BenchmarkParameters {
+    /// Parse and validate TOML text that must hold the benchmark form
+    /// (detected or forced); a thesis-form file is
+    /// [`ParameterError::WrongForm`].
+    pub fn from_toml_str(
+        text: &str,
+        path: impl AsRef<Path>,
+    ) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+        let path = path.as_ref();
+        match ParameterSet::from_toml_str(text, path)? {
+            (ParameterSet::Benchmark(p), w) => Ok((p, w)),
+            (other, _) => Err(wrong_form(path, Form::Benchmark, other.form())),
+        }
+    }
+
+    /// Read and validate a benchmark-form file: TOML when the name ends in
+    /// `.toml`, else the text format (uncertainties dropped; see
+    /// [`MeasuredBenchmark::load`] to keep them).
+    pub fn load(path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+        let path = path.as_ref();
+        match ParameterSet::load(path)? {
+            (ParameterSet::Benchmark(p), w) => Ok((p, w)),
+            (other, _) => Err(wrong_form(path, Form::Benchmark, other.form())),
+        }
+    }
+
+    /// TOML text (`form = "benchmark"`, one commented `symbol = value` line per
+    /// symbol, shortest round-trip float representation): reads back exactly.
+    pub fn to_toml_string(&self) -> String {
+        write_toml(
+            Form::Benchmark,
+            |s| self.get(s),
+            BenchmarkParameters::describe,
+            "Benchmark-form bicycle parameters (Meijaard et al. 2007, Table 1). Axes x \
+             forward, y right, z down; SI units.",
+        )
+    }
+}
+
+pub(crate) fn read(path: &Path) -> Result<String, ParameterError> {
+    std::fs::read_to_string(path).map_err(|source| ParameterError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn missing(path: &Path, field: &str) -> ParameterError {
+    ParameterError::MissingField {
+        path: path.to_path_buf(),
+        field: field.to_string(),
+    }
+}
+
+fn wrong_form(path: &Path, expected: Form, found: Form) -> ParameterError {
+    ParameterError::WrongForm {
+        path: path.to_path_buf(),
+        expected: expected.name(),
+        found: found.name(),
+    }
+}
+
+/// 1-based line of a byte offset.
+pub(crate) fn line_of_offset(text: &str, offset: usize) -> usize {
+    let end = offset.min(text.len());
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// Format an `f64` as a TOML float that parses back to the same value
+/// (shortest round-trip digits; `nan`, `inf`, `-inf` spelled the TOML way).
+pub(crate) fn toml_float(x: f64) -> String {
+    if x.is_nan() {
+        "nan".to_string()
+    } else if x.is_infinite() {
+        if x > 0.0 { "inf" } else { "-inf" }.to_string()
+    } else {
+        // Debug prints the shortest representation that round-trips, always
+        // with a `.` or an exponent (`85.0`, `1e-7`), both valid TOML floats.
+        format!("{x:?}")
+    }
+}
+
+fn write_toml(
+    form: Form,
+    get: impl Fn(&str) -> Option<f64>,
+    describe: fn(&str) -> Option<&'static str>,
+    header: &str,
+) -> String {
+    let mut out = String::new();
+    let _ = writeln!(out, "# {header}");
+    let _ = writeln!(out, "form = \"{}\"", form.name());
+    for &sym in form.symbols() {
+        let value = toml_float(get(sym).unwrap_or(f64::NAN));
+        let line = format!("{sym} = {value}");
+        let _ = writeln!(out, "{line:<32} # {}", describe(sym).unwrap_or(""));
+    }
+    out
+}
+
+/// The numeric fields of a TOML parameter table, with their lines.
+struct TomlFields {
+    form: Form,
+    values: BTreeMap<String, (f64, usize)>,
+}
+
+fn toml_type(value: &DeValue<'_>) -> &'static str {
+    match value {
+        DeValue::String(_) => "a string",
+        DeValue::Integer(_) => "an integer",
+        DeValue::Float(_) => "a float",
+        DeValue::Boolean(_) => "a boolean",
+        DeValue::Datetime(_) => "a datetime",
+        DeValue::Array(_) => "an array",
+        DeValue::Table(_) => "a table",
+    }
+}
+
+fn parse_toml_fields(text: &str, path: &Path) -> Result<TomlFields, ParameterError> {
+    let pb = || path.to_path_buf();
+    let line = |span: std::ops::Range<usize>| line_of_offset(text, span.start);
+    let doc = DeTable::parse(text).map_err(|e| ParameterError::Toml {
+        path: pb(),
+        line: e.span().map(|s| line_of_offset(text, s.start)),
+        message: e.message().trim().to_string(),
+    })?;
+    let root = doc.get_ref();
+
+    // Choose the table that holds the parameters.
+    let mut forced: Option<(String, usize)> = None;
+    let table: &DeTable<'_> = match root.get_key_value("parameters") {
+        Some((key, value)) => {
+            let DeValue::Table(t) = value.get_ref() else {
+                return Err(ParameterError::WrongType {
+                    path: pb(),
+                    line: line(key.span()),
+                    field: "parameters".to_string(),
+                    expected: "a table",
+                    found: toml_type(value.get_ref()),
+                });
+            };
+            // Other tables are ignored; a stray top-level scalar other than
+            // `form` is a mistake.
+            for (k, v) in root.iter() {
+                let name: &str = k.get_ref();
+                match v.get_ref() {
+                    DeValue::Table(_) | DeValue::Array(_) => {}
+                    _ if name == "form" => forced = Some(form_value(k, v, path, text)?),
+                    _ if name == "parameters" => {}
+                    _ => {
+                        return Err(ParameterError::UnknownField {
+                            path: pb(),
+                            line: line(k.span()),
+                            field: name.to_string(),
+                            why: "only `form` and tables may sit beside a [parameters] table",
+                        })
+                    }
+                }
+            }
+            t
+        }
+        None => root,
+    };
+
+    // Entries in file order.
+    let mut entries: Vec<(&Spanned<_>, &Spanned<DeValue<'_>>)> = table.iter().collect();
+    entries.sort_by_key(|(k, _)| k.span().start);
+    if let Some((k, v)) = entries.iter().find(|(k, _)| k.get_ref() == "form") {
+        forced = Some(form_value(k, v, path, text)?);
+    }
+
+    let form = match forced {
+        Some((name, l)) => Form::from_name(&name).ok_or(ParameterError::InvalidForm {
+            path: pb(),
+            line: l,
+            value: name,
+        })?,
+        None => detect_form(&entries, path, text)?,
+    };
+
+    let mut values = BTreeMap::new();
+    for (k, v) in entries {
+        let name: &str = k.get_ref();
+        let l = line(k.span());
+        if name == "form" {
+            continue;
+        }
+        if !form.symbols().contains(&name) {
+            return Err(ParameterError::UnknownField {
+                path: pb(),
+                line: l,
+                field: name.to_string(),
+                why: match form {
+                    Form::Thesis => "not a thesis-form symbol",
+                    Form::Benchmark => "not a benchmark-form symbol",
+                },
+            });
+        }
+        let value = match v.get_ref() {
+            DeValue::Float(f) => f.as_str().parse::<f64>().ok(),
+            DeValue::Integer(i) => i64::from_str_radix(i.as_str(), i.radix())
+                .ok()
+                .map(|n| n as f64)
+                .or_else(|| i.as_str().parse::<f64>().ok()),
+            other => {
+                return Err(ParameterError::WrongType {
+                    path: pb(),
+                    line: l,
+                    field: name.to_string(),
+                    expected: "a number",
+                    found: toml_type(other),
+                })
+            }
+        };
+        let value = value.ok_or_else(|| ParameterError::Toml {
+            path: pb(),
+            line: Some(l),
+            message: format!("cannot read the number of `{name}`"),
+        })?;
+        values.insert(name.to_string(), (value, l));
+    }
+    Ok(TomlFields { form, values })
+}
+
+fn form_value(
+    key: &Spanned<std::borrow::Cow<'_, str>>,
+    value: &Spanned<DeValue<'_>>,
+    path: &Path,
+    text: &str,
+) -> Result<(String, usize), ParameterError> {
+    let l = line_of_offset(text, key.span().start);
+    match value.get_ref() {
+        DeValue::String(s) => Ok((s.to_string(), l)),
+        other => Err(ParameterError::WrongType {
+            path: path.to_path_buf(),
+            line: l,
+            field: "form".to_string(),
+            expected: "\"thesis\" or \"benchmark\"",
+            found: toml_type(other),
+        }),
+    }
+}
+
+fn detect_form(
+    entries: &[(&Spanned<std::borrow::Cow<'_, str>>, &Spanned<DeValue<'_>>)],
+    path: &Path,
+    text: &str,
+) -> Result<Form, ParameterError> {
+    let first_of = |form: Form, other: Form| {
+        entries.iter().find_map(|(k, _)| {
+            let name: &str = k.get_ref();
+            (form.symbols().contains(&name) && !other.symbols().contains(&name))
+                .then(|| (name.to_string(), line_of_offset(text, k.span().start)))
+        })
+    };
+    match (
+        first_of(Form::Thesis, Form::Benchmark),
+        first_of(Form::Benchmark, Form::Thesis),
+    ) {
+        (Some(_), None) => Ok(Form::Thesis),
+        (None, Some(_)) => Ok(Form::Benchmark),
+        (Some((thesis_key, thesis_line)), Some((benchmark_key, benchmark_line))) => {
+            Err(ParameterError::AmbiguousForm {
+                path: path.to_path_buf(),
+                thesis_key,
+                thesis_line,
+                benchmark_key,
+                benchmark_line,
+            })
+        }
+        (None, None) => Err(ParameterError::UnknownForm {
+            path: PathBuf::from(path),
+        }),
+    }
+}

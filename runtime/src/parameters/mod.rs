@@ -1,0 +1,43 @@
+//! Bicycle parameter sets: the thesis form (Martin Recuero 2009, section 4.4)
+//! and the benchmark form (Meijaard et al. 2007, Table 1), loading,
+//! validation and conversion between them.
+//!
+//! - [`ThesisParameters`] / [`BenchmarkParameters`]: the two forms, with the
+//!   reference bicycles [`ThesisParameters::thesis_bicycle`] and
+//!   [`BenchmarkParameters::benchmark_bicycle`] (also embedded as TOML:
+//!   [`THESIS_BICYCLE_TOML`], [`BENCHMARK_BICYCLE_TOML`]).
+//! - [`ParameterSet::load`]: TOML files of either form (detected from the keys
+//!   or forced with `form = "..."`) and the benchmark text files of
+//!   BicycleParameters / HumanControl ([`MeasuredBenchmark`] keeps their
+//!   `+/-` uncertainties).
+//! - `validate()`: errors ([`ParameterError`]) for non-finite values,
+//!   non-positive masses/radii/inertias and non-positive-definite tensors;
+//!   warnings ([`ParameterWarning`]) for principal moments that violate the
+//!   triangle inequality and for degenerate bodies (skate wheels, point
+//!   masses, as in the two-mass-skate bicycle).
+//! - [`ThesisParameters::to_benchmark`] / [`BenchmarkParameters::to_thesis`]:
+//!   exact conversions (geometry in [`ThesisParameters::to_benchmark`]).
+//!
+//! ```
+//! use bikedyn_runtime::parameters::{ParameterWarning, ThesisParameters};
+//! let thesis = ThesisParameters::thesis_bicycle();
+//! let warnings = thesis.validate().unwrap();
+//! assert!(matches!(warnings[0], ParameterWarning::TriangleInequality { body: "handlebar", .. }));
+//! let bench = thesis.to_benchmark().unwrap();
+//! assert!((bench.steer_axis_tilt - 0.315).abs() < 0.01);
+//! ```
+
+mod benchmark;
+mod convert;
+mod error;
+mod load;
+mod text;
+mod thesis;
+mod validate;
+
+pub use benchmark::{BenchmarkParameters, BENCHMARK_BICYCLE_TOML};
+pub use error::{Origin, ParameterError, ParameterWarning};
+pub use load::{Form, ParameterSet};
+pub use text::{MeasuredBenchmark, EXTRA_TEXT_FIELDS};
+pub use thesis::{ThesisParameters, THESIS_BICYCLE_TOML};
+pub use validate::body;

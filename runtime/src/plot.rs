@@ -1,0 +1,1225 @@
+//! Publication plots with plotters: the eigenvalue continuation diagram
+//! (Meijaard et al. 2007, Fig. 3) and two-parameter stability maps.
+//!
+//! The format follows the file extension: `.svg` (vector, for papers) or
+//! `.png` (raster); anything else is [`PlotError::UnsupportedFormat`]. Files
+//! are written atomically (see [`crate::output`]).
+//!
+//! # Fonts
+//! plotters is built with its pure-Rust `ab_glyph` text engine, which needs a
+//! TrueType/OpenType font registered at run time, for PNG *and* SVG (plotters
+//! measures text to lay out labels even when the SVG only references the
+//! family `sans-serif`). The font is taken from, in order:
+//! [`PlotOptions::font_path`], the environment variable `BIKEDYN_FONT`, a list
+//! of common system locations (DejaVu Sans, Liberation Sans, FreeSans, Arial),
+//! and finally a scan of the system font directories. If none is found,
+//! [`PlotError::NoFont`] says what was searched (on Debian/Ubuntu:
+//! `apt-get install fonts-dejavu-core`). The font bytes are loaded once per
+//! distinct font file and kept for the life of the process.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
+use plotters::prelude::*;
+
+use crate::eigen::{CriticalSpeeds, EigenSweep, Mode};
+use crate::output::{write_atomic_via_path, write_string_atomic, OutputError};
+use crate::sweep::{MapQuantity, StabilityMap};
+
+/// Font family name under which the font is registered and used.
+const FAMILY: &str = "sans-serif";
+
+/// Environment variable naming a TTF/OTF font file for plot text.
+pub const FONT_ENV: &str = "BIKEDYN_FONT";
+
+/// Errors of the plot functions; all name the offending path where there is one.
+#[derive(Debug, thiserror::Error)]
+pub enum PlotError {
+    /// File extension is neither `.svg` nor `.png`.
+    #[error("cannot plot to {}: unsupported file extension (use .svg or .png)", .path.display())]
+    UnsupportedFormat {
+        /// Requested output path.
+        path: PathBuf,
+    },
+    /// No usable font file was found.
+    #[error(
+        "no TrueType/OpenType font found for plot text (searched {}); install one \
+         (Debian/Ubuntu: apt-get install fonts-dejavu-core) or set {FONT_ENV} or PlotOptions::font_path",
+        .searched.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+    )]
+    NoFont {
+        /// Locations tried.
+        searched: Vec<PathBuf>,
+    },
+    /// A font file could not be read or parsed.
+    #[error("cannot use font {}: {message}", .path.display())]
+    Font {
+        /// Font file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// Nothing to plot (empty sweep or grid).
+    #[error("cannot plot to {}: no data", .path.display())]
+    NoData {
+        /// Requested output path.
+        path: PathBuf,
+    },
+    /// Invalid plot options (size, ranges).
+    #[error("cannot plot to {}: invalid options: {message}", .path.display())]
+    InvalidOptions {
+        /// Requested output path.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// plotters reported an error while drawing.
+    #[error("cannot plot to {}: drawing failed: {message}", .path.display())]
+    Drawing {
+        /// Requested output path.
+        path: PathBuf,
+        /// plotters' message.
+        message: String,
+    },
+    /// Writing the file failed (nothing was written at the path).
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}
+
+/// Image format, from the file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ImageFormat {
+    /// Scalable vector graphics.
+    Svg,
+    /// Portable network graphics (RGB).
+    Png,
+}
+
+impl ImageFormat {
+    /// Format from the (case-insensitive) extension of `path`.
+    pub fn from_path(path: &Path) -> Result<Self, PlotError> {
+        match path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).as_deref() {
+            Some("svg") => Ok(ImageFormat::Svg),
+            Some("png") => Ok(ImageFormat::Png),
+            _ => Err(PlotError::UnsupportedFormat { path: path.to_path_buf() }),
+        }
+    }
+}
+
+/// Where the legend goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum LegendPosition {
+    /// The plot-area corner that covers the fewest curve points (ties: lower
+    /// left, lower right, upper left, upper right).
+    #[default]
+    Auto,
+    /// Upper left corner of the plot area.
+    UpperLeft,
+    /// Upper right corner.
+    UpperRight,
+    /// Lower left corner.
+    LowerLeft,
+    /// Lower right corner.
+    LowerRight,
+    /// No legend.
+    Hidden,
+}
+
+/// Plot options. `PlotOptions::default()` gives an 800x600 figure with
+/// automatic ranges, no title, 16 px text and an automatically placed legend.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlotOptions {
+    /// Width in pixels at `scale = 1` (default 800).
+    pub width: u32,
+    /// Height in pixels at `scale = 1` (default 600).
+    pub height: u32,
+    /// Multiplies the pixel size, fonts and line widths (default 1; use 2-3
+    /// for print-resolution PNG). SVG output is resolution independent anyway.
+    pub scale: f64,
+    /// Title above the plot (default none; papers usually use a caption).
+    pub title: Option<String>,
+    /// Horizontal range; default: the data's range.
+    pub x_range: Option<(f64, f64)>,
+    /// Vertical range (continuation diagram); default: all eigenvalue parts
+    /// with 5% padding. Curves are clipped at the limits (e.g. `(-10, 10)` cuts
+    /// off the fast castering mode).
+    pub y_range: Option<(f64, f64)>,
+    /// Horizontal axis label; default per plot ("forward speed v (m/s)", or the
+    /// parameter name of a map).
+    pub x_label: Option<String>,
+    /// Vertical axis label; default "eigenvalue (1/s)" or the parameter name.
+    pub y_label: Option<String>,
+    /// Base font size in pixels at `scale = 1` (default 16).
+    pub font_size: f64,
+    /// Legend placement (default [`LegendPosition::Auto`]).
+    pub legend: LegendPosition,
+    /// Shade the self-stable speed intervals and mark `v_w`, `v_c` (default true;
+    /// needs critical speeds).
+    pub show_stable_band: bool,
+    /// TTF/OTF font for text (default: search, see the module docs).
+    pub font_path: Option<PathBuf>,
+}
+
+impl Default for PlotOptions {
+    fn default() -> Self {
+        Self {
+            width: 800,
+            height: 600,
+            scale: 1.0,
+            title: None,
+            x_range: None,
+            y_range: None,
+            x_label: None,
+            y_label: None,
+            font_size: 16.0,
+            legend: LegendPosition::Auto,
+            show_stable_band: true,
+            font_path: None,
+        }
+    }
+}
+
+impl PlotOptions {
+    fn check(&self, path: &Path) -> Result<(), PlotError> {
+        let bad = |m: String| Err(PlotError::InvalidOptions { path: path.to_path_buf(), message: m });
+        if !(self.scale.is_finite() && self.scale > 0.0) {
+            return bad(format!("scale must be positive, got {}", self.scale));
+        }
+        if !(self.font_size.is_finite() && self.font_size > 0.0) {
+            return bad(format!("font_size must be positive, got {}", self.font_size));
+        }
+        let (w, h) = self.pixel_size();
+        if w < 200 || h < 150 || w > 20_000 || h > 20_000 {
+            return bad(format!("image size {w}x{h} px out of range (200x150 to 20000x20000)"));
+        }
+        for (name, r) in [("x_range", self.x_range), ("y_range", self.y_range)] {
+            if let Some((lo, hi)) = r {
+                if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                    return bad(format!("{name} must be finite and increasing, got ({lo}, {hi})"));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn pixel_size(&self) -> (u32, u32) {
+        ((self.width as f64 * self.scale).round() as u32, (self.height as f64 * self.scale).round() as u32)
+    }
+
+    fn px(&self, x: f64) -> f64 {
+        x * self.scale
+    }
+
+    fn pxi(&self, x: f64) -> i32 {
+        (x * self.scale).round() as i32
+    }
+
+    fn pxu(&self, x: f64) -> u32 {
+        (x * self.scale).round().max(1.0) as u32
+    }
+
+    fn font(&self, rel: f64) -> TextStyle<'static> {
+        TextStyle::from((FAMILY, self.font_size * self.scale * rel).into_font())
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Fonts
+
+static REGISTERED: Mutex<Option<HashSet<PathBuf>>> = Mutex::new(None);
+static DEFAULT_FONT: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+const FONT_CANDIDATES: &[&str] = &[
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu-sans-fonts/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/local/share/fonts/DejaVuSans.ttf",
+    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/truetype/liberation2/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/liberation-sans/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/liberation/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/truetype/freefont/FreeSans.ttf",
+    "/usr/share/fonts/gnu-free/FreeSans.ttf",
+    "/System/Library/Fonts/Supplemental/Arial.ttf",
+    "/Library/Fonts/Arial.ttf",
+    "C:\\Windows\\Fonts\\arial.ttf",
+];
+
+const FONT_DIRS: &[&str] = &["/usr/share/fonts", "/usr/local/share/fonts", "/System/Library/Fonts", "/Library/Fonts"];
+
+fn scan_fonts(dir: &Path, depth: u32, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let mut entries: Vec<_> = entries.flatten().map(|e| e.path()).collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            if depth > 0 {
+                scan_fonts(&p, depth - 1, out);
+            }
+        } else if p
+            .extension()
+            .map(|e| matches!(e.to_string_lossy().to_ascii_lowercase().as_str(), "ttf" | "otf"))
+            .unwrap_or(false)
+        {
+            out.push(p);
+        }
+    }
+}
+
+/// Locate a font for plot text: `$BIKEDYN_FONT`, known system paths, then a
+/// scan of the system font directories (preferring regular sans-serif faces).
+pub fn find_font() -> Result<PathBuf, PlotError> {
+    let mut searched = Vec::new();
+    if let Some(p) = std::env::var_os(FONT_ENV) {
+        let p = PathBuf::from(p);
+        if p.is_file() {
+            return Ok(p);
+        }
+        searched.push(p);
+    }
+    for c in FONT_CANDIDATES {
+        let p = PathBuf::from(c);
+        if p.is_file() {
+            return Ok(p);
+        }
+    }
+    searched.extend(FONT_CANDIDATES.iter().map(PathBuf::from));
+    let mut dirs: Vec<PathBuf> = FONT_DIRS.iter().map(PathBuf::from).collect();
+    if let Some(home) = std::env::var_os("HOME") {
+        dirs.push(Path::new(&home).join(".local/share/fonts"));
+        dirs.push(Path::new(&home).join(".fonts"));
+    }
+    let mut found = Vec::new();
+    for d in &dirs {
+        scan_fonts(d, 4, &mut found);
+    }
+    searched.extend(dirs);
+    let score = |p: &PathBuf| {
+        let n = p.file_stem().map(|s| s.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
+        let styled = ["bold", "italic", "oblique", "light", "mono", "condensed", "black", "thin", "narrow", "serif"]
+            .iter()
+            .any(|s| n.replace("sans", "").contains(s));
+        (!n.contains("sans") as u8) + 2 * (styled as u8)
+    };
+    found.sort_by_key(score);
+    found.into_iter().next().ok_or(PlotError::NoFont { searched })
+}
+
+/// Register the font file `path` for plot text (idempotent per path). Later
+/// plots without [`PlotOptions::font_path`] use it too.
+pub fn use_font(path: impl AsRef<Path>) -> Result<(), PlotError> {
+    let path = path.as_ref().to_path_buf();
+    let mut reg = REGISTERED.lock().unwrap_or_else(|e| e.into_inner());
+    let reg = reg.get_or_insert_with(HashSet::new);
+    let mut default = DEFAULT_FONT.lock().unwrap_or_else(|e| e.into_inner());
+    if reg.contains(&path) {
+        if default.as_ref() != Some(&path) {
+            // Re-register to make it current (bytes are already leaked).
+            register_file(&path)?;
+            *default = Some(path);
+        }
+        return Ok(());
+    }
+    register_file(&path)?;
+    reg.insert(path.clone());
+    *default = Some(path);
+    Ok(())
+}
+
+fn register_file(path: &Path) -> Result<(), PlotError> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| PlotError::Font { path: path.to_path_buf(), message: e.to_string() })?;
+    // plotters' ab_glyph registry needs 'static bytes; the leak is bounded by
+    // one copy per distinct font file (see `use_font`).
+    static LEAKED: Mutex<Vec<(PathBuf, &'static [u8])>> = Mutex::new(Vec::new());
+    let mut leaked = LEAKED.lock().unwrap_or_else(|e| e.into_inner());
+    let bytes: &'static [u8] = match leaked.iter().find(|(p, _)| p == path) {
+        Some((_, b)) => b,
+        None => {
+            let b: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+            leaked.push((path.to_path_buf(), b));
+            b
+        }
+    };
+    plotters::style::register_font(FAMILY, FontStyle::Normal, bytes).map_err(|_| PlotError::Font {
+        path: path.to_path_buf(),
+        message: "not a valid TrueType/OpenType font".into(),
+    })
+}
+
+fn ensure_font(opts: &PlotOptions) -> Result<(), PlotError> {
+    if let Some(p) = &opts.font_path {
+        return use_font(p);
+    }
+    if DEFAULT_FONT.lock().unwrap_or_else(|e| e.into_inner()).is_some() {
+        return Ok(());
+    }
+    use_font(find_font()?)
+}
+
+// ---------------------------------------------------------------------------
+// Rendering
+
+type DrawErr = String;
+
+fn de<E: std::fmt::Display>(e: E) -> DrawErr {
+    e.to_string()
+}
+
+/// A figure that can draw itself on any plotters backend.
+trait Figure {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr>;
+}
+
+fn render(path: &Path, opts: &PlotOptions, fig: &impl Figure) -> Result<(), PlotError> {
+    let format = ImageFormat::from_path(path)?;
+    opts.check(path)?;
+    ensure_font(opts)?;
+    let size = opts.pixel_size();
+    let drawing = |message| PlotError::Drawing { path: path.to_path_buf(), message };
+    match format {
+        ImageFormat::Svg => {
+            let mut svg = String::new();
+            {
+                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+                fig.draw(&root).map_err(drawing)?;
+                root.present().map_err(|e| drawing(e.to_string()))?;
+            }
+            write_string_atomic(path, &svg)?;
+        }
+        ImageFormat::Png => {
+            let mut draw_error = None;
+            let r = write_atomic_via_path(path, |tmp| -> Result<(), String> {
+                let root = BitMapBackend::new(tmp, size).into_drawing_area();
+                let res = fig.draw(&root).and_then(|()| root.present().map_err(de));
+                if let Err(e) = &res {
+                    draw_error = Some(e.clone());
+                }
+                res
+            });
+            if let Some(m) = draw_error {
+                return Err(drawing(m));
+            }
+            r?;
+        }
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------
+// Helpers
+
+const WEAVE: RGBColor = RGBColor(0, 114, 178);
+const CAPSIZE: RGBColor = RGBColor(213, 94, 0);
+const CASTERING: RGBColor = RGBColor(117, 112, 179);
+const OTHER: RGBColor = RGBColor(110, 110, 110);
+const BAND: RGBColor = RGBColor(0, 158, 115);
+const GRID: RGBColor = RGBColor(225, 225, 225);
+const MISSING: RGBColor = RGBColor(200, 200, 200);
+const FAILED: RGBColor = RGBColor(120, 120, 120);
+
+fn mode_class(m: Mode) -> usize {
+    match m {
+        Mode::Weave => 0,
+        Mode::Capsize => 1,
+        Mode::Castering => 2,
+        Mode::Other(_) => 3,
+    }
+}
+
+const CLASS_NAMES: [&str; 4] = ["weave", "capsize", "castering", "other"];
+const CLASS_COLORS: [RGBColor; 4] = [WEAVE, CAPSIZE, CASTERING, OTHER];
+
+/// Tick label: shortest decimal of the value rounded to 6 significant places.
+fn tick(v: f64) -> String {
+    if v == 0.0 || v.abs() < 1e-12 {
+        return "0".into();
+    }
+    let mag = v.abs().log10().floor() as i32;
+    if !(-4..=6).contains(&mag) {
+        return format!("{v:.2e}");
+    }
+    let decimals = (5 - mag).clamp(0, 10) as usize;
+    let s = format!("{v:.decimals$}");
+    let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s };
+    if s == "-0" {
+        "0".into()
+    } else {
+        s
+    }
+}
+
+/// Clip a polyline to the box, returning the visible pieces.
+fn clip_polyline(pts: &[(f64, f64)], (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> Vec<Vec<(f64, f64)>> {
+    let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
+    let mut cur: Vec<(f64, f64)> = Vec::new();
+    let inside = |p: (f64, f64)| p.0 >= x0 && p.0 <= x1 && p.1 >= y0 && p.1 <= y1;
+    if pts.len() == 1 && inside(pts[0]) {
+        return vec![pts.to_vec()];
+    }
+    for w in pts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        // Liang-Barsky.
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        let mut visible = true;
+        for (p, q) in [(-dx, a.0 - x0), (dx, x1 - a.0), (-dy, a.1 - y0), (dy, y1 - a.1)] {
+            if p == 0.0 {
+                if q < 0.0 {
+                    visible = false;
+                    break;
+                }
+            } else {
+                let r = q / p;
+                if p < 0.0 {
+                    t0 = t0.max(r);
+                } else {
+                    t1 = t1.min(r);
+                }
+            }
+        }
+        if !visible || t0 > t1 {
+            if cur.len() > 1 {
+                out.push(std::mem::take(&mut cur));
+            }
+            cur.clear();
+            continue;
+        }
+        let pa = (a.0 + t0 * dx, a.1 + t0 * dy);
+        let pb = (a.0 + t1 * dx, a.1 + t1 * dy);
+        if cur.is_empty() || t0 > 0.0 {
+            if cur.len() > 1 {
+                out.push(std::mem::take(&mut cur));
+            }
+            cur.clear();
+            cur.push(pa);
+        }
+        cur.push(pb);
+        if t1 < 1.0 {
+            out.push(std::mem::take(&mut cur));
+        }
+    }
+    if cur.len() > 1 {
+        out.push(cur);
+    }
+    out
+}
+
+/// Width of the left label area: widest tick label of `lo..hi` (with about
+/// `n` "nice" ticks, as plotters chooses them) plus tick marks and the rotated
+/// axis description.
+fn label_area_width<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, o: &PlotOptions, (lo, hi): (f64, f64), n: usize) -> u32 {
+    let font = o.font(0.9);
+    let raw = (hi - lo) / n.max(1) as f64;
+    let mut widest = 0;
+    if raw.is_finite() && raw > 0.0 {
+        let p = 10f64.powf(raw.log10().floor());
+        let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * p).find(|s| *s >= raw).unwrap_or(10.0 * p);
+        let mut v = (lo / step).ceil() * step;
+        let mut guard = 0;
+        while v <= hi && guard < 100 {
+            let w = root.estimate_text_size(&tick(v), &font).map(|t| t.0).unwrap_or(0);
+            widest = widest.max(w);
+            v += step;
+            guard += 1;
+        }
+    }
+    widest + o.pxu(5.0 + 8.0) + o.pxu(o.font_size * 1.9)
+}
+
+fn padded(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (-1.0, 1.0);
+    }
+    if hi - lo <= 1e-12 * lo.abs().max(hi.abs()).max(1.0) {
+        return (lo - 0.5, hi + 0.5);
+    }
+    let d = (hi - lo) * frac;
+    (lo - d, hi + d)
+}
+
+// ---------------------------------------------------------------------------
+// Continuation diagram
+
+struct Curve {
+    class: usize,
+    imag: bool,
+    points: Vec<(f64, f64)>,
+}
+
+/// Real parts per mode (one branch per distinct root, conjugates merged) and
+/// the positive imaginary part per mode, as continuous pieces.
+fn continuation_curves(sweep: &EigenSweep) -> Vec<Curve> {
+    let mut curves = Vec::new();
+    for class in 0..4 {
+        let per_point: Vec<Vec<f64>> = sweep
+            .points
+            .iter()
+            .map(|p| {
+                let mut re: Vec<f64> = (0..4)
+                    .filter(|&k| mode_class(p.modes[k]) == class && p.eigenvalues[k].im >= 0.0)
+                    .map(|k| p.eigenvalues[k].re)
+                    .collect();
+                re.sort_by(|a, b| b.total_cmp(a));
+                re
+            })
+            .collect();
+        let branches = per_point.iter().map(Vec::len).max().unwrap_or(0);
+        for b in 0..branches {
+            let mut cur = Vec::new();
+            for (p, re) in sweep.points.iter().zip(&per_point) {
+                match re.get(b) {
+                    Some(&r) => cur.push((p.v, r)),
+                    None => {
+                        if !cur.is_empty() {
+                            curves.push(Curve { class, imag: false, points: std::mem::take(&mut cur) });
+                        }
+                    }
+                }
+            }
+            if !cur.is_empty() {
+                curves.push(Curve { class, imag: false, points: cur });
+            }
+        }
+        // Imaginary part: largest positive imaginary part of the class; pieces
+        // start/end at the neighbouring samples where it is zero.
+        let im: Vec<Option<f64>> = sweep
+            .points
+            .iter()
+            .map(|p| {
+                let ks: Vec<usize> = (0..4).filter(|&k| mode_class(p.modes[k]) == class).collect();
+                if ks.is_empty() {
+                    None
+                } else {
+                    Some(ks.iter().map(|&k| p.eigenvalues[k].im.abs()).fold(0.0, f64::max))
+                }
+            })
+            .collect();
+        let n = im.len();
+        let positive = |k: usize| im[k].is_some_and(|x| x > 0.0);
+        let mut cur: Vec<(f64, f64)> = Vec::new();
+        for k in 0..n {
+            let include = positive(k)
+                || (im[k].is_some() && ((k > 0 && positive(k - 1)) || (k + 1 < n && positive(k + 1))));
+            if include {
+                cur.push((sweep.points[k].v, im[k].unwrap_or(0.0)));
+                if !positive(k) && cur.len() > 1 {
+                    curves.push(Curve { class, imag: true, points: std::mem::take(&mut cur) });
+                    // A zero sample can also start the next piece.
+                    if k + 1 < n && positive(k + 1) {
+                        cur.push((sweep.points[k].v, 0.0));
+                    }
+                }
+            } else if !cur.is_empty() {
+                if cur.len() > 1 {
+                    curves.push(Curve { class, imag: true, points: std::mem::take(&mut cur) });
+                }
+                cur.clear();
+            }
+        }
+        if cur.len() > 1 {
+            curves.push(Curve { class, imag: true, points: cur });
+        }
+    }
+    curves
+}
+
+struct Continuation<'a> {
+    sweep: &'a EigenSweep,
+    critical: Option<&'a CriticalSpeeds>,
+    opts: &'a PlotOptions,
+    curves: Vec<Curve>,
+    xr: (f64, f64),
+    yr: (f64, f64),
+}
+
+/// Draw the continuation diagram of `sweep` (real parts solid, imaginary parts
+/// dashed, one colour per mode) to `path` (`.svg` or `.png`).
+///
+/// With `critical`, the self-stable speed intervals are shaded and `v_w`,
+/// `v_c` are marked and annotated (if in the plotted range and
+/// [`PlotOptions::show_stable_band`] is set).
+pub fn plot_continuation(
+    path: impl AsRef<Path>,
+    sweep: &EigenSweep,
+    critical: Option<&CriticalSpeeds>,
+    opts: &PlotOptions,
+) -> Result<(), PlotError> {
+    let path = path.as_ref();
+    ImageFormat::from_path(path)?;
+    if sweep.points.is_empty() {
+        return Err(PlotError::NoData { path: path.to_path_buf() });
+    }
+    let curves = continuation_curves(sweep);
+    let xr = opts.x_range.unwrap_or_else(|| {
+        let lo = sweep.points.iter().map(|p| p.v).fold(f64::INFINITY, f64::min);
+        let hi = sweep.points.iter().map(|p| p.v).fold(f64::NEG_INFINITY, f64::max);
+        if hi > lo {
+            (lo, hi)
+        } else {
+            padded(lo, hi, 0.0)
+        }
+    });
+    let yr = opts.y_range.unwrap_or_else(|| {
+        let vals = curves
+            .iter()
+            .flat_map(|c| c.points.iter())
+            .filter(|p| p.0 >= xr.0 && p.0 <= xr.1)
+            .map(|p| p.1)
+            .chain([0.0]);
+        let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| (l.min(y), h.max(y)));
+        padded(lo, hi, 0.05)
+    });
+    render(path, opts, &Continuation { sweep, critical, opts, curves, xr, yr })
+}
+
+/// Draw `text` with `sub` as a subscript after its first character
+/// (e.g. "v", "w", " = 4.29 m/s"), top-left at `(x, y)`.
+fn draw_subscripted<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    (x, y): (i32, i32),
+    parts: (&str, &str, &str),
+    opts: &PlotOptions,
+) -> Result<(), DrawErr> {
+    let main = opts.font(1.0);
+    let small = opts.font(0.72);
+    let w1 = root.estimate_text_size(parts.0, &main).map_err(de)?.0 as i32;
+    let w2 = root.estimate_text_size(parts.1, &small).map_err(de)?.0 as i32;
+    root.draw(&Text::new(parts.0.to_string(), (x, y), main.clone())).map_err(de)?;
+    root.draw(&Text::new(parts.1.to_string(), (x + w1, y + opts.pxi(opts.font_size * 0.45)), small))
+        .map_err(de)?;
+    root.draw(&Text::new(parts.2.to_string(), (x + w1 + w2 + opts.pxi(1.0), y), main)).map_err(de)?;
+    Ok(())
+}
+
+fn subscripted_width<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    parts: (&str, &str, &str),
+    opts: &PlotOptions,
+) -> Result<i32, DrawErr> {
+    let main = opts.font(1.0);
+    let small = opts.font(0.72);
+    Ok(root.estimate_text_size(parts.0, &main).map_err(de)?.0 as i32
+        + root.estimate_text_size(parts.1, &small).map_err(de)?.0 as i32
+        + root.estimate_text_size(parts.2, &main).map_err(de)?.0 as i32
+        + opts.pxi(1.0))
+}
+
+impl Figure for Continuation<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
+        let o = self.opts;
+        let (xr, yr) = (self.xr, self.yr);
+        root.fill(&WHITE).map_err(de)?;
+        let mut builder = ChartBuilder::on(root);
+        builder
+            .margin_top(o.pxu(if o.title.is_some() { 10.0 } else { 18.0 }))
+            .margin_right(o.pxu(24.0))
+            .margin_left(o.pxu(10.0))
+            .margin_bottom(o.pxu(10.0))
+            .x_label_area_size(o.pxu(o.font_size * 3.4))
+            .y_label_area_size(label_area_width(root, o, yr, 10));
+        if let Some(t) = &o.title {
+            builder.caption(t, o.font(1.25));
+        }
+        let mut chart = builder.build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(de)?;
+        let xl = o.x_label.clone().unwrap_or_else(|| "forward speed v (m/s)".into());
+        let yl = o.y_label.clone().unwrap_or_else(|| "eigenvalue (1/s)".into());
+        chart
+            .configure_mesh()
+            .bold_line_style(GRID.stroke_width(o.pxu(1.0)))
+            .light_line_style(TRANSPARENT)
+            .axis_style(BLACK.stroke_width(o.pxu(1.0)))
+            .set_all_tick_mark_size(o.pxi(5.0))
+            .x_labels(11)
+            .y_labels(10)
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .label_style(o.font(0.9))
+            .axis_desc_style(o.font(1.0))
+            .x_desc(xl)
+            .y_desc(yl)
+            .draw()
+            .map_err(de)?;
+
+        // Stable band(s) and critical speeds.
+        let band = o.show_stable_band.then_some(self.critical).flatten();
+        let mut has_band = false;
+        if let Some(cs) = band {
+            for [lo, hi] in &cs.stable_intervals {
+                let (lo, hi) = (lo.max(xr.0), hi.min(xr.1));
+                if hi > lo {
+                    has_band = true;
+                    chart
+                        .draw_series(std::iter::once(Rectangle::new(
+                            [(lo, yr.0), (hi, yr.1)],
+                            BAND.mix(0.13).filled(),
+                        )))
+                        .map_err(de)?;
+                }
+            }
+        }
+        // Zero line.
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(xr.0, 0.0), (xr.1, 0.0)],
+                BLACK.stroke_width(o.pxu(1.0)),
+            )))
+            .map_err(de)?;
+        let marks: Vec<(f64, &str)> = band
+            .map(|cs| {
+                [(cs.weave_speed, "w"), (cs.capsize_speed, "c")]
+                    .into_iter()
+                    .filter_map(|(v, s)| v.filter(|v| *v >= xr.0 && *v <= xr.1).map(|v| (v, s)))
+                    .collect()
+            })
+            .unwrap_or_default();
+        for (v, _) in &marks {
+            chart
+                .draw_series(std::iter::once(DashedPathElement::new(
+                    vec![(*v, yr.0), (*v, yr.1)],
+                    o.pxi(5.0),
+                    o.pxi(4.0),
+                    RGBColor(90, 90, 90).stroke_width(o.pxu(1.0)),
+                )))
+                .map_err(de)?;
+        }
+
+        // Curves: imaginary (dashed) first so real parts are on top.
+        let lw = o.pxu(2.0);
+        for imag in [true, false] {
+            for c in self.curves.iter().filter(|c| c.imag == imag) {
+                let style = CLASS_COLORS[c.class].stroke_width(lw);
+                for piece in clip_polyline(&c.points, xr, yr) {
+                    if imag {
+                        chart
+                            .draw_series(std::iter::once(DashedPathElement::new(
+                                piece,
+                                o.pxi(9.0),
+                                o.pxi(5.0),
+                                style,
+                            )))
+                            .map_err(de)?;
+                    } else {
+                        chart.draw_series(LineSeries::new(piece, style)).map_err(de)?;
+                    }
+                }
+            }
+        }
+        // Frame.
+        chart
+            .draw_series(std::iter::once(Rectangle::new([(xr.0, yr.0), (xr.1, yr.1)], BLACK.stroke_width(o.pxu(1.0)))))
+            .map_err(de)?;
+        // Crossing markers and annotations.
+        let mut obstacles: Vec<(i32, i32, i32, i32)> = Vec::new();
+        if yr.0 <= 0.0 && yr.1 >= 0.0 {
+            for (v, _) in &marks {
+                chart
+                    .draw_series(std::iter::once(Circle::new((*v, 0.0), o.pxi(4.0), BLACK.filled())))
+                    .map_err(de)?;
+            }
+        }
+        let (px0, py0) = chart.backend_coord(&(xr.0, yr.1));
+        let (px1, _) = chart.backend_coord(&(xr.1, yr.1));
+        for (k, (v, sub)) in marks.iter().enumerate() {
+            let value = format!(" = {} m/s", fmt_speed(*v));
+            let parts = ("v", *sub, value.as_str());
+            let w = subscripted_width(root, parts, o)?;
+            let (xv, _) = chart.backend_coord(&(*v, yr.1));
+            let gap = o.pxi(5.0);
+            // Lower mark: label left of its line; upper: right (outside the band).
+            let left_side = marks.len() == 2 && k == 0 || (marks.len() == 1 && xv - px0 > px1 - xv);
+            let mut x = if left_side { xv - gap - w } else { xv + gap };
+            x = x.clamp(px0 + gap, (px1 - gap - w).max(px0 + gap));
+            let y = py0 + o.pxi(6.0);
+            // White backing so the label stays readable over the mesh.
+            root.draw(&Rectangle::new(
+                [(x - o.pxi(2.0), y - o.pxi(1.0)), (x + w + o.pxi(2.0), y + o.pxi(o.font_size * 1.3))],
+                WHITE.mix(0.85).filled(),
+            ))
+            .map_err(de)?;
+            draw_subscripted(root, (x, y), parts, o)?;
+            obstacles.push((x, y, x + w, y + o.pxi(o.font_size * 1.3)));
+        }
+
+        if o.legend == LegendPosition::Hidden {
+            return Ok(());
+        }
+        // Legend entries: modes present, line styles, band.
+        let mut classes: Vec<usize> = self.curves.iter().map(|c| c.class).collect();
+        classes.sort();
+        classes.dedup();
+        let legend_len = o.px(28.0) as i32;
+        for &cl in &classes {
+            let color = CLASS_COLORS[cl];
+            let sw = o.pxu(2.0);
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(de)?
+                .label(CLASS_NAMES[cl])
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + legend_len, y)], color.stroke_width(sw)));
+        }
+        let grey = RGBColor(60, 60, 60);
+        let sw = o.pxu(2.0);
+        chart
+            .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+            .map_err(de)?
+            .label("real part")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + legend_len, y)], grey.stroke_width(sw)));
+        if self.curves.iter().any(|c| c.imag) {
+            let (dash, gap) = (o.pxi(9.0), o.pxi(5.0));
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(de)?
+                .label("imaginary part")
+                .legend(move |(x, y)| {
+                    DashedPathElement::new(vec![(x, y), (x + legend_len, y)], dash, gap, grey.stroke_width(sw))
+                });
+        }
+        if has_band {
+            let h = o.pxi(6.0);
+            chart
+                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
+                .map_err(de)?
+                .label("self-stable")
+                .legend(move |(x, y)| Rectangle::new([(x, y - h), (x + legend_len, y + h)], BAND.mix(0.25).filled()));
+        }
+        let n_entries = classes.len() + 1 + self.curves.iter().any(|c| c.imag) as usize + has_band as usize;
+        let label_font = o.font(0.9);
+        let longest = ["imaginary part", "self-stable", "castering"]
+            .iter()
+            .map(|s| root.estimate_text_size(s, &label_font).map(|t| t.0).unwrap_or(0))
+            .max()
+            .unwrap_or(0) as i32;
+        // plotters' legend box: margin 5 + entries of ~font height + 10 spacing.
+        let entry_h = o.pxi(o.font_size * 0.9) + o.pxi(10.0).max(10);
+        let box_w = longest + legend_len + o.pxi(25.0);
+        let box_h = n_entries as i32 * entry_h + o.pxi(10.0);
+        let pos = choose_legend(o.legend, &chart_pixels(&chart, &self.curves, xr, yr), &obstacles, &chart, (box_w, box_h));
+        chart
+            .configure_series_labels()
+            .position(pos)
+            .margin(o.pxu(8.0))
+            .legend_area_size(legend_len + o.pxi(6.0))
+            .label_font(label_font)
+            .background_style(WHITE.mix(0.9).filled())
+            .border_style(RGBColor(160, 160, 160).stroke_width(o.pxu(1.0)))
+            .draw()
+            .map_err(de)?;
+        let _ = self.sweep;
+        Ok(())
+    }
+}
+
+fn fmt_speed(v: f64) -> String {
+    format!("{v:.2}")
+}
+
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
+
+/// Curve samples in backend pixels, densified to ~4 px spacing.
+fn chart_pixels<DB: DrawingBackend>(chart: &Chart<'_, DB>, curves: &[Curve], xr: (f64, f64), yr: (f64, f64)) -> Vec<(i32, i32)> {
+    let mut out = Vec::new();
+    for c in curves {
+        for piece in clip_polyline(&c.points, xr, yr) {
+            for w in piece.windows(2) {
+                let a = chart.backend_coord(&w[0]);
+                let b = chart.backend_coord(&w[1]);
+                let d = ((b.0 - a.0) as f64).hypot((b.1 - a.1) as f64);
+                let n = (d / 4.0).ceil().max(1.0) as i32;
+                for k in 0..=n {
+                    let t = k as f64 / n as f64;
+                    out.push((
+                        (a.0 as f64 + t * (b.0 - a.0) as f64) as i32,
+                        (a.1 as f64 + t * (b.1 - a.1) as f64) as i32,
+                    ));
+                }
+            }
+        }
+    }
+    out
+}
+
+fn choose_legend<DB: DrawingBackend>(
+    pref: LegendPosition,
+    pixels: &[(i32, i32)],
+    obstacles: &[(i32, i32, i32, i32)],
+    chart: &Chart<'_, DB>,
+    (w, h): (i32, i32),
+) -> SeriesLabelPosition {
+    let fixed = match pref {
+        LegendPosition::UpperLeft => Some(SeriesLabelPosition::UpperLeft),
+        LegendPosition::UpperRight => Some(SeriesLabelPosition::UpperRight),
+        LegendPosition::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
+        LegendPosition::LowerRight => Some(SeriesLabelPosition::LowerRight),
+        LegendPosition::Auto | LegendPosition::Hidden => None,
+    };
+    if let Some(p) = fixed {
+        return p;
+    }
+    let area = chart.plotting_area();
+    let ((ax0, ay0), (ax1, ay1)) = {
+        let r = area.get_pixel_range();
+        ((r.0.start, r.1.start), (r.0.end, r.1.end))
+    };
+    let m = 5 + 8; // plotters' 5 px plus our margin
+    let candidates = [
+        (SeriesLabelPosition::LowerLeft, (ax0 + m, ay1 - m - h)),
+        (SeriesLabelPosition::LowerRight, (ax1 - m - w, ay1 - m - h)),
+        (SeriesLabelPosition::UpperLeft, (ax0 + m, ay0 + m)),
+        (SeriesLabelPosition::UpperRight, (ax1 - m - w, ay0 + m)),
+    ];
+    let pad = 6;
+    let mut best = (usize::MAX, SeriesLabelPosition::LowerLeft);
+    for (pos, (x, y)) in candidates {
+        let inside = |p: &(i32, i32)| p.0 >= x - pad && p.0 <= x + w + pad && p.1 >= y - pad && p.1 <= y + h + pad;
+        let mut cost = pixels.iter().filter(|p| inside(p)).count();
+        for o in obstacles {
+            if o.0 < x + w && o.2 > x && o.1 < y + h && o.3 > y {
+                cost += 10_000;
+            }
+        }
+        if cost < best.0 {
+            best = (cost, pos);
+        }
+    }
+    best.1
+}
+
+// ---------------------------------------------------------------------------
+// Stability map
+
+/// Viridis colour map (matplotlib), `t` in `[0, 1]`.
+fn viridis(t: f64) -> RGBColor {
+    const C: [(u8, u8, u8); 9] = [
+        (68, 1, 84),
+        (72, 40, 120),
+        (62, 73, 137),
+        (49, 104, 142),
+        (38, 130, 142),
+        (31, 158, 137),
+        (53, 183, 121),
+        (110, 206, 88),
+        (253, 231, 37),
+    ];
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    let s = t * (C.len() - 1) as f64;
+    let k = (s.floor() as usize).min(C.len() - 2);
+    let f = s - k as f64;
+    let lerp = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
+    RGBColor(lerp(C[k].0, C[k + 1].0), lerp(C[k].1, C[k + 1].1), lerp(C[k].2, C[k + 1].2))
+}
+
+/// Cell edges of a (sorted or unsorted) axis: midpoints between neighbours.
+fn cell_edges(values: &[f64]) -> Vec<(f64, f64)> {
+    let n = values.len();
+    (0..n)
+        .map(|k| {
+            let v = values[k];
+            let lo = if k > 0 { 0.5 * (values[k - 1] + v) } else if n > 1 { v - 0.5 * (values[1] - v) } else { v - 0.5 };
+            let hi = if k + 1 < n { 0.5 * (v + values[k + 1]) } else if n > 1 { v + 0.5 * (v - values[k - 1]) } else { v + 0.5 };
+            (lo.min(hi), lo.max(hi))
+        })
+        .collect()
+}
+
+fn missing_label(q: MapQuantity) -> &'static str {
+    match q {
+        MapQuantity::StableWidth => "not self-stable",
+        MapQuantity::WeaveSpeed => "no weave speed",
+        MapQuantity::CapsizeSpeed => "no capsize speed",
+    }
+}
+
+struct MapFigure<'a> {
+    map: &'a StabilityMap,
+    quantity: MapQuantity,
+    opts: &'a PlotOptions,
+    vrange: (f64, f64),
+}
+
+/// Draw a heat map of `quantity` over the grid of `map` with a colour bar to
+/// `path` (`.svg` or `.png`). Cells without the quantity (e.g. never
+/// self-stable) are light grey, failed cells dark grey.
+pub fn plot_stability_map(
+    path: impl AsRef<Path>,
+    map: &StabilityMap,
+    quantity: MapQuantity,
+    opts: &PlotOptions,
+) -> Result<(), PlotError> {
+    let path = path.as_ref();
+    ImageFormat::from_path(path)?;
+    let (nx, ny) = map.shape();
+    if nx == 0 || ny == 0 || map.cells.len() != nx * ny {
+        return Err(PlotError::NoData { path: path.to_path_buf() });
+    }
+    if map.x.values.iter().chain(&map.y.values).any(|v| !v.is_finite()) {
+        return Err(PlotError::InvalidOptions { path: path.to_path_buf(), message: "non-finite grid value".into() });
+    }
+    let vals: Vec<f64> = map.cells.iter().filter_map(|c| quantity.value(c)).collect();
+    let (mut lo, hi) = vals.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    if quantity == MapQuantity::StableWidth {
+        lo = 0.0;
+    }
+    let vrange = if vals.is_empty() {
+        (0.0, 1.0)
+    } else if hi - lo > 1e-12 * hi.abs().max(1.0) {
+        (lo, hi)
+    } else {
+        padded(lo, hi, 0.0)
+    };
+    render(path, opts, &MapFigure { map, quantity, opts, vrange })
+}
+
+impl Figure for MapFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
+        let o = self.opts;
+        let m = self.map;
+        root.fill(&WHITE).map_err(de)?;
+        let area = match &o.title {
+            Some(t) => root.titled(t, o.font(1.25)).map_err(de)?,
+            None => root.clone(),
+        };
+        let (w, _) = area.dim_in_pixel();
+        let cb_w = o.pxi(150.0).min(w as i32 / 3);
+        let (main, side) = area.split_horizontally(w as i32 - cb_w);
+
+        let xe = cell_edges(&m.x.values);
+        let ye = cell_edges(&m.y.values);
+        let xr = o.x_range.unwrap_or_else(|| {
+            (xe.iter().map(|e| e.0).fold(f64::INFINITY, f64::min), xe.iter().map(|e| e.1).fold(f64::NEG_INFINITY, f64::max))
+        });
+        let yr = o.y_range.unwrap_or_else(|| {
+            (ye.iter().map(|e| e.0).fold(f64::INFINITY, f64::min), ye.iter().map(|e| e.1).fold(f64::NEG_INFINITY, f64::max))
+        });
+        let mut chart = ChartBuilder::on(&main)
+            .margin_top(o.pxu(18.0))
+            .margin_right(o.pxu(10.0))
+            .margin_left(o.pxu(10.0))
+            .margin_bottom(o.pxu(10.0))
+            .x_label_area_size(o.pxu(o.font_size * 3.4))
+            .y_label_area_size(label_area_width(root, o, yr, 10))
+            .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
+            .map_err(de)?;
+        let (vlo, vhi) = self.vrange;
+        let mut any_missing = false;
+        let mut any_failed = false;
+        let (nx, ny) = m.shape();
+        let mut rects = Vec::with_capacity(nx * ny);
+        for i in 0..nx {
+            for j in 0..ny {
+                let Some(c) = m.cell(i, j) else { continue };
+                let color = match (c, self.quantity.value(c)) {
+                    (Err(_), _) => {
+                        any_failed = true;
+                        FAILED
+                    }
+                    (Ok(_), None) => {
+                        any_missing = true;
+                        MISSING
+                    }
+                    (Ok(_), Some(v)) => viridis((v - vlo) / (vhi - vlo)),
+                };
+                let (x0, x1) = (xe[i].0.max(xr.0), xe[i].1.min(xr.1));
+                let (y0, y1) = (ye[j].0.max(yr.0), ye[j].1.min(yr.1));
+                if x1 > x0 && y1 > y0 {
+                    rects.push(Rectangle::new([(x0, y0), (x1, y1)], color.filled()));
+                }
+            }
+        }
+        chart.draw_series(rects).map_err(de)?;
+        let xl = o.x_label.clone().unwrap_or_else(|| m.x.name.clone());
+        let yl = o.y_label.clone().unwrap_or_else(|| m.y.name.clone());
+        chart
+            .configure_mesh()
+            .disable_mesh()
+            .axis_style(BLACK.stroke_width(o.pxu(1.0)))
+            .set_all_tick_mark_size(o.pxi(5.0))
+            .x_labels(10)
+            .y_labels(10)
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .label_style(o.font(0.9))
+            .axis_desc_style(o.font(1.0))
+            .x_desc(xl)
+            .y_desc(yl)
+            .draw()
+            .map_err(de)?;
+        // Frame around the map.
+        chart
+            .draw_series(std::iter::once(Rectangle::new([(xr.0, yr.0), (xr.1, yr.1)], BLACK.stroke_width(o.pxu(1.0)))))
+            .map_err(de)?;
+
+        // Colour bar, aligned with the plotting area.
+        let plot = chart.plotting_area().get_pixel_range();
+        let (side_x0, side_y0) = {
+            let r = side.get_pixel_range();
+            (r.0.start, r.1.start)
+        };
+        let patches = any_missing as i32 + any_failed as i32;
+        let patch_h = o.pxi(o.font_size * 1.5);
+        let bar_top = plot.1.start - side_y0;
+        let bar_bottom = plot.1.end - side_y0 - patches * patch_h - if patches > 0 { o.pxi(8.0) } else { 0 };
+        let bar_x = o.pxi(14.0);
+        let bar_w = o.pxi(22.0);
+        // Right label area: widest tick label + gap + rotated description.
+        let tick_font = o.font(0.85);
+        let tick_w = [vlo, 0.5 * (vlo + vhi), vhi, vlo + 0.9 * (vhi - vlo)]
+            .iter()
+            .map(|v| root.estimate_text_size(&tick(*v), &tick_font).map(|t| t.0).unwrap_or(0))
+            .max()
+            .unwrap_or(0) as i32;
+        let label_area = tick_w + o.pxi(12.0) + o.pxi(o.font_size * 0.95 * 1.6);
+        let bar = side.margin(bar_top.max(0) as u32, 0, 0, 0);
+        let bar = bar.shrink((bar_x, 0), ((bar_w + label_area) as u32, (bar_bottom - bar_top).max(10) as u32));
+        let mut cb = ChartBuilder::on(&bar)
+            .right_y_label_area_size(label_area as u32)
+            .build_cartesian_2d(0.0..1.0, vlo..vhi)
+            .map_err(de)?;
+        let steps = 256;
+        cb.draw_series((0..steps).map(|k| {
+            let a = vlo + (vhi - vlo) * k as f64 / steps as f64;
+            let b = vlo + (vhi - vlo) * (k + 1) as f64 / steps as f64;
+            Rectangle::new([(0.0, a), (1.0, b)], viridis((k as f64 + 0.5) / steps as f64).filled())
+        }))
+        .map_err(de)?;
+        cb.configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .axis_style(BLACK.stroke_width(o.pxu(1.0)))
+            .set_all_tick_mark_size(o.pxi(4.0))
+            .y_labels(8)
+            .y_label_formatter(&|v| tick(*v))
+            .label_style(tick_font.clone())
+            .axis_desc_style(o.font(0.95))
+            .y_desc(self.quantity.label())
+            .draw()
+            .map_err(de)?;
+        cb.draw_series(std::iter::once(Rectangle::new([(0.0, vlo), (1.0, vhi)], BLACK.stroke_width(o.pxu(1.0)))))
+            .map_err(de)?;
+
+        // Grey patches for missing / failed cells, below the bar.
+        let mut y = plot.1.end - patches * patch_h;
+        let x = side_x0 + bar_x;
+        for (show, color, label) in [(any_missing, MISSING, missing_label(self.quantity)), (any_failed, FAILED, "failed")] {
+            if !show {
+                continue;
+            }
+            let s = o.pxi(o.font_size * 0.9);
+            root.draw(&Rectangle::new([(x, y + o.pxi(2.0)), (x + bar_w, y + o.pxi(2.0) + s)], color.filled()))
+                .map_err(de)?;
+            root.draw(&Rectangle::new(
+                [(x, y + o.pxi(2.0)), (x + bar_w, y + o.pxi(2.0) + s)],
+                BLACK.stroke_width(o.pxu(1.0)),
+            ))
+            .map_err(de)?;
+            root.draw(&Text::new(label.to_string(), (x + bar_w + o.pxi(6.0), y + o.pxi(2.0)), o.font(0.8)))
+                .map_err(de)?;
+            y += patch_h;
+        }
+        Ok(())
+    }
+}

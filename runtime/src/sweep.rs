@@ -1,0 +1,400 @@
+//! Parallel sweeps of the canonical linear bicycle: over forward speed, over one
+//! design parameter, and over a two-parameter grid (a [`StabilityMap`]).
+//!
+//! * [`speed_sweep`] wraps [`eigen_sweep`] (mode labels are tracked
+//!   continuously along the speed list, so it runs serially).
+//! * [`parameter_sweep`] and [`stability_map`] evaluate, per parameter value or
+//!   grid cell, a caller-supplied mapping `parameter(s) -> CanonicalMatrices`
+//!   (this is where a generated model is linearized) and then
+//!   [`critical_speeds`] over `[speed_min, speed_max]`. Cells run in parallel
+//!   with rayon; results are returned in input order, independent of the
+//!   number of threads. A failing cell (mapping error, eigen error or a panic
+//!   in the mapping) is recorded as a [`CellError`] in that cell; it never
+//!   aborts the sweep and never produces NaN.
+//!
+//! A progress bar (indicatif) is drawn on stderr only when
+//! [`SweepOptions::progress`] is set, stderr is a terminal, and the run has
+//! lasted longer than [`SweepOptions::progress_delay`] (so short runs, tests and
+//! redirected output stay quiet).
+
+use std::fmt::Display;
+use std::io::IsTerminal;
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::canonical::CanonicalMatrices;
+use crate::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds, EigenError, EigenSweep};
+
+/// Options shared by the parameter sweeps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepOptions {
+    /// Lower end of the forward-speed range searched for critical speeds (m/s).
+    /// Default `0.0`.
+    pub speed_min: f64,
+    /// Upper end of the forward-speed range (m/s). Default `10.0` (the range of
+    /// Meijaard et al. 2007, Fig. 3).
+    pub speed_max: f64,
+    /// Allow a progress bar on stderr. Default `true`; it is still hidden when
+    /// stderr is not a terminal or the run is short.
+    pub progress: bool,
+    /// The bar appears only once the run has taken this long. Default 1 s.
+    pub progress_delay: Duration,
+}
+
+impl Default for SweepOptions {
+    fn default() -> Self {
+        Self {
+            speed_min: 0.0,
+            speed_max: 10.0,
+            progress: true,
+            progress_delay: Duration::from_secs(1),
+        }
+    }
+}
+
+impl SweepOptions {
+    /// Options with the speed range `[speed_min, speed_max]` and other fields default.
+    pub fn with_speed_range(speed_min: f64, speed_max: f64) -> Self {
+        Self { speed_min, speed_max, ..Self::default() }
+    }
+
+    fn validate(&self) -> Result<(), SweepError> {
+        if !(self.speed_min.is_finite() && self.speed_max.is_finite())
+            || self.speed_min >= self.speed_max
+        {
+            return Err(SweepError::InvalidSpeedRange {
+                speed_min: self.speed_min,
+                speed_max: self.speed_max,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Errors that reject a whole sweep (per-cell failures are [`CellError`]s).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SweepError {
+    /// `speed_min`/`speed_max` not finite or not increasing.
+    #[error("invalid speed range [{speed_min}, {speed_max}] (need finite speed_min < speed_max)")]
+    InvalidSpeedRange {
+        /// Requested lower end.
+        speed_min: f64,
+        /// Requested upper end.
+        speed_max: f64,
+    },
+    /// The speed sweep itself failed.
+    #[error(transparent)]
+    Eigen(#[from] EigenError),
+}
+
+/// Where a cell failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CellStage {
+    /// The caller's mapping `parameter -> CanonicalMatrices` returned an error.
+    Model,
+    /// The caller's mapping panicked (the panic was caught).
+    Panic,
+    /// [`critical_speeds`] failed.
+    Eigen,
+}
+
+/// Recorded failure of one parameter value or grid cell.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("{} failed: {message}", match stage { CellStage::Model => "model mapping", CellStage::Panic => "model mapping (panic)", CellStage::Eigen => "eigen analysis" })]
+pub struct CellError {
+    /// Which step failed.
+    pub stage: CellStage,
+    /// The error's message.
+    pub message: String,
+}
+
+/// Self-stability summary of one bicycle over `[speed_min, speed_max]`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StabilitySummary {
+    /// `v_w`, weave (Hopf) speed, if in range (m/s).
+    pub weave_speed: Option<f64>,
+    /// `v_c`, capsize speed, if in range (m/s).
+    pub capsize_speed: Option<f64>,
+    /// `v_d`, speed where the real weave roots merge into a complex pair (m/s).
+    pub weave_real_pair_merge: Option<f64>,
+    /// Maximal self-stable intervals `[lo, hi]` within the speed range (m/s).
+    pub stable_intervals: Vec<[f64; 2]>,
+    /// Total length of the stable intervals (m/s); `0` if never stable.
+    /// A lower bound of the true width when [`Self::open_ended`] is set.
+    pub stable_width: f64,
+    /// The last stable interval reaches `speed_max` (stable at the end of the range).
+    pub open_ended: bool,
+}
+
+impl StabilitySummary {
+    /// Summary of critical speeds computed over `[speed_min, speed_max]`.
+    pub fn from_critical(c: &CriticalSpeeds, speed_max: f64) -> Self {
+        let stable_width = c
+            .stable_intervals
+            .iter()
+            .map(|[lo, hi]| (hi - lo).max(0.0))
+            .filter(|w| w.is_finite())
+            .sum();
+        let open_ended = c
+            .stable_intervals
+            .last()
+            .is_some_and(|[_, hi]| (speed_max - hi).abs() <= 1e-9 * speed_max.abs().max(1.0));
+        Self {
+            weave_speed: c.weave_speed,
+            capsize_speed: c.capsize_speed,
+            weave_real_pair_merge: c.weave_real_pair_merge,
+            stable_intervals: c.stable_intervals.clone(),
+            stable_width,
+            open_ended,
+        }
+    }
+
+    /// First (lowest-speed) stable interval.
+    pub fn first_stable_interval(&self) -> Option<[f64; 2]> {
+        self.stable_intervals.first().copied()
+    }
+}
+
+/// A named parameter axis (`name` is used as CSV column header and default plot label).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ParamAxis {
+    /// Name, e.g. `"trail c (m)"`.
+    pub name: String,
+    /// Values, in the order results are reported.
+    pub values: Vec<f64>,
+}
+
+impl ParamAxis {
+    /// New axis.
+    pub fn new(name: impl Into<String>, values: Vec<f64>) -> Self {
+        Self { name: name.into(), values }
+    }
+}
+
+/// Result at one parameter value or grid cell.
+pub type CellResult = Result<StabilitySummary, CellError>;
+
+/// Result of a one-parameter sweep; `points[k]` belongs to `param.values[k]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterSweep {
+    /// The swept parameter.
+    pub param: ParamAxis,
+    /// Speed range searched, `[speed_min, speed_max]` (m/s).
+    pub speed_range: [f64; 2],
+    /// One result per parameter value, in input order.
+    pub points: Vec<CellResult>,
+}
+
+/// Result of a two-parameter grid. Row-major: `cells[i * y.values.len() + j]`
+/// belongs to `(x.values[i], y.values[j])`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StabilityMap {
+    /// First parameter (horizontal plot axis).
+    pub x: ParamAxis,
+    /// Second parameter (vertical plot axis).
+    pub y: ParamAxis,
+    /// Speed range searched, `[speed_min, speed_max]` (m/s).
+    pub speed_range: [f64; 2],
+    /// Row-major cells.
+    pub cells: Vec<CellResult>,
+}
+
+impl StabilityMap {
+    /// Grid shape `(nx, ny)`.
+    pub fn shape(&self) -> (usize, usize) {
+        (self.x.values.len(), self.y.values.len())
+    }
+
+    /// Cell at `(x.values[i], y.values[j])`.
+    pub fn cell(&self, i: usize, j: usize) -> Option<&CellResult> {
+        let (nx, ny) = self.shape();
+        if i < nx && j < ny {
+            self.cells.get(i * ny + j)
+        } else {
+            None
+        }
+    }
+
+    /// Number of failed cells.
+    pub fn failures(&self) -> usize {
+        self.cells.iter().filter(|c| c.is_err()).count()
+    }
+}
+
+/// Quantity of a [`StabilitySummary`] shown in tables and maps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
+pub enum MapQuantity {
+    /// Width of the self-stable speed range (m/s); `None` when never stable.
+    #[default]
+    StableWidth,
+    /// Weave speed `v_w` (m/s).
+    WeaveSpeed,
+    /// Capsize speed `v_c` (m/s).
+    CapsizeSpeed,
+}
+
+impl MapQuantity {
+    /// Value for a cell; `None` for failed cells and when the quantity does not exist.
+    pub fn value(&self, cell: &CellResult) -> Option<f64> {
+        let s = cell.as_ref().ok()?;
+        match self {
+            MapQuantity::StableWidth => (s.stable_width > 0.0).then_some(s.stable_width),
+            MapQuantity::WeaveSpeed => s.weave_speed,
+            MapQuantity::CapsizeSpeed => s.capsize_speed,
+        }
+    }
+
+    /// Axis/colour-bar label with unit.
+    pub fn label(&self) -> &'static str {
+        match self {
+            MapQuantity::StableWidth => "self-stable speed range width (m/s)",
+            MapQuantity::WeaveSpeed => "weave speed (m/s)",
+            MapQuantity::CapsizeSpeed => "capsize speed (m/s)",
+        }
+    }
+}
+
+/// `n` evenly spaced values from `start` to `end` inclusive (`n = 1` gives `[start]`).
+pub fn linspace(start: f64, end: f64, n: usize) -> Vec<f64> {
+    match n {
+        0 => Vec::new(),
+        1 => vec![start],
+        _ => (0..n)
+            .map(|k| {
+                if k + 1 == n {
+                    end
+                } else {
+                    start + (end - start) * (k as f64) / ((n - 1) as f64)
+                }
+            })
+            .collect(),
+    }
+}
+
+/// Eigenvalues and mode labels at each speed (serial; wraps [`eigen_sweep`]).
+pub fn speed_sweep(c: &CanonicalMatrices, speeds: &[f64]) -> Result<EigenSweep, EigenError> {
+    eigen_sweep(c, speeds)
+}
+
+/// Critical speeds of the bicycle returned by `map(value)`, for each value, in parallel.
+///
+/// `map` is where the caller linearizes its model at the parameter value. Its
+/// errors (and panics) are recorded per value, as are eigen-analysis errors.
+/// Fails as a whole only for an invalid speed range.
+pub fn parameter_sweep<F, E>(
+    param: ParamAxis,
+    map: F,
+    opts: &SweepOptions,
+) -> Result<ParameterSweep, SweepError>
+where
+    F: Fn(f64) -> Result<CanonicalMatrices, E> + Sync,
+    E: Display,
+{
+    opts.validate()?;
+    let progress = Progress::new(param.values.len(), "parameter sweep", opts);
+    let points = param
+        .values
+        .par_iter()
+        .map(|&p| {
+            let r = evaluate_cell(|| map(p), opts);
+            progress.inc();
+            r
+        })
+        .collect();
+    progress.finish();
+    Ok(ParameterSweep { param, speed_range: [opts.speed_min, opts.speed_max], points })
+}
+
+/// Critical speeds over the grid `x.values x y.values` (row-major, `x` outer), in parallel.
+///
+/// Same error policy as [`parameter_sweep`].
+pub fn stability_map<F, E>(
+    x: ParamAxis,
+    y: ParamAxis,
+    map: F,
+    opts: &SweepOptions,
+) -> Result<StabilityMap, SweepError>
+where
+    F: Fn(f64, f64) -> Result<CanonicalMatrices, E> + Sync,
+    E: Display,
+{
+    opts.validate()?;
+    let (nx, ny) = (x.values.len(), y.values.len());
+    let progress = Progress::new(nx * ny, "stability map", opts);
+    let cells = (0..nx * ny)
+        .into_par_iter()
+        .map(|k| {
+            let (px, py) = (x.values[k / ny], y.values[k % ny]);
+            let r = evaluate_cell(|| map(px, py), opts);
+            progress.inc();
+            r
+        })
+        .collect();
+    progress.finish();
+    Ok(StabilityMap { x, y, speed_range: [opts.speed_min, opts.speed_max], cells })
+}
+
+fn evaluate_cell<E: Display>(
+    map: impl FnOnce() -> Result<CanonicalMatrices, E>,
+    opts: &SweepOptions,
+) -> CellResult {
+    let c = match catch_unwind(AssertUnwindSafe(map)) {
+        Ok(Ok(c)) => c,
+        Ok(Err(e)) => return Err(CellError { stage: CellStage::Model, message: e.to_string() }),
+        Err(payload) => {
+            let message = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "panic".to_string());
+            return Err(CellError { stage: CellStage::Panic, message });
+        }
+    };
+    critical_speeds(&c, opts.speed_min, opts.speed_max)
+        .map(|cs| StabilitySummary::from_critical(&cs, opts.speed_max))
+        .map_err(|e| CellError { stage: CellStage::Eigen, message: e.to_string() })
+}
+
+/// Progress bar that starts hidden and is switched to stderr after the delay
+/// (only if enabled and stderr is a terminal).
+struct Progress {
+    bar: ProgressBar,
+    enabled: bool,
+    shown: AtomicBool,
+    delay: Duration,
+}
+
+impl Progress {
+    fn new(len: usize, what: &'static str, opts: &SweepOptions) -> Self {
+        let enabled = opts.progress && std::io::stderr().is_terminal() && len > 1;
+        let bar = ProgressBar::with_draw_target(Some(len as u64), ProgressDrawTarget::hidden());
+        if let Ok(style) = ProgressStyle::with_template(
+            "{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} (eta {eta})",
+        ) {
+            bar.set_style(style);
+        }
+        bar.set_message(what);
+        Self { bar, enabled, shown: AtomicBool::new(false), delay: opts.progress_delay }
+    }
+
+    fn inc(&self) {
+        self.bar.inc(1);
+        if self.enabled
+            && !self.shown.load(Ordering::Relaxed)
+            && self.bar.elapsed() >= self.delay
+            && !self.shown.swap(true, Ordering::AcqRel)
+        {
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+        }
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
