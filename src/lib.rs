@@ -8,3 +8,7 @@ pub use bikedyn_runtime as runtime;
 pub mod generated;
 
 pub use generated::{ThesisWhipple, WhippleOffset};
+
+pub mod bicycle;
+pub mod models;
+pub mod bench;

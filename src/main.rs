@@ -1,1 +1,421 @@
-fn main() {}
+//! The `bikedyn` command line: parses arguments and calls the library.
+
+use anyhow::{bail, Context, Result};
+use bikedyn::bicycle::{Bicycle, BUILT_IN};
+use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds};
+use bikedyn::runtime::output;
+use bikedyn::runtime::plot::{plot_continuation, plot_stability_map, PlotOptions};
+use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
+use bikedyn::runtime::verify::VerifyOptions;
+use bikedyn::runtime::CanonicalMatrices;
+use clap::{Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(name = "bikedyn", version, about = "Symbolic multibody bicycle models, generated code, linearization and stability")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Format {
+    Table,
+    Csv,
+    Json,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FormName {
+    Benchmark,
+    Thesis,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// The main job on embedded defaults: verify the generated models, print
+    /// the canonical matrices and self-stable speeds of the built-in bicycles,
+    /// and write eigenvalue tables and continuation diagrams to a folder.
+    Report {
+        /// Output folder.
+        #[arg(long, default_value = "bikedyn-report")]
+        out: PathBuf,
+    },
+    /// Check every generated derivative against finite differences.
+    Verify {
+        /// Model name (default: all models).
+        #[arg(long)]
+        model: Option<String>,
+        /// Number of random states.
+        #[arg(long, default_value_t = 20)]
+        states: usize,
+        /// Seed of the random states.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// JSON output.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Canonical matrices M0, C1, K0, K2 (Meijaard et al. 2007 form).
+    Canonical {
+        /// Built-in bicycle (thesis, benchmark) or parameter file.
+        #[arg(long, default_value = "thesis")]
+        bike: String,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Eigenvalues and modes over forward speed.
+    Eig {
+        /// Built-in bicycle (thesis, benchmark) or parameter file.
+        #[arg(long, default_value = "thesis")]
+        bike: String,
+        /// Speeds START:STOP:STEP (m/s).
+        #[arg(long, default_value = "0:10:0.5")]
+        speeds: String,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        /// Write the table/CSV/JSON to this file instead of standard output.
+        #[arg(long)]
+        output: Option<PathBuf>,
+        /// Continuation diagram (.svg or .png).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// Weave and capsize speeds and the self-stable speed interval(s).
+    Stability {
+        /// Built-in bicycle (thesis, benchmark) or parameter file.
+        #[arg(long, default_value = "thesis")]
+        bike: String,
+        /// Upper end of the searched speed range (m/s).
+        #[arg(long, default_value_t = 10.0)]
+        speed_max: f64,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Stability over one parameter, or over a grid of two (a stability map).
+    Sweep {
+        /// Built-in bicycle (thesis, benchmark) or parameter file.
+        #[arg(long, default_value = "thesis")]
+        bike: String,
+        /// Parameter symbol (thesis: Rt, x4, d4, ...; benchmark: c, lam, w, ...).
+        #[arg(long)]
+        param: String,
+        /// Values START:STOP:STEP.
+        #[arg(long)]
+        values: String,
+        /// Second parameter for a two-parameter stability map.
+        #[arg(long)]
+        param2: Option<String>,
+        /// Values of the second parameter START:STOP:STEP.
+        #[arg(long)]
+        values2: Option<String>,
+        /// Upper end of the searched speed range (m/s).
+        #[arg(long, default_value_t = 10.0)]
+        speed_max: f64,
+        #[arg(long, value_enum, default_value_t = Format::Table)]
+        format: Format,
+        #[arg(long)]
+        output: Option<PathBuf>,
+        /// Stability map plot (.svg or .png), two-parameter sweeps only.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// Parameter sets: show or convert between thesis and benchmark forms.
+    Params {
+        #[command(subcommand)]
+        command: ParamsCommand,
+    },
+    /// Print timing and operation-count figures of the generated code.
+    Bench {
+        /// Fewer repetitions (for a quick look).
+        #[arg(long)]
+        quick: bool,
+    },
+}
+
+#[derive(Subcommand)]
+enum ParamsCommand {
+    /// Convert a parameter file (or built-in bicycle) to the other form (TOML on stdout).
+    Convert {
+        #[arg(long, value_enum)]
+        to: FormName,
+        /// Parameter file or built-in name.
+        file: String,
+        #[arg(long)]
+        output: Option<PathBuf>,
+    },
+    /// Print a bicycle's parameters (TOML) and its validation warnings.
+    Show {
+        #[arg(long, default_value = "thesis")]
+        bike: String,
+    },
+}
+
+fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let nums: Vec<f64> = parts
+        .iter()
+        .map(|p| p.trim().parse::<f64>().with_context(|| format!("{what}: `{p}` is not a number (expected START:STOP:STEP)")))
+        .collect::<Result<_>>()?;
+    match nums.as_slice() {
+        [x] if x.is_finite() => Ok(vec![*x]),
+        [a, b, h] if a.is_finite() && b.is_finite() && h.is_finite() && *h > 0.0 && b >= a => {
+            let n = ((b - a) / h + 1e-9).floor() as usize;
+            if n > 10_000_000 {
+                bail!("{what}: {} points is too many", n + 1);
+            }
+            Ok((0..=n).map(|k| a + k as f64 * h).collect())
+        }
+        _ => bail!("{what}: `{s}` must be START:STOP:STEP with STEP > 0 and STOP >= START"),
+    }
+}
+
+fn load(bike: &str) -> Result<Bicycle> {
+    let b = Bicycle::resolve(bike)?;
+    for w in &b.warnings {
+        eprintln!("warning ({}): {w}", b.name);
+    }
+    Ok(b)
+}
+
+fn critical(c: &CanonicalMatrices, vmax: f64) -> Result<CriticalSpeeds> {
+    Ok(critical_speeds(c, 0.0, vmax)?)
+}
+
+fn emit(text: &str, output: &Option<PathBuf>) -> Result<()> {
+    match output {
+        Some(p) => output::write_string_atomic(p, text)?,
+        None => print!("{text}"),
+    }
+    Ok(())
+}
+
+fn stability_json(name: &str, c: &CriticalSpeeds) -> serde_json::Value {
+    serde_json::json!({
+        "bike": name,
+        "weave_speed": c.weave_speed,
+        "capsize_speed": c.capsize_speed,
+        "weave_real_pair_merge_speed": c.weave_real_pair_merge,
+        "stable_intervals": c.stable_intervals,
+        "crossings": c.crossings.iter().map(|x| serde_json::json!({
+            "speed": x.speed, "mode": x.mode.name(), "direction": format!("{:?}", x.direction).to_lowercase(), "frequency": x.frequency
+        })).collect::<Vec<_>>(),
+    })
+}
+
+fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
+    let f = |x: Option<f64>| x.map(|v| format!("{v:.10} m/s")).unwrap_or_else(|| "none in range".into());
+    let mut s = format!("bicycle: {name}\n");
+    s += &format!("  weave speed v_w:   {}\n", f(c.weave_speed));
+    s += &format!("  capsize speed v_c: {}\n", f(c.capsize_speed));
+    s += &format!("  weave real-pair merge v_d: {}\n", f(c.weave_real_pair_merge));
+    if c.stable_intervals.is_empty() {
+        s += "  self-stable: never in the searched range\n";
+    }
+    for [lo, hi] in &c.stable_intervals {
+        s += &format!("  self-stable from {lo:.4} to {hi:.4} m/s\n");
+    }
+    s
+}
+
+fn canonical_text(c: &CanonicalMatrices) -> String {
+    let m = |name: &str, x: &nalgebra::Matrix2<f64>| {
+        format!("{name} = [[{:.14}, {:.14}],\n      [{:.14}, {:.14}]]\n", x[(0, 0)], x[(0, 1)], x[(1, 0)], x[(1, 1)])
+    };
+    format!("{}{}{}{}g = {}\n", m("M0", &c.m0), m("C1", &c.c1), m("K0", &c.k0), m("K2", &c.k2), c.g)
+}
+
+fn canonical_json(c: &CanonicalMatrices) -> serde_json::Value {
+    serde_json::json!({
+        "M0": CanonicalMatrices::rows(&c.m0), "C1": CanonicalMatrices::rows(&c.c1),
+        "K0": CanonicalMatrices::rows(&c.k0), "K2": CanonicalMatrices::rows(&c.k2), "g": c.g,
+    })
+}
+
+fn run(cli: Cli) -> Result<bool> {
+    match cli.command {
+        Command::Report { out } => {
+            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+            let mut ok = true;
+            for m in bikedyn::models::MODELS {
+                let r = bikedyn::models::verify_model(m, &VerifyOptions::default()).expect("known model");
+                println!("verify {m}: {}", if r.passed { "passed" } else { "FAILED" });
+                ok &= r.passed;
+            }
+            let speeds = parse_range("0:10:0.01", "speeds")?;
+            for (name, _) in BUILT_IN {
+                let b = load(name)?;
+                let c = b.canonical()?;
+                let crit = critical(&c, 10.0)?;
+                println!("\n{}", stability_text(name, &crit));
+                println!("{}", canonical_text(&c));
+                let sweep = eigen_sweep(&c, &speeds)?;
+                output::save_eigen_sweep_csv(out.join(format!("{name}_eigenvalues.csv")), &sweep)?;
+                output::save_eigen_sweep_json(out.join(format!("{name}_eigenvalues.json")), &sweep)?;
+                let opts = PlotOptions { y_range: Some((-10.0, 10.0)), ..PlotOptions::default() };
+                for ext in ["svg", "png"] {
+                    plot_continuation(out.join(format!("{name}_continuation.{ext}")), &sweep, Some(&crit), &opts)?;
+                }
+                output::save_json(out.join(format!("{name}_stability.json")), &stability_json(name, &crit))?;
+            }
+            println!("wrote tables and plots to {}", out.display());
+            Ok(ok)
+        }
+        Command::Verify { model, states, seed, json } => {
+            let names: Vec<&str> = match &model {
+                Some(m) => vec![m.as_str()],
+                None => bikedyn::models::MODELS.to_vec(),
+            };
+            let opts = VerifyOptions { states, seed, ..VerifyOptions::default() };
+            let mut reports = Vec::new();
+            for n in names {
+                let r = bikedyn::models::verify_model(n, &opts)
+                    .with_context(|| format!("unknown model `{n}` (models: {})", bikedyn::models::MODELS.join(", ")))?;
+                reports.push(r);
+            }
+            let passed = reports.iter().all(|r| r.passed);
+            if json {
+                let quantities: Vec<_> = reports
+                    .iter()
+                    .flat_map(|r| r.quantities.iter().map(move |q| serde_json::json!({
+                        "model": r.model, "name": q.name, "max_rel_error": q.max_rel_error, "tolerance": q.tolerance, "passed": q.passed
+                    })))
+                    .collect();
+                println!("{}", serde_json::to_string_pretty(&serde_json::json!({"passed": passed, "quantities": quantities}))?);
+            } else {
+                for r in &reports {
+                    println!("model {} ({} random states, seed {}):", r.model, r.states, r.seed);
+                    for q in &r.quantities {
+                        println!("  {:<40} max rel error {:>10.3e}  tolerance {:>8.1e}  {}", q.name, q.max_rel_error, q.tolerance, if q.passed { "ok" } else { "FAIL" });
+                    }
+                }
+                println!("{}", if passed { "verification passed" } else { "verification FAILED" });
+            }
+            Ok(passed)
+        }
+        Command::Canonical { bike, json } => {
+            let b = load(&bike)?;
+            let c = b.canonical()?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&canonical_json(&c))?);
+            } else {
+                print!("{}", canonical_text(&c));
+            }
+            Ok(true)
+        }
+        Command::Eig { bike, speeds, format, output: out, plot } => {
+            let b = load(&bike)?;
+            let c = b.canonical()?;
+            let speeds = parse_range(&speeds, "--speeds")?;
+            let sweep = eigen_sweep(&c, &speeds)?;
+            let text = match format {
+                Format::Table => output::format_eigen_table(&sweep),
+                Format::Json => serde_json::to_string_pretty(&output::eigen_sweep_json(&sweep))? + "\n",
+                Format::Csv => {
+                    let mut buf = Vec::new();
+                    output::write_eigen_sweep_csv(&mut buf, &sweep)?;
+                    String::from_utf8(buf)?
+                }
+            };
+            emit(&text, &out)?;
+            if let Some(p) = plot {
+                let vmax = speeds.last().copied().unwrap_or(10.0).max(speeds[0] + 1e-9);
+                let crit = critical_speeds(&c, speeds[0], vmax).ok();
+                plot_continuation(&p, &sweep, crit.as_ref(), &PlotOptions::default())?;
+                eprintln!("wrote {}", p.display());
+            }
+            Ok(true)
+        }
+        Command::Stability { bike, speed_max, json } => {
+            let b = load(&bike)?;
+            let crit = critical(&b.canonical()?, speed_max)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&stability_json(&bike, &crit))?);
+            } else {
+                print!("{}", stability_text(&bike, &crit));
+            }
+            Ok(true)
+        }
+        Command::Sweep { bike, param, values, param2, values2, speed_max, format, output: out, plot } => {
+            let b = load(&bike)?;
+            let xs = parse_range(&values, "--values")?;
+            let opts = SweepOptions::with_speed_range(0.0, speed_max);
+            let text = match (param2, values2) {
+                (Some(p2), Some(v2)) => {
+                    let ys = parse_range(&v2, "--values2")?;
+                    b.with_parameter(&param, xs[0])?.with_parameter(&p2, ys[0])?;
+                    let map = stability_map(
+                        ParamAxis::new(param.clone(), xs),
+                        ParamAxis::new(p2.clone(), ys),
+                        |x, y| b.with_parameter(&param, x).and_then(|b| b.with_parameter(&p2, y)).and_then(|b| b.canonical()),
+                        &opts,
+                    )?;
+                    if let Some(p) = &plot {
+                        plot_stability_map(p, &map, MapQuantity::StableWidth, &PlotOptions::default())?;
+                        eprintln!("wrote {}", p.display());
+                    }
+                    match format {
+                        Format::Table => output::format_stability_map_table(&map),
+                        Format::Json => serde_json::to_string_pretty(&output::stability_map_json(&map))? + "\n",
+                        Format::Csv => {
+                            let mut buf = Vec::new();
+                            output::write_stability_map_csv(&mut buf, &map)?;
+                            String::from_utf8(buf)?
+                        }
+                    }
+                }
+                (None, None) => {
+                    b.with_parameter(&param, xs[0])?;
+                    if plot.is_some() {
+                        bail!("--plot draws a two-parameter stability map: give --param2 and --values2");
+                    }
+                    let s = parameter_sweep(ParamAxis::new(param.clone(), xs), |x| b.with_parameter(&param, x).and_then(|b| b.canonical()), &opts)?;
+                    match format {
+                        Format::Table => output::format_parameter_table(&s),
+                        Format::Json => serde_json::to_string_pretty(&output::parameter_sweep_json(&s))? + "\n",
+                        Format::Csv => {
+                            let mut buf = Vec::new();
+                            output::write_parameter_sweep_csv(&mut buf, &s)?;
+                            String::from_utf8(buf)?
+                        }
+                    }
+                }
+                _ => bail!("--param2 and --values2 go together"),
+            };
+            emit(&text, &out)?;
+            Ok(true)
+        }
+        Command::Params { command } => match command {
+            ParamsCommand::Convert { to, file, output: out } => {
+                let b = load(&file)?;
+                let text = match to {
+                    FormName::Benchmark => b.parameters.to_benchmark()?.to_toml_string(),
+                    FormName::Thesis => b.thesis()?.to_toml_string(),
+                };
+                emit(&text, &out)?;
+                Ok(true)
+            }
+            ParamsCommand::Show { bike } => {
+                let b = load(&bike)?;
+                print!("{}", b.parameters.to_toml_string());
+                Ok(true)
+            }
+        },
+        Command::Bench { quick } => {
+            bikedyn::bench::run(quick)?;
+            Ok(true)
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(1),
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -310,7 +310,7 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
             let args = if q.inputs.rates { quote!(param: &[T], p: &[T], #dp_arg) } else { quote!(param: &[T], p: &[T]) };
             quote! {
                 #[doc = #doc]
-                #[allow(unused_variables, clippy::all)]
+                #[allow(unused_variables, non_snake_case, clippy::all)]
                 pub fn #name<T: Scalar>(#args) -> T {
                     #(#body)*
                     #r
@@ -328,7 +328,7 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
             };
             quote! {
                 #[doc = #doc]
-                #[allow(unused_variables, clippy::all)]
+                #[allow(unused_variables, non_snake_case, clippy::all)]
                 pub fn #name<T: Scalar>(#args) {
                     debug_assert_eq!(out.len(), #n);
                     #(#body)*

@@ -487,3 +487,59 @@ pub fn validate(m: &Model) -> Vec<Diagnostic> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::expr::{coord, num, param, rate, vec3};
+
+    #[test]
+    fn validation_reports_every_problem_at_once() {
+        let mut m = Model::builder("broken");
+        let th = m.coordinate("theta", Role::Independent, 0.0, "angle");
+        m.coordinate("theta", Role::Dependent, 0.0, "again");
+        m.parameter("L", "length");
+        let f = m.frame("pendulum", GROUND, vec![(Axis::Y, th + coord("undeclared"))]);
+        let p = m.point("tip", None, vec![(f, vec3(param("L") * rate("theta"), num(0), param("missing")))]);
+        let _ = m.body("bob", f, param("m"), crate::expr::inertia_wheel(num(1), num(1)), p);
+        let err = m.build().unwrap_err();
+        let ModelError::Invalid { problems, .. } = &err;
+        let has = |d: &Diagnostic| problems.contains(d);
+        assert!(has(&Diagnostic::Duplicate { kind: "coordinate", name: "theta".into() }));
+        assert!(has(&Diagnostic::Undeclared { kind: "coordinate", name: "undeclared".into(), used_in: "frame `pendulum`".into() }));
+        assert!(has(&Diagnostic::Undeclared { kind: "parameter", name: "missing".into(), used_in: "point `tip`".into() }));
+        assert!(has(&Diagnostic::Undeclared { kind: "parameter", name: "m".into(), used_in: "mass of body `bob`".into() }));
+        assert!(has(&Diagnostic::RateInGeometry { item: "point `tip`".into() }));
+        assert!(has(&Diagnostic::HolonomicCount { dependent: 1, constraints: 0 }));
+        assert!(has(&Diagnostic::DegreesOfFreedom { coordinates: 2, independent: 1, constraints: 0 }));
+        let text = err.to_string();
+        assert!(text.contains("7 problems") || problems.len() >= 7, "{text}");
+    }
+
+    #[test]
+    fn asymmetric_inertia_and_time_in_geometry_are_reported() {
+        let mut m = Model::builder("bad");
+        let th = m.coordinate("theta", Role::Independent, 0.0, "angle");
+        let f = m.frame("a", GROUND, vec![(Axis::Z, th * crate::expr::time())]);
+        let p = m.point("c", None, vec![(f, vec3(num(1), num(0), num(0)))]);
+        let mut i = crate::expr::inertia_wheel(num(1), num(2));
+        i[0][1] = num(3);
+        m.body("b", f, num(1), i, p);
+        let ModelError::Invalid { problems, .. } = m.build().unwrap_err();
+        assert!(problems.contains(&Diagnostic::AsymmetricInertia { body: "b".into() }));
+        assert!(problems.contains(&Diagnostic::TimeDependentGeometry { item: "frame `a`".into() }));
+    }
+
+    #[test]
+    fn the_thesis_models_validate() {
+        let models = crate::models::all().unwrap();
+        assert_eq!(models.len(), 2);
+        let thesis = &models[0];
+        assert_eq!(thesis.coordinates.len(), 9);
+        assert_eq!(thesis.holonomic.len(), 3);
+        assert_eq!(thesis.nonholonomic.len(), 4);
+        let names: Vec<&str> = thesis.coordinates.iter().map(|c| c.name.as_str()).collect();
+        assert_eq!(names, ["xc", "yc", "phi", "theta", "psi", "beta", "gamma", "eps", "xi"]);
+        assert!(models[1].parameters.iter().any(|p| p.name == "d4"));
+    }
+}

@@ -192,6 +192,8 @@ pub struct Crossing {
 pub struct CriticalSpeeds {
     /// `v_d`: speed where the two real weave roots merge into the weave pair.
     pub weave_real_pair_merge: Option<f64>,
+    /// The double real eigenvalue (1/s) of the weave at `v_d` (3.7829 for the benchmark).
+    pub weave_merge_eigenvalue: Option<f64>,
     /// `v_w`: weave Hopf speed (first stabilizing weave crossing).
     pub weave_speed: Option<f64>,
     /// `v_c`: capsize speed (first destabilizing capsize crossing).
@@ -282,9 +284,9 @@ impl CharPoly {
         let g = self.g;
         let u = v * v;
         [
-            g.mul_add(g * self.e0, u * g.mul_add(self.e1, u * self.e2)),
-            v * g.mul_add(self.d0, u * self.d2),
-            g.mul_add(self.b0, u * self.b2),
+            g * (g * self.e0) + u * (g * self.e1 + u * self.e2),
+            v * (g * self.d0 + u * self.d2),
+            g * self.b0 + u * self.b2,
             v * self.a3,
             self.k4,
         ]
@@ -295,8 +297,8 @@ impl CharPoly {
         let g = self.g;
         let u = v * v;
         [
-            2.0 * v * g.mul_add(self.e1, 2.0 * u * self.e2),
-            g.mul_add(self.d0, 3.0 * u * self.d2),
+            2.0 * v * (g * self.e1 + 2.0 * u * self.e2),
+            g * self.d0 + 3.0 * u * self.d2,
             2.0 * v * self.b2,
             self.a3,
             0.0,

@@ -1172,7 +1172,7 @@ impl Figure for MapFigure<'_> {
             .map(|v| root.estimate_text_size(&tick(*v), &tick_font).map(|t| t.0).unwrap_or(0))
             .max()
             .unwrap_or(0) as i32;
-        let label_area = tick_w + o.pxi(12.0) + o.pxi(o.font_size * 0.95 * 1.6);
+        let label_area = tick_w + o.pxi(10.0) + o.pxi(o.font_size * 0.95 * 1.25);
         let bar = side.margin(bar_top.max(0) as u32, 0, 0, 0);
         let bar = bar.shrink((bar_x, 0), ((bar_w + label_area) as u32, (bar_bottom - bar_top).max(10) as u32));
         let mut cb = ChartBuilder::on(&bar)
@@ -1221,5 +1221,49 @@ impl Figure for MapFigure<'_> {
             y += patch_h;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plot_clip_polyline_splits_at_box() {
+        let pts = [(0.0, 0.0), (1.0, 2.0), (2.0, 0.0), (3.0, 0.5)];
+        let pieces = clip_polyline(&pts, (0.0, 3.0), (-1.0, 1.0));
+        assert_eq!(pieces.len(), 2);
+        assert_eq!(pieces[0], vec![(0.0, 0.0), (0.5, 1.0)]);
+        assert_eq!(pieces[1], vec![(1.5, 1.0), (2.0, 0.0), (3.0, 0.5)]);
+        assert!(clip_polyline(&[(0.0, 5.0), (1.0, 6.0)], (0.0, 1.0), (0.0, 1.0)).is_empty());
+        assert_eq!(clip_polyline(&pts, (-1.0, 4.0), (-3.0, 3.0)), vec![pts.to_vec()]);
+    }
+
+    #[test]
+    fn plot_tick_labels_are_short() {
+        assert_eq!(tick(0.0), "0");
+        assert_eq!(tick(-0.0), "0");
+        assert_eq!(tick(2.0), "2");
+        assert_eq!(tick(-25.0), "-25");
+        assert_eq!(tick(0.30000000000000004), "0.3");
+        assert_eq!(tick(1.2), "1.2");
+        assert_eq!(tick(1e-7), "1.00e-7");
+    }
+
+    #[test]
+    fn plot_cell_edges_and_colormap() {
+        assert_eq!(cell_edges(&[0.0, 1.0, 3.0]), vec![(-0.5, 0.5), (0.5, 2.0), (2.0, 4.0)]);
+        assert_eq!(cell_edges(&[2.0]), vec![(1.5, 2.5)]);
+        assert_eq!(viridis(0.0), RGBColor(68, 1, 84));
+        assert_eq!(viridis(1.0), RGBColor(253, 231, 37));
+        assert_eq!(viridis(f64::NAN), RGBColor(68, 1, 84));
+    }
+
+    #[test]
+    fn plot_format_from_extension() {
+        assert_eq!(ImageFormat::from_path(Path::new("a/b.SVG")).unwrap(), ImageFormat::Svg);
+        assert_eq!(ImageFormat::from_path(Path::new("b.png")).unwrap(), ImageFormat::Png);
+        assert!(ImageFormat::from_path(Path::new("b.jpg")).is_err());
+        assert!(ImageFormat::from_path(Path::new("png")).is_err());
     }
 }

@@ -398,3 +398,44 @@ impl Progress {
         self.bar.finish_and_clear();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sweep_linspace_endpoints_exact() {
+        assert!(linspace(0.0, 1.0, 0).is_empty());
+        assert_eq!(linspace(2.0, 3.0, 1), vec![2.0]);
+        let v = linspace(0.0, 10.0, 101);
+        assert_eq!(v.len(), 101);
+        assert_eq!(v[0], 0.0);
+        assert_eq!(v[100], 10.0);
+        assert!((v[43] - 4.3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sweep_summary_width_and_open_end() {
+        let c = CriticalSpeeds {
+            weave_speed: Some(4.0),
+            capsize_speed: Some(6.0),
+            stable_intervals: vec![[4.0, 6.0], [8.0, 10.0]],
+            ..CriticalSpeeds::default()
+        };
+        let s = StabilitySummary::from_critical(&c, 10.0);
+        assert_eq!(s.stable_width, 4.0);
+        assert!(s.open_ended);
+        assert_eq!(s.first_stable_interval(), Some([4.0, 6.0]));
+        let s = StabilitySummary::from_critical(&CriticalSpeeds::default(), 10.0);
+        assert_eq!((s.stable_width, s.open_ended), (0.0, false));
+        assert_eq!(MapQuantity::StableWidth.value(&Ok(s)), None);
+    }
+
+    #[test]
+    fn sweep_invalid_options_rejected() {
+        let o = SweepOptions { speed_min: f64::NAN, ..SweepOptions::default() };
+        assert!(o.validate().is_err());
+        assert!(SweepOptions::with_speed_range(3.0, 3.0).validate().is_err());
+        assert!(SweepOptions::default().validate().is_ok());
+    }
+}

@@ -1,12 +1,303 @@
-//! Critical speeds (placeholder while implementing).
+//! Critical speeds from exact smooth functions of the speed.
+//!
+//! With `u = v^2` the characteristic quartic has coefficients
+//! `k4`, `k3 = v a3`, `k2 = g b0 + u b2`, `k1 = v (g d0 + u d2)`,
+//! `k0 = g^2 e0 + g u e1 + u^2 e2` ([`CharPoly`]). Then:
+//! * a **real root crosses zero** where `k0 = det(g K0 + v^2 K2) = 0`: a quadratic in
+//!   `u`, solved in closed form (cancellation-free formula);
+//! * a **complex pair crosses the imaginary axis** (`s = +-i w`) where the Hurwitz
+//!   determinant `H = k1 k2 k3 - k4 k1^2 - k0 k3^2 = 0` with `w^2 = k1/k3 > 0`.
+//!   `H / v^2` is again a quadratic in `u`, solved in closed form (if `a3 = 0`, the
+//!   condition degenerates to `k1 = 0`, handled separately);
+//! * the **direction** of each crossing is the sign of `Re ds/dv = -Re(p_v / p_s)` at
+//!   the crossing root (exact derivatives of the coefficient polynomials);
+//! * the **weave merge** `v_d` is bracketed on a labelled grid (the two weave roots
+//!   are real below and complex above), bisected on the count of real roots, and
+//!   polished by Newton on the double-root system `p(s, v) = 0`, `p_s(s, v) = 0`.
+
 use super::*;
 
+/// Real roots of `a x^2 + b x + c = 0` (simple roots only: a double root is a
+/// tangency, not a crossing).
+fn quadratic_real_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
+    if a == 0.0 {
+        if b == 0.0 {
+            return vec![];
+        }
+        return vec![-c / b];
+    }
+    let disc = b * b - 4.0 * a * c;
+    if !(disc > 0.0) {
+        return vec![];
+    }
+    let q = -0.5 * (b + disc.sqrt().copysign(b));
+    let mut r = vec![q / a];
+    if q != 0.0 {
+        r.push(c / q);
+    } else {
+        r.push(0.0);
+    }
+    r.retain(|x| x.is_finite());
+    r
+}
+
+/// `(p, p_s, p_ss, p_v, p_sv)` at complex `s` and speed `v`.
+fn derivs(cp: &CharPoly, s: C64, v: f64) -> (C64, C64, C64, C64, C64) {
+    let k = cp.coeffs(v);
+    let kd = cp.dcoeffs(v);
+    let zero = C64::new(0.0, 0.0);
+    let (mut p, mut ps, mut pss, mut pv, mut psv) = (zero, zero, zero, zero, zero);
+    for i in (0..5).rev() {
+        pss = pss * s + ps * 2.0;
+        ps = ps * s + p;
+        p = p * s + k[i];
+        psv = psv * s + pv;
+        pv = pv * s + kd[i];
+    }
+    (p, ps, pss, pv, psv)
+}
+
+fn direction(cp: &CharPoly, s: C64, v: f64) -> Option<CrossingDirection> {
+    let (_, ps, _, pv, _) = derivs(cp, s, v);
+    if ps.norm_sqr() == 0.0 {
+        return None;
+    }
+    let dsdv = -pv / ps;
+    if dsdv.re > 0.0 {
+        Some(CrossingDirection::Destabilizing)
+    } else if dsdv.re < 0.0 {
+        Some(CrossingDirection::Stabilizing)
+    } else {
+        None
+    }
+}
+
 /// Critical speeds and all real-part zero crossings in `[v_min, v_max]`.
-pub fn critical_speeds(
-    c: &CanonicalMatrices,
-    v_min: f64,
-    v_max: f64,
-) -> Result<CriticalSpeeds, EigenError> {
-    let _ = (c, v_min, v_max);
-    Err(EigenError::NoConvergence { what: "not implemented yet".into() })
+///
+/// * `crossings`: every speed in the range (negative speeds included if the range
+///   contains them) where a real root passes through zero or a complex pair
+///   crosses the imaginary axis, ascending, with the label of the crossing root
+///   (tracked as in [`eigen_sweep`]) and the direction with increasing speed.
+/// * `weave_speed` (`v_w`): the lowest speed `>= 0` in the range where the weave
+///   becomes stable (stabilizing weave crossing); `capsize_speed` (`v_c`): the lowest
+///   speed `>= 0` in the range where the capsize mode becomes unstable;
+///   `weave_real_pair_merge` (`v_d`): the lowest speed `>= 0` in the range where the
+///   two real weave roots merge into the weave pair (with the double root in
+///   `weave_merge_eigenvalue`). Each is `None` if it does not occur in the range.
+/// * `stable_intervals`: maximal closed sub-intervals where all real parts are
+///   negative (endpoints are crossing speeds or the range ends; interior checked at
+///   midpoints between consecutive crossings).
+///
+/// Crossings exactly at `v = 0` (possible only for a bicycle that is oscillatory at
+/// rest) and tangential touches are not reported.
+pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<CriticalSpeeds, EigenError> {
+    if !v_min.is_finite() || !v_max.is_finite() {
+        return Err(EigenError::NonFinite { what: format!("speed range [{v_min}, {v_max}]") });
+    }
+    if v_min > v_max {
+        return Err(EigenError::InvalidArgument { what: format!("v_min = {v_min} > v_max = {v_max}") });
+    }
+    let cp = CharPoly::new(c)?;
+    let g = cp.g;
+    let in_range = |v: f64| v >= v_min && v <= v_max;
+    // (speed, kind, omega)
+    let mut cands: Vec<(f64, CrossingKind, f64)> = Vec::new();
+    let push_u = |u: f64, kind: CrossingKind, w: f64, cands: &mut Vec<(f64, CrossingKind, f64)>| {
+        if u > 0.0 && u.is_finite() {
+            let v = u.sqrt();
+            for v in [v, -v] {
+                if in_range(v) {
+                    cands.push((v, kind, w));
+                }
+            }
+        }
+    };
+    // Real root through zero: k0(u) = e2 u^2 + g e1 u + g^2 e0.
+    for u in quadratic_real_roots(cp.e2, g * cp.e1, g * g * cp.e0) {
+        push_u(u, CrossingKind::RealRoot, 0.0, &mut cands);
+    }
+    // Complex pair through the imaginary axis.
+    if cp.a3 != 0.0 {
+        // H/u = (g d0 + u d2)(g b0 + u b2) a3 - k4 (g d0 + u d2)^2 - (g^2 e0 + g u e1 + u^2 e2) a3^2
+        let (a3, k4) = (cp.a3, cp.k4);
+        let (p0, p1) = (g * cp.d0, cp.d2); // k1/v = p0 + p1 u
+        let (q0, q1) = (g * cp.b0, cp.b2); // k2 = q0 + q1 u
+        let (r0, r1, r2) = (g * g * cp.e0, g * cp.e1, cp.e2); // k0
+        let h2 = a3 * p1 * q1 - k4 * p1 * p1 - a3 * a3 * r2;
+        let h1 = a3 * (p0 * q1 + p1 * q0) - 2.0 * k4 * p0 * p1 - a3 * a3 * r1;
+        let h0 = a3 * p0 * q0 - k4 * p0 * p0 - a3 * a3 * r0;
+        for u in quadratic_real_roots(h2, h1, h0) {
+            let w2 = (p0 + p1 * u) / a3;
+            if w2 > 0.0 {
+                push_u(u, CrossingKind::ComplexPair, w2.sqrt(), &mut cands);
+            }
+        }
+    } else if cp.d2 != 0.0 {
+        // k3 == 0: need k1 = 0, then k4 w^4 - k2 w^2 + k0 = 0 with w^2 > 0.
+        let u = -g * cp.d0 / cp.d2;
+        if u > 0.0 {
+            let k = cp.coeffs(u.sqrt());
+            for w2 in quadratic_real_roots(k[4], -k[2], k[0]) {
+                if w2 > 0.0 {
+                    push_u(u, CrossingKind::ComplexPair, w2.sqrt(), &mut cands);
+                }
+            }
+        }
+    }
+    cands.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
+
+    // Labels at the crossing speeds.
+    let speeds: Vec<f64> = cands.iter().map(|x| x.0).collect();
+    let labelled = track(&cp, &speeds)?;
+    let mut crossings = Vec::new();
+    for ((v, kind, w), l) in cands.iter().zip(&labelled) {
+        let target = C64::new(0.0, *w);
+        let Some(dir) = direction(&cp, target, *v) else { continue };
+        let mut best = 0;
+        for k in 1..4 {
+            if (l.roots[k] - target).norm_sqr() < (l.roots[best] - target).norm_sqr() {
+                best = k;
+            }
+        }
+        crossings.push(Crossing { speed: *v, mode: l.labels[best], direction: dir, kind: *kind, frequency: *w });
+    }
+
+    let weave_speed = crossings
+        .iter()
+        .find(|x| {
+            x.speed >= 0.0
+                && x.mode == Mode::Weave
+                && x.kind == CrossingKind::ComplexPair
+                && x.direction == CrossingDirection::Stabilizing
+        })
+        .map(|x| x.speed);
+    let capsize_speed = crossings
+        .iter()
+        .find(|x| x.speed >= 0.0 && x.mode == Mode::Capsize && x.direction == CrossingDirection::Destabilizing)
+        .map(|x| x.speed);
+
+    // Stable intervals.
+    let mut breaks = vec![v_min];
+    breaks.extend(crossings.iter().map(|x| x.speed).filter(|&v| v > v_min && v < v_max));
+    breaks.push(v_max);
+    breaks.dedup();
+    let stable_at = |v: f64| -> Result<bool, EigenError> { Ok(cp.roots(v)?.iter().all(|z| z.re < 0.0)) };
+    let mut stable_intervals: Vec<[f64; 2]> = Vec::new();
+    if breaks.len() == 1 {
+        if stable_at(v_min)? {
+            stable_intervals.push([v_min, v_max]);
+        }
+    } else {
+        for w in breaks.windows(2) {
+            if stable_at(0.5 * (w[0] + w[1]))? {
+                match stable_intervals.last_mut() {
+                    Some(last) if last[1] == w[0] => last[1] = w[1],
+                    _ => stable_intervals.push([w[0], w[1]]),
+                }
+            }
+        }
+    }
+
+    let (weave_real_pair_merge, weave_merge_eigenvalue) = match weave_merge(&cp, v_min.max(0.0), v_max)? {
+        Some((v, s)) => (Some(v), Some(s)),
+        None => (None, None),
+    };
+    Ok(CriticalSpeeds {
+        weave_real_pair_merge,
+        weave_merge_eigenvalue,
+        weave_speed,
+        capsize_speed,
+        crossings,
+        stable_intervals,
+    })
+}
+
+fn real_count(cp: &CharPoly, v: f64) -> Result<usize, EigenError> {
+    Ok(cp.roots(v)?.iter().filter(|z| z.im == 0.0).count())
+}
+
+/// Grid intervals used to bracket `v_d`.
+const MERGE_GRID: usize = 512;
+
+/// `(v_d, s_d)`: lowest speed in `[lo, hi]` where the two weave roots turn from real
+/// to complex, and the double root there.
+fn weave_merge(cp: &CharPoly, lo: f64, hi: f64) -> Result<Option<(f64, f64)>, EigenError> {
+    if !(hi > lo) {
+        return Ok(None);
+    }
+    let grid: Vec<f64> = (0..=MERGE_GRID).map(|i| lo + (hi - lo) * (i as f64 / MERGE_GRID as f64)).collect();
+    let lab = track(cp, &grid)?;
+    let weave_state = |l: &Labelled| -> Option<bool> {
+        // Some(true): both weave roots real; Some(false): both complex
+        let w: Vec<C64> = (0..4).filter(|&k| l.labels[k] == Mode::Weave).map(|k| l.roots[k]).collect();
+        if w.len() != 2 {
+            return None;
+        }
+        match (w[0].im == 0.0, w[1].im == 0.0) {
+            (true, true) => Some(true),
+            (false, false) => Some(false),
+            _ => None,
+        }
+    };
+    for i in 0..MERGE_GRID {
+        if weave_state(&lab[i]) == Some(true) && weave_state(&lab[i + 1]) == Some(false) {
+            let (mut a, mut b) = (grid[i], grid[i + 1]);
+            let na = real_count(cp, a)?;
+            for _ in 0..200 {
+                let m = 0.5 * (a + b);
+                if m <= a || m >= b {
+                    break;
+                }
+                if real_count(cp, m)? == na {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            let vm = 0.5 * (a + b);
+            // start: mean of the closest pair of real roots at a
+            let z = cp.roots(a)?;
+            let reals: Vec<f64> = z.iter().filter(|x| x.im == 0.0).map(|x| x.re).collect();
+            let mut s0 = None;
+            let mut dbest = f64::INFINITY;
+            for p in 0..reals.len() {
+                for q in p + 1..reals.len() {
+                    let d = (reals[p] - reals[q]).abs();
+                    if d < dbest {
+                        dbest = d;
+                        s0 = Some(0.5 * (reals[p] + reals[q]));
+                    }
+                }
+            }
+            let Some(s0) = s0 else { return Ok(Some((vm, z[0].re))) };
+            return Ok(Some(match double_root_newton(cp, s0, vm) {
+                Some((v, s)) if (v - vm).abs() <= 1e-9 * vm.abs().max(1.0) => (v, s),
+                _ => (vm, s0),
+            }));
+        }
+    }
+    Ok(None)
+}
+
+/// Newton on `p(s, v) = 0`, `p_s(s, v) = 0` (real `s`).
+fn double_root_newton(cp: &CharPoly, mut s: f64, mut v: f64) -> Option<(f64, f64)> {
+    for _ in 0..30 {
+        let (p, ps, pss, pv, psv) = derivs(cp, C64::new(s, 0.0), v);
+        let (p, ps, pss, pv, psv) = (p.re, ps.re, pss.re, pv.re, psv.re);
+        let det = ps * psv - pv * pss;
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let ds = (-p * psv + pv * ps) / det;
+        let dv = (-ps * ps + pss * p) / det;
+        s += ds;
+        v += dv;
+        if !(s.is_finite() && v.is_finite()) {
+            return None;
+        }
+        if dv.abs() <= 1e-16 * v.abs().max(1.0) && ds.abs() <= 1e-15 * s.abs().max(1.0) {
+            return Some((v, s));
+        }
+    }
+    Some((v, s))
 }

@@ -47,14 +47,22 @@ pub(crate) fn quartic_roots(k: &[f64; 5]) -> Option<[C64; 4]> {
     let b = k[2] / k4;
     let c = k[1] / k4;
     let d = k[0] / k4;
-    let r = a.abs().max(b.abs().sqrt()).max(c.abs().cbrt()).max(d.abs().sqrt().sqrt());
-    if !r.is_finite() {
+    if !(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite()) {
         return None;
     }
-    if r == 0.0 {
+    if a == 0.0 && b == 0.0 && c == 0.0 && d == 0.0 {
         return Some([C64::new(0.0, 0.0); 4]);
     }
-    let rho = pow2_near(r);
+    // rho ~ max(|a|, |b|^(1/2), |c|^(1/3), |d|^(1/4)) as a power of two, from exponents.
+    let ex = |x: f64, n: i64| -> i64 {
+        if x == 0.0 {
+            i64::MIN / 2
+        } else {
+            (((x.to_bits() >> 52) & 0x7ff) as i64 - 1023).div_euclid(n)
+        }
+    };
+    let er = ex(a, 1).max(ex(b, 2)).max(ex(c, 3)).max(ex(d, 4)).clamp(-1000, 1000);
+    let rho = f64::from_bits(((er + 1023) as u64) << 52);
     let (r1, r2) = (rho, rho * rho);
     let (a, b, c, d) = (a / r1, b / r2, c / (r2 * r1), d / (r2 * r2));
     // Unnormalised coefficients in the scaled variable, divided by a power of two
@@ -102,9 +110,9 @@ fn horner_real(e: &[f64; 5], x: f64) -> (f64, f64, f64) {
     let mut s = e[4].abs();
     let ax = x.abs();
     for i in (0..4).rev() {
-        dp = dp.mul_add(x, p);
-        p = p.mul_add(x, e[i]);
-        s = s.mul_add(ax, e[i].abs());
+        dp = dp * x + p;
+        p = p * x + e[i];
+        s = s * ax + e[i].abs();
     }
     (p, dp, s)
 }
@@ -116,7 +124,7 @@ fn horner_complex(e: &[f64; 5], z: C64) -> (C64, C64, f64) {
     let (mut pr, mut pi) = (e[4], 0.0);
     let (mut dr, mut di) = (0.0, 0.0);
     let mut s = e[4].abs();
-    let az = z.norm();
+    let az = z.re.abs().max(z.im.abs()) * std::f64::consts::SQRT_2; // >= |z|
     for i in (0..4).rev() {
         let ndr = dr * zr - di * zi + pr;
         let ndi = dr * zi + di * zr + pi;
@@ -126,7 +134,7 @@ fn horner_complex(e: &[f64; 5], z: C64) -> (C64, C64, f64) {
         let npi = pr * zi + pi * zr;
         pr = npr;
         pi = npi;
-        s = s.mul_add(az, e[i].abs());
+        s = s * az + e[i].abs();
     }
     (C64::new(pr, pi), C64::new(dr, di), s)
 }
@@ -157,8 +165,8 @@ fn largest_real_cubic_root(bb: f64, cc: f64, dd: f64) -> f64 {
     };
     let mut y = t - sh;
     // Guarded Newton polish on the cubic.
-    let f = |y: f64| ((y + bb).mul_add(y, cc)).mul_add(y, dd);
-    let df = |y: f64| (3.0 * y + 2.0 * bb).mul_add(y, cc);
+    let f = |y: f64| ((y + bb) * y + cc) * y + dd;
+    let df = |y: f64| (3.0 * y + 2.0 * bb) * y + cc;
     let mut fy = f(y);
     for _ in 0..4 {
         let d = df(y);
@@ -348,10 +356,13 @@ fn polish_all(e: &[f64; 5], z: [C64; 4]) -> Option<[C64; 4]> {
     let mut gap = [f64::INFINITY; 4];
     for i in 0..4 {
         for j in i + 1..4 {
-            let d = (z[i] - z[j]).norm();
+            let d = (z[i] - z[j]).norm_sqr();
             gap[i] = gap[i].min(d);
             gap[j] = gap[j].min(d);
         }
+    }
+    for g in gap.iter_mut() {
+        *g = g.sqrt();
     }
     let mut out = z;
     for i in 0..4 {
@@ -414,29 +425,35 @@ fn polish_real(e: &[f64; 5], x0: f64, gap: f64) -> Option<f64> {
 fn polish_complex(e: &[f64; 5], z0: C64, gap: f64) -> Option<C64> {
     let mut z = z0;
     let gap = gap.min(2.0 * z0.im.abs());
+    let g2 = gap * gap;
     let (mut p, mut dp, mut sc) = horner_complex(e, z);
+    let mut p2 = p.norm_sqr();
     for _ in 0..8 {
-        if p == C64::new(0.0, 0.0) || dp == C64::new(0.0, 0.0) {
+        let d2 = dp.norm_sqr();
+        if p2 == 0.0 || d2 == 0.0 {
             break;
         }
-        let step = p / dp;
-        let sn = step.norm();
-        if !(sn < 0.5 * gap) {
+        let step = p * dp.conj() / d2;
+        let sn2 = step.norm_sqr();
+        if !(sn2 < 0.25 * g2) {
             break;
         }
-        if sn <= 1e-9 * z.norm().max(gap.min(1.0)) && sn <= 1e-6 * gap {
+        if sn2 <= 1e-18 * z.norm_sqr().max(g2.min(1.0)) && sn2 <= 1e-12 * g2 {
             z -= step;
-            return (p.norm() <= BACKWARD_TOL * sc).then_some(z);
+            return (p2 <= BACKWARD_TOL * BACKWARD_TOL * sc * sc).then_some(z);
         }
         let zn = z - step;
         let (pn, dpn, scn) = horner_complex(e, zn);
-        if !(pn.norm() < p.norm()) {
+        let pn2 = pn.norm_sqr();
+        if !(pn2 < p2) {
             break;
         }
         z = zn;
         p = pn;
+        p2 = pn2;
         dp = dpn;
         sc = scn;
     }
-    (z.re.is_finite() && z.im.is_finite() && p.norm() <= BACKWARD_TOL * sc).then_some(z)
+    let _ = p;
+    (z.re.is_finite() && z.im.is_finite() && p2 <= BACKWARD_TOL * BACKWARD_TOL * sc * sc).then_some(z)
 }

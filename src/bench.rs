@@ -1,0 +1,113 @@
+//! `bikedyn bench`: figures for the generated code and the stability
+//! pipeline (printed, never asserted; timings depend on the machine).
+
+use crate::bicycle::canonical_of;
+use crate::generated::{ThesisWhipple, CODEGEN_REPORT};
+use crate::models::default_parameters;
+use bikedyn_runtime::eigen::eigenvalues;
+use bikedyn_runtime::parameters::ThesisParameters;
+use bikedyn_runtime::MultibodyModel;
+use rayon::prelude::*;
+use std::hint::black_box;
+use std::time::Instant;
+
+fn per_call(reps: usize, mut f: impl FnMut(usize)) -> f64 {
+    // Warm up, then time `reps` calls.
+    for i in 0..reps.min(1000) {
+        f(i);
+    }
+    let t = Instant::now();
+    for i in 0..reps {
+        f(i);
+    }
+    t.elapsed().as_secs_f64() / reps as f64
+}
+
+/// Print the figures. `quick` uses fewer repetitions.
+pub fn run(quick: bool) -> anyhow::Result<()> {
+    let reps = if quick { 20_000 } else { 400_000 };
+    println!("== code generation (build.rs, last build) ==");
+    let report: serde_json::Value = serde_json::from_str(CODEGEN_REPORT)?;
+    for m in report.as_array().into_iter().flatten() {
+        println!(
+            "model {:<16} derivation {:>6.2} s   derivation + emission {:>6.2} s   operations {:>9} before / {:>6} after optimisation",
+            m["model"].as_str().unwrap_or("?"),
+            m["derivation_s"].as_f64().unwrap_or(f64::NAN),
+            m["derivation_and_emission_s"].as_f64().unwrap_or(f64::NAN),
+            m["operations_before"],
+            m["operations_after"]
+        );
+    }
+
+    println!("\n== generated functions of thesis_whipple (f64, one state per call, {reps} calls) ==");
+    type M = ThesisWhipple;
+    let param = default_parameters::<M>();
+    let nq = M::nq();
+    let (nh, nnh) = (M::HOLONOMIC.len(), M::NONHOLONOMIC.len());
+    // A small ring of states so the calls are not constant-folded.
+    let states: Vec<(Vec<f64>, Vec<f64>)> = (0..64)
+        .map(|k| {
+            let x = k as f64 / 64.0;
+            let p: Vec<f64> = (0..nq).map(|j| M::INITIAL_GUESS[j] + 0.3 * (x * (j + 1) as f64).sin()).collect();
+            let dp: Vec<f64> = (0..nq).map(|j| (x * 3.0 + j as f64).cos()).collect();
+            (p, dp)
+        })
+        .collect();
+    let mut buf = vec![0.0; nq * nq];
+    let flops = |name: &str| M::FLOPS.iter().find(|(n, _)| *n == name).map(|x| x.1).unwrap_or(0);
+    let mut total = 0.0;
+    let mut row = |name: &str, secs: f64| {
+        total += secs;
+        println!("  {name:<28} {:>8.1} ns/call   {:>6} flops/call", secs * 1e9, flops(name));
+    };
+    let s = &states;
+    row("mass_matrix", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::mass_matrix(&param, p, &mut buf); black_box(&buf); }));
+    row("quadratic_velocity_forces", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::quadratic_velocity_forces(&param, p, dp, &mut buf[..nq]); black_box(&buf); }));
+    row("gravity_forces", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::gravity_forces(&param, p, &mut buf[..nq]); black_box(&buf); }));
+    row("applied_forces", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::applied_forces(&param, 0.1, p, dp, &mut buf[..nq]); black_box(&buf); }));
+    row("holonomic_residuals", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::holonomic_residuals(&param, 0.1, p, &mut buf[..nh]); black_box(&buf); }));
+    row("holonomic_jacobian", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::holonomic_jacobian(&param, 0.1, p, &mut buf[..nh * nq]); black_box(&buf); }));
+    row("holonomic_time_derivative", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::holonomic_time_derivative(&param, 0.1, p, &mut buf[..nh]); black_box(&buf); }));
+    row("holonomic_convective", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::holonomic_convective(&param, 0.1, p, dp, &mut buf[..nh]); black_box(&buf); }));
+    row("nonholonomic_velocities", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::nonholonomic_velocities(&param, 0.1, p, dp, &mut buf[..nnh]); black_box(&buf); }));
+    row("nonholonomic_matrix", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::nonholonomic_matrix(&param, 0.1, p, &mut buf[..nnh * nq]); black_box(&buf); }));
+    row("nonholonomic_convective", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::nonholonomic_convective(&param, 0.1, p, dp, &mut buf[..nnh]); black_box(&buf); }));
+    row("kinetic_energy", per_call(reps, |i| { let (p, dp) = &s[i % 64]; black_box(M::kinetic_energy(&param, p, dp)); }));
+    row("potential_energy", per_call(reps, |i| { let (p, _) = &s[i % 64]; black_box(M::potential_energy(&param, p)); }));
+    row("point_positions", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::point_positions(&param, p, &mut buf[..6]); black_box(&buf); }));
+    let all_flops: usize = M::FLOPS.iter().map(|x| x.1).sum();
+    println!("  {:<28} {:>8.1} ns/state  {:>6} flops/state (target: under 1000 ns)", "all quantities together", total * 1e9, all_flops);
+
+    println!("\n== linearization and eigenvalues (thesis bicycle) ==");
+    let thesis = ThesisParameters::thesis_bicycle();
+    let lin_reps = if quick { 200 } else { 2000 };
+    let t_lin = per_call(lin_reps, |_| { black_box(canonical_of(black_box(&thesis)).ok()); });
+    let c = canonical_of(&thesis)?;
+    let t_eig = per_call(reps, |i| { black_box(eigenvalues(&c, (i % 1000) as f64 * 0.01).ok()); });
+    println!("  exact linearization (canonical M0, C1, K0, K2 from the generated equations, once per design): {:>8.2} us", t_lin * 1e6);
+    println!("  eigenvalues of the 4x4 state matrix per speed point:                                     {:>8.1} ns", t_eig * 1e9);
+    println!("  one speed point including its share of the linearization over 100 speeds:               {:>8.1} ns (target: under 2000 ns per core)", (t_eig + t_lin / 100.0) * 1e9);
+
+    let (designs, speeds) = if quick { (100usize, 1000usize) } else { (1000, 1000) };
+    let t = Instant::now();
+    let stable: usize = (0..designs)
+        .into_par_iter()
+        .map(|k| {
+            let mut p = thesis;
+            p.steer_point_x *= 1.0 + 0.02 * (k as f64 / designs as f64 - 0.5);
+            match canonical_of(&p) {
+                Ok(c) => (0..speeds).filter(|&i| eigenvalues(&c, i as f64 * 10.0 / speeds as f64).map(|e| e.iter().all(|s| s.re < 0.0)).unwrap_or(false)).count(),
+                Err(_) => 0,
+            }
+        })
+        .sum();
+    let el = t.elapsed().as_secs_f64();
+    println!(
+        "  design x speed sweep: {designs} designs x {speeds} speeds = {} points on {} threads in {:.3} s ({:.0} ns/point; {stable} stable points) (target: 10^6 points under 2 s)",
+        designs * speeds,
+        rayon::current_num_threads(),
+        el,
+        el / (designs * speeds) as f64 * 1e9
+    );
+    Ok(())
+}

@@ -1,0 +1,116 @@
+//! Bicycles as users name them (built-in names or parameter files), mapped to
+//! the generated model that represents them and to their canonical matrices.
+
+use crate::generated::{ThesisWhipple, WhippleOffset};
+use bikedyn_runtime::canonical::CanonicalMatrices;
+use bikedyn_runtime::linearize::{canonical_matrices, LinearizeError};
+use bikedyn_runtime::parameters::{BenchmarkParameters, ParameterError, ParameterSet, ParameterWarning, ThesisParameters};
+use std::path::Path;
+use thiserror::Error;
+
+/// Built-in bicycles.
+pub const BUILT_IN: &[(&str, &str)] = &[
+    ("thesis", "the instrumented bicycle of Martin Recuero (2009), section 4.4 (default)"),
+    ("benchmark", "the benchmark bicycle of Meijaard et al. (2007), Table 1"),
+];
+
+/// Errors of resolving or analysing a bicycle.
+#[derive(Debug, Error)]
+pub enum BicycleError {
+    #[error(transparent)]
+    Parameters(#[from] ParameterError),
+    #[error("linearization of `{bike}` failed: {source}")]
+    Linearize { bike: String, source: LinearizeError },
+    #[error("unknown parameter `{name}`: use a thesis symbol ({thesis}) or a benchmark symbol ({benchmark})")]
+    UnknownParameter { name: String, thesis: String, benchmark: String },
+    #[error("`{spec}` is neither a built-in bicycle (thesis, benchmark) nor an existing file")]
+    NotFound { spec: String },
+}
+
+/// A resolved bicycle.
+#[derive(Clone, Debug)]
+pub struct Bicycle {
+    /// Built-in name or file path.
+    pub name: String,
+    /// Parameters as given (thesis or benchmark form).
+    pub parameters: ParameterSet,
+    /// Validation warnings (e.g. triangle inequality of inertia tensors).
+    pub warnings: Vec<ParameterWarning>,
+}
+
+impl Bicycle {
+    /// Resolve `thesis`, `benchmark` or a parameter file (TOML in either form,
+    /// or the `name = value[+/-std]` text form of bicycleparameters/HumanControl).
+    pub fn resolve(spec: &str) -> Result<Bicycle, BicycleError> {
+        let (parameters, warnings) = match spec {
+            "thesis" => {
+                let p = ThesisParameters::thesis_bicycle();
+                let w = p.validate()?;
+                (ParameterSet::Thesis(p), w)
+            }
+            "benchmark" => {
+                let p = BenchmarkParameters::benchmark_bicycle();
+                let w = p.validate()?;
+                (ParameterSet::Benchmark(p), w)
+            }
+            path if Path::new(path).exists() => ParameterSet::load(path)?,
+            _ => return Err(BicycleError::NotFound { spec: spec.to_string() }),
+        };
+        Ok(Bicycle { name: spec.to_string(), parameters, warnings })
+    }
+
+    /// Thesis-form parameters (converted if given in benchmark form).
+    pub fn thesis(&self) -> Result<ThesisParameters, BicycleError> {
+        Ok(self.parameters.to_thesis()?)
+    }
+
+    /// Canonical matrices from the generated multibody equations.
+    pub fn canonical(&self) -> Result<CanonicalMatrices, BicycleError> {
+        canonical_of(&self.thesis()?).map_err(|source| BicycleError::Linearize { bike: self.name.clone(), source })
+    }
+
+    /// The same bicycle with one parameter changed. `symbol` is a thesis
+    /// symbol (`Rt`, `x4`, `d4`, ...) or a benchmark symbol (`c`, `lam`, ...).
+    pub fn with_parameter(&self, symbol: &str, value: f64) -> Result<Bicycle, BicycleError> {
+        let parameters = if ThesisParameters::SYMBOLS.contains(&symbol) {
+            ParameterSet::Thesis(set_field(&self.thesis()?, symbol, value)?)
+        } else if BenchmarkParameters::SYMBOLS.contains(&symbol) {
+            ParameterSet::Benchmark(set_field(&self.parameters.to_benchmark()?, symbol, value)?)
+        } else {
+            return Err(BicycleError::UnknownParameter {
+                name: symbol.to_string(),
+                thesis: ThesisParameters::SYMBOLS.join(", "),
+                benchmark: BenchmarkParameters::SYMBOLS.join(", "),
+            });
+        };
+        let warnings = parameters.validate()?;
+        Ok(Bicycle { name: format!("{} ({symbol} = {value})", self.name), parameters, warnings })
+    }
+
+    /// Value of a thesis or benchmark symbol.
+    pub fn value(&self, symbol: &str) -> Option<f64> {
+        self.thesis().ok().and_then(|t| t.get(symbol)).or_else(|| self.parameters.to_benchmark().ok().and_then(|b| b.get(symbol)))
+    }
+}
+
+/// Set one serde-named field (the parameter symbol) of a parameter struct.
+fn set_field<P: serde::Serialize + serde::de::DeserializeOwned>(p: &P, symbol: &str, value: f64) -> Result<P, BicycleError> {
+    let mut v = serde_json::to_value(p).expect("parameter structs serialize");
+    v[symbol] = serde_json::Value::from(value);
+    serde_json::from_value(v).map_err(|_| BicycleError::UnknownParameter {
+        name: symbol.to_string(),
+        thesis: ThesisParameters::SYMBOLS.join(", "),
+        benchmark: BenchmarkParameters::SYMBOLS.join(", "),
+    })
+}
+
+/// Canonical matrices of thesis-form parameters: the thesis model when the
+/// fork mass centre is on the steer axis (`d4 = 0`), the offset variant
+/// otherwise.
+pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, LinearizeError> {
+    if p.fork_com_offset == 0.0 {
+        canonical_matrices::<ThesisWhipple>(|s| p.get(s))
+    } else {
+        canonical_matrices::<WhippleOffset>(|s| p.get(s))
+    }
+}

@@ -1,0 +1,44 @@
+//! The committed copies in `generated/snapshots/` must equal what build.rs
+//! emits, so that a model change shows up as a readable diff in review.
+//! Refresh them with `UPDATE_SNAPSHOTS=1 cargo test --test codegen_snapshots`.
+
+use std::path::Path;
+
+#[test]
+fn generated_snapshots_are_fresh() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("generated/snapshots");
+    let update = std::env::var("UPDATE_SNAPSHOTS").is_ok_and(|v| v == "1");
+    let mut stale = Vec::new();
+    for (name, emitted) in bikedyn::generated::SOURCES {
+        let path = dir.join(format!("{name}.rs"));
+        if update {
+            std::fs::create_dir_all(&dir).unwrap();
+            std::fs::write(&path, emitted).unwrap();
+            continue;
+        }
+        match std::fs::read_to_string(&path) {
+            Ok(committed) if committed == *emitted => {}
+            Ok(committed) => {
+                let line = committed.lines().zip(emitted.lines()).position(|(a, b)| a != b).map(|i| i + 1);
+                stale.push(format!("{} differs from the emitted code (first difference at line {:?})", path.display(), line));
+            }
+            Err(e) => stale.push(format!("{} cannot be read: {e}", path.display())),
+        }
+    }
+    assert!(
+        stale.is_empty(),
+        "stale generated snapshots:\n  {}\nrun `UPDATE_SNAPSHOTS=1 cargo test --test codegen_snapshots` and review the diff",
+        stale.join("\n  ")
+    );
+}
+
+#[test]
+fn snapshots_have_a_header_naming_model_sources_and_hash() {
+    for (name, emitted) in bikedyn::generated::SOURCES {
+        let first = emitted.lines().next().unwrap();
+        assert!(first.starts_with("// @generated"), "{name}: {first}");
+        assert!(first.contains(&format!("model \"{name}\"")), "{name}: {first}");
+        assert!(first.contains("modeler/src/models/"), "{name}: {first}");
+        assert!(first.contains("model hash"), "{name}: {first}");
+    }
+}
