@@ -12,7 +12,7 @@ fn every_generated_derivative_of_every_model_matches_finite_differences() {
             println!("{m}: {:<40} {:.3e} (tol {:.0e})", q.name, q.max_rel_error, q.tolerance);
         }
         assert!(r.passed, "{m} failed verification: {:#?}", r.quantities.iter().filter(|q| !q.passed).collect::<Vec<_>>());
-        assert_eq!(r.quantities.len(), 12);
+        assert_eq!(r.quantities.len(), 13);
     }
 }
 

@@ -262,8 +262,36 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
             body.push(stmt);
         }
     }
+    // Pair sin(a) and cos(a) into one sin_cos call, emitted at the first of the two.
+    let mut partner: HashMap<usize, (usize, usize)> = HashMap::new();
+    {
+        let mut sin_of = HashMap::new();
+        let mut cos_of = HashMap::new();
+        for (i, n) in dag.nodes.iter().enumerate() {
+            match n {
+                Node::Sin(a) => { sin_of.insert(*a, i); }
+                Node::Cos(a) => { cos_of.insert(*a, i); }
+                _ => {}
+            }
+        }
+        for (a, &si) in &sin_of {
+            if let Some(&ci) = cos_of.get(a) {
+                partner.insert(si.min(ci), (si, ci));
+                partner.insert(si.max(ci), (usize::MAX, usize::MAX));
+            }
+        }
+    }
     for (i, n) in dag.nodes.iter().enumerate() {
         let t = format_ident!("t{}", i);
+        if let Some(&(si, ci)) = partner.get(&i) {
+            if si == usize::MAX {
+                continue;
+            }
+            let Node::Sin(a) = dag.nodes[si] else { unreachable!("paired node is a sine") };
+            let (s_id, c_id, a) = (format_ident!("t{}", si), format_ident!("t{}", ci), var(a, &dag.nodes));
+            body.push(quote!(let (#s_id, #c_id): (T, T) = #a.sin_cos();));
+            continue;
+        }
         let e = match n {
             Node::Input(_) | Node::Const(_) => continue,
             Node::Add(v) => {
@@ -392,6 +420,15 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
     let indep: Vec<usize> = m.coordinates.iter().enumerate().filter(|(_, c)| c.role == Role::Independent).map(|(i, _)| i).collect();
     let dep: Vec<usize> = m.coordinates.iter().enumerate().filter(|(_, c)| c.role == Role::Dependent).map(|(i, _)| i).collect();
     let guess: Vec<proc_macro2::Literal> = m.coordinates.iter().map(|c| proc_macro2::Literal::f64_suffixed(c.guess)).collect();
+    let mut layout = Vec::new();
+    let mut offset = 0usize;
+    for q in d.quantities.iter().filter(|q| q.name != "all_quantities") {
+        if let crate::derive::Shape::Buffer { .. } = q.shape {
+            let (n, len) = (q.name, q.outputs.len());
+            layout.push(quote!((#n, #offset, #len)));
+            offset += len;
+        }
+    }
     let flop_names: Vec<&str> = reports.iter().map(|r| r.name).collect();
     let flop_counts: Vec<usize> = reports.iter().map(|r| r.after.total()).collect();
     let coord_docs: Vec<String> = m.coordinates.iter().map(|c| format!("`{}`: {}", c.name, c.doc)).collect();
@@ -423,7 +460,9 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             const INDEPENDENT: &'static [usize] = &[#(#indep),*];
             const DEPENDENT: &'static [usize] = &[#(#dep),*];
             const INITIAL_GUESS: &'static [f64] = &[#(#guess),*];
+            const ALL_QUANTITIES_LAYOUT: &'static [(&'static str, usize, usize)] = &[#(#layout),*];
             const FLOPS: &'static [(&'static str, usize)] = &[#((#flop_names, #flop_counts)),*];
+            fn all_quantities<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) { all_quantities(param, t, p, dp, out) }
             fn mass_matrix<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) { mass_matrix(param, p, out) }
             fn quadratic_velocity_forces<T: Scalar>(param: &[T], p: &[T], dp: &[T], out: &mut [T]) { quadratic_velocity_forces(param, p, dp, out) }
             fn gravity_forces<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) { gravity_forces(param, p, out) }

@@ -474,7 +474,40 @@ fn match_roots(prev: &Labelled, new: &[C64; 4]) -> ([C64; 4], bool) {
             }
         }
     }
-    (out, dmax < 0.3 * sep)
+    (out, dmax <= 0.3 * sep)
+}
+
+/// A complex-conjugate pair is one mode: when two roots with different labels
+/// form a pair, the pair takes the lower-ranked label `L` (weave < capsize <
+/// castering < other) and the displaced label `D` passes to the other root labelled
+/// `L`, if any. Two *real* roots sharing a non-weave label (a capsize/castering pair
+/// that split again) become capsize (larger) and castering (smaller).
+fn pair_rule(z: &[C64; 4], mut l: [Mode; 4]) -> [Mode; 4] {
+    for i in 0..4 {
+        if z[i].im <= 0.0 {
+            continue;
+        }
+        let Some(j) = (0..4).find(|&j| j != i && z[j] == z[i].conj()) else { continue };
+        if l[i] == l[j] {
+            continue;
+        }
+        let (lo, hi) = if rank(l[i]) <= rank(l[j]) { (l[i], l[j]) } else { (l[j], l[i]) };
+        if let Some(k) = (0..4).find(|&k| k != i && k != j && l[k] == lo) {
+            l[k] = hi;
+        }
+        l[i] = lo;
+        l[j] = lo;
+    }
+    for i in 0..4 {
+        for j in i + 1..4 {
+            if l[i] == l[j] && l[i] != Mode::Weave && z[i].im == 0.0 && z[j].im == 0.0 {
+                let (big, small) = if z[i].re >= z[j].re { (i, j) } else { (j, i) };
+                l[big] = Mode::Capsize;
+                l[small] = Mode::Castering;
+            }
+        }
+    }
+    l
 }
 
 /// Continue labelled roots from `v0` (>= 0) to `v1` (>= 0) adaptively.
@@ -496,7 +529,7 @@ fn continue_to(cp: &CharPoly, start: Labelled, v0: f64, v1: f64) -> Result<Label
         let z = cp.roots(vt)?;
         let (m, ok) = match_roots(&cur, &z);
         if ok || h.abs() <= hmin {
-            cur = Labelled { roots: m, labels: cur.labels };
+            cur = Labelled { roots: m, labels: pair_rule(&m, cur.labels) };
             v = vt;
             h *= 2.0;
             if h.abs() > (v1 - v).abs() && v != v1 {
@@ -509,8 +542,42 @@ fn continue_to(cp: &CharPoly, start: Labelled, v0: f64, v1: f64) -> Result<Label
     Ok(cur)
 }
 
+/// Characteristic speed of the bicycle, `sqrt(g |b0| / |b2|)` (where the gravity and
+/// speed terms of `k2` balance; 3.4 m/s for the benchmark), 1 m/s if undefined.
+fn speed_scale(cp: &CharPoly) -> f64 {
+    let r = (cp.g * cp.b0 / cp.b2).abs().sqrt();
+    if r.is_finite() && r > 0.0 {
+        r
+    } else {
+        let r = (cp.g * cp.d0 / cp.d2).abs().sqrt();
+        if r.is_finite() && r > 0.0 {
+            r
+        } else {
+            1.0
+        }
+    }
+}
+
+/// Anchor speed and labels (a property of the bicycle only, independent of the
+/// requested speeds): the first speed of the ladder `30 vs * 2^k` (k = 0..10), then
+/// `30 vs / 1.25^k` (k = 1..80), with the pattern *one complex pair + two real roots*
+/// (`vs` = [`speed_scale`]); otherwise the fallback classification at `30 vs`.
+fn anchor(cp: &CharPoly) -> Result<(f64, Labelled), EigenError> {
+    let base = 30.0 * speed_scale(cp);
+    let ladder = (0..=10).map(|k| base * 2f64.powi(k)).chain((1..=80).map(|k| base / 1.25f64.powi(k)));
+    for v in ladder {
+        let z = cp.roots(v)?;
+        if let Some(l) = classify_anchor(&z) {
+            return Ok((v, Labelled { roots: z, labels: l }));
+        }
+    }
+    let z = cp.roots(base)?;
+    Ok((base, Labelled { roots: z, labels: classify_fallback(&z) }))
+}
+
 /// Labels at every `|v|` of `speeds` (any order, any sign). Returns labelled roots in
-/// canonical order, one per input speed.
+/// canonical order, one per input speed. Every speed is reached by continuation
+/// from the anchor, so labels do not depend on which other speeds are requested.
 pub(crate) fn track(cp: &CharPoly, speeds: &[f64]) -> Result<Vec<Labelled>, EigenError> {
     if speeds.is_empty() {
         return Ok(Vec::new());
@@ -520,37 +587,22 @@ pub(crate) fn track(cp: &CharPoly, speeds: &[f64]) -> Result<Vec<Labelled>, Eige
             return Err(EigenError::NonFinite { what: format!("speed {v}") });
         }
     }
-    let mut order: Vec<usize> = (0..speeds.len()).collect();
-    order.sort_by(|&i, &j| speeds[j].abs().partial_cmp(&speeds[i].abs()).unwrap_or(std::cmp::Ordering::Equal));
-    let vtop = speeds[order[0]].abs();
-    // Anchor search.
-    let mut anchor = None;
-    let z = cp.roots(vtop)?;
-    if let Some(l) = classify_anchor(&z) {
-        anchor = Some((vtop, Labelled { roots: z, labels: l }));
-    } else {
-        let mut va = vtop.max(1.0);
-        for _ in 0..40 {
-            va *= 1.25;
-            let z = cp.roots(va)?;
-            if let Some(l) = classify_anchor(&z) {
-                anchor = Some((va, Labelled { roots: z, labels: l }));
-                break;
-            }
+    let (va, start) = anchor(cp)?;
+    let mut out = vec![start; speeds.len()];
+    let by_abs = |i: &usize, j: &usize| speeds[*i].abs().partial_cmp(&speeds[*j].abs()).unwrap_or(std::cmp::Ordering::Equal);
+    // above the anchor: ascending; below: descending
+    let mut up: Vec<usize> = (0..speeds.len()).filter(|&i| speeds[i].abs() > va).collect();
+    up.sort_by(by_abs);
+    let mut down: Vec<usize> = (0..speeds.len()).filter(|&i| speeds[i].abs() <= va).collect();
+    down.sort_by(|i, j| by_abs(j, i));
+    for chain in [up, down] {
+        let (mut vcur, mut cur) = (va, start);
+        for i in chain {
+            let v = speeds[i].abs();
+            cur = continue_to(cp, cur, vcur, v)?.canonical();
+            vcur = v;
+            out[i] = if speeds[i] < 0.0 { cur.mirrored() } else { cur };
         }
-    }
-    let (mut vcur, mut cur) = match anchor {
-        Some(a) => a,
-        None => (vtop, Labelled { roots: z, labels: classify_fallback(&z) }),
-    };
-    let mut out = vec![cur; speeds.len()];
-    for &i in &order {
-        let va = speeds[i].abs();
-        cur = continue_to(cp, cur, vcur, va)?;
-        vcur = va;
-        let l = cur.canonical();
-        out[i] = if speeds[i] < 0.0 { l.mirrored() } else { l };
-        cur = l;
     }
     Ok(out)
 }

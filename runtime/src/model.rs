@@ -35,6 +35,9 @@ pub trait MultibodyModel: Send + Sync + 'static {
     const DEPENDENT: &'static [usize];
     /// Initial guess of every coordinate for the constraint solver.
     const INITIAL_GUESS: &'static [f64];
+    /// Layout of [`MultibodyModel::all_quantities`]'s output: `(function
+    /// name, offset, length)` for every buffer quantity, in order.
+    const ALL_QUANTITIES_LAYOUT: &'static [(&'static str, usize, usize)];
     /// Floating-point operations per call of each generated function
     /// (after common-subexpression elimination), by function name.
     const FLOPS: &'static [(&'static str, usize)];
@@ -78,6 +81,9 @@ pub trait MultibodyModel: Send + Sync + 'static {
     fn kinetic_energy<T: Scalar>(param: &[T], p: &[T], dp: &[T]) -> T;
     /// Potential energy of gravity `V` (J), with `Qgrav = -dV/dp`.
     fn potential_energy<T: Scalar>(param: &[T], p: &[T]) -> T;
+    /// Every buffer quantity at once (one shared set of common
+    /// subexpressions), concatenated as [`MultibodyModel::ALL_QUANTITIES_LAYOUT`] says.
+    fn all_quantities<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
     /// Global positions of the points of interest, `3 x npoints` (x, y, z per point).
     fn point_positions<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
 }

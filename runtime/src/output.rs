@@ -107,18 +107,31 @@ static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
     let name = match path.file_name() {
         Some(n) => n.to_string_lossy().into_owned(),
-        None => return Err(OutputError::InvalidPath { path: path.to_path_buf() }),
+        None => {
+            return Err(OutputError::InvalidPath {
+                path: path.to_path_buf(),
+            })
+        }
     };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
     if !dir.is_dir() {
-        return Err(OutputError::NoSuchDirectory { path: path.to_path_buf(), dir });
+        return Err(OutputError::NoSuchDirectory {
+            path: path.to_path_buf(),
+            dir,
+        });
     }
     // Keep the extension last: some encoders choose the format from it.
-    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or(name);
-    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or(name);
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
     let mut last_err = None;
     for _ in 0..16 {
         let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -144,8 +157,16 @@ fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
 
 /// fsync the complete temporary file, rename it over `path`, fsync the directory.
 fn commit(tmp: &Path, path: &Path) -> Result<(), OutputError> {
-    let io_err = |op, source| OutputError::Io { path: path.to_path_buf(), op, source };
-    let f = OpenOptions::new().read(true).write(true).open(tmp).map_err(|e| io_err("reopen temporary file", e))?;
+    let io_err = |op, source| OutputError::Io {
+        path: path.to_path_buf(),
+        op,
+        source,
+    };
+    let f = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(tmp)
+        .map_err(|e| io_err("reopen temporary file", e))?;
     f.sync_all().map_err(|e| io_err("fsync", e))?;
     drop(f);
     if let Ok(meta) = fs::metadata(path) {
@@ -155,7 +176,11 @@ fn commit(tmp: &Path, path: &Path) -> Result<(), OutputError> {
     fs::rename(tmp, path).map_err(|e| io_err("rename temporary file", e))?;
     #[cfg(unix)]
     if let Some(dir) = path.parent() {
-        let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
+        let dir = if dir.as_os_str().is_empty() {
+            Path::new(".")
+        } else {
+            dir
+        };
         // Best effort: some file systems do not support fsync on directories.
         if let Ok(d) = File::open(dir) {
             let _ = d.sync_all();
@@ -177,8 +202,15 @@ where
     let (file, tmp) = create_temp(path)?;
     let result = (|| {
         let mut w = BufWriter::new(file);
-        write(&mut w).map_err(|e| OutputError::Content { path: path.to_path_buf(), source: e.into() })?;
-        w.flush().map_err(|e| OutputError::Io { path: path.to_path_buf(), op: "write", source: e })?;
+        write(&mut w).map_err(|e| OutputError::Content {
+            path: path.to_path_buf(),
+            source: e.into(),
+        })?;
+        w.flush().map_err(|e| OutputError::Io {
+            path: path.to_path_buf(),
+            op: "write",
+            source: e,
+        })?;
         drop(w);
         commit(&tmp, path)
     })();
@@ -200,7 +232,10 @@ where
     let (file, tmp) = create_temp(path)?;
     drop(file);
     let result = produce(&tmp)
-        .map_err(|e| OutputError::Content { path: path.to_path_buf(), source: e.into() })
+        .map_err(|e| OutputError::Content {
+            path: path.to_path_buf(),
+            source: e.into(),
+        })
         .and_then(|()| commit(&tmp, path));
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
@@ -399,7 +434,11 @@ fn cell_fields(c: &CellResult) -> Vec<String> {
                 opt(first.map(|i| i[0])),
                 opt(first.map(|i| i[1])),
                 s.stable_intervals.len().to_string(),
-                s.stable_intervals.iter().map(|[a, b]| format!("{}:{}", num(*a), num(*b))).collect::<Vec<_>>().join(";"),
+                s.stable_intervals
+                    .iter()
+                    .map(|[a, b]| format!("{}:{}", num(*a), num(*b)))
+                    .collect::<Vec<_>>()
+                    .join(";"),
                 s.open_ended.to_string(),
                 String::new(),
             ]
@@ -425,7 +464,14 @@ fn cell_json(c: &CellResult) -> serde_json::Map<String, Value> {
             m.insert("error".into(), Value::Null);
         }
         Err(e) => {
-            for k in ["weave_speed", "capsize_speed", "weave_real_pair_merge", "stable_intervals", "stable_width", "open_ended"] {
+            for k in [
+                "weave_speed",
+                "capsize_speed",
+                "weave_real_pair_merge",
+                "stable_intervals",
+                "stable_width",
+                "open_ended",
+            ] {
                 m.insert(k.into(), Value::Null);
             }
             m.insert("error".into(), json!({"stage": e.stage, "message": e.message}));
@@ -436,7 +482,9 @@ fn cell_json(c: &CellResult) -> serde_json::Map<String, Value> {
 
 /// Header of the parameter-sweep CSV: the parameter's name, then the cell columns.
 pub fn parameter_sweep_csv_header(s: &ParameterSweep) -> Vec<String> {
-    std::iter::once(s.param.name.clone()).chain(CELL_COLUMNS.iter().map(|c| c.to_string())).collect()
+    std::iter::once(s.param.name.clone())
+        .chain(CELL_COLUMNS.iter().map(|c| c.to_string()))
+        .collect()
 }
 
 /// Write a parameter sweep as CSV, one row per parameter value.
@@ -555,7 +603,11 @@ fn summary_row(c: &CellResult) -> Vec<String> {
             if s.stable_intervals.is_empty() {
                 "-".into()
             } else {
-                s.stable_intervals.iter().map(|[a, b]| format!("[{a:.3}, {b:.3}]")).collect::<Vec<_>>().join(" ")
+                s.stable_intervals
+                    .iter()
+                    .map(|[a, b]| format!("[{a:.3}, {b:.3}]"))
+                    .collect::<Vec<_>>()
+                    .join(" ")
             },
         ],
         Err(e) => vec!["-".into(), "-".into(), "-".into(), format!("error: {e}")],
@@ -566,8 +618,9 @@ const SUMMARY_HEADER: [&str; 4] = ["v_w (m/s)", "v_c (m/s)", "stable width (m/s)
 
 /// Aligned plain-text table of a parameter sweep (`+` marks a width cut off at `speed_max`).
 pub fn format_parameter_table(s: &ParameterSweep) -> String {
-    let header: Vec<String> =
-        std::iter::once(s.param.name.clone()).chain(SUMMARY_HEADER.iter().map(|h| h.to_string())).collect();
+    let header: Vec<String> = std::iter::once(s.param.name.clone())
+        .chain(SUMMARY_HEADER.iter().map(|h| h.to_string()))
+        .collect();
     let rows: Vec<Vec<String>> = s
         .param
         .values

@@ -101,10 +101,16 @@ pub enum ImageFormat {
 impl ImageFormat {
     /// Format from the (case-insensitive) extension of `path`.
     pub fn from_path(path: &Path) -> Result<Self, PlotError> {
-        match path.extension().map(|e| e.to_string_lossy().to_ascii_lowercase()).as_deref() {
+        match path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase())
+            .as_deref()
+        {
             Some("svg") => Ok(ImageFormat::Svg),
             Some("png") => Ok(ImageFormat::Png),
-            _ => Err(PlotError::UnsupportedFormat { path: path.to_path_buf() }),
+            _ => Err(PlotError::UnsupportedFormat {
+                path: path.to_path_buf(),
+            }),
         }
     }
 }
@@ -129,7 +135,7 @@ pub enum LegendPosition {
 }
 
 /// Plot options. `PlotOptions::default()` gives an 800x600 figure with
-/// automatic ranges, no title, 16 px text and an automatically placed legend.
+/// automatic ranges, no title, 18 px text and an automatically placed legend.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlotOptions {
     /// Width in pixels at `scale = 1` (default 800).
@@ -152,7 +158,8 @@ pub struct PlotOptions {
     pub x_label: Option<String>,
     /// Vertical axis label; default "eigenvalue (1/s)" or the parameter name.
     pub y_label: Option<String>,
-    /// Base font size in pixels at `scale = 1` (default 16).
+    /// Base font size in pixels at `scale = 1` (default 18; plotters renders SVG
+    /// text at this size / 1.24).
     pub font_size: f64,
     /// Legend placement (default [`LegendPosition::Auto`]).
     pub legend: LegendPosition,
@@ -174,7 +181,7 @@ impl Default for PlotOptions {
             y_range: None,
             x_label: None,
             y_label: None,
-            font_size: 16.0,
+            font_size: 18.0,
             legend: LegendPosition::Auto,
             show_stable_band: true,
             font_path: None,
@@ -184,7 +191,12 @@ impl Default for PlotOptions {
 
 impl PlotOptions {
     fn check(&self, path: &Path) -> Result<(), PlotError> {
-        let bad = |m: String| Err(PlotError::InvalidOptions { path: path.to_path_buf(), message: m });
+        let bad = |m: String| {
+            Err(PlotError::InvalidOptions {
+                path: path.to_path_buf(),
+                message: m,
+            })
+        };
         if !(self.scale.is_finite() && self.scale > 0.0) {
             return bad(format!("scale must be positive, got {}", self.scale));
         }
@@ -206,7 +218,10 @@ impl PlotOptions {
     }
 
     fn pixel_size(&self) -> (u32, u32) {
-        ((self.width as f64 * self.scale).round() as u32, (self.height as f64 * self.scale).round() as u32)
+        (
+            (self.width as f64 * self.scale).round() as u32,
+            (self.height as f64 * self.scale).round() as u32,
+        )
     }
 
     fn px(&self, x: f64) -> f64 {
@@ -249,7 +264,12 @@ const FONT_CANDIDATES: &[&str] = &[
     "C:\\Windows\\Fonts\\arial.ttf",
 ];
 
-const FONT_DIRS: &[&str] = &["/usr/share/fonts", "/usr/local/share/fonts", "/System/Library/Fonts", "/Library/Fonts"];
+const FONT_DIRS: &[&str] = &[
+    "/usr/share/fonts",
+    "/usr/local/share/fonts",
+    "/System/Library/Fonts",
+    "/Library/Fonts",
+];
 
 fn scan_fonts(dir: &Path, depth: u32, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
@@ -299,10 +319,24 @@ pub fn find_font() -> Result<PathBuf, PlotError> {
     }
     searched.extend(dirs);
     let score = |p: &PathBuf| {
-        let n = p.file_stem().map(|s| s.to_string_lossy().to_ascii_lowercase()).unwrap_or_default();
-        let styled = ["bold", "italic", "oblique", "light", "mono", "condensed", "black", "thin", "narrow", "serif"]
-            .iter()
-            .any(|s| n.replace("sans", "").contains(s));
+        let n = p
+            .file_stem()
+            .map(|s| s.to_string_lossy().to_ascii_lowercase())
+            .unwrap_or_default();
+        let styled = [
+            "bold",
+            "italic",
+            "oblique",
+            "light",
+            "mono",
+            "condensed",
+            "black",
+            "thin",
+            "narrow",
+            "serif",
+        ]
+        .iter()
+        .any(|s| n.replace("sans", "").contains(s));
         (!n.contains("sans") as u8) + 2 * (styled as u8)
     };
     found.sort_by_key(score);
@@ -331,8 +365,10 @@ pub fn use_font(path: impl AsRef<Path>) -> Result<(), PlotError> {
 }
 
 fn register_file(path: &Path) -> Result<(), PlotError> {
-    let bytes = std::fs::read(path)
-        .map_err(|e| PlotError::Font { path: path.to_path_buf(), message: e.to_string() })?;
+    let bytes = std::fs::read(path).map_err(|e| PlotError::Font {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
     // plotters' ab_glyph registry needs 'static bytes; the leak is bounded by
     // one copy per distinct font file (see `use_font`).
     static LEAKED: Mutex<Vec<(PathBuf, &'static [u8])>> = Mutex::new(Vec::new());
@@ -380,7 +416,10 @@ fn render(path: &Path, opts: &PlotOptions, fig: &impl Figure) -> Result<(), Plot
     opts.check(path)?;
     ensure_font(opts)?;
     let size = opts.pixel_size();
-    let drawing = |message| PlotError::Drawing { path: path.to_path_buf(), message };
+    let drawing = |message| PlotError::Drawing {
+        path: path.to_path_buf(),
+        message,
+    };
     match format {
         ImageFormat::Svg => {
             let mut svg = String::new();
@@ -445,7 +484,11 @@ fn tick(v: f64) -> String {
     }
     let decimals = (5 - mag).clamp(0, 10) as usize;
     let s = format!("{v:.decimals$}");
-    let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s };
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    };
     if s == "-0" {
         "0".into()
     } else {
@@ -509,26 +552,45 @@ fn clip_polyline(pts: &[(f64, f64)], (x0, x1): (f64, f64), (y0, y1): (f64, f64))
     out
 }
 
-/// Width of the left label area: widest tick label of `lo..hi` (with about
-/// `n` "nice" ticks, as plotters chooses them) plus tick marks and the rotated
-/// axis description.
-fn label_area_width<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, o: &PlotOptions, (lo, hi): (f64, f64), n: usize) -> u32 {
-    let font = o.font(0.9);
+/// Width of the widest tick label of `lo..hi` with about `n` "nice" ticks
+/// (1-2-5 steps, as plotters chooses them).
+fn widest_tick<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    font: &TextStyle<'_>,
+    (lo, hi): (f64, f64),
+    n: usize,
+) -> u32 {
     let raw = (hi - lo) / n.max(1) as f64;
     let mut widest = 0;
     if raw.is_finite() && raw > 0.0 {
         let p = 10f64.powf(raw.log10().floor());
-        let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * p).find(|s| *s >= raw).unwrap_or(10.0 * p);
-        let mut v = (lo / step).ceil() * step;
-        let mut guard = 0;
-        while v <= hi && guard < 100 {
-            let w = root.estimate_text_size(&tick(v), &font).map(|t| t.0).unwrap_or(0);
+        let step = [1.0, 2.0, 5.0, 10.0]
+            .iter()
+            .map(|m| m * p)
+            .find(|s| *s >= raw)
+            .unwrap_or(10.0 * p);
+        let mut k = (lo / step).ceil();
+        while k * step <= hi && widest < 10_000 {
+            let w = root.estimate_text_size(&tick(k * step), font).map(|t| t.0).unwrap_or(0);
             widest = widest.max(w);
-            v += step;
-            guard += 1;
+            k += 1.0;
+            if k > (lo / step).ceil() + 100.0 {
+                break;
+            }
         }
     }
-    widest + o.pxu(5.0 + 8.0) + o.pxu(o.font_size * 1.9)
+    widest
+}
+
+/// Width of the left label area: widest tick label plus tick marks and the
+/// rotated axis description.
+fn label_area_width<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    o: &PlotOptions,
+    range: (f64, f64),
+    n: usize,
+) -> u32 {
+    widest_tick(root, &o.font(0.9), range, n) + o.pxu(5.0 + 8.0) + o.pxu(o.font_size * 1.9)
 }
 
 fn padded(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
@@ -576,13 +638,21 @@ fn continuation_curves(sweep: &EigenSweep) -> Vec<Curve> {
                     Some(&r) => cur.push((p.v, r)),
                     None => {
                         if !cur.is_empty() {
-                            curves.push(Curve { class, imag: false, points: std::mem::take(&mut cur) });
+                            curves.push(Curve {
+                                class,
+                                imag: false,
+                                points: std::mem::take(&mut cur),
+                            });
                         }
                     }
                 }
             }
             if !cur.is_empty() {
-                curves.push(Curve { class, imag: false, points: cur });
+                curves.push(Curve {
+                    class,
+                    imag: false,
+                    points: cur,
+                });
             }
         }
         // Imaginary part: largest positive imaginary part of the class; pieces
@@ -603,12 +673,16 @@ fn continuation_curves(sweep: &EigenSweep) -> Vec<Curve> {
         let positive = |k: usize| im[k].is_some_and(|x| x > 0.0);
         let mut cur: Vec<(f64, f64)> = Vec::new();
         for k in 0..n {
-            let include = positive(k)
-                || (im[k].is_some() && ((k > 0 && positive(k - 1)) || (k + 1 < n && positive(k + 1))));
+            let include =
+                positive(k) || (im[k].is_some() && ((k > 0 && positive(k - 1)) || (k + 1 < n && positive(k + 1))));
             if include {
                 cur.push((sweep.points[k].v, im[k].unwrap_or(0.0)));
                 if !positive(k) && cur.len() > 1 {
-                    curves.push(Curve { class, imag: true, points: std::mem::take(&mut cur) });
+                    curves.push(Curve {
+                        class,
+                        imag: true,
+                        points: std::mem::take(&mut cur),
+                    });
                     // A zero sample can also start the next piece.
                     if k + 1 < n && positive(k + 1) {
                         cur.push((sweep.points[k].v, 0.0));
@@ -616,13 +690,21 @@ fn continuation_curves(sweep: &EigenSweep) -> Vec<Curve> {
                 }
             } else if !cur.is_empty() {
                 if cur.len() > 1 {
-                    curves.push(Curve { class, imag: true, points: std::mem::take(&mut cur) });
+                    curves.push(Curve {
+                        class,
+                        imag: true,
+                        points: std::mem::take(&mut cur),
+                    });
                 }
                 cur.clear();
             }
         }
         if cur.len() > 1 {
-            curves.push(Curve { class, imag: true, points: cur });
+            curves.push(Curve {
+                class,
+                imag: true,
+                points: cur,
+            });
         }
     }
     curves
@@ -652,7 +734,9 @@ pub fn plot_continuation(
     let path = path.as_ref();
     ImageFormat::from_path(path)?;
     if sweep.points.is_empty() {
-        return Err(PlotError::NoData { path: path.to_path_buf() });
+        return Err(PlotError::NoData {
+            path: path.to_path_buf(),
+        });
     }
     let curves = continuation_curves(sweep);
     let xr = opts.x_range.unwrap_or_else(|| {
@@ -674,39 +758,62 @@ pub fn plot_continuation(
         let (lo, hi) = vals.fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), y| (l.min(y), h.max(y)));
         padded(lo, hi, 0.05)
     });
-    render(path, opts, &Continuation { sweep, critical, opts, curves, xr, yr })
+    render(
+        path,
+        opts,
+        &Continuation {
+            sweep,
+            critical,
+            opts,
+            curves,
+            xr,
+            yr,
+        },
+    )
 }
 
-/// Draw `text` with `sub` as a subscript after its first character
-/// (e.g. "v", "w", " = 4.29 m/s"), top-left at `(x, y)`.
+/// Layout of "main, subscript, rest" (e.g. "v", "w", " = 4.29 m/s"): x
+/// offsets of the three parts and the total width. Leading spaces of the rest
+/// become an explicit gap (SVG viewers drop leading whitespace in text).
+fn subscript_layout<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    parts: (&str, &str, &str),
+    o: &PlotOptions,
+) -> Result<([i32; 3], i32), DrawErr> {
+    let main = o.font(1.0);
+    let small = o.font(0.72);
+    let w1 = root.estimate_text_size(parts.0, &main).map_err(de)?.0 as i32;
+    let w2 = root.estimate_text_size(parts.1, &small).map_err(de)?.0 as i32;
+    let rest = parts.2.trim_start();
+    let gap = if rest.len() < parts.2.len() {
+        o.pxi(o.font_size * 0.3)
+    } else {
+        o.pxi(1.0)
+    };
+    let w3 = root.estimate_text_size(rest, &main).map_err(de)?.0 as i32;
+    Ok(([0, w1, w1 + w2 + gap], w1 + w2 + gap + w3))
+}
+
+/// Draw a subscripted label (see [`subscript_layout`]) with its top-left at `(x, y)`.
 fn draw_subscripted<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     (x, y): (i32, i32),
     parts: (&str, &str, &str),
-    opts: &PlotOptions,
+    o: &PlotOptions,
 ) -> Result<(), DrawErr> {
-    let main = opts.font(1.0);
-    let small = opts.font(0.72);
-    let w1 = root.estimate_text_size(parts.0, &main).map_err(de)?.0 as i32;
-    let w2 = root.estimate_text_size(parts.1, &small).map_err(de)?.0 as i32;
-    root.draw(&Text::new(parts.0.to_string(), (x, y), main.clone())).map_err(de)?;
-    root.draw(&Text::new(parts.1.to_string(), (x + w1, y + opts.pxi(opts.font_size * 0.45)), small))
+    let (off, _) = subscript_layout(root, parts, o)?;
+    let main = o.font(1.0);
+    root.draw(&Text::new(parts.0.to_string(), (x + off[0], y), main.clone()))
         .map_err(de)?;
-    root.draw(&Text::new(parts.2.to_string(), (x + w1 + w2 + opts.pxi(1.0), y), main)).map_err(de)?;
+    root.draw(&Text::new(
+        parts.1.to_string(),
+        (x + off[1], y + o.pxi(o.font_size * 0.45)),
+        o.font(0.72),
+    ))
+    .map_err(de)?;
+    root.draw(&Text::new(parts.2.trim_start().to_string(), (x + off[2], y), main))
+        .map_err(de)?;
     Ok(())
-}
-
-fn subscripted_width<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    parts: (&str, &str, &str),
-    opts: &PlotOptions,
-) -> Result<i32, DrawErr> {
-    let main = opts.font(1.0);
-    let small = opts.font(0.72);
-    Ok(root.estimate_text_size(parts.0, &main).map_err(de)?.0 as i32
-        + root.estimate_text_size(parts.1, &small).map_err(de)?.0 as i32
-        + root.estimate_text_size(parts.2, &main).map_err(de)?.0 as i32
-        + opts.pxi(1.0))
 }
 
 impl Figure for Continuation<'_> {
@@ -811,7 +918,10 @@ impl Figure for Continuation<'_> {
         }
         // Frame.
         chart
-            .draw_series(std::iter::once(Rectangle::new([(xr.0, yr.0), (xr.1, yr.1)], BLACK.stroke_width(o.pxu(1.0)))))
+            .draw_series(std::iter::once(Rectangle::new(
+                [(xr.0, yr.0), (xr.1, yr.1)],
+                BLACK.stroke_width(o.pxu(1.0)),
+            )))
             .map_err(de)?;
         // Crossing markers and annotations.
         let mut obstacles: Vec<(i32, i32, i32, i32)> = Vec::new();
@@ -827,7 +937,7 @@ impl Figure for Continuation<'_> {
         for (k, (v, sub)) in marks.iter().enumerate() {
             let value = format!(" = {} m/s", fmt_speed(*v));
             let parts = ("v", *sub, value.as_str());
-            let w = subscripted_width(root, parts, o)?;
+            let w = subscript_layout(root, parts, o)?.1;
             let (xv, _) = chart.backend_coord(&(*v, yr.1));
             let gap = o.pxi(5.0);
             // Lower mark: label left of its line; upper: right (outside the band).
@@ -837,7 +947,10 @@ impl Figure for Continuation<'_> {
             let y = py0 + o.pxi(6.0);
             // White backing so the label stays readable over the mesh.
             root.draw(&Rectangle::new(
-                [(x - o.pxi(2.0), y - o.pxi(1.0)), (x + w + o.pxi(2.0), y + o.pxi(o.font_size * 1.3))],
+                [
+                    (x - o.pxi(2.0), y - o.pxi(1.0)),
+                    (x + w + o.pxi(2.0), y + o.pxi(o.font_size * 1.3)),
+                ],
                 WHITE.mix(0.85).filled(),
             ))
             .map_err(de)?;
@@ -898,7 +1011,13 @@ impl Figure for Continuation<'_> {
         let entry_h = o.pxi(o.font_size * 0.9) + o.pxi(10.0).max(10);
         let box_w = longest + legend_len + o.pxi(25.0);
         let box_h = n_entries as i32 * entry_h + o.pxi(10.0);
-        let pos = choose_legend(o.legend, &chart_pixels(&chart, &self.curves, xr, yr), &obstacles, &chart, (box_w, box_h));
+        let pos = choose_legend(
+            o.legend,
+            &chart_pixels(&chart, &self.curves, xr, yr),
+            &obstacles,
+            &chart,
+            (box_w, box_h),
+        );
         chart
             .configure_series_labels()
             .position(pos)
@@ -918,10 +1037,16 @@ fn fmt_speed(v: f64) -> String {
     format!("{v:.2}")
 }
 
-type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
+type Chart<'a, DB> =
+    ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
 
 /// Curve samples in backend pixels, densified to ~4 px spacing.
-fn chart_pixels<DB: DrawingBackend>(chart: &Chart<'_, DB>, curves: &[Curve], xr: (f64, f64), yr: (f64, f64)) -> Vec<(i32, i32)> {
+fn chart_pixels<DB: DrawingBackend>(
+    chart: &Chart<'_, DB>,
+    curves: &[Curve],
+    xr: (f64, f64),
+    yr: (f64, f64),
+) -> Vec<(i32, i32)> {
     let mut out = Vec::new();
     for c in curves {
         for piece in clip_polyline(&c.points, xr, yr) {
@@ -1010,7 +1135,11 @@ fn viridis(t: f64) -> RGBColor {
     let k = (s.floor() as usize).min(C.len() - 2);
     let f = s - k as f64;
     let lerp = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
-    RGBColor(lerp(C[k].0, C[k + 1].0), lerp(C[k].1, C[k + 1].1), lerp(C[k].2, C[k + 1].2))
+    RGBColor(
+        lerp(C[k].0, C[k + 1].0),
+        lerp(C[k].1, C[k + 1].1),
+        lerp(C[k].2, C[k + 1].2),
+    )
 }
 
 /// Cell edges of a (sorted or unsorted) axis: midpoints between neighbours.
@@ -1019,8 +1148,20 @@ fn cell_edges(values: &[f64]) -> Vec<(f64, f64)> {
     (0..n)
         .map(|k| {
             let v = values[k];
-            let lo = if k > 0 { 0.5 * (values[k - 1] + v) } else if n > 1 { v - 0.5 * (values[1] - v) } else { v - 0.5 };
-            let hi = if k + 1 < n { 0.5 * (v + values[k + 1]) } else if n > 1 { v + 0.5 * (v - values[k - 1]) } else { v + 0.5 };
+            let lo = if k > 0 {
+                0.5 * (values[k - 1] + v)
+            } else if n > 1 {
+                v - 0.5 * (values[1] - v)
+            } else {
+                v - 0.5
+            };
+            let hi = if k + 1 < n {
+                0.5 * (v + values[k + 1])
+            } else if n > 1 {
+                v + 0.5 * (v - values[k - 1])
+            } else {
+                v + 0.5
+            };
             (lo.min(hi), lo.max(hi))
         })
         .collect()
@@ -1054,13 +1195,20 @@ pub fn plot_stability_map(
     ImageFormat::from_path(path)?;
     let (nx, ny) = map.shape();
     if nx == 0 || ny == 0 || map.cells.len() != nx * ny {
-        return Err(PlotError::NoData { path: path.to_path_buf() });
+        return Err(PlotError::NoData {
+            path: path.to_path_buf(),
+        });
     }
     if map.x.values.iter().chain(&map.y.values).any(|v| !v.is_finite()) {
-        return Err(PlotError::InvalidOptions { path: path.to_path_buf(), message: "non-finite grid value".into() });
+        return Err(PlotError::InvalidOptions {
+            path: path.to_path_buf(),
+            message: "non-finite grid value".into(),
+        });
     }
     let vals: Vec<f64> = map.cells.iter().filter_map(|c| quantity.value(c)).collect();
-    let (mut lo, hi) = vals.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    let (mut lo, hi) = vals
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
     if quantity == MapQuantity::StableWidth {
         lo = 0.0;
     }
@@ -1071,7 +1219,16 @@ pub fn plot_stability_map(
     } else {
         padded(lo, hi, 0.0)
     };
-    render(path, opts, &MapFigure { map, quantity, opts, vrange })
+    render(
+        path,
+        opts,
+        &MapFigure {
+            map,
+            quantity,
+            opts,
+            vrange,
+        },
+    )
 }
 
 impl Figure for MapFigure<'_> {
@@ -1084,16 +1241,40 @@ impl Figure for MapFigure<'_> {
             None => root.clone(),
         };
         let (w, _) = area.dim_in_pixel();
-        let cb_w = o.pxi(150.0).min(w as i32 / 3);
+        let (vlo, vhi) = self.vrange;
+        let any_missing = m.cells.iter().any(|c| c.is_ok() && self.quantity.value(c).is_none());
+        let any_failed = m.cells.iter().any(|c| c.is_err());
+        // Colour-bar column: bar, tick labels, rotated description; wide enough
+        // for the grey-patch labels below it.
+        let bar_x = o.pxi(14.0);
+        let bar_w = o.pxi(22.0);
+        let tick_font = o.font(0.85);
+        let tick_w = widest_tick(root, &tick_font, (vlo, vhi), 8) as i32;
+        let label_area = tick_w + o.pxi(10.0) + o.pxi(o.font_size * 0.95 * 1.25);
+        let patch_font = o.font(0.8);
+        let patch_text = [(any_missing, missing_label(self.quantity)), (any_failed, "failed")]
+            .iter()
+            .filter(|(show, _)| *show)
+            .map(|(_, t)| root.estimate_text_size(t, &patch_font).map(|d| d.0 as i32).unwrap_or(0))
+            .max()
+            .map(|t| bar_w + o.pxi(6.0) + t)
+            .unwrap_or(0);
+        let cb_w = (bar_x + (bar_w + label_area).max(patch_text) + o.pxi(12.0)).min(w as i32 / 3);
         let (main, side) = area.split_horizontally(w as i32 - cb_w);
 
         let xe = cell_edges(&m.x.values);
         let ye = cell_edges(&m.y.values);
         let xr = o.x_range.unwrap_or_else(|| {
-            (xe.iter().map(|e| e.0).fold(f64::INFINITY, f64::min), xe.iter().map(|e| e.1).fold(f64::NEG_INFINITY, f64::max))
+            (
+                xe.iter().map(|e| e.0).fold(f64::INFINITY, f64::min),
+                xe.iter().map(|e| e.1).fold(f64::NEG_INFINITY, f64::max),
+            )
         });
         let yr = o.y_range.unwrap_or_else(|| {
-            (ye.iter().map(|e| e.0).fold(f64::INFINITY, f64::min), ye.iter().map(|e| e.1).fold(f64::NEG_INFINITY, f64::max))
+            (
+                ye.iter().map(|e| e.0).fold(f64::INFINITY, f64::min),
+                ye.iter().map(|e| e.1).fold(f64::NEG_INFINITY, f64::max),
+            )
         });
         let mut chart = ChartBuilder::on(&main)
             .margin_top(o.pxu(18.0))
@@ -1104,23 +1285,14 @@ impl Figure for MapFigure<'_> {
             .y_label_area_size(label_area_width(root, o, yr, 10))
             .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
             .map_err(de)?;
-        let (vlo, vhi) = self.vrange;
-        let mut any_missing = false;
-        let mut any_failed = false;
         let (nx, ny) = m.shape();
         let mut rects = Vec::with_capacity(nx * ny);
         for i in 0..nx {
             for j in 0..ny {
                 let Some(c) = m.cell(i, j) else { continue };
                 let color = match (c, self.quantity.value(c)) {
-                    (Err(_), _) => {
-                        any_failed = true;
-                        FAILED
-                    }
-                    (Ok(_), None) => {
-                        any_missing = true;
-                        MISSING
-                    }
+                    (Err(_), _) => FAILED,
+                    (Ok(_), None) => MISSING,
                     (Ok(_), Some(v)) => viridis((v - vlo) / (vhi - vlo)),
                 };
                 let (x0, x1) = (xe[i].0.max(xr.0), xe[i].1.min(xr.1));
@@ -1150,7 +1322,10 @@ impl Figure for MapFigure<'_> {
             .map_err(de)?;
         // Frame around the map.
         chart
-            .draw_series(std::iter::once(Rectangle::new([(xr.0, yr.0), (xr.1, yr.1)], BLACK.stroke_width(o.pxu(1.0)))))
+            .draw_series(std::iter::once(Rectangle::new(
+                [(xr.0, yr.0), (xr.1, yr.1)],
+                BLACK.stroke_width(o.pxu(1.0)),
+            )))
             .map_err(de)?;
 
         // Colour bar, aligned with the plotting area.
@@ -1163,18 +1338,11 @@ impl Figure for MapFigure<'_> {
         let patch_h = o.pxi(o.font_size * 1.5);
         let bar_top = plot.1.start - side_y0;
         let bar_bottom = plot.1.end - side_y0 - patches * patch_h - if patches > 0 { o.pxi(8.0) } else { 0 };
-        let bar_x = o.pxi(14.0);
-        let bar_w = o.pxi(22.0);
-        // Right label area: widest tick label + gap + rotated description.
-        let tick_font = o.font(0.85);
-        let tick_w = [vlo, 0.5 * (vlo + vhi), vhi, vlo + 0.9 * (vhi - vlo)]
-            .iter()
-            .map(|v| root.estimate_text_size(&tick(*v), &tick_font).map(|t| t.0).unwrap_or(0))
-            .max()
-            .unwrap_or(0) as i32;
-        let label_area = tick_w + o.pxi(10.0) + o.pxi(o.font_size * 0.95 * 1.25);
         let bar = side.margin(bar_top.max(0) as u32, 0, 0, 0);
-        let bar = bar.shrink((bar_x, 0), ((bar_w + label_area) as u32, (bar_bottom - bar_top).max(10) as u32));
+        let bar = bar.shrink(
+            (bar_x, 0),
+            ((bar_w + label_area) as u32, (bar_bottom - bar_top).max(10) as u32),
+        );
         let mut cb = ChartBuilder::on(&bar)
             .right_y_label_area_size(label_area as u32)
             .build_cartesian_2d(0.0..1.0, vlo..vhi)
@@ -1198,26 +1366,39 @@ impl Figure for MapFigure<'_> {
             .y_desc(self.quantity.label())
             .draw()
             .map_err(de)?;
-        cb.draw_series(std::iter::once(Rectangle::new([(0.0, vlo), (1.0, vhi)], BLACK.stroke_width(o.pxu(1.0)))))
-            .map_err(de)?;
+        cb.draw_series(std::iter::once(Rectangle::new(
+            [(0.0, vlo), (1.0, vhi)],
+            BLACK.stroke_width(o.pxu(1.0)),
+        )))
+        .map_err(de)?;
 
         // Grey patches for missing / failed cells, below the bar.
         let mut y = plot.1.end - patches * patch_h;
         let x = side_x0 + bar_x;
-        for (show, color, label) in [(any_missing, MISSING, missing_label(self.quantity)), (any_failed, FAILED, "failed")] {
+        for (show, color, label) in [
+            (any_missing, MISSING, missing_label(self.quantity)),
+            (any_failed, FAILED, "failed"),
+        ] {
             if !show {
                 continue;
             }
             let s = o.pxi(o.font_size * 0.9);
-            root.draw(&Rectangle::new([(x, y + o.pxi(2.0)), (x + bar_w, y + o.pxi(2.0) + s)], color.filled()))
-                .map_err(de)?;
+            root.draw(&Rectangle::new(
+                [(x, y + o.pxi(2.0)), (x + bar_w, y + o.pxi(2.0) + s)],
+                color.filled(),
+            ))
+            .map_err(de)?;
             root.draw(&Rectangle::new(
                 [(x, y + o.pxi(2.0)), (x + bar_w, y + o.pxi(2.0) + s)],
                 BLACK.stroke_width(o.pxu(1.0)),
             ))
             .map_err(de)?;
-            root.draw(&Text::new(label.to_string(), (x + bar_w + o.pxi(6.0), y + o.pxi(2.0)), o.font(0.8)))
-                .map_err(de)?;
+            root.draw(&Text::new(
+                label.to_string(),
+                (x + bar_w + o.pxi(6.0), y + o.pxi(2.0)),
+                patch_font.clone(),
+            ))
+            .map_err(de)?;
             y += patch_h;
         }
         Ok(())

@@ -36,6 +36,8 @@ pub trait Scalar:
     fn cos(self) -> Self;
     fn sqrt(self) -> Self;
     fn powi(self, n: i32) -> Self;
+    /// `(sin, cos)` in one call (generated code pairs them).
+    fn sin_cos(self) -> (Self, Self);
     #[inline(always)]
     fn zero() -> Self {
         Self::cst(0.0)
@@ -70,6 +72,10 @@ impl Scalar for f64 {
     #[inline(always)]
     fn powi(self, n: i32) -> Self {
         f64::powi(self, n)
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        f64::sin_cos(self)
     }
 }
 
@@ -200,6 +206,11 @@ impl<const N: usize> Scalar for Dual<N> {
     fn powi(self, n: i32) -> Self {
         let p = self.re.powi(n - 1);
         self.chain(p * self.re, n as f64 * p)
+    }
+    #[inline(always)]
+    fn sin_cos(self) -> (Self, Self) {
+        let (s, c) = self.re.sin_cos();
+        (self.chain(s, c), self.chain(c, -s))
     }
 }
 

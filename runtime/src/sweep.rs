@@ -60,13 +60,15 @@ impl Default for SweepOptions {
 impl SweepOptions {
     /// Options with the speed range `[speed_min, speed_max]` and other fields default.
     pub fn with_speed_range(speed_min: f64, speed_max: f64) -> Self {
-        Self { speed_min, speed_max, ..Self::default() }
+        Self {
+            speed_min,
+            speed_max,
+            ..Self::default()
+        }
     }
 
     fn validate(&self) -> Result<(), SweepError> {
-        if !(self.speed_min.is_finite() && self.speed_max.is_finite())
-            || self.speed_min >= self.speed_max
-        {
+        if !(self.speed_min.is_finite() && self.speed_max.is_finite()) || self.speed_min >= self.speed_max {
             return Err(SweepError::InvalidSpeedRange {
                 speed_min: self.speed_min,
                 speed_max: self.speed_max,
@@ -140,7 +142,7 @@ impl StabilitySummary {
             .iter()
             .map(|[lo, hi]| (hi - lo).max(0.0))
             .filter(|w| w.is_finite())
-            .sum();
+            .fold(0.0, |a, w| a + w); // not `sum()`: that gives -0.0 when empty
         let open_ended = c
             .stable_intervals
             .last()
@@ -173,7 +175,10 @@ pub struct ParamAxis {
 impl ParamAxis {
     /// New axis.
     pub fn new(name: impl Into<String>, values: Vec<f64>) -> Self {
-        Self { name: name.into(), values }
+        Self {
+            name: name.into(),
+            values,
+        }
     }
 }
 
@@ -287,11 +292,7 @@ pub fn speed_sweep(c: &CanonicalMatrices, speeds: &[f64]) -> Result<EigenSweep, 
 /// `map` is where the caller linearizes its model at the parameter value. Its
 /// errors (and panics) are recorded per value, as are eigen-analysis errors.
 /// Fails as a whole only for an invalid speed range.
-pub fn parameter_sweep<F, E>(
-    param: ParamAxis,
-    map: F,
-    opts: &SweepOptions,
-) -> Result<ParameterSweep, SweepError>
+pub fn parameter_sweep<F, E>(param: ParamAxis, map: F, opts: &SweepOptions) -> Result<ParameterSweep, SweepError>
 where
     F: Fn(f64) -> Result<CanonicalMatrices, E> + Sync,
     E: Display,
@@ -308,18 +309,17 @@ where
         })
         .collect();
     progress.finish();
-    Ok(ParameterSweep { param, speed_range: [opts.speed_min, opts.speed_max], points })
+    Ok(ParameterSweep {
+        param,
+        speed_range: [opts.speed_min, opts.speed_max],
+        points,
+    })
 }
 
 /// Critical speeds over the grid `x.values x y.values` (row-major, `x` outer), in parallel.
 ///
 /// Same error policy as [`parameter_sweep`].
-pub fn stability_map<F, E>(
-    x: ParamAxis,
-    y: ParamAxis,
-    map: F,
-    opts: &SweepOptions,
-) -> Result<StabilityMap, SweepError>
+pub fn stability_map<F, E>(x: ParamAxis, y: ParamAxis, map: F, opts: &SweepOptions) -> Result<StabilityMap, SweepError>
 where
     F: Fn(f64, f64) -> Result<CanonicalMatrices, E> + Sync,
     E: Display,
@@ -337,28 +337,41 @@ where
         })
         .collect();
     progress.finish();
-    Ok(StabilityMap { x, y, speed_range: [opts.speed_min, opts.speed_max], cells })
+    Ok(StabilityMap {
+        x,
+        y,
+        speed_range: [opts.speed_min, opts.speed_max],
+        cells,
+    })
 }
 
-fn evaluate_cell<E: Display>(
-    map: impl FnOnce() -> Result<CanonicalMatrices, E>,
-    opts: &SweepOptions,
-) -> CellResult {
+fn evaluate_cell<E: Display>(map: impl FnOnce() -> Result<CanonicalMatrices, E>, opts: &SweepOptions) -> CellResult {
     let c = match catch_unwind(AssertUnwindSafe(map)) {
         Ok(Ok(c)) => c,
-        Ok(Err(e)) => return Err(CellError { stage: CellStage::Model, message: e.to_string() }),
+        Ok(Err(e)) => {
+            return Err(CellError {
+                stage: CellStage::Model,
+                message: e.to_string(),
+            })
+        }
         Err(payload) => {
             let message = payload
                 .downcast_ref::<&str>()
                 .map(|s| s.to_string())
                 .or_else(|| payload.downcast_ref::<String>().cloned())
                 .unwrap_or_else(|| "panic".to_string());
-            return Err(CellError { stage: CellStage::Panic, message });
+            return Err(CellError {
+                stage: CellStage::Panic,
+                message,
+            });
         }
     };
     critical_speeds(&c, opts.speed_min, opts.speed_max)
         .map(|cs| StabilitySummary::from_critical(&cs, opts.speed_max))
-        .map_err(|e| CellError { stage: CellStage::Eigen, message: e.to_string() })
+        .map_err(|e| CellError {
+            stage: CellStage::Eigen,
+            message: e.to_string(),
+        })
 }
 
 /// Progress bar that starts hidden and is switched to stderr after the delay
@@ -374,13 +387,17 @@ impl Progress {
     fn new(len: usize, what: &'static str, opts: &SweepOptions) -> Self {
         let enabled = opts.progress && std::io::stderr().is_terminal() && len > 1;
         let bar = ProgressBar::with_draw_target(Some(len as u64), ProgressDrawTarget::hidden());
-        if let Ok(style) = ProgressStyle::with_template(
-            "{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} (eta {eta})",
-        ) {
+        if let Ok(style) = ProgressStyle::with_template("{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} (eta {eta})")
+        {
             bar.set_style(style);
         }
         bar.set_message(what);
-        Self { bar, enabled, shown: AtomicBool::new(false), delay: opts.progress_delay }
+        Self {
+            bar,
+            enabled,
+            shown: AtomicBool::new(false),
+            delay: opts.progress_delay,
+        }
     }
 
     fn inc(&self) {
@@ -428,12 +445,16 @@ mod tests {
         assert_eq!(s.first_stable_interval(), Some([4.0, 6.0]));
         let s = StabilitySummary::from_critical(&CriticalSpeeds::default(), 10.0);
         assert_eq!((s.stable_width, s.open_ended), (0.0, false));
+        assert!(s.stable_width.is_sign_positive(), "no -0.0 in outputs");
         assert_eq!(MapQuantity::StableWidth.value(&Ok(s)), None);
     }
 
     #[test]
     fn sweep_invalid_options_rejected() {
-        let o = SweepOptions { speed_min: f64::NAN, ..SweepOptions::default() };
+        let o = SweepOptions {
+            speed_min: f64::NAN,
+            ..SweepOptions::default()
+        };
         assert!(o.validate().is_err());
         assert!(SweepOptions::with_speed_range(3.0, 3.0).validate().is_err());
         assert!(SweepOptions::default().validate().is_ok());

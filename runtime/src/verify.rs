@@ -108,6 +108,7 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
     let mut a_pow_v = Acc::new("power p'^T Qv = -1/2 p'^T dM/dt p'", tol);
     let mut a_pow_g = Acc::new("power p'^T Qgrav = -dV/dt", tol);
     let mut a_t = Acc::new("T = 1/2 p'^T M p'", 1e-13);
+    let mut a_all = Acc::new("all_quantities = individual functions", 1e-12);
     for _ in 0..opts.states {
         let p: Vec<f64> = (0..nq).map(|j| M::INITIAL_GUESS[j] + rng.uniform(-0.6, 0.6)).collect();
         let dp: Vec<f64> = (0..nq).map(|_| rng.uniform(-3.0, 3.0)).collect();
@@ -214,6 +215,29 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         // T = 1/2 p'^T M p'.
         let tt = 0.5 * (0..nq).map(|a| (0..nq).map(|c| dp[a] * m0[a * nq + c] * dp[c]).sum::<f64>()).sum::<f64>();
         a_t.compare(&[M::kinetic_energy(param, &p, &dp)], &[tt]);
+        // all_quantities must reproduce every individual function.
+        let total: usize = M::ALL_QUANTITIES_LAYOUT.iter().map(|x| x.2).sum();
+        let mut all = vec![0.0; total];
+        M::all_quantities(param, t, &p, &dp, &mut all);
+        for &(name, off, len) in M::ALL_QUANTITIES_LAYOUT {
+            let mut one = vec![0.0; len];
+            match name {
+                "mass_matrix" => M::mass_matrix(param, &p, &mut one),
+                "quadratic_velocity_forces" => M::quadratic_velocity_forces(param, &p, &dp, &mut one),
+                "gravity_forces" => M::gravity_forces(param, &p, &mut one),
+                "applied_forces" => M::applied_forces(param, t, &p, &dp, &mut one),
+                "holonomic_residuals" => M::holonomic_residuals(param, t, &p, &mut one),
+                "holonomic_jacobian" => M::holonomic_jacobian(param, t, &p, &mut one),
+                "holonomic_time_derivative" => M::holonomic_time_derivative(param, t, &p, &mut one),
+                "holonomic_convective" => M::holonomic_convective(param, t, &p, &dp, &mut one),
+                "nonholonomic_velocities" => M::nonholonomic_velocities(param, t, &p, &dp, &mut one),
+                "nonholonomic_matrix" => M::nonholonomic_matrix(param, t, &p, &mut one),
+                "nonholonomic_convective" => M::nonholonomic_convective(param, t, &p, &dp, &mut one),
+                "point_positions" => M::point_positions(param, &p, &mut one),
+                _ => one.copy_from_slice(&all[off..off + len]),
+            }
+            a_all.compare(&all[off..off + len], &one);
+        }
         // Power identities.
         let pq: f64 = (0..nq).map(|a| dp[a] * qv[a]).sum();
         let pm: f64 = -0.5 * (0..nq).map(|a| (0..nq).map(|c| dp[a] * mdot[a * nq + c] * dp[c]).sum::<f64>()).sum::<f64>();
@@ -225,7 +249,7 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         a_pow_g.compare(&[pg / vs], &[-dvdt / vs]);
     }
     let quantities: Vec<QuantityCheck> =
-        [a_cq, a_ct, a_dcq, a_b, a_dbdp, a_qv, a_qg, a_sym, a_psd, a_t, a_pow_v, a_pow_g].into_iter().map(Acc::done).collect();
+        [a_cq, a_ct, a_dcq, a_b, a_dbdp, a_qv, a_qg, a_sym, a_psd, a_t, a_pow_v, a_pow_g, a_all].into_iter().map(Acc::done).collect();
     VerifyReport {
         model: M::NAME.into(),
         states: opts.states,

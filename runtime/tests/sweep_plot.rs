@@ -10,15 +10,14 @@ use std::path::{Path, PathBuf};
 
 use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::output::{
-    eigen_sweep_csv_header, eigen_sweep_json, format_eigen_table, format_parameter_table,
-    format_stability_map_table, parameter_sweep_json, save_eigen_sweep_csv, save_eigen_sweep_json,
-    save_parameter_sweep_csv, save_stability_map_csv, save_stability_map_json, stability_map_json,
-    write_atomic, write_eigen_sweep_csv, write_stability_map_csv, OutputError,
+    eigen_sweep_csv_header, eigen_sweep_json, format_eigen_table, format_parameter_table, format_stability_map_table,
+    parameter_sweep_json, save_eigen_sweep_csv, save_eigen_sweep_json, save_parameter_sweep_csv,
+    save_stability_map_csv, save_stability_map_json, stability_map_json, write_atomic, write_eigen_sweep_csv,
+    write_stability_map_csv, OutputError,
 };
 use bikedyn_runtime::plot::{plot_continuation, plot_stability_map, use_font, PlotError, PlotOptions};
 use bikedyn_runtime::sweep::{
-    linspace, parameter_sweep, speed_sweep, stability_map, CellStage, MapQuantity, ParamAxis,
-    SweepError, SweepOptions,
+    linspace, parameter_sweep, speed_sweep, stability_map, CellStage, MapQuantity, ParamAxis, SweepError, SweepOptions,
 };
 use nalgebra::Matrix2;
 
@@ -46,8 +45,10 @@ fn test_dir(name: &str) -> PathBuf {
 }
 
 fn entries(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> =
-        fs::read_dir(dir).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    let mut v: Vec<String> = fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
     v.sort();
     v
 }
@@ -85,7 +86,10 @@ fn scaled(a: f64, b: f64) -> Result<CanonicalMatrices, String> {
 }
 
 fn quiet(speed_min: f64, speed_max: f64) -> SweepOptions {
-    SweepOptions { progress: false, ..SweepOptions::with_speed_range(speed_min, speed_max) }
+    SweepOptions {
+        progress: false,
+        ..SweepOptions::with_speed_range(speed_min, speed_max)
+    }
 }
 
 #[test]
@@ -121,7 +125,12 @@ fn sweep_speed_json_schema() {
         .iter()
         .map(|e| [e[0].as_f64().unwrap(), e[1].as_f64().unwrap()])
         .collect();
-    let modes: Vec<&str> = p["modes"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
+    let modes: Vec<&str> = p["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m.as_str().unwrap())
+        .collect();
     assert_eq!(modes, ["weave", "weave", "capsize", "castering"]);
     let expect = [
         [-0.77534188219585, 4.46486771378823],
@@ -130,7 +139,10 @@ fn sweep_speed_json_schema() {
         [-14.0783896927982, 0.0],
     ];
     for (a, b) in ev.iter().zip(&expect) {
-        assert!((a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9, "{a:?} vs {b:?}");
+        assert!(
+            (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9,
+            "{a:?} vs {b:?}"
+        );
     }
 
     // File round trip.
@@ -276,8 +288,12 @@ fn sweep_failed_cells_are_recorded_not_fatal() {
 
 #[test]
 fn sweep_parameter_sweep_outputs() {
-    let p = parameter_sweep(ParamAxis::new("K2 scale", linspace(0.6, 1.4, 17)), |a| scaled(a, 1.0), &quiet(0.0, 10.0))
-        .unwrap();
+    let p = parameter_sweep(
+        ParamAxis::new("K2 scale", linspace(0.6, 1.4, 17)),
+        |a| scaled(a, 1.0),
+        &quiet(0.0, 10.0),
+    )
+    .unwrap();
     assert_eq!(p.points.len(), 17);
     let s = p.points[8].as_ref().unwrap();
     assert!((s.weave_speed.unwrap() - WEAVE_SPEED).abs() < 1e-6);
@@ -317,7 +333,10 @@ fn sweep_output_missing_directory_is_typed_error_without_file() {
 
     // Plots report it the same way.
     let err = plot_continuation(dir.join("nope").join("fig.png"), &sweep, None, &PlotOptions::default()).unwrap_err();
-    assert!(matches!(err, PlotError::Output(OutputError::NoSuchDirectory { .. })), "{err:?}");
+    assert!(
+        matches!(err, PlotError::Output(OutputError::NoSuchDirectory { .. })),
+        "{err:?}"
+    );
     assert!(entries(&dir).is_empty());
 }
 
@@ -352,7 +371,6 @@ fn sweep_output_atomic_write_keeps_old_file_on_failure() {
     assert_eq!(fs::read(&png).unwrap(), b"old figure");
 }
 
-
 #[test]
 fn plot_continuation_svg_and_png() {
     let c = benchmark();
@@ -364,14 +382,24 @@ fn plot_continuation_svg_and_png() {
     plot_continuation(dir.join("fig.png"), &sweep, Some(&crit), &opts).unwrap();
     let svg = fs::read_to_string(dir.join("fig.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.len() > 1000);
-    for label in ["weave", "capsize", "castering", "forward speed v (m/s)", "eigenvalue (1/s)"] {
+    for label in [
+        "weave",
+        "capsize",
+        "castering",
+        "forward speed v (m/s)",
+        "eigenvalue (1/s)",
+    ] {
         assert!(svg.contains(label), "SVG lacks {label}");
     }
     let png = fs::read(dir.join("fig.png")).unwrap();
     assert!(png.len() > 1000);
     assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     // Clipped y range and upper-case extension.
-    let clipped = PlotOptions { y_range: Some((-10.0, 10.0)), title: Some("benchmark".into()), ..PlotOptions::default() };
+    let clipped = PlotOptions {
+        y_range: Some((-10.0, 10.0)),
+        title: Some("benchmark".into()),
+        ..PlotOptions::default()
+    };
     plot_continuation(dir.join("clipped.PNG"), &sweep, Some(&crit), &clipped).unwrap();
     assert_eq!(entries(&dir), ["clipped.PNG", "fig.png", "fig.svg"]);
 }

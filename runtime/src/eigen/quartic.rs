@@ -350,6 +350,9 @@ fn companion(a: f64, b: f64, c: f64, d: f64) -> Option<[C64; 4]> {
 /// Backward-error bound accepted after polishing: `|p(z)| <= 1e-9 sum |e_i| |z|^i`.
 const BACKWARD_TOL: f64 = 1e-9;
 
+/// Residual regarded as rounding noise: `|p(z)| <= 2 eps sum |e_i| |z|^i`.
+const NOISE: f64 = 2.0 * EPS;
+
 /// Guarded Newton polish of all roots (pairs kept exactly conjugate). `None` if a
 /// root is non-finite or fails the backward-error test.
 fn polish_all(e: &[f64; 5], z: [C64; 4]) -> Option<[C64; 4]> {
@@ -395,7 +398,9 @@ fn polish_real(e: &[f64; 5], x0: f64, gap: f64) -> Option<f64> {
     let mut x = x0;
     let (mut p, mut dp, mut sc) = horner_real(e, x);
     for _ in 0..8 {
-        if p == 0.0 || dp == 0.0 {
+        // at rounding-noise level the root is as good as the evaluation allows; a
+        // further step would only wander (notably inside a near-double cluster)
+        if p.abs() <= NOISE * sc || dp == 0.0 {
             break;
         }
         let step = p / dp;
@@ -430,7 +435,7 @@ fn polish_complex(e: &[f64; 5], z0: C64, gap: f64) -> Option<C64> {
     let mut p2 = p.norm_sqr();
     for _ in 0..8 {
         let d2 = dp.norm_sqr();
-        if p2 == 0.0 || d2 == 0.0 {
+        if p2 <= NOISE * NOISE * sc * sc || d2 == 0.0 {
             break;
         }
         let step = p * dp.conj() / d2;
