@@ -62,7 +62,14 @@ fn main() {
         let functions: Vec<String> = emitted
             .reports
             .iter()
-            .map(|r| format!("{{\"name\":\"{}\",\"operations_before\":{},\"operations_after\":{}}}", r.name, r.before.total(), r.after.total()))
+            .map(|r| {
+                format!(
+                    "{{\"name\":\"{}\",\"operations_before\":{},\"operations_after\":{}}}",
+                    r.name,
+                    r.before.total(),
+                    r.after.total()
+                )
+            })
             .collect();
         json.push(format!(
             "{{\"model\":\"{}\",\"derivation_s\":{},\"derivation_and_emission_s\":{},\"operations_before\":{},\"operations_after\":{},\"functions\":[{}]}}",

@@ -17,8 +17,14 @@ pub use whipple_offset::WhippleOffset;
 
 /// Emitted sources by model name, as build.rs wrote them.
 pub const SOURCES: &[(&str, &str)] = &[
-    ("thesis_whipple", include_str!(concat!(env!("OUT_DIR"), "/thesis_whipple.rs"))),
-    ("whipple_offset", include_str!(concat!(env!("OUT_DIR"), "/whipple_offset.rs"))),
+    (
+        "thesis_whipple",
+        include_str!(concat!(env!("OUT_DIR"), "/thesis_whipple.rs")),
+    ),
+    (
+        "whipple_offset",
+        include_str!(concat!(env!("OUT_DIR"), "/whipple_offset.rs")),
+    ),
 ];
 
 /// Derivation time and operation counts of the last code generation (JSON).

@@ -48,7 +48,9 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
     let states: Vec<(Vec<f64>, Vec<f64>)> = (0..64)
         .map(|k| {
             let x = k as f64 / 64.0;
-            let p: Vec<f64> = (0..nq).map(|j| M::INITIAL_GUESS[j] + 0.3 * (x * (j + 1) as f64).sin()).collect();
+            let p: Vec<f64> = (0..nq)
+                .map(|j| M::INITIAL_GUESS[j] + 0.3 * (x * (j + 1) as f64).sin())
+                .collect();
             let dp: Vec<f64> = (0..nq).map(|j| (x * 3.0 + j as f64).cos()).collect();
             (p, dp)
         })
@@ -58,38 +60,162 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
     let mut total = 0.0;
     let mut row = |name: &str, secs: f64| {
         total += secs;
-        println!("  {name:<28} {:>8.1} ns/call   {:>6} flops/call", secs * 1e9, flops(name));
+        println!(
+            "  {name:<28} {:>8.1} ns/call   {:>6} flops/call",
+            secs * 1e9,
+            flops(name)
+        );
     };
     let s = &states;
-    row("mass_matrix", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::mass_matrix(&param, p, &mut buf); black_box(&buf); }));
-    row("quadratic_velocity_forces", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::quadratic_velocity_forces(&param, p, dp, &mut buf[..nq]); black_box(&buf); }));
-    row("gravity_forces", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::gravity_forces(&param, p, &mut buf[..nq]); black_box(&buf); }));
-    row("applied_forces", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::applied_forces(&param, 0.1, p, dp, &mut buf[..nq]); black_box(&buf); }));
-    row("holonomic_residuals", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::holonomic_residuals(&param, 0.1, p, &mut buf[..nh]); black_box(&buf); }));
-    row("holonomic_jacobian", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::holonomic_jacobian(&param, 0.1, p, &mut buf[..nh * nq]); black_box(&buf); }));
-    row("holonomic_time_derivative", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::holonomic_time_derivative(&param, 0.1, p, &mut buf[..nh]); black_box(&buf); }));
-    row("holonomic_convective", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::holonomic_convective(&param, 0.1, p, dp, &mut buf[..nh]); black_box(&buf); }));
-    row("nonholonomic_velocities", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::nonholonomic_velocities(&param, 0.1, p, dp, &mut buf[..nnh]); black_box(&buf); }));
-    row("nonholonomic_matrix", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::nonholonomic_matrix(&param, 0.1, p, &mut buf[..nnh * nq]); black_box(&buf); }));
-    row("nonholonomic_convective", per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::nonholonomic_convective(&param, 0.1, p, dp, &mut buf[..nnh]); black_box(&buf); }));
-    row("kinetic_energy", per_call(reps, |i| { let (p, dp) = &s[i % 64]; black_box(M::kinetic_energy(&param, p, dp)); }));
-    row("potential_energy", per_call(reps, |i| { let (p, _) = &s[i % 64]; black_box(M::potential_energy(&param, p)); }));
-    row("point_positions", per_call(reps, |i| { let (p, _) = &s[i % 64]; M::point_positions(&param, p, &mut buf[..6]); black_box(&buf); }));
+    row(
+        "mass_matrix",
+        per_call(reps, |i| {
+            let (p, _) = &s[i % 64];
+            M::mass_matrix(&param, p, &mut buf);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "quadratic_velocity_forces",
+        per_call(reps, |i| {
+            let (p, dp) = &s[i % 64];
+            M::quadratic_velocity_forces(&param, p, dp, &mut buf[..nq]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "gravity_forces",
+        per_call(reps, |i| {
+            let (p, _) = &s[i % 64];
+            M::gravity_forces(&param, p, &mut buf[..nq]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "applied_forces",
+        per_call(reps, |i| {
+            let (p, dp) = &s[i % 64];
+            M::applied_forces(&param, 0.1, p, dp, &mut buf[..nq]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "holonomic_residuals",
+        per_call(reps, |i| {
+            let (p, _) = &s[i % 64];
+            M::holonomic_residuals(&param, 0.1, p, &mut buf[..nh]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "holonomic_jacobian",
+        per_call(reps, |i| {
+            let (p, _) = &s[i % 64];
+            M::holonomic_jacobian(&param, 0.1, p, &mut buf[..nh * nq]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "holonomic_time_derivative",
+        per_call(reps, |i| {
+            let (p, _) = &s[i % 64];
+            M::holonomic_time_derivative(&param, 0.1, p, &mut buf[..nh]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "holonomic_convective",
+        per_call(reps, |i| {
+            let (p, dp) = &s[i % 64];
+            M::holonomic_convective(&param, 0.1, p, dp, &mut buf[..nh]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "nonholonomic_velocities",
+        per_call(reps, |i| {
+            let (p, dp) = &s[i % 64];
+            M::nonholonomic_velocities(&param, 0.1, p, dp, &mut buf[..nnh]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "nonholonomic_matrix",
+        per_call(reps, |i| {
+            let (p, _) = &s[i % 64];
+            M::nonholonomic_matrix(&param, 0.1, p, &mut buf[..nnh * nq]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "nonholonomic_convective",
+        per_call(reps, |i| {
+            let (p, dp) = &s[i % 64];
+            M::nonholonomic_convective(&param, 0.1, p, dp, &mut buf[..nnh]);
+            black_box(&buf);
+        }),
+    );
+    row(
+        "kinetic_energy",
+        per_call(reps, |i| {
+            let (p, dp) = &s[i % 64];
+            black_box(M::kinetic_energy(&param, p, dp));
+        }),
+    );
+    row(
+        "potential_energy",
+        per_call(reps, |i| {
+            let (p, _) = &s[i % 64];
+            black_box(M::potential_energy(&param, p));
+        }),
+    );
+    row(
+        "point_positions",
+        per_call(reps, |i| {
+            let (p, _) = &s[i % 64];
+            M::point_positions(&param, p, &mut buf[..6]);
+            black_box(&buf);
+        }),
+    );
     let singles: usize = M::FLOPS.iter().filter(|x| x.0 != "all_quantities").map(|x| x.1).sum();
-    println!("  {:<28} {:>8.1} ns/state  {:>6} flops/state", "sum of the calls above", total * 1e9, singles);
+    println!(
+        "  {:<28} {:>8.1} ns/state  {:>6} flops/state",
+        "sum of the calls above",
+        total * 1e9,
+        singles
+    );
     let n_all: usize = M::ALL_QUANTITIES_LAYOUT.iter().map(|x| x.2).sum();
     let mut all = vec![0.0; n_all];
-    let t_all = per_call(reps, |i| { let (p, dp) = &s[i % 64]; M::all_quantities(&param, 0.1, p, dp, &mut all); black_box(&all); });
-    println!("  {:<28} {:>8.1} ns/state  {:>6} flops/state (target: under 1000 ns)", "all_quantities (one call)", t_all * 1e9, flops("all_quantities"));
+    let t_all = per_call(reps, |i| {
+        let (p, dp) = &s[i % 64];
+        M::all_quantities(&param, 0.1, p, dp, &mut all);
+        black_box(&all);
+    });
+    println!(
+        "  {:<28} {:>8.1} ns/state  {:>6} flops/state (target: under 1000 ns)",
+        "all_quantities (one call)",
+        t_all * 1e9,
+        flops("all_quantities")
+    );
 
     println!("\n== linearization and eigenvalues (thesis bicycle) ==");
     let thesis = ThesisParameters::thesis_bicycle();
     let lin_reps = if quick { 200 } else { 2000 };
-    let t_lin = per_call(lin_reps, |_| { black_box(canonical_of(black_box(&thesis)).ok()); });
+    let t_lin = per_call(lin_reps, |_| {
+        black_box(canonical_of(black_box(&thesis)).ok());
+    });
     let c = canonical_of(&thesis)?;
-    let t_eig = per_call(reps, |i| { black_box(eigenvalues(&c, (i % 1000) as f64 * 0.01).ok()); });
-    println!("  exact linearization (canonical M0, C1, K0, K2 from the generated equations, once per design): {:>8.2} us", t_lin * 1e6);
-    println!("  eigenvalues of the 4x4 state matrix per speed point:                                     {:>8.1} ns", t_eig * 1e9);
+    let t_eig = per_call(reps, |i| {
+        black_box(eigenvalues(&c, (i % 1000) as f64 * 0.01).ok());
+    });
+    println!(
+        "  exact linearization (canonical M0, C1, K0, K2 from the generated equations, once per design): {:>8.2} us",
+        t_lin * 1e6
+    );
+    println!(
+        "  eigenvalues of the 4x4 state matrix per speed point:                                     {:>8.1} ns",
+        t_eig * 1e9
+    );
     println!("  one speed point including its share of the linearization over 100 speeds:               {:>8.1} ns (target: under 2000 ns per core)", (t_eig + t_lin / 100.0) * 1e9);
 
     let (designs, speeds) = if quick { (100usize, 1000usize) } else { (1000, 1000) };
@@ -100,7 +226,13 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
             let mut p = thesis;
             p.steer_point_x *= 1.0 + 0.02 * (k as f64 / designs as f64 - 0.5);
             match canonical_of(&p) {
-                Ok(c) => (0..speeds).filter(|&i| eigenvalues(&c, i as f64 * 10.0 / speeds as f64).map(|e| e.iter().all(|s| s.re < 0.0)).unwrap_or(false)).count(),
+                Ok(c) => (0..speeds)
+                    .filter(|&i| {
+                        eigenvalues(&c, i as f64 * 10.0 / speeds as f64)
+                            .map(|e| e.iter().all(|s| s.re < 0.0))
+                            .unwrap_or(false)
+                    })
+                    .count(),
                 Err(_) => 0,
             }
         })

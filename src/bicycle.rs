@@ -4,13 +4,18 @@
 use crate::generated::{ThesisWhipple, WhippleOffset};
 use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::linearize::{canonical_matrices, LinearizeError};
-use bikedyn_runtime::parameters::{BenchmarkParameters, ParameterError, ParameterSet, ParameterWarning, ThesisParameters};
+use bikedyn_runtime::parameters::{
+    BenchmarkParameters, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
+};
 use std::path::Path;
 use thiserror::Error;
 
 /// Built-in bicycles.
 pub const BUILT_IN: &[(&str, &str)] = &[
-    ("thesis", "the instrumented bicycle of Martin Recuero (2009), section 4.4 (default)"),
+    (
+        "thesis",
+        "the instrumented bicycle of Martin Recuero (2009), section 4.4 (default)",
+    ),
     ("benchmark", "the benchmark bicycle of Meijaard et al. (2007), Table 1"),
 ];
 
@@ -22,7 +27,11 @@ pub enum BicycleError {
     #[error("linearization of `{bike}` failed: {source}")]
     Linearize { bike: String, source: LinearizeError },
     #[error("unknown parameter `{name}`: use a thesis symbol ({thesis}) or a benchmark symbol ({benchmark})")]
-    UnknownParameter { name: String, thesis: String, benchmark: String },
+    UnknownParameter {
+        name: String,
+        thesis: String,
+        benchmark: String,
+    },
     #[error("`{spec}` is neither a built-in bicycle (thesis, benchmark) nor an existing file")]
     NotFound { spec: String },
 }
@@ -56,7 +65,11 @@ impl Bicycle {
             path if Path::new(path).exists() => ParameterSet::load(path)?,
             _ => return Err(BicycleError::NotFound { spec: spec.to_string() }),
         };
-        Ok(Bicycle { name: spec.to_string(), parameters, warnings })
+        Ok(Bicycle {
+            name: spec.to_string(),
+            parameters,
+            warnings,
+        })
     }
 
     /// Thesis-form parameters (converted if given in benchmark form).
@@ -66,7 +79,10 @@ impl Bicycle {
 
     /// Canonical matrices from the generated multibody equations.
     pub fn canonical(&self) -> Result<CanonicalMatrices, BicycleError> {
-        canonical_of(&self.thesis()?).map_err(|source| BicycleError::Linearize { bike: self.name.clone(), source })
+        canonical_of(&self.thesis()?).map_err(|source| BicycleError::Linearize {
+            bike: self.name.clone(),
+            source,
+        })
     }
 
     /// The same bicycle with one parameter changed. `symbol` is a thesis
@@ -84,17 +100,28 @@ impl Bicycle {
             });
         };
         let warnings = parameters.validate()?;
-        Ok(Bicycle { name: format!("{} ({symbol} = {value})", self.name), parameters, warnings })
+        Ok(Bicycle {
+            name: format!("{} ({symbol} = {value})", self.name),
+            parameters,
+            warnings,
+        })
     }
 
     /// Value of a thesis or benchmark symbol.
     pub fn value(&self, symbol: &str) -> Option<f64> {
-        self.thesis().ok().and_then(|t| t.get(symbol)).or_else(|| self.parameters.to_benchmark().ok().and_then(|b| b.get(symbol)))
+        self.thesis()
+            .ok()
+            .and_then(|t| t.get(symbol))
+            .or_else(|| self.parameters.to_benchmark().ok().and_then(|b| b.get(symbol)))
     }
 }
 
 /// Set one serde-named field (the parameter symbol) of a parameter struct.
-fn set_field<P: serde::Serialize + serde::de::DeserializeOwned>(p: &P, symbol: &str, value: f64) -> Result<P, BicycleError> {
+fn set_field<P: serde::Serialize + serde::de::DeserializeOwned>(
+    p: &P,
+    symbol: &str,
+    value: f64,
+) -> Result<P, BicycleError> {
     let mut v = serde_json::to_value(p).expect("parameter structs serialize");
     v[symbol] = serde_json::Value::from(value);
     serde_json::from_value(v).map_err(|_| BicycleError::UnknownParameter {

@@ -9,6 +9,6 @@ pub mod generated;
 
 pub use generated::{ThesisWhipple, WhippleOffset};
 
+pub mod bench;
 pub mod bicycle;
 pub mod models;
-pub mod bench;

@@ -13,7 +13,11 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Parser)]
-#[command(name = "bikedyn", version, about = "Symbolic multibody bicycle models, generated code, linearization and stability")]
+#[command(
+    name = "bikedyn",
+    version,
+    about = "Symbolic multibody bicycle models, generated code, linearization and stability"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -156,7 +160,11 @@ fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
     let parts: Vec<&str> = s.split(':').collect();
     let nums: Vec<f64> = parts
         .iter()
-        .map(|p| p.trim().parse::<f64>().with_context(|| format!("{what}: `{p}` is not a number (expected START:STOP:STEP)")))
+        .map(|p| {
+            p.trim()
+                .parse::<f64>()
+                .with_context(|| format!("{what}: `{p}` is not a number (expected START:STOP:STEP)"))
+        })
         .collect::<Result<_>>()?;
     match nums.as_slice() {
         [x] if x.is_finite() => Ok(vec![*x]),
@@ -205,7 +213,10 @@ fn stability_json(name: &str, c: &CriticalSpeeds) -> serde_json::Value {
 }
 
 fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
-    let f = |x: Option<f64>| x.map(|v| format!("{v:.10} m/s")).unwrap_or_else(|| "none in range".into());
+    let f = |x: Option<f64>| {
+        x.map(|v| format!("{v:.10} m/s"))
+            .unwrap_or_else(|| "none in range".into())
+    };
     let mut s = format!("bicycle: {name}\n");
     s += &format!("  weave speed v_w:   {}\n", f(c.weave_speed));
     s += &format!("  capsize speed v_c: {}\n", f(c.capsize_speed));
@@ -221,9 +232,22 @@ fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
 
 fn canonical_text(c: &CanonicalMatrices) -> String {
     let m = |name: &str, x: &nalgebra::Matrix2<f64>| {
-        format!("{name} = [[{:.14}, {:.14}],\n      [{:.14}, {:.14}]]\n", x[(0, 0)], x[(0, 1)], x[(1, 0)], x[(1, 1)])
+        format!(
+            "{name} = [[{:.14}, {:.14}],\n      [{:.14}, {:.14}]]\n",
+            x[(0, 0)],
+            x[(0, 1)],
+            x[(1, 0)],
+            x[(1, 1)]
+        )
     };
-    format!("{}{}{}{}g = {}\n", m("M0", &c.m0), m("C1", &c.c1), m("K0", &c.k0), m("K2", &c.k2), c.g)
+    format!(
+        "{}{}{}{}g = {}\n",
+        m("M0", &c.m0),
+        m("C1", &c.c1),
+        m("K0", &c.k0),
+        m("K2", &c.k2),
+        c.g
+    )
 }
 
 fn canonical_json(c: &CanonicalMatrices) -> serde_json::Value {
@@ -253,21 +277,38 @@ fn run(cli: Cli) -> Result<bool> {
                 let sweep = eigen_sweep(&c, &speeds)?;
                 output::save_eigen_sweep_csv(out.join(format!("{name}_eigenvalues.csv")), &sweep)?;
                 output::save_eigen_sweep_json(out.join(format!("{name}_eigenvalues.json")), &sweep)?;
-                let opts = PlotOptions { y_range: Some((-10.0, 10.0)), ..PlotOptions::default() };
+                let opts = PlotOptions {
+                    y_range: Some((-10.0, 10.0)),
+                    ..PlotOptions::default()
+                };
                 for ext in ["svg", "png"] {
-                    plot_continuation(out.join(format!("{name}_continuation.{ext}")), &sweep, Some(&crit), &opts)?;
+                    plot_continuation(
+                        out.join(format!("{name}_continuation.{ext}")),
+                        &sweep,
+                        Some(&crit),
+                        &opts,
+                    )?;
                 }
                 output::save_json(out.join(format!("{name}_stability.json")), &stability_json(name, &crit))?;
             }
             println!("wrote tables and plots to {}", out.display());
             Ok(ok)
         }
-        Command::Verify { model, states, seed, json } => {
+        Command::Verify {
+            model,
+            states,
+            seed,
+            json,
+        } => {
             let names: Vec<&str> = match &model {
                 Some(m) => vec![m.as_str()],
                 None => bikedyn::models::MODELS.to_vec(),
             };
-            let opts = VerifyOptions { states, seed, ..VerifyOptions::default() };
+            let opts = VerifyOptions {
+                states,
+                seed,
+                ..VerifyOptions::default()
+            };
             let mut reports = Vec::new();
             for n in names {
                 let r = bikedyn::models::verify_model(n, &opts)
@@ -282,15 +323,31 @@ fn run(cli: Cli) -> Result<bool> {
                         "model": r.model, "name": q.name, "max_rel_error": q.max_rel_error, "tolerance": q.tolerance, "passed": q.passed
                     })))
                     .collect();
-                println!("{}", serde_json::to_string_pretty(&serde_json::json!({"passed": passed, "quantities": quantities}))?);
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&serde_json::json!({"passed": passed, "quantities": quantities}))?
+                );
             } else {
                 for r in &reports {
                     println!("model {} ({} random states, seed {}):", r.model, r.states, r.seed);
                     for q in &r.quantities {
-                        println!("  {:<40} max rel error {:>10.3e}  tolerance {:>8.1e}  {}", q.name, q.max_rel_error, q.tolerance, if q.passed { "ok" } else { "FAIL" });
+                        println!(
+                            "  {:<40} max rel error {:>10.3e}  tolerance {:>8.1e}  {}",
+                            q.name,
+                            q.max_rel_error,
+                            q.tolerance,
+                            if q.passed { "ok" } else { "FAIL" }
+                        );
                     }
                 }
-                println!("{}", if passed { "verification passed" } else { "verification FAILED" });
+                println!(
+                    "{}",
+                    if passed {
+                        "verification passed"
+                    } else {
+                        "verification FAILED"
+                    }
+                );
             }
             Ok(passed)
         }
@@ -304,7 +361,13 @@ fn run(cli: Cli) -> Result<bool> {
             }
             Ok(true)
         }
-        Command::Eig { bike, speeds, format, output: out, plot } => {
+        Command::Eig {
+            bike,
+            speeds,
+            format,
+            output: out,
+            plot,
+        } => {
             let b = load(&bike)?;
             let c = b.canonical()?;
             let speeds = parse_range(&speeds, "--speeds")?;
@@ -337,7 +400,17 @@ fn run(cli: Cli) -> Result<bool> {
             }
             Ok(true)
         }
-        Command::Sweep { bike, param, values, param2, values2, speed_max, format, output: out, plot } => {
+        Command::Sweep {
+            bike,
+            param,
+            values,
+            param2,
+            values2,
+            speed_max,
+            format,
+            output: out,
+            plot,
+        } => {
             let b = load(&bike)?;
             let xs = parse_range(&values, "--values")?;
             let opts = SweepOptions::with_speed_range(0.0, speed_max);
@@ -348,7 +421,11 @@ fn run(cli: Cli) -> Result<bool> {
                     let map = stability_map(
                         ParamAxis::new(param.clone(), xs),
                         ParamAxis::new(p2.clone(), ys),
-                        |x, y| b.with_parameter(&param, x).and_then(|b| b.with_parameter(&p2, y)).and_then(|b| b.canonical()),
+                        |x, y| {
+                            b.with_parameter(&param, x)
+                                .and_then(|b| b.with_parameter(&p2, y))
+                                .and_then(|b| b.canonical())
+                        },
                         &opts,
                     )?;
                     if let Some(p) = &plot {
@@ -370,7 +447,11 @@ fn run(cli: Cli) -> Result<bool> {
                     if plot.is_some() {
                         bail!("--plot draws a two-parameter stability map: give --param2 and --values2");
                     }
-                    let s = parameter_sweep(ParamAxis::new(param.clone(), xs), |x| b.with_parameter(&param, x).and_then(|b| b.canonical()), &opts)?;
+                    let s = parameter_sweep(
+                        ParamAxis::new(param.clone(), xs),
+                        |x| b.with_parameter(&param, x).and_then(|b| b.canonical()),
+                        &opts,
+                    )?;
                     match format {
                         Format::Table => output::format_parameter_table(&s),
                         Format::Json => serde_json::to_string_pretty(&output::parameter_sweep_json(&s))? + "\n",

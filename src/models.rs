@@ -14,7 +14,9 @@ pub const MODELS: &[&str] = &[ThesisWhipple::NAME, WhippleOffset::NAME];
 /// a forward speed of 4.5 m/s.
 pub fn default_parameters<M: MultibodyModel>() -> Vec<f64> {
     let p = if M::PARAMETERS.contains(&"d4") {
-        BenchmarkParameters::benchmark_bicycle().to_thesis().expect("the benchmark bicycle converts")
+        BenchmarkParameters::benchmark_bicycle()
+            .to_thesis()
+            .expect("the benchmark bicycle converts")
     } else {
         ThesisParameters::thesis_bicycle()
     };

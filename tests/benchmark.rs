@@ -35,7 +35,11 @@ fn assert_matrix_close(name: &str, got: &Matrix2<f64>, want: &Matrix2<f64>, rel:
         for j in 0..2 {
             let (g, w) = (got[(i, j)], want[(i, j)]);
             let denom = if w == 0.0 { scale } else { w.abs() };
-            assert!((g - w).abs() <= rel * denom, "{name}[{i}][{j}] = {g:.17} but the paper gives {w:.17} (rel error {:.2e})", (g - w).abs() / denom);
+            assert!(
+                (g - w).abs() <= rel * denom,
+                "{name}[{i}][{j}] = {g:.17} but the paper gives {w:.17} (rel error {:.2e})",
+                (g - w).abs() / denom
+            );
         }
     }
 }
@@ -119,14 +123,25 @@ fn exact_linearization_is_more_accurate_than_the_thesis_finite_differences() {
         [&l.mass, &l.damping, &l.stiffness]
             .iter()
             .zip(&want)
-            .map(|(m, w)| (0..4).map(|k| (m[(k / 2, k % 2)] - w[(k / 2, k % 2)]).abs()).fold(0.0, f64::max) / w.amax())
+            .map(|(m, w)| {
+                (0..4)
+                    .map(|k| (m[(k / 2, k % 2)] - w[(k / 2, k % 2)]).abs())
+                    .fold(0.0, f64::max)
+                    / w.amax()
+            })
             .fold(0.0, f64::max)
     };
     let (e_exact, e_fd) = (err(&exact), err(&fd));
     println!("M, C, K at {v} m/s vs the paper: exact (dual numbers) {e_exact:.2e}, thesis finite differences (h = 1e-6) {e_fd:.2e}");
     assert!(e_exact < 1e-13, "exact linearization off by {e_exact:e}");
-    assert!(e_fd > 10.0 * e_exact.max(1e-16), "finite differences should be visibly less accurate: {e_fd:e}");
-    assert!(e_fd < 1e-4, "the finite-difference cross-check must still agree roughly: {e_fd:e}");
+    assert!(
+        e_fd > 10.0 * e_exact.max(1e-16),
+        "finite differences should be visibly less accurate: {e_fd:e}"
+    );
+    assert!(
+        e_fd < 1e-4,
+        "the finite-difference cross-check must still agree roughly: {e_fd:e}"
+    );
 }
 
 #[test]
@@ -143,7 +158,10 @@ fn thesis_model_and_offset_model_agree_when_the_offset_is_zero() {
 
 #[test]
 fn cli_stability_of_the_benchmark_prints_the_published_speeds() {
-    let out = Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(["stability", "--bike", "benchmark", "--json"]).output().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
+        .args(["stability", "--bike", "benchmark", "--json"])
+        .output()
+        .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!((v["weave_speed"].as_f64().unwrap() - 4.29238253634111).abs() < 1e-10);

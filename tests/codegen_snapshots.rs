@@ -19,8 +19,16 @@ fn generated_snapshots_are_fresh() {
         match std::fs::read_to_string(&path) {
             Ok(committed) if committed == *emitted => {}
             Ok(committed) => {
-                let line = committed.lines().zip(emitted.lines()).position(|(a, b)| a != b).map(|i| i + 1);
-                stale.push(format!("{} differs from the emitted code (first difference at line {:?})", path.display(), line));
+                let line = committed
+                    .lines()
+                    .zip(emitted.lines())
+                    .position(|(a, b)| a != b)
+                    .map(|i| i + 1);
+                stale.push(format!(
+                    "{} differs from the emitted code (first difference at line {:?})",
+                    path.display(),
+                    line
+                ));
             }
             Err(e) => stale.push(format!("{} cannot be read: {e}", path.display())),
         }

@@ -96,7 +96,11 @@ fn rotation(axis: Axis, angle: &Atom) -> M3 {
     let (o, l) = (zero(), Atom::num(1));
     match axis {
         Axis::X => [[l, o.clone(), o.clone()], [o.clone(), c.clone(), -&s], [o, s, c]],
-        Axis::Y => [[c.clone(), o.clone(), s.clone()], [o.clone(), l, o.clone()], [-&s, o, c]],
+        Axis::Y => [
+            [c.clone(), o.clone(), s.clone()],
+            [o.clone(), l, o.clone()],
+            [-&s, o, c],
+        ],
         Axis::Z => [[c.clone(), -&s, o.clone()], [s, c, o.clone()], [o.clone(), o, l]],
     }
 }
@@ -151,8 +155,18 @@ pub fn derive(model: &Model) -> Derived {
     };
     let d = Deriver {
         m: model,
-        param_index: model.parameters.iter().enumerate().map(|(i, p)| (p.name.as_str(), i)).collect(),
-        coord_index: model.coordinates.iter().enumerate().map(|(i, p)| (p.name.as_str(), i)).collect(),
+        param_index: model
+            .parameters
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.name.as_str(), i))
+            .collect(),
+        coord_index: model
+            .coordinates
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.name.as_str(), i))
+            .collect(),
         sym,
     };
     let nq = model.coordinates.len();
@@ -196,17 +210,26 @@ pub fn derive(model: &Model) -> Derived {
     }
     // Jacobians H_i = dRG_i/dp (3 x nq) and Gl_i = d(omega_local)/dp' (3 x nq).
     let jac = |v: &V3, s: &dyn Fn(usize) -> Symbol| -> Vec<V3> {
-        (0..nq).map(|j| std::array::from_fn(|i| v[i].derivative(s(j)))).collect()
+        (0..nq)
+            .map(|j| std::array::from_fn(|i| v[i].derivative(s(j))))
+            .collect()
     };
-    let body_h: Vec<Vec<V3>> = d.m.bodies.iter().map(|b| jac(&points[b.mass_centre.0], &|j| q_at(j))).collect();
-    let body_g: Vec<Vec<V3>> = d.m.bodies.iter().map(|b| jac(&omega_local[b.frame.0], &|j| d.sym.rates[j])).collect();
+    let body_h: Vec<Vec<V3>> =
+        d.m.bodies
+            .iter()
+            .map(|b| jac(&points[b.mass_centre.0], &|j| q_at(j)))
+            .collect();
+    let body_g: Vec<Vec<V3>> =
+        d.m.bodies
+            .iter()
+            .map(|b| jac(&omega_local[b.frame.0], &|j| d.sym.rates[j]))
+            .collect();
     let masses: Vec<Atom> = d.m.bodies.iter().map(|b| d.atom(&b.mass)).collect();
-    let inertias: Vec<M3> = d
-        .m
-        .bodies
-        .iter()
-        .map(|b| std::array::from_fn(|i| std::array::from_fn(|j| d.atom(&b.inertia[i][j]))))
-        .collect();
+    let inertias: Vec<M3> =
+        d.m.bodies
+            .iter()
+            .map(|b| std::array::from_fn(|i| std::array::from_fn(|j| d.atom(&b.inertia[i][j]))))
+            .collect();
 
     // Mass matrix, eq. 32: M = sum m H^T H + Gl^T I Gl.
     let mut mass = vec![zero(); nq * nq];
@@ -276,20 +299,24 @@ pub fn derive(model: &Model) -> Derived {
         }
     }
     // Holonomic constraints: Res, Cq, Ct, dCqdp = d(Cq p')/dp p'.
-    let res: Vec<Atom> = d
-        .m
-        .holonomic
-        .iter()
-        .map(|h| match h {
-            Holonomic::Residual { expr, .. } => d.atom(expr),
-            Holonomic::PointComponent { point, axis, .. } => points[point.0][axis.index()].clone(),
-            Holonomic::PointComponentStationary { point, axis, coordinate, .. } => {
-                points[point.0][axis.index()].derivative(q_at(d.coord_index[coordinate.as_str()]))
-            }
-        })
-        .collect();
+    let res: Vec<Atom> =
+        d.m.holonomic
+            .iter()
+            .map(|h| match h {
+                Holonomic::Residual { expr, .. } => d.atom(expr),
+                Holonomic::PointComponent { point, axis, .. } => points[point.0][axis.index()].clone(),
+                Holonomic::PointComponentStationary {
+                    point,
+                    axis,
+                    coordinate,
+                    ..
+                } => points[point.0][axis.index()].derivative(q_at(d.coord_index[coordinate.as_str()])),
+            })
+            .collect();
     let nh = res.len();
-    let cq: Vec<Atom> = (0..nh).flat_map(|i| (0..nq).map(|j| res[i].derivative(q_at(j))).collect::<Vec<_>>()).collect();
+    let cq: Vec<Atom> = (0..nh)
+        .flat_map(|i| (0..nq).map(|j| res[i].derivative(q_at(j))).collect::<Vec<_>>())
+        .collect();
     let ct: Vec<Atom> = res.iter().map(|r| r.derivative(d.sym.time)).collect();
     let convective = |rows: &[Atom], n: usize| -> Vec<Atom> {
         (0..n)
@@ -319,38 +346,146 @@ pub fn derive(model: &Model) -> Derived {
         })
         .collect();
     let nnh = vel.len();
-    let bmat: Vec<Atom> =
-        (0..nnh).flat_map(|i| (0..nq).map(|j| vel[i].derivative(d.sym.rates[j])).collect::<Vec<_>>()).collect();
+    let bmat: Vec<Atom> = (0..nnh)
+        .flat_map(|i| (0..nq).map(|j| vel[i].derivative(d.sym.rates[j])).collect::<Vec<_>>())
+        .collect();
     let dbdp: Vec<Atom> = vel.iter().map(|v| rate_of(v)).collect();
-    let poi: Vec<Atom> = d.m.points_of_interest.iter().flat_map(|p| points[p.0].clone()).collect();
+    let poi: Vec<Atom> =
+        d.m.points_of_interest
+            .iter()
+            .flat_map(|p| points[p.0].clone())
+            .collect();
 
     let (all, no_t, t_only) = (
-        Inputs { time: true, coordinates: true, rates: true },
-        Inputs { time: false, coordinates: true, rates: true },
-        Inputs { time: true, coordinates: true, rates: false },
+        Inputs {
+            time: true,
+            coordinates: true,
+            rates: true,
+        },
+        Inputs {
+            time: false,
+            coordinates: true,
+            rates: true,
+        },
+        Inputs {
+            time: true,
+            coordinates: true,
+            rates: false,
+        },
     );
-    let pos = Inputs { time: false, coordinates: true, rates: false };
+    let pos = Inputs {
+        time: false,
+        coordinates: true,
+        rates: false,
+    };
     let buf = |rows, cols| Shape::Buffer { rows, cols };
     let quantities = vec![
-        Quantity { name: "mass_matrix", doc: "Mass matrix M(p), thesis eq. 32 (row-major nq x nq).", inputs: pos, shape: buf(nq, nq), outputs: mass },
-        Quantity { name: "quadratic_velocity_forces", doc: "Quadratic-velocity forces Qv = -d(M p')/dp p' + dT/dp, thesis eq. 36.", inputs: no_t, shape: buf(nq, 1), outputs: qv },
-        Quantity { name: "gravity_forces", doc: "Gravity forces Qgrav = sum H_i^T [0 0 -m_i g], thesis eq. 38.", inputs: pos, shape: buf(nq, 1), outputs: gravity },
-        Quantity { name: "applied_forces", doc: "Applied generalized forces Qext(p, p', t).", inputs: all, shape: buf(nq, 1), outputs: applied },
-        Quantity { name: "holonomic_residuals", doc: "Holonomic constraint residuals Res(p, t).", inputs: t_only, shape: buf(nh, 1), outputs: res },
-        Quantity { name: "holonomic_jacobian", doc: "Holonomic constraint Jacobian Cq = dRes/dp (row-major nh x nq).", inputs: t_only, shape: buf(nh, nq), outputs: cq },
-        Quantity { name: "holonomic_time_derivative", doc: "Ct = dRes/dt.", inputs: t_only, shape: buf(nh, 1), outputs: ct },
-        Quantity { name: "holonomic_convective", doc: "dCqdp = d(Cq p')/dp p'.", inputs: all, shape: buf(nh, 1), outputs: dcqdp },
-        Quantity { name: "nonholonomic_velocities", doc: "Constrained velocities (contact-point velocities), zero when the constraints hold.", inputs: all, shape: buf(nnh, 1), outputs: vel },
-        Quantity { name: "nonholonomic_matrix", doc: "Nonholonomic matrix B = d(velocities)/dp' (row-major nnh x nq).", inputs: t_only, shape: buf(nnh, nq), outputs: bmat },
-        Quantity { name: "nonholonomic_convective", doc: "dBdp = d(B p')/dp p'.", inputs: all, shape: buf(nnh, 1), outputs: dbdp },
-        Quantity { name: "kinetic_energy", doc: "Kinetic energy T = 1/2 p'^T M p' (J).", inputs: no_t, shape: Shape::Scalar, outputs: vec![kinetic] },
-        Quantity { name: "potential_energy", doc: "Gravitational potential energy V (J), Qgrav = -dV/dp.", inputs: pos, shape: Shape::Scalar, outputs: vec![potential] },
-        Quantity { name: "point_positions", doc: "Global positions of the points of interest (x, y, z per point).", inputs: pos, shape: buf(d.m.points_of_interest.len(), 3), outputs: poi },
+        Quantity {
+            name: "mass_matrix",
+            doc: "Mass matrix M(p), thesis eq. 32 (row-major nq x nq).",
+            inputs: pos,
+            shape: buf(nq, nq),
+            outputs: mass,
+        },
+        Quantity {
+            name: "quadratic_velocity_forces",
+            doc: "Quadratic-velocity forces Qv = -d(M p')/dp p' + dT/dp, thesis eq. 36.",
+            inputs: no_t,
+            shape: buf(nq, 1),
+            outputs: qv,
+        },
+        Quantity {
+            name: "gravity_forces",
+            doc: "Gravity forces Qgrav = sum H_i^T [0 0 -m_i g], thesis eq. 38.",
+            inputs: pos,
+            shape: buf(nq, 1),
+            outputs: gravity,
+        },
+        Quantity {
+            name: "applied_forces",
+            doc: "Applied generalized forces Qext(p, p', t).",
+            inputs: all,
+            shape: buf(nq, 1),
+            outputs: applied,
+        },
+        Quantity {
+            name: "holonomic_residuals",
+            doc: "Holonomic constraint residuals Res(p, t).",
+            inputs: t_only,
+            shape: buf(nh, 1),
+            outputs: res,
+        },
+        Quantity {
+            name: "holonomic_jacobian",
+            doc: "Holonomic constraint Jacobian Cq = dRes/dp (row-major nh x nq).",
+            inputs: t_only,
+            shape: buf(nh, nq),
+            outputs: cq,
+        },
+        Quantity {
+            name: "holonomic_time_derivative",
+            doc: "Ct = dRes/dt.",
+            inputs: t_only,
+            shape: buf(nh, 1),
+            outputs: ct,
+        },
+        Quantity {
+            name: "holonomic_convective",
+            doc: "dCqdp = d(Cq p')/dp p'.",
+            inputs: all,
+            shape: buf(nh, 1),
+            outputs: dcqdp,
+        },
+        Quantity {
+            name: "nonholonomic_velocities",
+            doc: "Constrained velocities (contact-point velocities), zero when the constraints hold.",
+            inputs: all,
+            shape: buf(nnh, 1),
+            outputs: vel,
+        },
+        Quantity {
+            name: "nonholonomic_matrix",
+            doc: "Nonholonomic matrix B = d(velocities)/dp' (row-major nnh x nq).",
+            inputs: t_only,
+            shape: buf(nnh, nq),
+            outputs: bmat,
+        },
+        Quantity {
+            name: "nonholonomic_convective",
+            doc: "dBdp = d(B p')/dp p'.",
+            inputs: all,
+            shape: buf(nnh, 1),
+            outputs: dbdp,
+        },
+        Quantity {
+            name: "kinetic_energy",
+            doc: "Kinetic energy T = 1/2 p'^T M p' (J).",
+            inputs: no_t,
+            shape: Shape::Scalar,
+            outputs: vec![kinetic],
+        },
+        Quantity {
+            name: "potential_energy",
+            doc: "Gravitational potential energy V (J), Qgrav = -dV/dp.",
+            inputs: pos,
+            shape: Shape::Scalar,
+            outputs: vec![potential],
+        },
+        Quantity {
+            name: "point_positions",
+            doc: "Global positions of the points of interest (x, y, z per point).",
+            inputs: pos,
+            shape: buf(d.m.points_of_interest.len(), 3),
+            outputs: poi,
+        },
     ];
     // Every buffer quantity in one function, so that they share common
     // subexpressions and trigonometric evaluations.
-    let all_outputs: Vec<Atom> =
-        quantities.iter().filter(|q| matches!(q.shape, Shape::Buffer { .. })).flat_map(|q| q.outputs.clone()).collect();
+    let all_outputs: Vec<Atom> = quantities
+        .iter()
+        .filter(|q| matches!(q.shape, Shape::Buffer { .. }))
+        .flat_map(|q| q.outputs.clone())
+        .collect();
     let n_all = all_outputs.len();
     let mut quantities = quantities;
     quantities.push(Quantity {
@@ -361,5 +496,10 @@ pub fn derive(model: &Model) -> Derived {
         outputs: all_outputs,
     });
     let Deriver { sym, .. } = d;
-    Derived { model: model.clone(), symbols: sym, quantities, elapsed: start.elapsed() }
+    Derived {
+        model: model.clone(),
+        symbols: sym,
+        quantities,
+        elapsed: start.elapsed(),
+    }
 }

@@ -102,7 +102,10 @@ impl<'a> Dag<'a> {
         self.add(Node::Const(x.to_bits()))
     }
     fn unsupported(&self, what: String) -> EmitError {
-        EmitError::Unsupported { function: self.function.to_string(), what }
+        EmitError::Unsupported {
+            function: self.function.to_string(),
+            what,
+        }
     }
     fn number(&self, v: AtomView) -> Result<Option<f64>, EmitError> {
         if let AtomView::Num(n) = v {
@@ -116,7 +119,9 @@ impl<'a> Dag<'a> {
     }
     fn pow(&mut self, base: usize, n: i64) -> usize {
         let m = n.unsigned_abs() as usize;
-        let p = if m == 1 { base } else {
+        let p = if m == 1 {
+            base
+        } else {
             self.tree_ops.arithmetic += m - 1;
             self.add(Node::Mul(vec![base; m]))
         };
@@ -134,7 +139,10 @@ impl<'a> Dag<'a> {
                 self.constant(x)
             }
             AtomView::Var(s) => {
-                let input = *self.inputs.get(&s.get_symbol()).ok_or_else(|| self.unsupported(format!("the symbol {v}")))?;
+                let input = *self
+                    .inputs
+                    .get(&s.get_symbol())
+                    .ok_or_else(|| self.unsupported(format!("the symbol {v}")))?;
                 self.add(Node::Input(input))
             }
             AtomView::Fun(f) => {
@@ -157,7 +165,9 @@ impl<'a> Dag<'a> {
             AtomView::Pow(p) => {
                 let (b, e) = p.get_base_exp();
                 let base = self.convert(b)?;
-                let e = self.number(e)?.ok_or_else(|| self.unsupported(format!("the power {v}")))?;
+                let e = self
+                    .number(e)?
+                    .ok_or_else(|| self.unsupported(format!("the power {v}")))?;
                 if e.fract() == 0.0 {
                     self.pow(base, e as i64)
                 } else if (2.0 * e).fract() == 0.0 {
@@ -183,7 +193,11 @@ impl<'a> Dag<'a> {
                     factors.insert(0, self.constant(coeff));
                 }
                 self.tree_ops.arithmetic += factors.len().saturating_sub(1);
-                let prod = if factors.len() == 1 { factors[0] } else { self.add(Node::Mul(factors)) };
+                let prod = if factors.len() == 1 {
+                    factors[0]
+                } else {
+                    self.add(Node::Mul(factors))
+                };
                 if coeff == -1.0 {
                     self.tree_ops.arithmetic += 1;
                     self.add(Node::Neg(prod))
@@ -233,18 +247,48 @@ fn ident(s: &str) -> Ident {
 }
 
 /// Emit one function; returns its tokens and report.
-fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -> Result<(TokenStream, FunctionReport), EmitError> {
-    let mut dag = Dag { nodes: Vec::new(), index: HashMap::new(), inputs, tree_ops: OpCount::default(), function: q.name };
-    let outs: Vec<usize> = q.outputs.iter().map(|a| dag.convert(a.as_view())).collect::<Result<_, _>>()?;
-    let report = FunctionReport { name: q.name, before: dag.tree_ops, after: count_dag(&dag.nodes) };
+fn emit_function(
+    q: &Quantity,
+    inputs: &HashMap<Symbol, Input>,
+    names: &Names,
+) -> Result<(TokenStream, FunctionReport), EmitError> {
+    let mut dag = Dag {
+        nodes: Vec::new(),
+        index: HashMap::new(),
+        inputs,
+        tree_ops: OpCount::default(),
+        function: q.name,
+    };
+    let outs: Vec<usize> = q
+        .outputs
+        .iter()
+        .map(|a| dag.convert(a.as_view()))
+        .collect::<Result<_, _>>()?;
+    let report = FunctionReport {
+        name: q.name,
+        before: dag.tree_ops,
+        after: count_dag(&dag.nodes),
+    };
     let var = |i: usize, nodes: &[Node]| -> TokenStream {
         match &nodes[i] {
-            Node::Input(Input::Param(k)) => { let n = &names.params[*k]; quote!(#n) }
-            Node::Input(Input::Coord(k)) => { let n = &names.coords[*k]; quote!(#n) }
-            Node::Input(Input::Rate(k)) => { let n = &names.rates[*k]; quote!(#n) }
+            Node::Input(Input::Param(k)) => {
+                let n = &names.params[*k];
+                quote!(#n)
+            }
+            Node::Input(Input::Coord(k)) => {
+                let n = &names.coords[*k];
+                quote!(#n)
+            }
+            Node::Input(Input::Rate(k)) => {
+                let n = &names.rates[*k];
+                quote!(#n)
+            }
             Node::Input(Input::Time) => quote!(t),
             Node::Const(b) => lit(f64::from_bits(*b)),
-            _ => { let n = format_ident!("t{}", i); quote!(#n) }
+            _ => {
+                let n = format_ident!("t{}", i);
+                quote!(#n)
+            }
         }
     };
     let mut body = Vec::new();
@@ -254,9 +298,18 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
         if let Node::Input(inp) = n {
             used[i] = true;
             let stmt = match inp {
-                Input::Param(k) => { let n = &names.params[*k]; quote!(let #n = param[#k];) }
-                Input::Coord(k) => { let n = &names.coords[*k]; quote!(let #n = p[#k];) }
-                Input::Rate(k) => { let n = &names.rates[*k]; quote!(let #n = dp[#k];) }
+                Input::Param(k) => {
+                    let n = &names.params[*k];
+                    quote!(let #n = param[#k];)
+                }
+                Input::Coord(k) => {
+                    let n = &names.coords[*k];
+                    quote!(let #n = p[#k];)
+                }
+                Input::Rate(k) => {
+                    let n = &names.rates[*k];
+                    quote!(let #n = dp[#k];)
+                }
                 Input::Time => quote!(),
             };
             body.push(stmt);
@@ -269,8 +322,12 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
         let mut cos_of = HashMap::new();
         for (i, n) in dag.nodes.iter().enumerate() {
             match n {
-                Node::Sin(a) => { sin_of.insert(*a, i); }
-                Node::Cos(a) => { cos_of.insert(*a, i); }
+                Node::Sin(a) => {
+                    sin_of.insert(*a, i);
+                }
+                Node::Cos(a) => {
+                    cos_of.insert(*a, i);
+                }
                 _ => {}
             }
         }
@@ -287,7 +344,9 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
             if si == usize::MAX {
                 continue;
             }
-            let Node::Sin(a) = dag.nodes[si] else { unreachable!("paired node is a sine") };
+            let Node::Sin(a) = dag.nodes[si] else {
+                unreachable!("paired node is a sine")
+            };
             let (s_id, c_id, a) = (format_ident!("t{}", si), format_ident!("t{}", ci), var(a, &dag.nodes));
             body.push(quote!(let (#s_id, #c_id): (T, T) = #a.sin_cos();));
             continue;
@@ -300,7 +359,9 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
                 let mut neg: Vec<TokenStream> = Vec::new();
                 for (c, is_neg) in &mut it {
                     if is_neg {
-                        if let Node::Neg(inner) = dag.nodes[c] { neg.push(var(inner, &dag.nodes)); }
+                        if let Node::Neg(inner) = dag.nodes[c] {
+                            neg.push(var(inner, &dag.nodes));
+                        }
                     } else {
                         pos.push(var(c, &dag.nodes));
                     }
@@ -319,11 +380,26 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
                 let (h, rest) = f.split_first().expect("products have factors");
                 quote!(#h #(* #rest)*)
             }
-            Node::Neg(a) => { let a = var(*a, &dag.nodes); quote!(-#a) }
-            Node::Recip(a) => { let a = var(*a, &dag.nodes); quote!(T::one() / #a) }
-            Node::Sin(a) => { let a = var(*a, &dag.nodes); quote!(#a.sin()) }
-            Node::Cos(a) => { let a = var(*a, &dag.nodes); quote!(#a.cos()) }
-            Node::Sqrt(a) => { let a = var(*a, &dag.nodes); quote!(#a.sqrt()) }
+            Node::Neg(a) => {
+                let a = var(*a, &dag.nodes);
+                quote!(-#a)
+            }
+            Node::Recip(a) => {
+                let a = var(*a, &dag.nodes);
+                quote!(T::one() / #a)
+            }
+            Node::Sin(a) => {
+                let a = var(*a, &dag.nodes);
+                quote!(#a.sin())
+            }
+            Node::Cos(a) => {
+                let a = var(*a, &dag.nodes);
+                quote!(#a.cos())
+            }
+            Node::Sqrt(a) => {
+                let a = var(*a, &dag.nodes);
+                quote!(#a.sqrt())
+            }
         };
         body.push(quote!(let #t: T = #e;));
     }
@@ -331,11 +407,19 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
     let name = ident(q.name);
     let doc = q.doc;
     let t_arg = if q.inputs.time { quote!(t: T) } else { quote!(_t: T) };
-    let dp_arg = if q.inputs.rates { quote!(dp: &[T]) } else { quote!(_dp: &[T]) };
+    let dp_arg = if q.inputs.rates {
+        quote!(dp: &[T])
+    } else {
+        quote!(_dp: &[T])
+    };
     let tokens = match q.shape {
         Shape::Scalar => {
             let r = var(outs[0], &dag.nodes);
-            let args = if q.inputs.rates { quote!(param: &[T], p: &[T], #dp_arg) } else { quote!(param: &[T], p: &[T]) };
+            let args = if q.inputs.rates {
+                quote!(param: &[T], p: &[T], #dp_arg)
+            } else {
+                quote!(param: &[T], p: &[T])
+            };
             quote! {
                 #[doc = #doc]
                 #[allow(unused_variables, non_snake_case, clippy::all)]
@@ -347,11 +431,18 @@ fn emit_function(q: &Quantity, inputs: &HashMap<Symbol, Input>, names: &Names) -
         }
         Shape::Buffer { .. } => {
             let n = outs.len();
-            let assigns = outs.iter().enumerate().map(|(k, &o)| { let v = var(o, &dag.nodes); quote!(out[#k] = #v;) });
+            let assigns = outs.iter().enumerate().map(|(k, &o)| {
+                let v = var(o, &dag.nodes);
+                quote!(out[#k] = #v;)
+            });
             let args = match (q.inputs.time, q.inputs.rates) {
-                _ if q.name == "mass_matrix" || q.name == "gravity_forces" || q.name == "point_positions" => quote!(param: &[T], p: &[T], out: &mut [T]),
+                _ if q.name == "mass_matrix" || q.name == "gravity_forces" || q.name == "point_positions" => {
+                    quote!(param: &[T], p: &[T], out: &mut [T])
+                }
                 (_, false) => quote!(param: &[T], #t_arg, p: &[T], out: &mut [T]),
-                (_, true) if q.name == "quadratic_velocity_forces" => quote!(param: &[T], p: &[T], dp: &[T], out: &mut [T]),
+                (_, true) if q.name == "quadratic_velocity_forces" => {
+                    quote!(param: &[T], p: &[T], dp: &[T], out: &mut [T])
+                }
                 (_, true) => quote!(param: &[T], #t_arg, p: &[T], dp: &[T], out: &mut [T]),
             };
             quote! {
@@ -386,7 +477,14 @@ pub fn fnv1a(data: &[u8]) -> u64 {
 }
 
 fn camel(s: &str) -> String {
-    s.split('_').map(|w| { let mut c = w.chars(); c.next().map(|f| f.to_uppercase().chain(c).collect::<String>()).unwrap_or_default() }).collect()
+    s.split('_')
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|f| f.to_uppercase().chain(c).collect::<String>())
+                .unwrap_or_default()
+        })
+        .collect()
 }
 
 /// Emit the whole model: one module body with the generated functions, the
@@ -394,9 +492,15 @@ fn camel(s: &str) -> String {
 pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
     let m = &d.model;
     let mut inputs = HashMap::new();
-    for (i, s) in d.symbols.params.iter().enumerate() { inputs.insert(*s, Input::Param(i)); }
-    for (i, s) in d.symbols.coords.iter().enumerate() { inputs.insert(*s, Input::Coord(i)); }
-    for (i, s) in d.symbols.rates.iter().enumerate() { inputs.insert(*s, Input::Rate(i)); }
+    for (i, s) in d.symbols.params.iter().enumerate() {
+        inputs.insert(*s, Input::Param(i));
+    }
+    for (i, s) in d.symbols.coords.iter().enumerate() {
+        inputs.insert(*s, Input::Coord(i));
+    }
+    for (i, s) in d.symbols.rates.iter().enumerate() {
+        inputs.insert(*s, Input::Rate(i));
+    }
     inputs.insert(d.symbols.time, Input::Time);
     let names = Names {
         params: m.parameters.iter().map(|p| format_ident!("p_{}", p.name)).collect(),
@@ -416,10 +520,30 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
     let params: Vec<&str> = m.parameters.iter().map(|c| c.name.as_str()).collect();
     let holo = m.holonomic_names();
     let nonholo = m.nonholonomic_names();
-    let poi: Vec<&str> = m.points_of_interest.iter().map(|p| m.points[p.0].name.as_str()).collect();
-    let indep: Vec<usize> = m.coordinates.iter().enumerate().filter(|(_, c)| c.role == Role::Independent).map(|(i, _)| i).collect();
-    let dep: Vec<usize> = m.coordinates.iter().enumerate().filter(|(_, c)| c.role == Role::Dependent).map(|(i, _)| i).collect();
-    let guess: Vec<proc_macro2::Literal> = m.coordinates.iter().map(|c| proc_macro2::Literal::f64_suffixed(c.guess)).collect();
+    let poi: Vec<&str> = m
+        .points_of_interest
+        .iter()
+        .map(|p| m.points[p.0].name.as_str())
+        .collect();
+    let indep: Vec<usize> = m
+        .coordinates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.role == Role::Independent)
+        .map(|(i, _)| i)
+        .collect();
+    let dep: Vec<usize> = m
+        .coordinates
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| c.role == Role::Dependent)
+        .map(|(i, _)| i)
+        .collect();
+    let guess: Vec<proc_macro2::Literal> = m
+        .coordinates
+        .iter()
+        .map(|c| proc_macro2::Literal::f64_suffixed(c.guess))
+        .collect();
     let mut layout = Vec::new();
     let mut offset = 0usize;
     for q in d.quantities.iter().filter(|q| q.name != "all_quantities") {
@@ -431,8 +555,16 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
     }
     let flop_names: Vec<&str> = reports.iter().map(|r| r.name).collect();
     let flop_counts: Vec<usize> = reports.iter().map(|r| r.after.total()).collect();
-    let coord_docs: Vec<String> = m.coordinates.iter().map(|c| format!("`{}`: {}", c.name, c.doc)).collect();
-    let param_docs: Vec<String> = m.parameters.iter().map(|c| format!("`{}`: {}", c.name, c.doc)).collect();
+    let coord_docs: Vec<String> = m
+        .coordinates
+        .iter()
+        .map(|c| format!("`{}`: {}", c.name, c.doc))
+        .collect();
+    let param_docs: Vec<String> = m
+        .parameters
+        .iter()
+        .map(|c| format!("`{}`: {}", c.name, c.doc))
+        .collect();
     let model_doc = format!("Generated model `{}`: {}", m.name, m.doc);
     let tokens = quote! {
         use bikedyn_runtime::{MultibodyModel, Scalar};
@@ -488,5 +620,119 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
         m.sources.join(", "),
         hash
     );
-    Ok(Emitted { source: format!("{header}{body}"), reports })
+    Ok(Emitted {
+        source: format!("{header}{body}"),
+        reports,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::derive::derive;
+    use crate::expr::{inertia_wheel, num, param, rate, vec3};
+    use crate::model::{Axis, Force, Model, Role, GROUND};
+
+    /// Symbolica's non-commercial licence allows one Symbolica thread at a
+    /// time; concurrent use from parallel test threads aborts the process.
+    static SYMBOLICA: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+    /// A planar pendulum with a driven pivot: small enough to check the
+    /// derivation by hand. Coordinates: pivot x (driven), angle theta.
+    fn pendulum() -> Model {
+        let mut m = Model::builder("pendulum").source("modeler/src/emit.rs");
+        let th = m.coordinate("theta", Role::Independent, 0.0, "angle (rad)");
+        let x = m.coordinate("x", Role::Dependent, 0.0, "pivot position (m)");
+        let l = m.parameter("L", "length (m)");
+        m.parameter("m", "mass (kg)");
+        m.parameter("I", "inertia (kg m^2)");
+        m.parameter("g", "gravity (m/s^2)");
+        m.parameter("c", "damping (N m s)");
+        m.gravity("g", Axis::Z);
+        let f = m.frame("arm", GROUND, vec![(Axis::Y, th)]);
+        let pivot = m.point("pivot", None, vec![(GROUND, vec3(x.clone(), num(0), num(0)))]);
+        let bob = m.point("bob", Some(pivot), vec![(f, vec3(num(0), num(0), -l))]);
+        m.body("bob", f, param("m"), inertia_wheel(param("I"), param("I")), bob);
+        m.holonomic(crate::model::Holonomic::Residual {
+            name: "drive".into(),
+            expr: x - crate::expr::time(),
+        });
+        m.force(Force::Generalized {
+            name: "damper".into(),
+            coordinate: "theta".into(),
+            expr: -(param("c") * rate("theta")),
+        });
+        m.point_of_interest(bob);
+        m.build().unwrap()
+    }
+
+    #[test]
+    fn pendulum_derivation_matches_hand_calculation() {
+        let _one_thread = SYMBOLICA.lock().unwrap_or_else(|e| e.into_inner());
+        let d = derive(&pendulum());
+        let q = |name: &str| d.quantities.iter().find(|q| q.name == name).unwrap();
+        let (th, l, mm, i, g) = (
+            symbol!("bikedyn_pendulum::q_theta"),
+            symbol!("bikedyn_pendulum::p_L"),
+            symbol!("bikedyn_pendulum::p_m"),
+            symbol!("bikedyn_pendulum::p_I"),
+            symbol!("bikedyn_pendulum::p_g"),
+        );
+        let (th, l, mm, i, g) = (Atom::var(th), Atom::var(l), Atom::var(mm), Atom::var(i), Atom::var(g));
+        let is_zero = |a: Atom| {
+            a.expand()
+                .replace(Symbol::COS.call((&th,)).pow(Atom::num(2)))
+                .with(Atom::num(1) - Symbol::SIN.call((&th,)).pow(Atom::num(2)))
+                .expand()
+                .is_zero()
+        };
+        // The bob is at (x - L sin(theta), 0, -L cos(theta)) (theta rotates
+        // about y), so M = [[m L^2 + I, -m L cos(theta)], [-m L cos(theta), m]].
+        let mass = &q("mass_matrix").outputs;
+        assert!(is_zero(&mass[0] - (&mm * &l * &l + &i)), "M11 = {}", mass[0]);
+        assert!(
+            is_zero(&mass[1] + &mm * &l * Symbol::COS.call((&th,))),
+            "M12 = {}",
+            mass[1]
+        );
+        assert!(is_zero(&mass[3] - &mm), "M22 = {}", mass[3]);
+        // Qgrav_theta = -m g L sin(theta): the bob is at z = -L cos(theta).
+        assert!(is_zero(
+            &q("gravity_forces").outputs[0] + &mm * &g * &l * Symbol::SIN.call((&th,))
+        ));
+        // Rheonomic constraint x - t: Cq = [0, 1], Ct = -1.
+        assert!(q("holonomic_jacobian").outputs[0].is_zero());
+        assert!(is_zero(&q("holonomic_time_derivative").outputs[0] + Atom::num(1)));
+    }
+
+    #[test]
+    fn pendulum_emission_shares_subexpressions_and_parses() {
+        let _one_thread = SYMBOLICA.lock().unwrap_or_else(|e| e.into_inner());
+        let d = derive(&pendulum());
+        let e = emit(&d).unwrap();
+        assert!(e.source.starts_with("// @generated"));
+        syn::parse_file(&e.source).unwrap();
+        for f in [
+            "pub fn mass_matrix<T: Scalar>",
+            "pub fn quadratic_velocity_forces<T: Scalar>",
+            "pub fn all_quantities<T: Scalar>",
+            "sin_cos()",
+        ] {
+            assert!(e.source.contains(f), "missing {f}");
+        }
+        let all = e.reports.iter().find(|r| r.name == "all_quantities").unwrap();
+        assert!(
+            all.after.total() < all.before.total(),
+            "CSE must remove operations: {:?}",
+            all
+        );
+        // The damper appears as an applied force on theta.
+        assert!(e.source.contains("p_c"));
+    }
+
+    #[test]
+    fn fnv_hash_is_stable() {
+        assert_eq!(fnv1a(b"bikedyn"), fnv1a(b"bikedyn"));
+        assert_ne!(fnv1a(b"a"), fnv1a(b"b"));
+    }
 }

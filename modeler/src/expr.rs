@@ -178,11 +178,7 @@ pub type Tensor3 = [[Expr; 3]; 3];
 /// Inertia tensor with the `xz` product only (bodies symmetric about their
 /// x-z plane, as every body of a bicycle in the Whipple model).
 pub fn inertia_xz(ixx: Expr, iyy: Expr, izz: Expr, ixz: Expr) -> Tensor3 {
-    [
-        [ixx, num(0), ixz.clone()],
-        [num(0), iyy, num(0)],
-        [ixz, num(0), izz],
-    ]
+    [[ixx, num(0), ixz.clone()], [num(0), iyy, num(0)], [ixz, num(0), izz]]
 }
 
 /// Inertia tensor of a body of revolution about its y axis (a wheel):

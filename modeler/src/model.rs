@@ -107,7 +107,12 @@ pub enum Holonomic {
     PointComponent { name: String, point: PointId, axis: Axis },
     /// The derivative of a point's global component with respect to a
     /// coordinate is zero (e.g. the contact point is the lowest of the rim).
-    PointComponentStationary { name: String, point: PointId, axis: Axis, coordinate: String },
+    PointComponentStationary {
+        name: String,
+        point: PointId,
+        axis: Axis,
+        coordinate: String,
+    },
 }
 
 /// A nonholonomic constraint, linear in the velocities.
@@ -115,7 +120,12 @@ pub enum Holonomic {
 pub enum Nonholonomic {
     /// A global component of the velocity of the material point of `body`
     /// that coincides with `point` is zero (rolling without slip).
-    ContactVelocity { name: String, body: BodyId, point: PointId, axis: Axis },
+    ContactVelocity {
+        name: String,
+        body: BodyId,
+        point: PointId,
+        axis: Axis,
+    },
     /// A general expression linear in the rates.
     Linear { name: String, expr: Expr },
 }
@@ -124,9 +134,18 @@ pub enum Nonholonomic {
 #[derive(Clone, Debug)]
 pub enum Force {
     /// A generalized force on one coordinate (e.g. a steer torque or damper).
-    Generalized { name: String, coordinate: String, expr: Expr },
+    Generalized {
+        name: String,
+        coordinate: String,
+        expr: Expr,
+    },
     /// A force at a body's mass centre, components in `frame`.
-    AtMassCentre { name: String, body: BodyId, frame: FrameId, force: Vec3 },
+    AtMassCentre {
+        name: String,
+        body: BodyId,
+        frame: FrameId,
+        force: Vec3,
+    },
 }
 
 /// A frozen, validated model.
@@ -153,14 +172,34 @@ pub struct Model {
 /// One problem found by validation.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Diagnostic {
-    Duplicate { kind: &'static str, name: String },
-    Undeclared { kind: &'static str, name: String, used_in: String },
-    TimeDependentGeometry { item: String },
-    RateInGeometry { item: String },
-    HolonomicCount { dependent: usize, constraints: usize },
-    DegreesOfFreedom { coordinates: usize, independent: usize, constraints: usize },
+    Duplicate {
+        kind: &'static str,
+        name: String,
+    },
+    Undeclared {
+        kind: &'static str,
+        name: String,
+        used_in: String,
+    },
+    TimeDependentGeometry {
+        item: String,
+    },
+    RateInGeometry {
+        item: String,
+    },
+    HolonomicCount {
+        dependent: usize,
+        constraints: usize,
+    },
+    DegreesOfFreedom {
+        coordinates: usize,
+        independent: usize,
+        constraints: usize,
+    },
     NoBodies,
-    AsymmetricInertia { body: String },
+    AsymmetricInertia {
+        body: String,
+    },
     NoIndependentCoordinates,
 }
 
@@ -232,7 +271,11 @@ impl Model {
                 sources: Vec::new(),
                 coordinates: Vec::new(),
                 parameters: Vec::new(),
-                frames: vec![Frame { name: "ground".into(), parent: GROUND, rotations: vec![] }],
+                frames: vec![Frame {
+                    name: "ground".into(),
+                    parent: GROUND,
+                    rotations: vec![],
+                }],
                 points: Vec::new(),
                 bodies: Vec::new(),
                 holonomic: Vec::new(),
@@ -266,9 +309,7 @@ impl Model {
         self.nonholonomic
             .iter()
             .map(|h| match h {
-                Nonholonomic::ContactVelocity { name, .. } | Nonholonomic::Linear { name, .. } => {
-                    name.clone()
-                }
+                Nonholonomic::ContactVelocity { name, .. } | Nonholonomic::Linear { name, .. } => name.clone(),
             })
             .collect()
     }
@@ -297,22 +338,39 @@ impl ModelBuilder {
     }
     /// Declare a parameter.
     pub fn parameter(&mut self, name: &str, doc: &str) -> Expr {
-        self.m.parameters.push(Parameter { name: name.into(), doc: doc.into() });
+        self.m.parameters.push(Parameter {
+            name: name.into(),
+            doc: doc.into(),
+        });
         Expr::Param(name.into())
     }
     /// Declare a frame reached from `parent` by elementary rotations.
     pub fn frame(&mut self, name: &str, parent: FrameId, rotations: Vec<(Axis, Expr)>) -> FrameId {
-        self.m.frames.push(Frame { name: name.into(), parent, rotations });
+        self.m.frames.push(Frame {
+            name: name.into(),
+            parent,
+            rotations,
+        });
         FrameId(self.m.frames.len() - 1)
     }
     /// Declare a point `base + sum A_frame v`.
     pub fn point(&mut self, name: &str, base: Option<PointId>, offsets: Vec<(FrameId, Vec3)>) -> PointId {
-        self.m.points.push(Point { name: name.into(), base, offsets });
+        self.m.points.push(Point {
+            name: name.into(),
+            base,
+            offsets,
+        });
         PointId(self.m.points.len() - 1)
     }
     /// Declare a rigid body.
     pub fn body(&mut self, name: &str, frame: FrameId, mass: Expr, inertia: Tensor3, mass_centre: PointId) -> BodyId {
-        self.m.bodies.push(Body { name: name.into(), frame, mass, inertia, mass_centre });
+        self.m.bodies.push(Body {
+            name: name.into(),
+            frame,
+            mass,
+            inertia,
+            mass_centre,
+        });
         BodyId(self.m.bodies.len() - 1)
     }
     /// Move a body's mass centre to another point (for model variants).
@@ -350,7 +408,10 @@ impl ModelBuilder {
         if problems.is_empty() {
             Ok(self.m)
         } else {
-            Err(ModelError::Invalid { model: self.m.name.clone(), problems })
+            Err(ModelError::Invalid {
+                model: self.m.name.clone(),
+                problems,
+            })
         }
     }
 }
@@ -359,7 +420,10 @@ fn duplicates<'a>(kind: &'static str, names: impl Iterator<Item = &'a str>, out:
     let mut seen = BTreeSet::new();
     for n in names {
         if !seen.insert(n) {
-            out.push(Diagnostic::Duplicate { kind, name: n.to_string() });
+            out.push(Diagnostic::Duplicate {
+                kind,
+                name: n.to_string(),
+            });
         }
     }
 }
@@ -403,9 +467,7 @@ pub fn validate(m: &Model) -> Vec<Diagnostic> {
     }
     for h in &m.holonomic {
         match h {
-            Holonomic::Residual { name, expr } => {
-                uses.push((expr, format!("holonomic constraint `{name}`"), false))
-            }
+            Holonomic::Residual { name, expr } => uses.push((expr, format!("holonomic constraint `{name}`"), false)),
             Holonomic::PointComponentStationary { name, coordinate, .. } => {
                 if !coords.contains(coordinate.as_str()) {
                     out.push(Diagnostic::Undeclared {
@@ -453,7 +515,11 @@ pub fn validate(m: &Model) -> Vec<Diagnostic> {
             };
             if !ok {
                 let kind = if kind == "rate" { "coordinate" } else { kind };
-                out.push(Diagnostic::Undeclared { kind, name, used_in: used_in.clone() });
+                out.push(Diagnostic::Undeclared {
+                    kind,
+                    name,
+                    used_in: used_in.clone(),
+                });
             } else if geometry && kind == "time" {
                 out.push(Diagnostic::TimeDependentGeometry { item: used_in.clone() });
             } else if geometry && kind == "rate" {
@@ -463,7 +529,11 @@ pub fn validate(m: &Model) -> Vec<Diagnostic> {
     }
     if let Some((g, _)) = &m.gravity {
         if !params.contains(g.as_str()) {
-            out.push(Diagnostic::Undeclared { kind: "parameter", name: g.clone(), used_in: "gravity".into() });
+            out.push(Diagnostic::Undeclared {
+                kind: "parameter",
+                name: g.clone(),
+                used_in: "gravity".into(),
+            });
         }
     }
     if m.bodies.is_empty() {
@@ -471,7 +541,10 @@ pub fn validate(m: &Model) -> Vec<Diagnostic> {
     }
     let dependent = m.coordinates.iter().filter(|c| c.role == Role::Dependent).count();
     if dependent != m.holonomic.len() {
-        out.push(Diagnostic::HolonomicCount { dependent, constraints: m.holonomic.len() });
+        out.push(Diagnostic::HolonomicCount {
+            dependent,
+            constraints: m.holonomic.len(),
+        });
     }
     let independent = m.coordinates.iter().filter(|c| c.role == Role::Independent).count();
     if independent == 0 {
@@ -500,18 +573,46 @@ mod tests {
         m.coordinate("theta", Role::Dependent, 0.0, "again");
         m.parameter("L", "length");
         let f = m.frame("pendulum", GROUND, vec![(Axis::Y, th + coord("undeclared"))]);
-        let p = m.point("tip", None, vec![(f, vec3(param("L") * rate("theta"), num(0), param("missing")))]);
+        let p = m.point(
+            "tip",
+            None,
+            vec![(f, vec3(param("L") * rate("theta"), num(0), param("missing")))],
+        );
         let _ = m.body("bob", f, param("m"), crate::expr::inertia_wheel(num(1), num(1)), p);
         let err = m.build().unwrap_err();
         let ModelError::Invalid { problems, .. } = &err;
         let has = |d: &Diagnostic| problems.contains(d);
-        assert!(has(&Diagnostic::Duplicate { kind: "coordinate", name: "theta".into() }));
-        assert!(has(&Diagnostic::Undeclared { kind: "coordinate", name: "undeclared".into(), used_in: "frame `pendulum`".into() }));
-        assert!(has(&Diagnostic::Undeclared { kind: "parameter", name: "missing".into(), used_in: "point `tip`".into() }));
-        assert!(has(&Diagnostic::Undeclared { kind: "parameter", name: "m".into(), used_in: "mass of body `bob`".into() }));
-        assert!(has(&Diagnostic::RateInGeometry { item: "point `tip`".into() }));
-        assert!(has(&Diagnostic::HolonomicCount { dependent: 1, constraints: 0 }));
-        assert!(has(&Diagnostic::DegreesOfFreedom { coordinates: 2, independent: 1, constraints: 0 }));
+        assert!(has(&Diagnostic::Duplicate {
+            kind: "coordinate",
+            name: "theta".into()
+        }));
+        assert!(has(&Diagnostic::Undeclared {
+            kind: "coordinate",
+            name: "undeclared".into(),
+            used_in: "frame `pendulum`".into()
+        }));
+        assert!(has(&Diagnostic::Undeclared {
+            kind: "parameter",
+            name: "missing".into(),
+            used_in: "point `tip`".into()
+        }));
+        assert!(has(&Diagnostic::Undeclared {
+            kind: "parameter",
+            name: "m".into(),
+            used_in: "mass of body `bob`".into()
+        }));
+        assert!(has(&Diagnostic::RateInGeometry {
+            item: "point `tip`".into()
+        }));
+        assert!(has(&Diagnostic::HolonomicCount {
+            dependent: 1,
+            constraints: 0
+        }));
+        assert!(has(&Diagnostic::DegreesOfFreedom {
+            coordinates: 2,
+            independent: 1,
+            constraints: 0
+        }));
         let text = err.to_string();
         assert!(text.contains("7 problems") || problems.len() >= 7, "{text}");
     }
@@ -527,7 +628,9 @@ mod tests {
         m.body("b", f, num(1), i, p);
         let ModelError::Invalid { problems, .. } = m.build().unwrap_err();
         assert!(problems.contains(&Diagnostic::AsymmetricInertia { body: "b".into() }));
-        assert!(problems.contains(&Diagnostic::TimeDependentGeometry { item: "frame `a`".into() }));
+        assert!(problems.contains(&Diagnostic::TimeDependentGeometry {
+            item: "frame `a`".into()
+        }));
     }
 
     #[test]

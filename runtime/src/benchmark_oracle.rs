@@ -26,12 +26,22 @@ pub fn meijaard_canonical(p: &BenchmarkParameters) -> CanonicalMatrices {
     let w = p.wheelbase;
     let c = p.trail;
     let lam = p.steer_axis_tilt;
-    let (rr, mr, irxx, iryy) = (p.rear_wheel_radius, p.rear_wheel_mass, p.rear_wheel_ixx, p.rear_wheel_iyy);
+    let (rr, mr, irxx, iryy) = (
+        p.rear_wheel_radius,
+        p.rear_wheel_mass,
+        p.rear_wheel_ixx,
+        p.rear_wheel_iyy,
+    );
     let (xb, zb, mb) = (p.rear_frame_com_x, p.rear_frame_com_z, p.rear_frame_mass);
     let (ibxx, ibzz, ibxz) = (p.rear_frame_ixx, p.rear_frame_izz, p.rear_frame_ixz);
     let (xh, zh, mh) = (p.front_frame_com_x, p.front_frame_com_z, p.front_frame_mass);
     let (ihxx, ihzz, ihxz) = (p.front_frame_ixx, p.front_frame_izz, p.front_frame_ixz);
-    let (rf, mf, ifxx, ifyy) = (p.front_wheel_radius, p.front_wheel_mass, p.front_wheel_ixx, p.front_wheel_iyy);
+    let (rf, mf, ifxx, ifyy) = (
+        p.front_wheel_radius,
+        p.front_wheel_mass,
+        p.front_wheel_ixx,
+        p.front_wheel_iyy,
+    );
 
     // (A 1-3) total mass and mass centre
     let mt = mr + mb + mh + mf;

@@ -16,7 +16,10 @@ pub struct NewtonOptions {
 }
 impl Default for NewtonOptions {
     fn default() -> Self {
-        NewtonOptions { tol: 1e-14, max_iterations: 50 }
+        NewtonOptions {
+            tol: 1e-14,
+            max_iterations: 50,
+        }
     }
 }
 
@@ -34,17 +37,29 @@ pub enum ConstraintError {
     /// Newton did not converge: for a bicycle this means the geometry has no
     /// ground contact (e.g. the front wheel cannot reach the ground).
     #[error("holonomic constraint `{constraint}` cannot be satisfied (residual {residual:.3e} after {iterations} Newton iterations): the geometry has no ground contact or the initial guess is too far")]
-    NotSatisfiable { constraint: &'static str, residual: f64, iterations: usize },
+    NotSatisfiable {
+        constraint: &'static str,
+        residual: f64,
+        iterations: usize,
+    },
     /// The constraint Jacobian with respect to the dependent coordinates is singular.
     #[error("the constraint Jacobian is singular at column {column} (pivot {pivot:.3e}) for the {what}: the dependent coordinates are not determined by the constraints here")]
-    SingularJacobian { what: &'static str, column: usize, pivot: f64 },
+    SingularJacobian {
+        what: &'static str,
+        column: usize,
+        pivot: f64,
+    },
     /// A parameter, coordinate or result is NaN or infinite.
     #[error("non-finite value in {what}")]
     NotFinite { what: &'static str },
 }
 
 fn singular(what: &'static str) -> impl Fn(Singular) -> ConstraintError {
-    move |s| ConstraintError::SingularJacobian { what, column: s.column, pivot: s.pivot }
+    move |s| ConstraintError::SingularJacobian {
+        what,
+        column: s.column,
+        pivot: s.pivot,
+    }
 }
 
 /// Solve the holonomic constraints for the dependent coordinates
@@ -62,7 +77,9 @@ pub fn solve_configuration<M: MultibodyModel, T: Scalar>(
     let dep = M::DEPENDENT;
     assert_eq!(p.len(), nq, "coordinate vector length");
     if param.iter().chain(p.iter()).any(|x| !x.re().is_finite()) || !t.re().is_finite() {
-        return Err(ConstraintError::NotFinite { what: "parameters or coordinates" });
+        return Err(ConstraintError::NotFinite {
+            what: "parameters or coordinates",
+        });
     }
     let paramf: Vec<f64> = param.iter().map(|x| x.re()).collect();
     let mut pf: Vec<f64> = p.iter().map(|x| x.re()).collect();
@@ -76,7 +93,9 @@ pub fn solve_configuration<M: MultibodyModel, T: Scalar>(
     let mut rnorm = norm(&res);
     while !(rnorm <= opts.tol) || iterations == 0 {
         if iterations >= opts.max_iterations || !rnorm.is_finite() {
-            let worst = (0..nh).max_by(|&a, &b| res[a].abs().total_cmp(&res[b].abs())).unwrap_or(0);
+            let worst = (0..nh)
+                .max_by(|&a, &b| res[a].abs().total_cmp(&res[b].abs()))
+                .unwrap_or(0);
             return Err(ConstraintError::NotSatisfiable {
                 constraint: M::HOLONOMIC.get(worst).copied().unwrap_or("?"),
                 residual: rnorm,
@@ -132,7 +151,10 @@ pub fn solve_configuration<M: MultibodyModel, T: Scalar>(
     for (k, &j) in dep.iter().enumerate() {
         p[j] -= res_t[k];
     }
-    Ok(NewtonInfo { iterations, residual: rnorm })
+    Ok(NewtonInfo {
+        iterations,
+        residual: rnorm,
+    })
 }
 
 /// The constraint matrix `D = [Cq; B]` and right-hand sides at velocity level
@@ -170,13 +192,21 @@ pub fn dependent_velocities<M: MultibodyModel>() -> Vec<usize> {
 
 /// Solve the velocity constraints for the dependent velocities, given the
 /// independent ones already in `dp` (thesis eq. 40-41).
-pub fn solve_velocities<M: MultibodyModel, T: Scalar>(param: &[T], t: T, p: &[T], dp: &mut [T]) -> Result<(), ConstraintError> {
+pub fn solve_velocities<M: MultibodyModel, T: Scalar>(
+    param: &[T],
+    t: T,
+    p: &[T],
+    dp: &mut [T],
+) -> Result<(), ConstraintError> {
     let nq = M::nq();
     let cm = constraint_matrices::<M, T>(param, t, p);
     let depv = dependent_velocities::<M>();
     let nd = depv.len();
     let nc = cm.d_rhs.len();
-    assert_eq!(nc, nd, "a validated model has as many constraints as dependent velocities");
+    assert_eq!(
+        nc, nd,
+        "a validated model has as many constraints as dependent velocities"
+    );
     let mut a = vec![T::zero(); nd * nd];
     let mut rhs = cm.d_rhs.clone();
     for i in 0..nc {

@@ -204,7 +204,6 @@ pub struct CriticalSpeeds {
     pub stable_intervals: Vec<[f64; 2]>,
 }
 
-
 /// Characteristic quartic `det(M0 s^2 + v C1 s + g K0 + v^2 K2)` as polynomials in
 /// the speed: with `u = v^2`,
 /// `k4 = det M0`, `k3 = v a3`, `k2 = g b0 + u b2`, `k1 = v (g d0 + u d2)`,
@@ -252,7 +251,9 @@ impl CharPoly {
     pub fn new(c: &CanonicalMatrices) -> Result<Self, EigenError> {
         for (name, m) in [("M0", &c.m0), ("C1", &c.c1), ("K0", &c.k0), ("K2", &c.k2)] {
             if !m.iter().all(|x| x.is_finite()) {
-                return Err(EigenError::NonFinite { what: format!("matrix {name}") });
+                return Err(EigenError::NonFinite {
+                    what: format!("matrix {name}"),
+                });
             }
         }
         if !c.g.is_finite() {
@@ -308,11 +309,14 @@ impl CharPoly {
     /// Roots at speed `v`, sorted by descending real part then imaginary part.
     pub fn roots(&self, v: f64) -> Result<[Complex<f64>; 4], EigenError> {
         if !v.is_finite() {
-            return Err(EigenError::NonFinite { what: format!("speed {v}") });
+            return Err(EigenError::NonFinite {
+                what: format!("speed {v}"),
+            });
         }
         let va = v.abs();
-        let mut z = quartic_roots(&self.coeffs(va))
-            .ok_or_else(|| EigenError::NoConvergence { what: format!("quartic roots at v = {v}") })?;
+        let mut z = quartic_roots(&self.coeffs(va)).ok_or_else(|| EigenError::NoConvergence {
+            what: format!("quartic roots at v = {v}"),
+        })?;
         if v < 0.0 {
             for x in z.iter_mut() {
                 *x = neg(*x);
@@ -384,8 +388,18 @@ impl Labelled {
         idx.sort_by(|&i, &j| {
             rank(self.labels[i])
                 .cmp(&rank(self.labels[j]))
-                .then(self.roots[j].im.partial_cmp(&self.roots[i].im).unwrap_or(std::cmp::Ordering::Equal))
-                .then(self.roots[j].re.partial_cmp(&self.roots[i].re).unwrap_or(std::cmp::Ordering::Equal))
+                .then(
+                    self.roots[j]
+                        .im
+                        .partial_cmp(&self.roots[i].im)
+                        .unwrap_or(std::cmp::Ordering::Equal),
+                )
+                .then(
+                    self.roots[j]
+                        .re
+                        .partial_cmp(&self.roots[i].re)
+                        .unwrap_or(std::cmp::Ordering::Equal),
+                )
         });
         let (r, l) = (self.roots, self.labels);
         for k in 0..4 {
@@ -401,7 +415,11 @@ impl Labelled {
         for x in r.iter_mut() {
             *x = neg(*x);
         }
-        Labelled { roots: r, labels: self.labels }.canonical()
+        Labelled {
+            roots: r,
+            labels: self.labels,
+        }
+        .canonical()
     }
 }
 
@@ -487,11 +505,17 @@ fn pair_rule(z: &[C64; 4], mut l: [Mode; 4]) -> [Mode; 4] {
         if z[i].im <= 0.0 {
             continue;
         }
-        let Some(j) = (0..4).find(|&j| j != i && z[j] == z[i].conj()) else { continue };
+        let Some(j) = (0..4).find(|&j| j != i && z[j] == z[i].conj()) else {
+            continue;
+        };
         if l[i] == l[j] {
             continue;
         }
-        let (lo, hi) = if rank(l[i]) <= rank(l[j]) { (l[i], l[j]) } else { (l[j], l[i]) };
+        let (lo, hi) = if rank(l[i]) <= rank(l[j]) {
+            (l[i], l[j])
+        } else {
+            (l[j], l[i])
+        };
         if let Some(k) = (0..4).find(|&k| k != i && k != j && l[k] == lo) {
             l[k] = hi;
         }
@@ -523,13 +547,22 @@ fn continue_to(cp: &CharPoly, start: Labelled, v0: f64, v1: f64) -> Result<Label
     while v != v1 {
         guard += 1;
         if guard > 2_000_000 {
-            return Err(EigenError::NoConvergence { what: "mode continuation".into() });
+            return Err(EigenError::NoConvergence {
+                what: "mode continuation".into(),
+            });
         }
-        let vt = if (v1 - v).abs() <= h.abs() * (1.0 + 1e-12) { v1 } else { v + h };
+        let vt = if (v1 - v).abs() <= h.abs() * (1.0 + 1e-12) {
+            v1
+        } else {
+            v + h
+        };
         let z = cp.roots(vt)?;
         let (m, ok) = match_roots(&cur, &z);
         if ok || h.abs() <= hmin {
-            cur = Labelled { roots: m, labels: pair_rule(&m, cur.labels) };
+            cur = Labelled {
+                roots: m,
+                labels: pair_rule(&m, cur.labels),
+            };
             v = vt;
             h *= 2.0;
             if h.abs() > (v1 - v).abs() && v != v1 {
@@ -564,7 +597,9 @@ fn speed_scale(cp: &CharPoly) -> f64 {
 /// (`vs` = [`speed_scale`]); otherwise the fallback classification at `30 vs`.
 fn anchor(cp: &CharPoly) -> Result<(f64, Labelled), EigenError> {
     let base = 30.0 * speed_scale(cp);
-    let ladder = (0..=10).map(|k| base * 2f64.powi(k)).chain((1..=80).map(|k| base / 1.25f64.powi(k)));
+    let ladder = (0..=10)
+        .map(|k| base * 2f64.powi(k))
+        .chain((1..=80).map(|k| base / 1.25f64.powi(k)));
     for v in ladder {
         let z = cp.roots(v)?;
         if let Some(l) = classify_anchor(&z) {
@@ -572,7 +607,13 @@ fn anchor(cp: &CharPoly) -> Result<(f64, Labelled), EigenError> {
         }
     }
     let z = cp.roots(base)?;
-    Ok((base, Labelled { roots: z, labels: classify_fallback(&z) }))
+    Ok((
+        base,
+        Labelled {
+            roots: z,
+            labels: classify_fallback(&z),
+        },
+    ))
 }
 
 /// Labels at every `|v|` of `speeds` (any order, any sign). Returns labelled roots in
@@ -584,12 +625,19 @@ pub(crate) fn track(cp: &CharPoly, speeds: &[f64]) -> Result<Vec<Labelled>, Eige
     }
     for &v in speeds {
         if !v.is_finite() {
-            return Err(EigenError::NonFinite { what: format!("speed {v}") });
+            return Err(EigenError::NonFinite {
+                what: format!("speed {v}"),
+            });
         }
     }
     let (va, start) = anchor(cp)?;
     let mut out = vec![start; speeds.len()];
-    let by_abs = |i: &usize, j: &usize| speeds[*i].abs().partial_cmp(&speeds[*j].abs()).unwrap_or(std::cmp::Ordering::Equal);
+    let by_abs = |i: &usize, j: &usize| {
+        speeds[*i]
+            .abs()
+            .partial_cmp(&speeds[*j].abs())
+            .unwrap_or(std::cmp::Ordering::Equal)
+    };
     // above the anchor: ascending; below: descending
     let mut up: Vec<usize> = (0..speeds.len()).filter(|&i| speeds[i].abs() > va).collect();
     up.sort_by(by_abs);
@@ -665,7 +713,12 @@ pub fn eigen_sweep(c: &CanonicalMatrices, speeds: &[f64]) -> Result<EigenSweep, 
                     eigenvector(c, v, s)
                 };
             }
-            EigenPoint { v, eigenvalues: l.roots, modes: l.labels, eigenvectors: vecs }
+            EigenPoint {
+                v,
+                eigenvalues: l.roots,
+                modes: l.labels,
+                eigenvectors: vecs,
+            }
         })
         .collect();
     Ok(EigenSweep { points })

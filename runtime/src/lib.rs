@@ -5,9 +5,9 @@
 pub mod benchmark_oracle;
 pub mod canonical;
 pub mod constraints;
+pub mod eigen;
 pub mod linalg;
 pub mod linearize;
-pub mod eigen;
 pub mod model;
 pub mod output;
 pub mod parameters;

@@ -168,15 +168,24 @@ pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, Line
     let mass = DMatrix::from_fn(2, 2, |i, j| mi[i * 2 + j].re);
     let stiffness = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[j]);
     let damping = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[2 + j]);
-    Ok(Linearization { mass, damping, stiffness })
+    Ok(Linearization {
+        mass,
+        damping,
+        stiffness,
+    })
 }
 
 /// The thesis's finite-difference linearization (forward differences, step
 /// `h`, `CalculaMatricesMCK.m`), kept to cross-check [`linearize`].
 pub fn linearize_finite_difference<M: MultibodyModel>(param: &[f64], h: f64) -> Result<Linearization, LinearizeError> {
-    let eval = |q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]| reduced_equations::<M, f64>(param, 0.0, &q, &dq, &ddq).map(|r| r.0);
+    let eval =
+        |q: [f64; 2], dq: [f64; 2], ddq: [f64; 2]| reduced_equations::<M, f64>(param, 0.0, &q, &dq, &ddq).map(|r| r.0);
     let e0 = eval([0.0; 2], [0.0; 2], [0.0; 2])?;
-    let mut lin = Linearization { mass: DMatrix::zeros(2, 2), damping: DMatrix::zeros(2, 2), stiffness: DMatrix::zeros(2, 2) };
+    let mut lin = Linearization {
+        mass: DMatrix::zeros(2, 2),
+        damping: DMatrix::zeros(2, 2),
+        stiffness: DMatrix::zeros(2, 2),
+    };
     for j in 0..2 {
         let mut u = [0.0; 2];
         u[j] = h;
@@ -194,10 +203,18 @@ pub fn linearize_finite_difference<M: MultibodyModel>(param: &[f64], h: f64) -> 
 
 /// Fill a model's parameter vector by name from `lookup`, with the forward
 /// speed `V`.
-pub fn parameter_vector<M: MultibodyModel>(lookup: impl Fn(&str) -> Option<f64>, speed: f64) -> Result<Vec<f64>, LinearizeError> {
+pub fn parameter_vector<M: MultibodyModel>(
+    lookup: impl Fn(&str) -> Option<f64>,
+    speed: f64,
+) -> Result<Vec<f64>, LinearizeError> {
     M::PARAMETERS
         .iter()
-        .map(|&n| if n == "V" { Some(speed) } else { lookup(n) }.ok_or_else(|| LinearizeError::MissingParameter { model: M::NAME, name: n.to_string() }))
+        .map(|&n| {
+            if n == "V" { Some(speed) } else { lookup(n) }.ok_or_else(|| LinearizeError::MissingParameter {
+                model: M::NAME,
+                name: n.to_string(),
+            })
+        })
         .collect()
 }
 
@@ -206,8 +223,13 @@ pub fn parameter_vector<M: MultibodyModel>(lookup: impl Fn(&str) -> Option<f64>,
 /// because the reduced equations are quadratic in the forward speed. The
 /// thesis's steer angle gamma is minus the benchmark's delta, so the
 /// off-diagonal entries change sign.
-pub fn canonical_matrices<M: MultibodyModel>(lookup: impl Fn(&str) -> Option<f64>) -> Result<CanonicalMatrices, LinearizeError> {
-    let g = lookup("g").ok_or_else(|| LinearizeError::MissingParameter { model: M::NAME, name: "g".into() })?;
+pub fn canonical_matrices<M: MultibodyModel>(
+    lookup: impl Fn(&str) -> Option<f64>,
+) -> Result<CanonicalMatrices, LinearizeError> {
+    let g = lookup("g").ok_or_else(|| LinearizeError::MissingParameter {
+        model: M::NAME,
+        name: "g".into(),
+    })?;
     let l0 = linearize::<M>(&parameter_vector::<M>(&lookup, 0.0)?)?;
     let l1 = linearize::<M>(&parameter_vector::<M>(&lookup, 1.0)?)?;
     let flip = |m: &DMatrix<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);

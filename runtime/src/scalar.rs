@@ -136,7 +136,10 @@ impl<const N: usize> Mul for Dual<N> {
         for k in 0..N {
             eps[k] = self.eps[k] * o.re + self.re * o.eps[k];
         }
-        Dual { re: self.re * o.re, eps }
+        Dual {
+            re: self.re * o.re,
+            eps,
+        }
     }
 }
 impl<const N: usize> Div for Dual<N> {

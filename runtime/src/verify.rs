@@ -41,7 +41,11 @@ pub struct VerifyOptions {
 }
 impl Default for VerifyOptions {
     fn default() -> Self {
-        VerifyOptions { states: 20, seed: 1, fd_tolerance: 1e-6 }
+        VerifyOptions {
+            states: 20,
+            seed: 1,
+            fd_tolerance: 1e-6,
+        }
     }
 }
 
@@ -71,7 +75,11 @@ impl Acc {
         Acc { name, tol, worst: 0.0 }
     }
     fn compare(&mut self, got: &[f64], want: &[f64]) {
-        let scale = want.iter().chain(got.iter()).fold(0.0f64, |m, x| m.max(x.abs())).max(1e-12);
+        let scale = want
+            .iter()
+            .chain(got.iter())
+            .fold(0.0f64, |m, x| m.max(x.abs()))
+            .max(1e-12);
         for (g, w) in got.iter().zip(want) {
             let e = (g - w).abs() / scale;
             if !(e <= self.worst) {
@@ -80,7 +88,12 @@ impl Acc {
         }
     }
     fn done(self) -> QuantityCheck {
-        QuantityCheck { name: self.name.into(), max_rel_error: self.worst, tolerance: self.tol, passed: self.worst <= self.tol }
+        QuantityCheck {
+            name: self.name.into(),
+            max_rel_error: self.worst,
+            tolerance: self.tol,
+            passed: self.worst <= self.tol,
+        }
     }
 }
 
@@ -143,16 +156,21 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         a_cq.compare(&cq, &fd);
         let mut ct = vec![0.0; nh];
         M::holonomic_time_derivative(param, t, &p, &mut ct);
-        a_ct.compare(&ct, &central(h, |s| {
-            let mut r = vec![0.0; nh];
-            M::holonomic_residuals(param, t + s, &p, &mut r);
-            r
-        }));
+        a_ct.compare(
+            &ct,
+            &central(h, |s| {
+                let mut r = vec![0.0; nh];
+                M::holonomic_residuals(param, t + s, &p, &mut r);
+                r
+            }),
+        );
         // dCqdp vs directional FD of Cq p' along p'.
         let cq_dp = |q: &[f64]| {
             let mut c = vec![0.0; nh * nq];
             M::holonomic_jacobian(param, t, q, &mut c);
-            (0..nh).map(|i| (0..nq).map(|k| c[i * nq + k] * dp[k]).sum()).collect::<Vec<f64>>()
+            (0..nh)
+                .map(|i| (0..nq).map(|k| c[i * nq + k] * dp[k]).sum())
+                .collect::<Vec<f64>>()
         };
         let mut dcq = vec![0.0; nh];
         M::holonomic_convective(param, t, &p, &dp, &mut dcq);
@@ -177,7 +195,9 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         let b_dp = |q: &[f64]| {
             let mut c = vec![0.0; nnh * nq];
             M::nonholonomic_matrix(param, t, q, &mut c);
-            (0..nnh).map(|i| (0..nq).map(|k| c[i * nq + k] * dp[k]).sum()).collect::<Vec<f64>>()
+            (0..nnh)
+                .map(|i| (0..nq).map(|k| c[i * nq + k] * dp[k]).sum())
+                .collect::<Vec<f64>>()
         };
         let mut dbdp = vec![0.0; nnh];
         M::nonholonomic_convective(param, t, &p, &dp, &mut dbdp);
@@ -195,7 +215,9 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         let dtdq: Vec<f64> = (0..nq)
             .map(|j| central(h, |s| vec![M::kinetic_energy(param, &shifted(Some(j), s, None), &dp)])[0])
             .collect();
-        let want: Vec<f64> = (0..nq).map(|a| -(0..nq).map(|c| mdot[a * nq + c] * dp[c]).sum::<f64>() + dtdq[a]).collect();
+        let want: Vec<f64> = (0..nq)
+            .map(|a| -(0..nq).map(|c| mdot[a * nq + c] * dp[c]).sum::<f64>() + dtdq[a])
+            .collect();
         a_qv.compare(&qv, &want);
         // Qgrav vs -dV/dp.
         let mut qg = vec![0.0; nq];
@@ -213,7 +235,10 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         let neg = ev.iter().fold(0.0f64, |m, x| m.max(-x)) / scale;
         a_psd.worst = a_psd.worst.max(neg);
         // T = 1/2 p'^T M p'.
-        let tt = 0.5 * (0..nq).map(|a| (0..nq).map(|c| dp[a] * m0[a * nq + c] * dp[c]).sum::<f64>()).sum::<f64>();
+        let tt = 0.5
+            * (0..nq)
+                .map(|a| (0..nq).map(|c| dp[a] * m0[a * nq + c] * dp[c]).sum::<f64>())
+                .sum::<f64>();
         a_t.compare(&[M::kinetic_energy(param, &p, &dp)], &[tt]);
         // all_quantities must reproduce every individual function.
         let total: usize = M::ALL_QUANTITIES_LAYOUT.iter().map(|x| x.2).sum();
@@ -240,7 +265,10 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         }
         // Power identities.
         let pq: f64 = (0..nq).map(|a| dp[a] * qv[a]).sum();
-        let pm: f64 = -0.5 * (0..nq).map(|a| (0..nq).map(|c| dp[a] * mdot[a * nq + c] * dp[c]).sum::<f64>()).sum::<f64>();
+        let pm: f64 = -0.5
+            * (0..nq)
+                .map(|a| (0..nq).map(|c| dp[a] * mdot[a * nq + c] * dp[c]).sum::<f64>())
+                .sum::<f64>();
         let ke = tt.abs().max(1e-12);
         a_pow_v.compare(&[pq / ke], &[pm / ke]);
         let pg: f64 = (0..nq).map(|a| dp[a] * qg[a]).sum();
@@ -248,8 +276,12 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         let vs = (0..nq).map(|a| (dp[a] * qg[a]).abs()).sum::<f64>().max(1e-12);
         a_pow_g.compare(&[pg / vs], &[-dvdt / vs]);
     }
-    let quantities: Vec<QuantityCheck> =
-        [a_cq, a_ct, a_dcq, a_b, a_dbdp, a_qv, a_qg, a_sym, a_psd, a_t, a_pow_v, a_pow_g, a_all].into_iter().map(Acc::done).collect();
+    let quantities: Vec<QuantityCheck> = [
+        a_cq, a_ct, a_dcq, a_b, a_dbdp, a_qv, a_qg, a_sym, a_psd, a_t, a_pow_v, a_pow_g, a_all,
+    ]
+    .into_iter()
+    .map(Acc::done)
+    .collect();
     VerifyReport {
         model: M::NAME.into(),
         states: opts.states,

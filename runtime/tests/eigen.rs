@@ -18,7 +18,9 @@ fn data() -> toml::Table {
 }
 
 fn f(v: &toml::Value) -> f64 {
-    v.as_float().or_else(|| v.as_integer().map(|i| i as f64)).expect("number")
+    v.as_float()
+        .or_else(|| v.as_integer().map(|i| i as f64))
+        .expect("number")
 }
 
 fn mat(t: &toml::Table, key: &str) -> Matrix2<f64> {
@@ -109,7 +111,12 @@ fn input_rounding_bound(c: &CanonicalMatrices, v: f64, s: C64) -> f64 {
     let mut num = 0.0;
     for i in 0..2 {
         for j in 0..2 {
-            for (m, weight) in [(&c.m0, s * s), (&c.c1, s * v), (&c.k0, C64::new(c.g, 0.0)), (&c.k2, C64::new(v * v, 0.0))] {
+            for (m, weight) in [
+                (&c.m0, s * s),
+                (&c.c1, s * v),
+                (&c.k0, C64::new(c.g, 0.0)),
+                (&c.k2, C64::new(v * v, 0.0)),
+            ] {
                 if !exact(m[(i, j)]) {
                     num += (cof[i][j] * weight).norm() * 5e-15;
                 }
@@ -125,14 +132,21 @@ fn check_table2(c: &CanonicalMatrices, extra: impl Fn(f64, C64) -> f64) {
     for row in table2() {
         let z = eigenvalues(c, row.v).unwrap();
         for (x, _) in &row.expected {
-            let got = z.iter().min_by(|a, b| (*a - x).norm().partial_cmp(&(*b - x).norm()).unwrap()).unwrap();
+            let got = z
+                .iter()
+                .min_by(|a, b| (*a - x).norm().partial_cmp(&(*b - x).norm()).unwrap())
+                .unwrap();
             // 1e-12 relative; where the printed figure (14 decimals, i.e. +-5e-15) has
             // too few significant digits for that (the capsize root near v_c, e.g.
             // -0.00406690076970 at v = 6), the printing resolution 5e-15 is the floor,
             // plus the propagated rounding of the inputs.
             let tol = (1e-12 * x.norm()).max(5e-15 + extra(row.v, *x));
             let err = (got - x).norm();
-            assert!(err <= tol, "v = {}: expected {x}, got {got}, |err| = {err:e} > tol {tol:e}", row.v);
+            assert!(
+                err <= tol,
+                "v = {}: expected {x}, got {got}, |err| = {err:e} > tol {tol:e}",
+                row.v
+            );
         }
     }
 }
@@ -160,7 +174,12 @@ fn eigen_table2_from_table1_parameters_via_oracle() {
 fn eigen_oracle_matches_published_canonical_matrices() {
     let c = meijaard_canonical(&table1());
     let p = published();
-    for (name, a, b) in [("M0", c.m0, p.m0), ("C1", c.c1, p.c1), ("K0", c.k0, p.k0), ("K2", c.k2, p.k2)] {
+    for (name, a, b) in [
+        ("M0", c.m0, p.m0),
+        ("C1", c.c1, p.c1),
+        ("K0", c.k0, p.k0),
+        ("K2", c.k2, p.k2),
+    ] {
         for i in 0..2 {
             for j in 0..2 {
                 let (x, y) = (a[(i, j)], b[(i, j)]);
@@ -191,10 +210,20 @@ fn eigen_critical_speeds_match_paper() {
         // crossings in [0, 10]: weave stabilises at v_w, capsize destabilises at v_c
         assert_eq!(cs.crossings.len(), 2, "{:?}", cs.crossings);
         let w = &cs.crossings[0];
-        assert_eq!((w.mode, w.kind, w.direction), (Mode::Weave, CrossingKind::ComplexPair, CrossingDirection::Stabilizing));
-        assert!((w.frequency - critical("weave_speed_frequency")).abs() <= 1e-10, "omega = {}", w.frequency);
+        assert_eq!(
+            (w.mode, w.kind, w.direction),
+            (Mode::Weave, CrossingKind::ComplexPair, CrossingDirection::Stabilizing)
+        );
+        assert!(
+            (w.frequency - critical("weave_speed_frequency")).abs() <= 1e-10,
+            "omega = {}",
+            w.frequency
+        );
         let k = &cs.crossings[1];
-        assert_eq!((k.mode, k.kind, k.direction), (Mode::Capsize, CrossingKind::RealRoot, CrossingDirection::Destabilizing));
+        assert_eq!(
+            (k.mode, k.kind, k.direction),
+            (Mode::Capsize, CrossingKind::RealRoot, CrossingDirection::Destabilizing)
+        );
         assert_eq!(k.frequency, 0.0);
         assert_eq!(cs.stable_intervals, vec![[vw, vc]]);
     }
@@ -208,7 +237,10 @@ fn eigen_critical_speeds_subranges_and_negative_speeds() {
     // range without events
     let cs = critical_speeds(&c, 1.0, 4.0).unwrap();
     assert!(cs.crossings.is_empty() && cs.stable_intervals.is_empty());
-    assert_eq!((cs.weave_real_pair_merge, cs.weave_speed, cs.capsize_speed), (None, None, None));
+    assert_eq!(
+        (cs.weave_real_pair_merge, cs.weave_speed, cs.capsize_speed),
+        (None, None, None)
+    );
     // entirely stable
     let cs = critical_speeds(&c, 5.0, 5.5).unwrap();
     assert_eq!(cs.stable_intervals, vec![[5.0, 5.5]]);
@@ -241,7 +273,14 @@ fn eigen_labels_at_table2_speeds() {
         assert_eq!(p.v, row.v);
         assert_eq!(p.modes, [Mode::Weave, Mode::Weave, Mode::Capsize, Mode::Castering]);
         for (x, m) in &row.expected {
-            let k = (0..4).min_by(|&a, &b| (p.eigenvalues[a] - x).norm().partial_cmp(&(p.eigenvalues[b] - x).norm()).unwrap()).unwrap();
+            let k = (0..4)
+                .min_by(|&a, &b| {
+                    (p.eigenvalues[a] - x)
+                        .norm()
+                        .partial_cmp(&(p.eigenvalues[b] - x).norm())
+                        .unwrap()
+                })
+                .unwrap();
             assert!((p.eigenvalues[k] - x).norm() < 1e-10);
             assert_eq!(p.modes[k], *m, "v = {}: {x} labelled {:?}", row.v, p.modes[k]);
         }
@@ -262,9 +301,20 @@ fn assert_continuous(sweep: &EigenSweep) {
         for k in 0..4 {
             let m = a.modes[k];
             // nearest root with the same label at the next speed
-            let moved = (0..4).filter(|&j| b.modes[j] == m).map(|j| (b.eigenvalues[j] - a.eigenvalues[k]).norm()).fold(f64::INFINITY, f64::min);
-            let sep = (0..4).filter(|&j| a.modes[j] != m).map(|j| (a.eigenvalues[j] - a.eigenvalues[k]).norm()).fold(f64::INFINITY, f64::min);
-            assert!(moved < 0.5 * sep, "label jump at v = {} -> {}: {m:?} moved {moved} (sep {sep})", a.v, b.v);
+            let moved = (0..4)
+                .filter(|&j| b.modes[j] == m)
+                .map(|j| (b.eigenvalues[j] - a.eigenvalues[k]).norm())
+                .fold(f64::INFINITY, f64::min);
+            let sep = (0..4)
+                .filter(|&j| a.modes[j] != m)
+                .map(|j| (a.eigenvalues[j] - a.eigenvalues[k]).norm())
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                moved < 0.5 * sep,
+                "label jump at v = {} -> {}: {m:?} moved {moved} (sep {sep})",
+                a.v,
+                b.v
+            );
         }
     }
 }
@@ -276,7 +326,12 @@ fn eigen_fine_sweep_no_label_swap() {
     let sweep = eigen_sweep(&c, &speeds).unwrap();
     let vd = critical("weave_real_pair_merge");
     for p in &sweep.points {
-        assert_eq!(p.modes, [Mode::Weave, Mode::Weave, Mode::Capsize, Mode::Castering], "v = {}", p.v);
+        assert_eq!(
+            p.modes,
+            [Mode::Weave, Mode::Weave, Mode::Capsize, Mode::Castering],
+            "v = {}",
+            p.v
+        );
         // weave: two real roots below v_d, an exact conjugate pair above
         let (w0, w1) = (p.eigenvalues[0], p.eigenvalues[1]);
         if p.v < vd {
@@ -319,7 +374,10 @@ fn eigen_double_root_and_rest() {
             let w: Vec<C64> = z.iter().copied().filter(|x| (x.re - sd).abs() < 0.5).collect();
             assert_eq!(w.len(), 2, "v = {v}: {z:?}");
             // the pair splits like sqrt(|v - v_d|); 1e-7 ~ sqrt(eps) conditioning floor
-            assert!((w[0] - sd).norm() < 3.0 * (v - vd).abs().sqrt() + 1e-7, "v = {v}: {w:?}");
+            assert!(
+                (w[0] - sd).norm() < 3.0 * (v - vd).abs().sqrt() + 1e-7,
+                "v = {v}: {w:?}"
+            );
             check_identities(&c, v, &z, 1e-12);
         }
     }
@@ -346,7 +404,10 @@ fn eigen_negative_speed_is_mirror() {
 #[test]
 fn eigen_vectors_are_null_vectors() {
     let c = published();
-    let speeds: Vec<f64> = (0..=40).map(|i| i as f64 * 0.25).chain([-2.0, critical("weave_real_pair_merge")]).collect();
+    let speeds: Vec<f64> = (0..=40)
+        .map(|i| i as f64 * 0.25)
+        .chain([-2.0, critical("weave_real_pair_merge")])
+        .collect();
     let sweep = eigen_sweep(&c, &speeds).unwrap();
     for p in &sweep.points {
         let a = c.state_matrix(p.v).unwrap();
@@ -370,7 +431,11 @@ fn eigen_vectors_are_null_vectors() {
                 r = r.max(acc.norm());
             }
             let scale = a.abs().max() + s.norm();
-            let tol = if (p.v - critical("weave_real_pair_merge")).abs() < 1e-6 { 1e-6 } else { 1e-12 };
+            let tol = if (p.v - critical("weave_real_pair_merge")).abs() < 1e-6 {
+                1e-6
+            } else {
+                1e-12
+            };
             assert!(r <= tol * scale, "v = {}, k = {k}: residual {r:e}", p.v);
             if s.im < 0.0 {
                 let up = (0..4).find(|&i| p.eigenvalues[i] == s.conj()).unwrap();
@@ -389,12 +454,24 @@ fn eigen_vectors_are_null_vectors() {
 fn eigen_errors_not_panics() {
     let mut c = published();
     assert!(matches!(eigenvalues(&c, f64::NAN), Err(EigenError::NonFinite { .. })));
-    assert!(matches!(eigenvalues(&c, f64::INFINITY), Err(EigenError::NonFinite { .. })));
-    assert!(matches!(eigen_sweep(&c, &[1.0, f64::NAN]), Err(EigenError::NonFinite { .. })));
+    assert!(matches!(
+        eigenvalues(&c, f64::INFINITY),
+        Err(EigenError::NonFinite { .. })
+    ));
+    assert!(matches!(
+        eigen_sweep(&c, &[1.0, f64::NAN]),
+        Err(EigenError::NonFinite { .. })
+    ));
     assert_eq!(eigen_sweep(&c, &[]).unwrap().points.len(), 0);
     c.m0 = Matrix2::new(1.0, 2.0, 2.0, 4.0);
-    assert!(matches!(eigenvalues(&c, 1.0), Err(EigenError::SingularMassMatrix { .. })));
-    assert!(matches!(critical_speeds(&c, 0.0, 1.0), Err(EigenError::SingularMassMatrix { .. })));
+    assert!(matches!(
+        eigenvalues(&c, 1.0),
+        Err(EigenError::SingularMassMatrix { .. })
+    ));
+    assert!(matches!(
+        critical_speeds(&c, 0.0, 1.0),
+        Err(EigenError::SingularMassMatrix { .. })
+    ));
     let mut c = published();
     c.k2[(0, 1)] = f64::NAN;
     assert!(matches!(eigenvalues(&c, 1.0), Err(EigenError::NonFinite { .. })));
@@ -402,7 +479,13 @@ fn eigen_errors_not_panics() {
     c.g = f64::INFINITY;
     assert!(matches!(eigen_sweep(&c, &[1.0]), Err(EigenError::NonFinite { .. })));
     // degenerate but valid: zero matrices except M0 -> all roots zero
-    let z = CanonicalMatrices { m0: Matrix2::identity(), c1: Matrix2::zeros(), k0: Matrix2::zeros(), k2: Matrix2::zeros(), g: 9.81 };
+    let z = CanonicalMatrices {
+        m0: Matrix2::identity(),
+        c1: Matrix2::zeros(),
+        k0: Matrix2::zeros(),
+        k2: Matrix2::zeros(),
+        g: 9.81,
+    };
     assert_eq!(eigenvalues(&z, 3.0).unwrap(), [C64::new(0.0, 0.0); 4]);
     assert!(eigen_sweep(&z, &[0.0, 1.0]).is_ok());
     assert!(critical_speeds(&z, 0.0, 1.0).is_ok());
@@ -453,7 +536,11 @@ fn check_identities(c: &CanonicalMatrices, v: f64, z: &[C64; 4], tol: f64) {
     let e4 = z[0] * z[1] * z[2] * z[3];
     let n = k[4];
     let a_state = c.state_matrix(v).unwrap();
-    assert!((e1 - C64::new(a_state.trace(), 0.0)).norm() <= 1e3 * tol * a, "trace: {e1} vs {}", a_state.trace());
+    assert!(
+        (e1 - C64::new(a_state.trace(), 0.0)).norm() <= 1e3 * tol * a,
+        "trace: {e1} vs {}",
+        a_state.trace()
+    );
     assert!((e1 + k[3] / n).norm() <= 1e3 * tol * a);
     assert!((e2 - k[2] / n).norm() <= 1e3 * tol * a * a);
     assert!((e3 + k[1] / n).norm() <= 1e3 * tol * a * a * a);
@@ -468,7 +555,12 @@ fn perturbed(f: &[f64; 13]) -> CanonicalMatrices {
     CanonicalMatrices {
         m0: Matrix2::new(p.m0[(0, 0)] * f[0], m12, m12, p.m0[(1, 1)] * f[2]),
         c1: Matrix2::new(0.0, p.c1[(0, 1)] * f[3], p.c1[(1, 0)] * f[4], p.c1[(1, 1)] * f[5]),
-        k0: Matrix2::new(p.k0[(0, 0)] * f[6], p.k0[(0, 1)] * f[7], p.k0[(1, 0)] * f[8], p.k0[(1, 1)] * f[9]),
+        k0: Matrix2::new(
+            p.k0[(0, 0)] * f[6],
+            p.k0[(0, 1)] * f[7],
+            p.k0[(1, 0)] * f[8],
+            p.k0[(1, 1)] * f[9],
+        ),
         k2: Matrix2::new(0.0, p.k2[(0, 1)] * f[10], 0.0, p.k2[(1, 1)] * f[11]),
         g: 9.81 * f[12],
     }

@@ -5,17 +5,15 @@ mod parameters {
     use std::path::{Path, PathBuf};
 
     use bikedyn_runtime::parameters::{
-        body, BenchmarkParameters, Form, MeasuredBenchmark, ParameterError, ParameterSet,
-        ParameterWarning, ThesisParameters, BENCHMARK_BICYCLE_TOML, THESIS_BICYCLE_TOML,
+        body, BenchmarkParameters, Form, MeasuredBenchmark, ParameterError, ParameterSet, ParameterWarning,
+        ThesisParameters, BENCHMARK_BICYCLE_TOML, THESIS_BICYCLE_TOML,
     };
     use proptest::prelude::*;
 
     /// `../../shared` relative to the crate, or `None` (with a skip message)
     /// when the shared data is not checked out.
     fn shared(sub: &str) -> Option<PathBuf> {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../../shared")
-            .join(sub);
+        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared").join(sub);
         if p.exists() {
             Some(p)
         } else {
@@ -58,9 +56,8 @@ mod parameters {
 
     #[test]
     fn benchmark_bicycle_toml_equals_constructor() {
-        let (p, warnings) =
-            BenchmarkParameters::from_toml_str(BENCHMARK_BICYCLE_TOML, "benchmark_bicycle.toml")
-                .expect("embedded benchmark TOML loads");
+        let (p, warnings) = BenchmarkParameters::from_toml_str(BENCHMARK_BICYCLE_TOML, "benchmark_bicycle.toml")
+            .expect("embedded benchmark TOML loads");
         assert_eq!(p, BenchmarkParameters::benchmark_bicycle());
         assert_eq!(p.steer_axis_tilt, std::f64::consts::PI / 10.0);
         assert!(warnings.is_empty(), "{warnings:?}");
@@ -68,8 +65,7 @@ mod parameters {
 
     #[test]
     fn thesis_bicycle_warns_triangle_inequality_for_handlebar_and_front_wheel_only() {
-        let (set, warnings) =
-            ParameterSet::from_toml_str(THESIS_BICYCLE_TOML, "thesis_bicycle.toml").unwrap();
+        let (set, warnings) = ParameterSet::from_toml_str(THESIS_BICYCLE_TOML, "thesis_bicycle.toml").unwrap();
         assert_eq!(set.form(), Form::Thesis);
         let bodies: Vec<&str> = warnings
             .iter()
@@ -93,10 +89,7 @@ mod parameters {
             return;
         };
         let (set, warnings) = ParameterSet::load(&path).unwrap();
-        assert_eq!(
-            set,
-            ParameterSet::Benchmark(BenchmarkParameters::benchmark_bicycle())
-        );
+        assert_eq!(set, ParameterSet::Benchmark(BenchmarkParameters::benchmark_bicycle()));
         assert!(warnings.is_empty());
     }
 
@@ -117,11 +110,7 @@ mod parameters {
         let text = ParameterSet::Benchmark(bench).to_toml_string();
         let (back, _) = BenchmarkParameters::from_toml_str(&text, "b").unwrap();
         for s in BenchmarkParameters::SYMBOLS {
-            assert_eq!(
-                back.get(s).unwrap().to_bits(),
-                bench.get(s).unwrap().to_bits(),
-                "{s}"
-            );
+            assert_eq!(back.get(s).unwrap().to_bits(), bench.get(s).unwrap().to_bits(), "{s}");
         }
     }
 
@@ -169,8 +158,7 @@ mod parameters {
         let err = ParameterSet::from_toml_str("g = 9.81\n", "g.toml").unwrap_err();
         assert!(matches!(err, ParameterError::UnknownForm { .. }), "{err}");
         // Beside a [parameters] table only `form` and other tables may appear.
-        let err = ParameterSet::from_toml_str("title = \"x\"\n[parameters]\nw = 1.0\n", "p.toml")
-            .unwrap_err();
+        let err = ParameterSet::from_toml_str("title = \"x\"\n[parameters]\nw = 1.0\n", "p.toml").unwrap_err();
         assert!(
             matches!(&err, ParameterError::UnknownField { field, line: 1, .. } if field == "title"),
             "{err}"
@@ -219,10 +207,7 @@ mod parameters {
         );
         assert_eq!(err.line(), Some(line));
         let msg = err.to_string();
-        assert!(
-            msg.contains("`I3y`") && msg.contains("thesis.toml"),
-            "{msg}"
-        );
+        assert!(msg.contains("`I3y`") && msg.contains("thesis.toml"), "{msg}");
     }
 
     #[test]
@@ -278,8 +263,7 @@ mod parameters {
             front_wheel_iyy: 0.0,
             ..BenchmarkParameters::benchmark_bicycle()
         };
-        let (back, _) =
-            BenchmarkParameters::from_toml_str(&b.to_toml_string(), "tms.toml").unwrap();
+        let (back, _) = BenchmarkParameters::from_toml_str(&b.to_toml_string(), "tms.toml").unwrap();
         assert_eq!(back, b);
         let warnings = b.validate().unwrap();
         let degenerate: Vec<(&str, &str)> = warnings
@@ -315,10 +299,7 @@ mod parameters {
     #[test]
     fn toml_syntax_error_and_wrong_type_name_the_line() {
         let err = ParameterSet::from_toml_str("w = 1.0\nc = = 2\n", "bad.toml").unwrap_err();
-        assert!(
-            matches!(&err, ParameterError::Toml { line: Some(2), .. }),
-            "{err}"
-        );
+        assert!(matches!(&err, ParameterError::Toml { line: Some(2), .. }), "{err}");
         assert!(err.to_string().starts_with("bad.toml:2"), "{err}");
         let text = BENCHMARK_BICYCLE_TOML.replace("c = 0.08", "c = \"0.08\"");
         let err = ParameterSet::from_toml_str(&text, "b.toml").unwrap_err();
@@ -387,18 +368,12 @@ IFyy=0.28
     fn malformed_text_line_names_its_line_number() {
         let text = TEXT.replace("IRyy=0.12", "IRyy 0.12");
         let err = MeasuredBenchmark::from_text_str(&text, "bad.txt").unwrap_err();
-        assert!(
-            matches!(&err, ParameterError::Syntax { line: 11, .. }),
-            "{err}"
-        );
+        assert!(matches!(&err, ParameterError::Syntax { line: 11, .. }), "{err}");
         assert!(err.to_string().starts_with("bad.txt:11:"), "{err}");
 
         let text = TEXT.replace("mR=2", "mR=2.0.1");
         let err = MeasuredBenchmark::from_text_str(&text, "bad.txt").unwrap_err();
-        assert!(
-            matches!(&err, ParameterError::Syntax { line: 9, .. }),
-            "{err}"
-        );
+        assert!(matches!(&err, ParameterError::Syntax { line: 9, .. }), "{err}");
 
         let text = TEXT.replace("mR=2", "mRR=2");
         let err = MeasuredBenchmark::from_text_str(&text, "bad.txt").unwrap_err();
@@ -479,12 +454,7 @@ IFyy=0.28
                     // Every measured bicycle converts to the thesis form and back.
                     let thesis = b.to_thesis().unwrap();
                     let back = thesis.to_benchmark().unwrap();
-                    assert_sets_close(
-                        &BenchmarkParameters::SYMBOLS,
-                        |s| b.get(s),
-                        |s| back.get(s),
-                        1e-11,
-                    );
+                    assert_sets_close(&BenchmarkParameters::SYMBOLS, |s| b.get(s), |s| back.get(s), 1e-11);
                     // ParameterSet::load agrees.
                     let (set, _) = ParameterSet::load(f).unwrap();
                     assert_eq!(set, ParameterSet::Benchmark(*b));
@@ -498,12 +468,7 @@ IFyy=0.28
 
     // ------------------------------------------------------------ conversions
 
-    fn assert_sets_close(
-        symbols: &[&str],
-        a: impl Fn(&str) -> Option<f64>,
-        b: impl Fn(&str) -> Option<f64>,
-        rel: f64,
-    ) {
+    fn assert_sets_close(symbols: &[&str], a: impl Fn(&str) -> Option<f64>, b: impl Fn(&str) -> Option<f64>, rel: f64) {
         for &s in symbols {
             let (x, y) = (a(s).unwrap(), b(s).unwrap());
             // Relative to the value, with a floor of 1e-2 in SI units
@@ -521,12 +486,7 @@ IFyy=0.28
         assert!(t.fork_com_offset.abs() > 1e-3, "d4 = {}", t.fork_com_offset);
         assert!(t.frame_pitch().unwrap() + b.steer_axis_tilt < 1e-15);
         let back = t.to_benchmark().unwrap();
-        assert_sets_close(
-            &BenchmarkParameters::SYMBOLS,
-            |s| b.get(s),
-            |s| back.get(s),
-            1e-13,
-        );
+        assert_sets_close(&BenchmarkParameters::SYMBOLS, |s| b.get(s), |s| back.get(s), 1e-13);
     }
 
     #[test]
@@ -544,29 +504,18 @@ IFyy=0.28
         );
         println!("{}", b.to_toml_string());
         assert!((0.08..=0.1).contains(&b.trail), "trail {}", b.trail);
-        assert!(
-            (b.steer_axis_tilt - 0.315).abs() < 0.005,
-            "lam {}",
-            b.steer_axis_tilt
-        );
+        assert!((b.steer_axis_tilt - 0.315).abs() < 0.005, "lam {}", b.steer_axis_tilt);
         assert!(b.wheelbase > 0.9 && b.wheelbase < 1.1, "w {}", b.wheelbase);
         // The wheel tensors are unchanged; the xz entries flip sign with the axes.
         assert_eq!(b.front_wheel_iyy, 0.119);
         let back = b.to_thesis().unwrap();
-        assert_sets_close(
-            &ThesisParameters::SYMBOLS,
-            |s| t.get(s),
-            |s| back.get(s),
-            1e-13,
-        );
+        assert_sets_close(&ThesisParameters::SYMBOLS, |s| t.get(s), |s| back.get(s), 1e-13);
         // Same triangle-inequality warnings in either form: principal moments
         // do not depend on the axes.
         let bodies = |w: Vec<ParameterWarning>| -> Vec<(&'static str, [f64; 3])> {
             w.into_iter()
                 .filter_map(|w| match w {
-                    ParameterWarning::TriangleInequality {
-                        body, principal, ..
-                    } => Some((body, principal)),
+                    ParameterWarning::TriangleInequality { body, principal, .. } => Some((body, principal)),
                     _ => None,
                 })
                 .collect()
@@ -593,21 +542,12 @@ IFyy=0.28
         println!("{err}");
         let mut b = BenchmarkParameters::benchmark_bicycle();
         b.steer_axis_tilt = 2.0;
-        assert!(matches!(
-            b.to_thesis(),
-            Err(ParameterError::SteerAxisNotUpright { .. })
-        ));
+        assert!(matches!(b.to_thesis(), Err(ParameterError::SteerAxisNotUpright { .. })));
     }
 
     fn benchmark_strategy() -> impl Strategy<Value = BenchmarkParameters> {
         (
-            (
-                0.7..1.4f64,
-                -0.05..0.2f64,
-                -0.3..0.7f64,
-                0.2..0.45f64,
-                0.2..0.45f64,
-            ),
+            (0.7..1.4f64, -0.05..0.2f64, -0.3..0.7f64, 0.2..0.45f64, 0.2..0.45f64),
             (0.0..1.0f64, -1.3..-0.2f64, 0.5..1.2f64, -1.1..-0.3f64),
             (0.1..20.0f64, 0.1..20.0f64, 0.1..20.0f64, -0.9..0.9f64),
             (0.01..1.0f64, 0.01..1.0f64, 0.01..1.0f64, -0.9..0.9f64),
@@ -648,13 +588,7 @@ IFyy=0.28
     fn thesis_strategy() -> impl Strategy<Value = ThesisParameters> {
         (
             (0.2..0.45f64, 0.2..0.45f64, 0.2..0.8f64, -0.2..0.6f64),
-            (
-                0.7..1.2f64,
-                -0.2..0.3f64,
-                -0.1..0.1f64,
-                -0.5..-0.2f64,
-                -0.1..0.1f64,
-            ),
+            (0.7..1.2f64, -0.2..0.3f64, -0.1..0.1f64, -0.5..-0.2f64, -0.1..0.1f64),
             (0.1..5.0f64, 0.1..5.0f64, 0.1..5.0f64, -0.9..0.9f64),
             (0.01..1.0f64, 0.01..1.0f64, 0.01..1.0f64, -0.9..0.9f64),
         )

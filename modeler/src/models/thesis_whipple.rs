@@ -5,7 +5,9 @@
 //! Axes: X forward, Y left, Z up.
 
 use crate::expr::{inertia_wheel, inertia_xz, num, time, vec3};
-use crate::model::{Axis, BodyId, FrameId, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, PointId, Role, GROUND};
+use crate::model::{
+    Axis, BodyId, FrameId, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, PointId, Role, GROUND,
+};
 use std::f64::consts::PI;
 
 /// Handles a variant of this model needs to modify it.
@@ -33,10 +35,25 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
     let phi = m.coordinate("phi", Role::Ignorable, 0.0, "yaw (rad)");
     let theta = m.coordinate("theta", Role::Independent, 0.0, "roll (rad), positive leaning right");
     let psi = m.coordinate("psi", Role::Dependent, 0.0, "rear wheel rotation (rad)");
-    let beta = m.coordinate("beta", Role::Dependent, -PI / 10.0, "frame pitch (rad); minus the steer-axis tilt when upright");
-    let gamma = m.coordinate("gamma", Role::Independent, 0.0, "steer angle about the steer axis (rad), positive turning left");
+    let beta = m.coordinate(
+        "beta",
+        Role::Dependent,
+        -PI / 10.0,
+        "frame pitch (rad); minus the steer-axis tilt when upright",
+    );
+    let gamma = m.coordinate(
+        "gamma",
+        Role::Independent,
+        0.0,
+        "steer angle about the steer axis (rad), positive turning left",
+    );
     let eps = m.coordinate("eps", Role::Ignorable, 0.0, "front wheel rotation (rad)");
-    let xi = m.coordinate("xi", Role::Dependent, PI / 2.0, "angle of the front contact point on the rim (rad)");
+    let xi = m.coordinate(
+        "xi",
+        Role::Dependent,
+        PI / 2.0,
+        "angle of the front contact point on the rim (rad)",
+    );
 
     // Parameters (section 4.4, Parametros.m).
     let v = m.parameter("V", "forward speed imposed by the driving constraint (m/s)");
@@ -77,17 +94,28 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
     let front_wheel_frame = m.frame("A5", fork_frame, vec![(Axis::Y, eps)]);
 
     // 3.5 Mass centres (eq. 13-19).
-    let g2 = m.point("G2", None, vec![(GROUND, vec3(xc, yc, num(0))), (roll, vec3(num(0), num(0), rt.clone()))]);
+    let g2 = m.point(
+        "G2",
+        None,
+        vec![(GROUND, vec3(xc, yc, num(0))), (roll, vec3(num(0), num(0), rt.clone()))],
+    );
     let g3 = m.point("G3", Some(g2), vec![(frame, vec3(x3, num(0), z3))]);
     let g4 = m.point("G4", Some(g2), vec![(frame, vec3(x4, num(0), z4))]);
     let g5 = m.point("G5", Some(g4), vec![(fork_frame, vec3(x5, num(0), z5))]);
     // Contact points: rear, straight below the rear wheel centre in the roll
     // frame; front (eq. 21), on the rim at angle xi.
-    let rear_contact = m.point("rear_contact", Some(g2), vec![(roll, vec3(num(0), num(0), -rt.clone()))]);
+    let rear_contact = m.point(
+        "rear_contact",
+        Some(g2),
+        vec![(roll, vec3(num(0), num(0), -rt.clone()))],
+    );
     let front_contact = m.point(
         "front_contact",
         Some(g5),
-        vec![(front_wheel_frame, vec3(rd.clone() * xi.clone().cos(), num(0), -(rd * xi.sin())))],
+        vec![(
+            front_wheel_frame,
+            vec3(rd.clone() * xi.clone().cos(), num(0), -(rd * xi.sin())),
+        )],
     );
     m.point_of_interest(rear_contact);
     m.point_of_interest(front_contact);
@@ -101,14 +129,21 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
 
     // 3.6 Constraints. Front contact on the ground and lowest point of the rim
     // (eq. 21-22); driving constraint psi - V t / Rt = 0 (eq. 26, as coded).
-    m.holonomic(Holonomic::PointComponent { name: "front_contact_height".into(), point: front_contact, axis: Axis::Z });
+    m.holonomic(Holonomic::PointComponent {
+        name: "front_contact_height".into(),
+        point: front_contact,
+        axis: Axis::Z,
+    });
     m.holonomic(Holonomic::PointComponentStationary {
         name: "front_contact_lowest".into(),
         point: front_contact,
         axis: Axis::Z,
         coordinate: "xi".into(),
     });
-    m.holonomic(Holonomic::Residual { name: "driving".into(), expr: psi - v * time() / rt });
+    m.holonomic(Holonomic::Residual {
+        name: "driving".into(),
+        expr: psi - v * time() / rt,
+    });
     // Rolling without slip (eq. 23-25).
     for (name, body, point, axis) in [
         ("rear_rolling_x", rear_wheel, rear_contact, Axis::X),
@@ -116,13 +151,26 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
         ("front_rolling_x", front_wheel, front_contact, Axis::X),
         ("front_rolling_y", front_wheel, front_contact, Axis::Y),
     ] {
-        m.nonholonomic(Nonholonomic::ContactVelocity { name: name.into(), body, point, axis });
+        m.nonholonomic(Nonholonomic::ContactVelocity {
+            name: name.into(),
+            body,
+            point,
+            axis,
+        });
     }
-    (m, WhippleParts { fork_frame, steer_point: g4, fork })
+    (
+        m,
+        WhippleParts {
+            fork_frame,
+            steer_point: g4,
+            fork,
+        },
+    )
 }
 
 /// The thesis model.
 pub fn model() -> Result<Model, ModelError> {
-    declare("thesis_whipple", "modeler/src/models/thesis_whipple.rs").0.build()
+    declare("thesis_whipple", "modeler/src/models/thesis_whipple.rs")
+        .0
+        .build()
 }
-

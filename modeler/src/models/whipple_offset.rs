@@ -12,7 +12,11 @@ pub fn model() -> Result<Model, ModelError> {
     let (mut m, parts) = super::thesis_whipple::declare("whipple_offset", "modeler/src/models/whipple_offset.rs");
     m.set_doc("Whipple bicycle with the handlebar/fork mass centre a distance d4 ahead of the steer axis (benchmark-compatible)");
     let d4 = m.parameter("d4", "handlebar/fork mass centre ahead of the steer axis, fork x (m)");
-    let g4 = m.point("G4_offset", Some(parts.steer_point), vec![(parts.fork_frame, vec3(d4, num(0), num(0)))]);
+    let g4 = m.point(
+        "G4_offset",
+        Some(parts.steer_point),
+        vec![(parts.fork_frame, vec3(d4, num(0), num(0)))],
+    );
     m.move_mass_centre(parts.fork, g4);
     m.build()
 }

@@ -92,10 +92,14 @@ fn direction(cp: &CharPoly, s: C64, v: f64) -> Option<CrossingDirection> {
 /// rest) and tangential touches are not reported.
 pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<CriticalSpeeds, EigenError> {
     if !v_min.is_finite() || !v_max.is_finite() {
-        return Err(EigenError::NonFinite { what: format!("speed range [{v_min}, {v_max}]") });
+        return Err(EigenError::NonFinite {
+            what: format!("speed range [{v_min}, {v_max}]"),
+        });
     }
     if v_min > v_max {
-        return Err(EigenError::InvalidArgument { what: format!("v_min = {v_min} > v_max = {v_max}") });
+        return Err(EigenError::InvalidArgument {
+            what: format!("v_min = {v_min} > v_max = {v_max}"),
+        });
     }
     let cp = CharPoly::new(c)?;
     let g = cp.g;
@@ -152,14 +156,22 @@ pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<
     let mut crossings = Vec::new();
     for ((v, kind, w), l) in cands.iter().zip(&labelled) {
         let target = C64::new(0.0, *w);
-        let Some(dir) = direction(&cp, target, *v) else { continue };
+        let Some(dir) = direction(&cp, target, *v) else {
+            continue;
+        };
         let mut best = 0;
         for k in 1..4 {
             if (l.roots[k] - target).norm_sqr() < (l.roots[best] - target).norm_sqr() {
                 best = k;
             }
         }
-        crossings.push(Crossing { speed: *v, mode: l.labels[best], direction: dir, kind: *kind, frequency: *w });
+        crossings.push(Crossing {
+            speed: *v,
+            mode: l.labels[best],
+            direction: dir,
+            kind: *kind,
+            frequency: *w,
+        });
     }
 
     let weave_speed = crossings
@@ -225,11 +237,16 @@ fn weave_merge(cp: &CharPoly, lo: f64, hi: f64) -> Result<Option<(f64, f64)>, Ei
     if !(hi > lo) {
         return Ok(None);
     }
-    let grid: Vec<f64> = (0..=MERGE_GRID).map(|i| lo + (hi - lo) * (i as f64 / MERGE_GRID as f64)).collect();
+    let grid: Vec<f64> = (0..=MERGE_GRID)
+        .map(|i| lo + (hi - lo) * (i as f64 / MERGE_GRID as f64))
+        .collect();
     let lab = track(cp, &grid)?;
     let weave_state = |l: &Labelled| -> Option<bool> {
         // Some(true): both weave roots real; Some(false): both complex
-        let w: Vec<C64> = (0..4).filter(|&k| l.labels[k] == Mode::Weave).map(|k| l.roots[k]).collect();
+        let w: Vec<C64> = (0..4)
+            .filter(|&k| l.labels[k] == Mode::Weave)
+            .map(|k| l.roots[k])
+            .collect();
         if w.len() != 2 {
             return None;
         }

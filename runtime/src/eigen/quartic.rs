@@ -220,7 +220,12 @@ fn ferrari(a: f64, b: f64, c: f64, d: f64) -> Option<[C64; 4]> {
 
 fn factor_residual(a: f64, b: f64, c: f64, d: f64, f: &[f64; 4]) -> [f64; 4] {
     let [p1, q1, p2, q2] = *f;
-    [p1 + p2 - a, p1.mul_add(p2, q1 + q2) - b, p1.mul_add(q2, p2 * q1) - c, q1.mul_add(q2, -d)]
+    [
+        p1 + p2 - a,
+        p1.mul_add(p2, q1 + q2) - b,
+        p1.mul_add(q2, p2 * q1) - c,
+        q1.mul_add(q2, -d),
+    ]
 }
 
 /// Newton on `(z^2+p1 z+q1)(z^2+p2 z+q2) = z^4+a z^3+b z^2+c z+d`, accepting only
@@ -235,8 +240,15 @@ fn refine_factors(a: f64, b: f64, c: f64, d: f64, mut f: [f64; 4]) -> [f64; 4] {
             break;
         }
         let [p1, q1, p2, q2] = f;
-        let j = [[1.0, 0.0, 1.0, 0.0], [p2, 1.0, p1, 1.0], [q2, p2, q1, p1], [0.0, q2, 0.0, q1]];
-        let Some(dx) = solve4(j, [-r[0], -r[1], -r[2], -r[3]]) else { break };
+        let j = [
+            [1.0, 0.0, 1.0, 0.0],
+            [p2, 1.0, p1, 1.0],
+            [q2, p2, q1, p1],
+            [0.0, q2, 0.0, q1],
+        ];
+        let Some(dx) = solve4(j, [-r[0], -r[1], -r[2], -r[3]]) else {
+            break;
+        };
         let fnew = [p1 + dx[0], q1 + dx[1], p2 + dx[2], q2 + dx[3]];
         let rnew = factor_residual(a, b, c, d, &fnew);
         let rnn = nrm(&rnew);

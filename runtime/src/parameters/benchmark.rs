@@ -91,8 +91,8 @@ pub struct BenchmarkParameters {
 impl BenchmarkParameters {
     /// Meijaard symbols in Table 1 order (the single name table).
     pub const SYMBOLS: [&'static str; 26] = [
-        "w", "c", "lam", "g", "rR", "mR", "IRxx", "IRyy", "xB", "zB", "mB", "IBxx", "IByy", "IBzz",
-        "IBxz", "xH", "zH", "mH", "IHxx", "IHyy", "IHzz", "IHxz", "rF", "mF", "IFxx", "IFyy",
+        "w", "c", "lam", "g", "rR", "mR", "IRxx", "IRyy", "xB", "zB", "mB", "IBxx", "IByy", "IBzz", "IBxz", "xH", "zH",
+        "mH", "IHxx", "IHyy", "IHzz", "IHxz", "rF", "mF", "IFxx", "IFyy",
     ];
 
     /// Value by Meijaard symbol.
@@ -170,9 +170,7 @@ impl BenchmarkParameters {
 
     /// Build a set by asking `value` for every symbol of [`Self::SYMBOLS`]
     /// (in that order); the first error is returned.
-    pub(crate) fn from_lookup<E>(
-        mut value: impl FnMut(&'static str) -> Result<f64, E>,
-    ) -> Result<Self, E> {
+    pub(crate) fn from_lookup<E>(mut value: impl FnMut(&'static str) -> Result<f64, E>) -> Result<Self, E> {
         Ok(BenchmarkParameters {
             wheelbase: value("w")?,
             trail: value("c")?,

@@ -44,10 +44,7 @@ fn point(x: f64, z: f64) -> Vector3<f64> {
     Vector3::new(x, 0.0, z)
 }
 
-fn check_finite(
-    symbols: &[&'static str],
-    get: impl Fn(&str) -> Option<f64>,
-) -> Result<(), ParameterError> {
+fn check_finite(symbols: &[&'static str], get: impl Fn(&str) -> Option<f64>) -> Result<(), ParameterError> {
     for &field in symbols {
         let value = get(field).unwrap_or(f64::NAN);
         if !value.is_finite() {
@@ -137,21 +134,9 @@ impl ThesisParameters {
         let ground_x = s.x - s.z * sb / cb;
         let wheelbase = c5.x;
         let p = flip();
-        let frame_i = p
-            * a
-            * xz_tensor(
-                self.frame_ixx,
-                self.frame_iyy,
-                self.frame_izz,
-                self.frame_ixz,
-            )
-            * a.transpose()
-            * p;
-        let fork_i = p
-            * a
-            * xz_tensor(self.fork_ixx, self.fork_iyy, self.fork_izz, self.fork_ixz)
-            * a.transpose()
-            * p;
+        let frame_i =
+            p * a * xz_tensor(self.frame_ixx, self.frame_iyy, self.frame_izz, self.frame_ixz) * a.transpose() * p;
+        let fork_i = p * a * xz_tensor(self.fork_ixx, self.fork_iyy, self.fork_izz, self.fork_ixz) * a.transpose() * p;
         Ok(BenchmarkParameters {
             wheelbase,
             trail: ground_x - wheelbase,

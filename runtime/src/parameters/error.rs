@@ -276,24 +276,18 @@ impl ParameterError {
     /// validation errors that have no origin yet. Other errors are unchanged.
     pub(crate) fn located(self, path: &Path, line_of: impl Fn(&str) -> Option<usize>) -> Self {
         match self {
-            ParameterError::NotFinite {
-                field,
-                value,
-                origin,
-            } if origin.path.is_none() => ParameterError::NotFinite {
+            ParameterError::NotFinite { field, value, origin } if origin.path.is_none() => ParameterError::NotFinite {
                 origin: Origin::new(path, line_of(&field)),
                 field,
                 value,
             },
-            ParameterError::NonPositive {
-                field,
-                value,
-                origin,
-            } if origin.path.is_none() => ParameterError::NonPositive {
-                origin: Origin::new(path, line_of(&field)),
-                field,
-                value,
-            },
+            ParameterError::NonPositive { field, value, origin } if origin.path.is_none() => {
+                ParameterError::NonPositive {
+                    origin: Origin::new(path, line_of(&field)),
+                    field,
+                    value,
+                }
+            }
             ParameterError::NonPhysicalInertia {
                 body,
                 ixx,
@@ -337,8 +331,7 @@ impl ParameterError {
             | ParameterError::WrongType { line, .. }
             | ParameterError::InvalidUncertainty { line, .. }
             | ParameterError::InvalidForm { line, .. } => Some(*line),
-            ParameterError::NotFinite { origin, .. }
-            | ParameterError::NonPositive { origin, .. } => origin.line,
+            ParameterError::NotFinite { origin, .. } | ParameterError::NonPositive { origin, .. } => origin.line,
             _ => None,
         }
     }

@@ -9,9 +9,7 @@ use std::path::{Path, PathBuf};
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-use super::{
-    BenchmarkParameters, MeasuredBenchmark, ParameterError, ParameterWarning, ThesisParameters,
-};
+use super::{BenchmarkParameters, MeasuredBenchmark, ParameterError, ParameterWarning, ThesisParameters};
 
 /// Which parameterization a set uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -87,14 +85,10 @@ impl ParameterSet {
     /// Returns the set and its warnings (triangle inequality, extra names of
     /// text files). To keep the `+/-` uncertainties of a text file, use
     /// [`MeasuredBenchmark::load`].
-    pub fn load(
-        path: impl AsRef<Path>,
-    ) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
+    pub fn load(path: impl AsRef<Path>) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         let text = read(path)?;
-        let is_toml = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        let is_toml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
         if is_toml {
             Self::from_toml_str(&text, path)
         } else {
@@ -112,15 +106,11 @@ impl ParameterSet {
         let fields = parse_toml_fields(text, path)?;
         let line_of = |f: &str| fields.values.get(f).map(|&(_, line)| line);
         let set = match fields.form {
-            Form::Thesis => {
-                ParameterSet::Thesis(ThesisParameters::from_lookup(|sym| {
-                    match fields.values.get(sym) {
-                        Some(&(v, _)) => Ok(v),
-                        None if sym == "d4" => Ok(0.0),
-                        None => Err(missing(path, sym)),
-                    }
-                })?)
-            }
+            Form::Thesis => ParameterSet::Thesis(ThesisParameters::from_lookup(|sym| match fields.values.get(sym) {
+                Some(&(v, _)) => Ok(v),
+                None if sym == "d4" => Ok(0.0),
+                None => Err(missing(path, sym)),
+            })?),
             Form::Benchmark => ParameterSet::Benchmark(BenchmarkParameters::from_lookup(|sym| {
                 fields
                     .values
@@ -202,10 +192,7 @@ impl ThesisParameters {
     /// Parse and validate TOML text that must hold the thesis form (detected
     /// or forced); a benchmark-form file is [`ParameterError::WrongForm`]
     /// (convert it with [`ParameterSet::to_thesis`] instead).
-    pub fn from_toml_str(
-        text: &str,
-        path: impl AsRef<Path>,
-    ) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+    pub fn from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         match ParameterSet::from_toml_str(text, path)? {
             (ParameterSet::Thesis(p), w) => Ok((p, w)),
@@ -236,10 +223,7 @@ impl BenchmarkParameters {
     /// Parse and validate TOML text that must hold the benchmark form
     /// (detected or forced); a thesis-form file is
     /// [`ParameterError::WrongForm`].
-    pub fn from_toml_str(
-        text: &str,
-        path: impl AsRef<Path>,
-    ) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+    pub fn from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         match ParameterSet::from_toml_str(text, path)? {
             (ParameterSet::Benchmark(p), w) => Ok((p, w)),
@@ -296,11 +280,7 @@ fn wrong_form(path: &Path, expected: Form, found: Form) -> ParameterError {
 /// 1-based line of a byte offset.
 pub(crate) fn line_of_offset(text: &str, offset: usize) -> usize {
     let end = offset.min(text.len());
-    text.as_bytes()[..end]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
+    text.as_bytes()[..end].iter().filter(|&&b| b == b'\n').count() + 1
 }
 
 /// Format an `f64` as a TOML float that parses back to the same value

@@ -11,10 +11,7 @@ use super::{BenchmarkParameters, ParameterError, ParameterWarning};
 /// [`MeasuredBenchmark::extras`].
 pub const EXTRA_TEXT_FIELDS: [(&str, &str); 26] = [
     ("v", "nominal forward speed of HumanControl files (m/s)"),
-    (
-        "yB",
-        "lateral offset of the rear-frame mass centre (m), 0 in the model",
-    ),
+    ("yB", "lateral offset of the rear-frame mass centre (m), 0 in the model"),
     (
         "yH",
         "lateral offset of the front-frame mass centre (m), 0 in the model",
@@ -27,10 +24,7 @@ pub const EXTRA_TEXT_FIELDS: [(&str, &str); 26] = [
         "IFzz",
         "front wheel moment about the vertical diameter (kg m^2), IFxx in the model",
     ),
-    (
-        "d1",
-        "BicycleParameters geometry: rear wheel centre to steer axis (m)",
-    ),
+    ("d1", "BicycleParameters geometry: rear wheel centre to steer axis (m)"),
     (
         "d2",
         "BicycleParameters geometry: along the steer axis between the wheel centres (m)",
@@ -39,14 +33,8 @@ pub const EXTRA_TEXT_FIELDS: [(&str, &str); 26] = [
         "d3",
         "BicycleParameters geometry: fork offset, steer axis to front wheel centre (m)",
     ),
-    (
-        "xcl",
-        "x of a reference point of HumanControl's rider models (m)",
-    ),
-    (
-        "zcl",
-        "z of a reference point of HumanControl's rider models (m)",
-    ),
+    ("xcl", "x of a reference point of HumanControl's rider models (m)"),
+    ("zcl", "z of a reference point of HumanControl's rider models (m)"),
     ("mG", "mass of front-frame sub-body G (kg), included in mH"),
     ("xG", "x of the mass centre of front-frame sub-body G (m)"),
     ("zG", "z of the mass centre of front-frame sub-body G (m)"),
@@ -110,10 +98,7 @@ impl MeasuredBenchmark {
     }
 
     /// Parse and validate text; `path` is only used in messages.
-    pub fn from_text_str(
-        text: &str,
-        path: impl AsRef<Path>,
-    ) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+    pub fn from_text_str(text: &str, path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         let pb = || path.to_path_buf();
         let mut values: BTreeMap<String, (f64, usize)> = BTreeMap::new();
@@ -195,11 +180,7 @@ impl MeasuredBenchmark {
                 })
         })?;
         let line_of = |f: &str| values.get(f).map(|&(_, l)| l);
-        warnings.extend(
-            parameters
-                .validate()
-                .map_err(|e| e.located(path, line_of))?,
-        );
+        warnings.extend(parameters.validate().map_err(|e| e.located(path, line_of))?);
         Ok((
             MeasuredBenchmark {
                 parameters,
@@ -218,9 +199,7 @@ impl MeasuredBenchmark {
 
 fn is_identifier(name: &str) -> bool {
     let mut chars = name.chars();
-    chars
-        .next()
-        .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+    chars.next().is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
@@ -338,8 +317,6 @@ impl Expr<'_> {
             digits(self);
         }
         let token = String::from_utf8_lossy(&self.s[start..self.pos]);
-        token
-            .parse::<f64>()
-            .map_err(|_| format!("`{token}` is not a number"))
+        token.parse::<f64>().map_err(|_| format!("`{token}` is not a number"))
     }
 }

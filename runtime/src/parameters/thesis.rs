@@ -95,8 +95,8 @@ pub struct ThesisParameters {
 impl ThesisParameters {
     /// Thesis symbols, in a fixed order (the single name table).
     pub const SYMBOLS: [&'static str; 26] = [
-        "Rt", "Rd", "x3", "z3", "x4", "z4", "x5", "z5", "d4", "m2", "m3", "m4", "m5", "I2x", "I2y",
-        "I3x", "I3y", "I3z", "I3zx", "I4x", "I4y", "I4z", "I4xz", "I5x", "I5y", "g",
+        "Rt", "Rd", "x3", "z3", "x4", "z4", "x5", "z5", "d4", "m2", "m3", "m4", "m5", "I2x", "I2y", "I3x", "I3y",
+        "I3z", "I3zx", "I4x", "I4y", "I4z", "I4xz", "I5x", "I5y", "g",
     ];
 
     /// Value by thesis symbol (the names the generated models use).
@@ -189,9 +189,7 @@ impl ThesisParameters {
 
     /// Build a set by asking `value` for every symbol of [`Self::SYMBOLS`]
     /// (in that order); the first error is returned.
-    pub(crate) fn from_lookup<E>(
-        mut value: impl FnMut(&'static str) -> Result<f64, E>,
-    ) -> Result<Self, E> {
+    pub(crate) fn from_lookup<E>(mut value: impl FnMut(&'static str) -> Result<f64, E>) -> Result<Self, E> {
         Ok(ThesisParameters {
             rear_wheel_radius: value("Rt")?,
             front_wheel_radius: value("Rd")?,

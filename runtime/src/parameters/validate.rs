@@ -71,10 +71,7 @@ impl Body {
     }
 
     fn check(&self, warnings: &mut Vec<ParameterWarning>) -> Result<(), ParameterError> {
-        let degenerate = |what| ParameterWarning::Degenerate {
-            body: self.name,
-            what,
-        };
+        let degenerate = |what| ParameterWarning::Degenerate { body: self.name, what };
         if let Some(r) = self.radius {
             if r.1 < 0.0 {
                 return Err(non_positive(r));
@@ -184,9 +181,7 @@ impl ThesisParameters {
     pub fn validate(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
         let s = self;
         validate_common(
-            Self::SYMBOLS
-                .iter()
-                .map(|&k| (k, s.get(k).unwrap_or(f64::NAN))),
+            Self::SYMBOLS.iter().map(|&k| (k, s.get(k).unwrap_or(f64::NAN))),
             &[("g", s.g)],
             &[
                 Body {
@@ -247,9 +242,7 @@ impl BenchmarkParameters {
     pub fn validate(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
         let s = self;
         validate_common(
-            Self::SYMBOLS
-                .iter()
-                .map(|&k| (k, s.get(k).unwrap_or(f64::NAN))),
+            Self::SYMBOLS.iter().map(|&k| (k, s.get(k).unwrap_or(f64::NAN))),
             &[("w", s.wheelbase), ("g", s.g)],
             &[
                 Body {
