@@ -74,3 +74,62 @@ fn cli_verify_rejects_an_unknown_model() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown model `tricycle`"));
 }
+
+/// The thesis model with a deliberately wrong `Cq` (one entry off by 1e-4
+/// relative) and a wrong `dBdp`: the checker must catch both and nothing else.
+struct Broken;
+
+mod broken_impl {
+    use super::Broken;
+    use bikedyn::generated::ThesisWhipple as W;
+    use bikedyn::runtime::{MultibodyModel, Scalar};
+
+    impl MultibodyModel for Broken {
+        const NAME: &'static str = "broken";
+        const COORDINATES: &'static [&'static str] = W::COORDINATES;
+        const PARAMETERS: &'static [&'static str] = W::PARAMETERS;
+        const HOLONOMIC: &'static [&'static str] = W::HOLONOMIC;
+        const NONHOLONOMIC: &'static [&'static str] = W::NONHOLONOMIC;
+        const POINTS: &'static [&'static str] = W::POINTS;
+        const INDEPENDENT: &'static [usize] = W::INDEPENDENT;
+        const DEPENDENT: &'static [usize] = W::DEPENDENT;
+        const INITIAL_GUESS: &'static [f64] = W::INITIAL_GUESS;
+        const ALL_QUANTITIES_LAYOUT: &'static [(&'static str, usize, usize)] = W::ALL_QUANTITIES_LAYOUT;
+        const FLOPS: &'static [(&'static str, usize)] = W::FLOPS;
+        fn mass_matrix<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) { W::mass_matrix(a, p, o) }
+        fn quadratic_velocity_forces<T: Scalar>(a: &[T], p: &[T], dp: &[T], o: &mut [T]) { W::quadratic_velocity_forces(a, p, dp, o) }
+        fn gravity_forces<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) { W::gravity_forces(a, p, o) }
+        fn applied_forces<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) { W::applied_forces(a, t, p, dp, o) }
+        fn holonomic_residuals<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) { W::holonomic_residuals(a, t, p, o) }
+        fn holonomic_jacobian<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
+            W::holonomic_jacobian(a, t, p, o);
+            o[3] *= T::cst(1.0 + 1e-4);
+        }
+        fn holonomic_time_derivative<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) { W::holonomic_time_derivative(a, t, p, o) }
+        fn holonomic_convective<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) { W::holonomic_convective(a, t, p, dp, o) }
+        fn nonholonomic_velocities<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) { W::nonholonomic_velocities(a, t, p, dp, o) }
+        fn nonholonomic_matrix<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) { W::nonholonomic_matrix(a, t, p, o) }
+        fn nonholonomic_convective<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::nonholonomic_convective(a, t, p, dp, o);
+            o[0] += T::cst(1e-3);
+        }
+        fn kinetic_energy<T: Scalar>(a: &[T], p: &[T], dp: &[T]) -> T { W::kinetic_energy(a, p, dp) }
+        fn potential_energy<T: Scalar>(a: &[T], p: &[T]) -> T { W::potential_energy(a, p) }
+        fn point_positions<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) { W::point_positions(a, p, o) }
+        fn all_quantities<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) { W::all_quantities(a, t, p, dp, o) }
+    }
+}
+
+#[test]
+fn verification_catches_wrong_derivatives() {
+    use bikedyn::runtime::verify::verify;
+    let param = bikedyn::models::default_parameters::<bikedyn::generated::ThesisWhipple>();
+    let r = verify::<Broken>(&param, &VerifyOptions { states: 5, seed: 11, ..Default::default() });
+    assert!(!r.passed);
+    let failed: Vec<&str> = r.quantities.iter().filter(|q| !q.passed).map(|q| q.name.as_str()).collect();
+    assert!(failed.contains(&"Cq"), "{failed:?}");
+    assert!(failed.contains(&"dBdp"), "{failed:?}");
+    // all_quantities still agrees with the unmodified functions it was compared to,
+    // except where the broken ones differ.
+    assert!(!failed.contains(&"Qv") && !failed.contains(&"B"), "{failed:?}");
+}
