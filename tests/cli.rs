@@ -1,0 +1,138 @@
+//! The `bikedyn` command line, end to end.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bikedyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
+}
+
+fn ok_json(args: &[&str]) -> serde_json::Value {
+    let out = bikedyn(args);
+    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("bikedyn-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+#[test]
+fn eig_json_has_the_documented_schema() {
+    let v = ok_json(&["eig", "--bike", "benchmark", "--speeds", "0:10:0.5", "--format", "json"]);
+    let pts = v.as_array().unwrap();
+    assert_eq!(pts.len(), 21);
+    for p in pts {
+        assert!(p["v"].is_f64() || p["v"].is_u64());
+        let ev = p["eigenvalues"].as_array().unwrap();
+        let modes = p["modes"].as_array().unwrap();
+        assert_eq!(ev.len(), 4);
+        assert_eq!(modes.len(), 4);
+        assert!(ev.iter().all(|e| e.as_array().unwrap().len() == 2));
+    }
+    let at5 = &pts[10];
+    assert_eq!(at5["v"].as_f64().unwrap(), 5.0);
+    let names: Vec<&str> = at5["modes"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
+    for m in ["weave", "capsize", "castering"] {
+        assert!(names.contains(&m), "{names:?}");
+    }
+}
+
+#[test]
+fn eig_csv_and_plot_files() {
+    let csv = tmp("eig.csv");
+    let svg = tmp("eig.svg");
+    let out = bikedyn(&["eig", "--bike", "thesis", "--speeds", "0:10:0.1", "--format", "csv", "--output", csv.to_str().unwrap(), "--plot", svg.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(text.lines().count(), 1 + 101);
+    assert!(text.lines().next().unwrap().starts_with("v,"));
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+}
+
+#[test]
+fn thesis_bicycle_is_self_stable_where_the_thesis_says() {
+    // Thesis section 4.4: self-stable from 3.4 to 6.1 m/s (read off a 0.5 m/s grid).
+    let v = ok_json(&["stability", "--bike", "thesis", "--json"]);
+    let iv = v["stable_intervals"].as_array().unwrap();
+    assert_eq!(iv.len(), 1);
+    let (lo, hi) = (iv[0][0].as_f64().unwrap(), iv[0][1].as_f64().unwrap());
+    assert!((3.4..3.5).contains(&lo) && (6.1..6.2).contains(&hi), "{lo} {hi}");
+    assert_eq!(v["weave_speed"].as_f64().unwrap(), lo);
+    assert_eq!(v["capsize_speed"].as_f64().unwrap(), hi);
+}
+
+#[test]
+fn params_convert_round_trips_through_files() {
+    let thesis = tmp("bench_as_thesis.toml");
+    let back = tmp("bench_back.toml");
+    let out = bikedyn(&["params", "convert", "--to", "thesis", "benchmark", "--output", thesis.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = bikedyn(&["params", "convert", "--to", "benchmark", thesis.to_str().unwrap(), "--output", back.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // The converted bicycle has the benchmark's weave speed.
+    let v = ok_json(&["stability", "--bike", back.to_str().unwrap(), "--json"]);
+    assert!((v["weave_speed"].as_f64().unwrap() - 4.29238253634111).abs() < 1e-9);
+}
+
+#[test]
+fn sweep_over_trail_and_a_stability_map() {
+    let v = ok_json(&["sweep", "--bike", "benchmark", "--param", "c", "--values", "0.04:0.12:0.04", "--format", "json"]);
+    let s = v.to_string();
+    assert!(s.contains("weave_speed"), "{s}");
+    let png = tmp("map.png");
+    let out = bikedyn(&[
+        "sweep", "--bike", "benchmark", "--param", "c", "--values", "0.02:0.12:0.05", "--param2", "lam", "--values2", "0.2:0.4:0.1",
+        "--format", "csv", "--plot", png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1 + 3 * 3);
+}
+
+#[test]
+fn bad_input_gives_clear_errors() {
+    let out = bikedyn(&["stability", "--bike", "no_such_bike"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no_such_bike"));
+    let bad = tmp("bad.txt");
+    std::fs::write(&bad, "w = 1.02\nc = oops\n").unwrap();
+    let out = bikedyn(&["stability", "--bike", bad.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.txt") && err.contains('2'), "{err}");
+    let out = bikedyn(&["eig", "--bike", "thesis", "--speeds", "10:0:1"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--speeds"));
+    let out = bikedyn(&["sweep", "--bike", "thesis", "--param", "wheelbase_typo", "--values", "0:1:0.5"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("wheelbase_typo"));
+}
+
+#[test]
+fn every_real_parameter_set_gives_its_stability_interval() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/parameter_sets/HumanControl_Par");
+    if !dir.exists() {
+        println!("skipped: {} is absent (real parameter sets are only in the development checkout)", dir.display());
+        return;
+    }
+    let mut stable = 0;
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let p = e.unwrap().path();
+        if !p.to_string_lossy().ends_with("Par.txt") {
+            continue;
+        }
+        let v = ok_json(&["stability", "--bike", p.to_str().unwrap(), "--json"]);
+        let n = v["stable_intervals"].as_array().unwrap().len();
+        println!("{}: {}", p.display(), v["stable_intervals"]);
+        // The measured bicycle + rigid rider sets of Moore (2012) are all
+        // self-stable somewhere below 10 m/s.
+        if p.file_name().unwrap().to_string_lossy().starts_with("Rigid") {
+            assert!(n >= 1, "{} has no stable interval", p.display());
+        }
+        stable += (n > 0) as usize;
+    }
+    assert!(stable >= 20, "{stable}");
+}
