@@ -230,6 +230,15 @@ fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
     s
 }
 
+/// "c: trail (m)" from a parameter symbol, for plot axes.
+fn axis_label(symbol: &str) -> String {
+    use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
+    match BenchmarkParameters::describe(symbol).or_else(|| ThesisParameters::describe(symbol)) {
+        Some(d) => format!("{d} [{symbol}]"),
+        None => symbol.to_string(),
+    }
+}
+
 fn canonical_text(c: &CanonicalMatrices) -> String {
     let m = |name: &str, x: &nalgebra::Matrix2<f64>| {
         format!(
@@ -429,7 +438,12 @@ fn run(cli: Cli) -> Result<bool> {
                         &opts,
                     )?;
                     if let Some(p) = &plot {
-                        plot_stability_map(p, &map, MapQuantity::StableWidth, &PlotOptions::default())?;
+                        let opts = PlotOptions {
+                            x_label: Some(axis_label(&param)),
+                            y_label: Some(axis_label(&p2)),
+                            ..PlotOptions::default()
+                        };
+                        plot_stability_map(p, &map, MapQuantity::StableWidth, &opts)?;
                         eprintln!("wrote {}", p.display());
                     }
                     match format {

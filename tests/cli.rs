@@ -9,7 +9,11 @@ fn bikedyn(args: &[&str]) -> Output {
 
 fn ok_json(args: &[&str]) -> serde_json::Value {
     let out = bikedyn(args);
-    assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
@@ -34,7 +38,12 @@ fn eig_json_has_the_documented_schema() {
     }
     let at5 = &pts[10];
     assert_eq!(at5["v"].as_f64().unwrap(), 5.0);
-    let names: Vec<&str> = at5["modes"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
+    let names: Vec<&str> = at5["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m.as_str().unwrap())
+        .collect();
     for m in ["weave", "capsize", "castering"] {
         assert!(names.contains(&m), "{names:?}");
     }
@@ -44,7 +53,19 @@ fn eig_json_has_the_documented_schema() {
 fn eig_csv_and_plot_files() {
     let csv = tmp("eig.csv");
     let svg = tmp("eig.svg");
-    let out = bikedyn(&["eig", "--bike", "thesis", "--speeds", "0:10:0.1", "--format", "csv", "--output", csv.to_str().unwrap(), "--plot", svg.to_str().unwrap()]);
+    let out = bikedyn(&[
+        "eig",
+        "--bike",
+        "thesis",
+        "--speeds",
+        "0:10:0.1",
+        "--format",
+        "csv",
+        "--output",
+        csv.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let text = std::fs::read_to_string(&csv).unwrap();
     assert_eq!(text.lines().count(), 1 + 101);
@@ -68,9 +89,25 @@ fn thesis_bicycle_is_self_stable_where_the_thesis_says() {
 fn params_convert_round_trips_through_files() {
     let thesis = tmp("bench_as_thesis.toml");
     let back = tmp("bench_back.toml");
-    let out = bikedyn(&["params", "convert", "--to", "thesis", "benchmark", "--output", thesis.to_str().unwrap()]);
+    let out = bikedyn(&[
+        "params",
+        "convert",
+        "--to",
+        "thesis",
+        "benchmark",
+        "--output",
+        thesis.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let out = bikedyn(&["params", "convert", "--to", "benchmark", thesis.to_str().unwrap(), "--output", back.to_str().unwrap()]);
+    let out = bikedyn(&[
+        "params",
+        "convert",
+        "--to",
+        "benchmark",
+        thesis.to_str().unwrap(),
+        "--output",
+        back.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     // The converted bicycle has the benchmark's weave speed.
     let v = ok_json(&["stability", "--bike", back.to_str().unwrap(), "--json"]);
@@ -79,13 +116,36 @@ fn params_convert_round_trips_through_files() {
 
 #[test]
 fn sweep_over_trail_and_a_stability_map() {
-    let v = ok_json(&["sweep", "--bike", "benchmark", "--param", "c", "--values", "0.04:0.12:0.04", "--format", "json"]);
+    let v = ok_json(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0.04:0.12:0.04",
+        "--format",
+        "json",
+    ]);
     let s = v.to_string();
     assert!(s.contains("weave_speed"), "{s}");
     let png = tmp("map.png");
     let out = bikedyn(&[
-        "sweep", "--bike", "benchmark", "--param", "c", "--values", "0.02:0.12:0.05", "--param2", "lam", "--values2", "0.2:0.4:0.1",
-        "--format", "csv", "--plot", png.to_str().unwrap(),
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0.02:0.12:0.05",
+        "--param2",
+        "lam",
+        "--values2",
+        "0.2:0.4:0.1",
+        "--format",
+        "csv",
+        "--plot",
+        png.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
@@ -106,7 +166,15 @@ fn bad_input_gives_clear_errors() {
     let out = bikedyn(&["eig", "--bike", "thesis", "--speeds", "10:0:1"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--speeds"));
-    let out = bikedyn(&["sweep", "--bike", "thesis", "--param", "wheelbase_typo", "--values", "0:1:0.5"]);
+    let out = bikedyn(&[
+        "sweep",
+        "--bike",
+        "thesis",
+        "--param",
+        "wheelbase_typo",
+        "--values",
+        "0:1:0.5",
+    ]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("wheelbase_typo"));
 }
@@ -115,7 +183,10 @@ fn bad_input_gives_clear_errors() {
 fn every_real_parameter_set_gives_its_stability_interval() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/parameter_sets/HumanControl_Par");
     if !dir.exists() {
-        println!("skipped: {} is absent (real parameter sets are only in the development checkout)", dir.display());
+        println!(
+            "skipped: {} is absent (real parameter sets are only in the development checkout)",
+            dir.display()
+        );
         return;
     }
     let mut stable = 0;

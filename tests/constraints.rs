@@ -17,14 +17,21 @@ fn newton_solves_the_holonomic_constraints_to_1e14_at_any_roll_and_steer() {
         let info = solve_configuration::<W, f64>(&param, 0.7, &mut p, &NewtonOptions::default()).unwrap();
         let mut res = vec![0.0; 3];
         W::holonomic_residuals(&param, 0.7, &p, &mut res);
-        assert!(res.iter().all(|r| r.abs() <= 1e-14), "roll {roll} steer {steer}: residuals {res:?} ({info:?})");
+        assert!(
+            res.iter().all(|r| r.abs() <= 1e-14),
+            "roll {roll} steer {steer}: residuals {res:?} ({info:?})"
+        );
         // Upright, the frame pitch is minus the steer-axis tilt of the thesis
         // bicycle (~18 degrees) and the contact is at the bottom of the rim:
         // xi is measured in the front-wheel axes, pitched by beta.
         if roll == 0.0 && steer == 0.0 {
             let lam = ThesisParameters::thesis_bicycle().frame_pitch().unwrap();
             assert!((p[5] - lam).abs() < 1e-12, "beta {} vs {lam}", p[5]);
-            assert!((p[8] - (std::f64::consts::FRAC_PI_2 - p[5])).abs() < 1e-12, "xi {}", p[8]);
+            assert!(
+                (p[8] - (std::f64::consts::FRAC_PI_2 - p[5])).abs() < 1e-12,
+                "xi {}",
+                p[8]
+            );
         }
     }
 }
@@ -60,7 +67,9 @@ fn a_front_wheel_that_cannot_reach_the_ground_is_a_typed_error_not_nan() {
     t.front_wheel_radius = 3.0; // far larger than the wheelbase allows
     let err = canonical_matrices::<W>(|s| t.get(s)).unwrap_err();
     match err {
-        LinearizeError::Constraint(ConstraintError::NotSatisfiable { constraint, residual, .. }) => {
+        LinearizeError::Constraint(ConstraintError::NotSatisfiable {
+            constraint, residual, ..
+        }) => {
             assert!(constraint.starts_with("front_contact"), "{constraint}");
             assert!(residual.is_finite() && residual > 1e-3);
         }

@@ -96,27 +96,53 @@ mod broken_impl {
         const INITIAL_GUESS: &'static [f64] = W::INITIAL_GUESS;
         const ALL_QUANTITIES_LAYOUT: &'static [(&'static str, usize, usize)] = W::ALL_QUANTITIES_LAYOUT;
         const FLOPS: &'static [(&'static str, usize)] = W::FLOPS;
-        fn mass_matrix<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) { W::mass_matrix(a, p, o) }
-        fn quadratic_velocity_forces<T: Scalar>(a: &[T], p: &[T], dp: &[T], o: &mut [T]) { W::quadratic_velocity_forces(a, p, dp, o) }
-        fn gravity_forces<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) { W::gravity_forces(a, p, o) }
-        fn applied_forces<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) { W::applied_forces(a, t, p, dp, o) }
-        fn holonomic_residuals<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) { W::holonomic_residuals(a, t, p, o) }
+        fn mass_matrix<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
+            W::mass_matrix(a, p, o)
+        }
+        fn quadratic_velocity_forces<T: Scalar>(a: &[T], p: &[T], dp: &[T], o: &mut [T]) {
+            W::quadratic_velocity_forces(a, p, dp, o)
+        }
+        fn gravity_forces<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
+            W::gravity_forces(a, p, o)
+        }
+        fn applied_forces<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::applied_forces(a, t, p, dp, o)
+        }
+        fn holonomic_residuals<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
+            W::holonomic_residuals(a, t, p, o)
+        }
         fn holonomic_jacobian<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
             W::holonomic_jacobian(a, t, p, o);
             o[3] *= T::cst(1.0 + 1e-4);
         }
-        fn holonomic_time_derivative<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) { W::holonomic_time_derivative(a, t, p, o) }
-        fn holonomic_convective<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) { W::holonomic_convective(a, t, p, dp, o) }
-        fn nonholonomic_velocities<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) { W::nonholonomic_velocities(a, t, p, dp, o) }
-        fn nonholonomic_matrix<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) { W::nonholonomic_matrix(a, t, p, o) }
+        fn holonomic_time_derivative<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
+            W::holonomic_time_derivative(a, t, p, o)
+        }
+        fn holonomic_convective<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::holonomic_convective(a, t, p, dp, o)
+        }
+        fn nonholonomic_velocities<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::nonholonomic_velocities(a, t, p, dp, o)
+        }
+        fn nonholonomic_matrix<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
+            W::nonholonomic_matrix(a, t, p, o)
+        }
         fn nonholonomic_convective<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
             W::nonholonomic_convective(a, t, p, dp, o);
             o[0] += T::cst(1e-3);
         }
-        fn kinetic_energy<T: Scalar>(a: &[T], p: &[T], dp: &[T]) -> T { W::kinetic_energy(a, p, dp) }
-        fn potential_energy<T: Scalar>(a: &[T], p: &[T]) -> T { W::potential_energy(a, p) }
-        fn point_positions<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) { W::point_positions(a, p, o) }
-        fn all_quantities<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) { W::all_quantities(a, t, p, dp, o) }
+        fn kinetic_energy<T: Scalar>(a: &[T], p: &[T], dp: &[T]) -> T {
+            W::kinetic_energy(a, p, dp)
+        }
+        fn potential_energy<T: Scalar>(a: &[T], p: &[T]) -> T {
+            W::potential_energy(a, p)
+        }
+        fn point_positions<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
+            W::point_positions(a, p, o)
+        }
+        fn all_quantities<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::all_quantities(a, t, p, dp, o)
+        }
     }
 }
 
@@ -124,9 +150,21 @@ mod broken_impl {
 fn verification_catches_wrong_derivatives() {
     use bikedyn::runtime::verify::verify;
     let param = bikedyn::models::default_parameters::<bikedyn::generated::ThesisWhipple>();
-    let r = verify::<Broken>(&param, &VerifyOptions { states: 5, seed: 11, ..Default::default() });
+    let r = verify::<Broken>(
+        &param,
+        &VerifyOptions {
+            states: 5,
+            seed: 11,
+            ..Default::default()
+        },
+    );
     assert!(!r.passed);
-    let failed: Vec<&str> = r.quantities.iter().filter(|q| !q.passed).map(|q| q.name.as_str()).collect();
+    let failed: Vec<&str> = r
+        .quantities
+        .iter()
+        .filter(|q| !q.passed)
+        .map(|q| q.name.as_str())
+        .collect();
     assert!(failed.contains(&"Cq"), "{failed:?}");
     assert!(failed.contains(&"dBdp"), "{failed:?}");
     // all_quantities still agrees with the unmodified functions it was compared to,

@@ -13,29 +13,41 @@
 //! `roots(-v) = -roots(v)`.
 //!
 //! # Mode classification rule
-//! Labels are attached to continuous root branches, not to sorted positions:
-//! 1. *Anchor.* At the highest requested |speed| (or, if needed, at higher speeds
-//!    `max(v,1) * 1.25^k`, up to ~7500 m/s) find a speed where the spectrum is
-//!    *one complex pair + two real roots*. There the pair is `Weave`, the more
-//!    negative real root is `Castering`, the other real root is `Capsize`. (This is
-//!    the generic high-speed picture of an uncontrolled bicycle: castering goes to
-//!    `-inf` roughly like `-v`, the weave frequency grows like `v`, capsize stays
-//!    small.) If no such speed exists, fall back at the top speed to: four real roots
-//!    sorted descending `[Weave, Weave, Capsize, Castering]`; two complex pairs: the
-//!    pair with the larger imaginary part `Weave`, the other `Other(k)`.
-//! 2. *Continuation.* Labels are carried down in speed by adaptive continuation:
-//!    between consecutive speeds the roots are matched by the permutation of least
-//!    total squared displacement, and the step is halved until the largest
-//!    displacement is below 0.3 times the smallest distance between roots carrying
-//!    *different* labels (roots sharing a label, e.g. the two weave roots at the
-//!    double root `v_d`, may be close or swap freely). Hence labels never swap, even
-//!    when the capsize root and a real weave root pass close to each other (then the
-//!    ordering along the real axis is kept: an avoided crossing). Only at an exact
-//!    collision of two differently-labelled roots (step below `1e-12 max(1,|v|)`) is
-//!    the minimal-displacement matching accepted as is.
-//! 3. Below the merge speed `v_d` the two real roots continuing the weave pair are
+//! Labels are attached to continuous root branches, not to sorted positions, and
+//! depend only on the bicycle and the speed (not on which other speeds are asked):
+//! 1. *Anchor.* Let `vs = sqrt(g |b0| / |b2|)` be the bicycle's characteristic speed
+//!    (where gravity and speed terms of the `s^2` coefficient balance; 3.4 m/s for
+//!    the benchmark). On the ladder `30 vs * 2^k` (k = 0..10), then `30 vs / 1.25^k`,
+//!    take the first speed where the spectrum is *one complex pair + two real roots*.
+//!    There the pair is `Weave`, the more negative real root `Castering`, the other
+//!    real root `Capsize` (the generic high-speed picture of an uncontrolled
+//!    bicycle: castering goes to `-inf` roughly like `-v`, the weave frequency grows
+//!    like `v`, capsize stays small). If no ladder speed has that pattern, fall back
+//!    at `30 vs` to: four real roots sorted descending `[Weave, Weave, Capsize,
+//!    Castering]`; two complex pairs: the pair with the larger imaginary part
+//!    `Weave`, the other `Other(2)`.
+//! 2. *Continuation.* Every requested speed is reached from the anchor by adaptive
+//!    continuation: between consecutive speeds the roots are matched by the
+//!    permutation of least total squared displacement, and the step is halved until
+//!    the largest displacement is at most 0.3 times the smallest distance between
+//!    roots carrying *different* labels (roots sharing a label, e.g. the two weave
+//!    roots at the double root `v_d`, may be close or swap freely). Hence labels
+//!    never swap when roots merely pass close to each other (e.g. the capsize root
+//!    and a real weave root: an avoided crossing keeps the order along the real
+//!    axis). Only at an exact collision of differently-labelled roots (step below
+//!    `1e-12 max(1, |v|)`) is the minimal-displacement matching accepted as is.
+//! 3. *A conjugate pair is one mode.* If two roots with different labels collide
+//!    and leave the real axis as a pair, the pair takes the lower-ranked label
+//!    (weave < capsize < castering < other) and the displaced label passes to the
+//!    other root that carried the pair's label (e.g. a real weave root merging with
+//!    capsize into an oscillation: the pair becomes weave and the remaining real weave
+//!    root becomes capsize). Two real roots sharing a non-weave label (a
+//!    capsize/castering pair that split again) become capsize (larger) and castering
+//!    (smaller).
+//! 4. Below the merge speed `v_d` the two real roots continuing the weave pair are
 //!    both labelled `Weave` (for the benchmark at `v = 0`: `+5.53` and `+3.13`;
 //!    `-3.13` is capsize and `-5.53` castering).
+//! 5. Negative speeds: `roots(-v) = -roots(v)` with the same labels.
 //!
 //! In an [`EigenPoint`] the eigenvalues are ordered by label: weave roots first
 //! (upper root of the pair, or the larger real root, first), then capsize, then

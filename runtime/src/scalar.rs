@@ -235,3 +235,94 @@ mod tests {
         assert!((f.eps[1] - dfdy).abs() < 1e-14);
     }
 }
+
+/// An `f64` that counts the floating-point operations done on it (per
+/// thread), to report flop counts beside timings. Transcendental calls count
+/// as one operation each.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Counted(pub f64);
+
+thread_local! {
+    static FLOPS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+impl Counted {
+    /// Operations counted on this thread since the last reset.
+    pub fn count() -> u64 {
+        FLOPS.with(|c| c.get())
+    }
+    /// Reset this thread's counter.
+    pub fn reset() {
+        FLOPS.with(|c| c.set(0));
+    }
+    #[inline(always)]
+    fn tick(n: u64) {
+        FLOPS.with(|c| c.set(c.get() + n));
+    }
+}
+
+macro_rules! counted_binop {
+    ($tr:ident, $m:ident, $atr:ident, $am:ident, $op:tt) => {
+        impl $tr for Counted {
+            type Output = Counted;
+            #[inline(always)]
+            fn $m(self, o: Counted) -> Counted {
+                Counted::tick(1);
+                Counted(self.0 $op o.0)
+            }
+        }
+        impl $atr for Counted {
+            #[inline(always)]
+            fn $am(&mut self, o: Counted) {
+                *self = *self $op o;
+            }
+        }
+    };
+}
+counted_binop!(Add, add, AddAssign, add_assign, +);
+counted_binop!(Sub, sub, SubAssign, sub_assign, -);
+counted_binop!(Mul, mul, MulAssign, mul_assign, *);
+impl Div for Counted {
+    type Output = Counted;
+    #[inline(always)]
+    fn div(self, o: Counted) -> Counted {
+        Counted::tick(1);
+        Counted(self.0 / o.0)
+    }
+}
+impl Neg for Counted {
+    type Output = Counted;
+    #[inline(always)]
+    fn neg(self) -> Counted {
+        Counted::tick(1);
+        Counted(-self.0)
+    }
+}
+impl Scalar for Counted {
+    fn cst(x: f64) -> Self {
+        Counted(x)
+    }
+    fn re(self) -> f64 {
+        self.0
+    }
+    fn sin(self) -> Self {
+        Counted::tick(1);
+        Counted(self.0.sin())
+    }
+    fn cos(self) -> Self {
+        Counted::tick(1);
+        Counted(self.0.cos())
+    }
+    fn sqrt(self) -> Self {
+        Counted::tick(1);
+        Counted(self.0.sqrt())
+    }
+    fn powi(self, n: i32) -> Self {
+        Counted::tick(1);
+        Counted(self.0.powi(n))
+    }
+    fn sin_cos(self) -> (Self, Self) {
+        Counted::tick(2);
+        (Counted(self.0.sin()), Counted(self.0.cos()))
+    }
+}

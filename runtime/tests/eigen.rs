@@ -660,17 +660,3 @@ proptest! {
         }
     }
 }
-#[test]
-fn eigen_zz_dbg() {
-    let c = published();
-    let vd = critical_speeds(&c, 0.0, 1.0).unwrap().weave_real_pair_merge.unwrap();
-    for k in 3..=16 {
-        for sign in [-1.0, 1.0] {
-            let v = vd + sign * 10f64.powi(-k);
-            let z = eigenvalues(&c, v).unwrap();
-            let a = c.state_matrix(v).unwrap();
-            let s: C64 = z.iter().sum();
-            println!("{k} {sign} {:?} sumerr {:e}", z, s.re - a.trace());
-        }
-    }
-}
