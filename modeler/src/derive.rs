@@ -136,7 +136,7 @@ impl<'a> Deriver<'a> {
     fn time_rate(&self, e: &Atom) -> Atom {
         let mut s = e.derivative(self.sym.time);
         for (j, q) in self.sym.coords.iter().enumerate() {
-            s = s + e.derivative(*q) * Atom::var(self.sym.rates[j]);
+            s += e.derivative(*q) * Atom::var(self.sym.rates[j]);
         }
         s
     }
@@ -237,8 +237,8 @@ pub fn derive(model: &Model) -> Derived {
         for b in a..nq {
             let mut s = zero();
             for i in 0..d.m.bodies.len() {
-                s = s + &masses[i] * dot(&body_h[i][a], &body_h[i][b]);
-                s = s + dot(&body_g[i][a], &mat_vec(&inertias[i], &body_g[i][b]));
+                s += &masses[i] * dot(&body_h[i][a], &body_h[i][b]);
+                s += dot(&body_g[i][a], &mat_vec(&inertias[i], &body_g[i][b]));
             }
             mass[a * nq + b] = s.clone();
             mass[b * nq + a] = s;
@@ -257,7 +257,7 @@ pub fn derive(model: &Model) -> Derived {
         let vel: V3 = std::array::from_fn(|k| (0..nq).fold(zero(), |s, j| s + &body_h[i][j][k] * dq(j)));
         let w = &omega_local[b.frame.0];
         let iw = mat_vec(&inertias[i], w);
-        kinetic = kinetic + (&masses[i] * dot(&vel, &vel) + dot(w, &iw)) / Atom::num(2);
+        kinetic += (&masses[i] * dot(&vel, &vel) + dot(w, &iw)) / Atom::num(2);
         let acc: V3 = std::array::from_fn(|k| rate_of(&vel[k]));
         let alpha: V3 = std::array::from_fn(|k| rate_of(&w[k]));
         let ia = mat_vec(&inertias[i], &alpha);
@@ -349,7 +349,7 @@ pub fn derive(model: &Model) -> Derived {
     let bmat: Vec<Atom> = (0..nnh)
         .flat_map(|i| (0..nq).map(|j| vel[i].derivative(d.sym.rates[j])).collect::<Vec<_>>())
         .collect();
-    let dbdp: Vec<Atom> = vel.iter().map(|v| rate_of(v)).collect();
+    let dbdp: Vec<Atom> = vel.iter().map(rate_of).collect();
     let poi: Vec<Atom> =
         d.m.points_of_interest
             .iter()

@@ -582,6 +582,7 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
 
         #(#fns)*
 
+        #[allow(clippy::approx_constant)]
         impl MultibodyModel for #ty {
             const NAME: &'static str = #name;
             const COORDINATES: &'static [&'static str] = COORDINATES;

@@ -96,13 +96,17 @@ pub enum EigenError {
 /// Mode label of an eigenvalue.
 ///
 /// * `Weave`: the oscillatory steer/roll mode. Below the merge speed `v_d` the
-///   weave "pair" is two *real* roots (at `v = 0`: one unstable, one stable
-///   inverted-pendulum root); both carry the label `Weave` and
-///   [`EigenPoint::is_oscillatory`] tells the two regimes apart.
-/// * `Capsize`: the real, slow roll mode (unstable above `v_c`).
-/// * `Castering`: the real, fast, strongly stable steer mode.
-/// * `Other(k)`: anything the classification rule could not assign (e.g. a
-///   second complex pair for an unusual bicycle); `k` is the eigenvalue index.
+///   weave "pair" is two *real* roots; both carry the label `Weave` and
+///   [`EigenPoint::is_oscillatory`] tells the two regimes apart. (Benchmark at
+///   `v = 0`: the four roots are `+-3.13`, `+-5.53`; the weave roots are `+5.53`
+///   and `+3.13`, which merge at `v_d = 0.684` into the double root `3.78`.)
+/// * `Capsize`: the slow, real roll mode (benchmark: unstable above `v_c`).
+/// * `Castering`: the fast, real, strongly stable steer mode.
+/// * `Other(k)`: a mode the classification rule could not name (only in the
+///   fallback, for a bicycle with two complex pairs at every anchor speed: the
+///   second pair is `Other(2)`).
+///
+/// See the module documentation for the classification rule.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Mode {
     /// Weave (complex pair above `v_d`, two real roots below).

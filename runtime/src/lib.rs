@@ -1,6 +1,8 @@
 //! bikedyn runtime: numerics on generated multibody models (nalgebra only; no
 //! Symbolica at run time).
 #![allow(clippy::needless_range_loop)]
+// `!(x <= tol)` is deliberate throughout: it treats NaN as a failure.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod benchmark_oracle;
 pub mod canonical;

@@ -711,7 +711,6 @@ fn continuation_curves(sweep: &EigenSweep) -> Vec<Curve> {
 }
 
 struct Continuation<'a> {
-    sweep: &'a EigenSweep,
     critical: Option<&'a CriticalSpeeds>,
     opts: &'a PlotOptions,
     curves: Vec<Curve>,
@@ -762,7 +761,6 @@ pub fn plot_continuation(
         path,
         opts,
         &Continuation {
-            sweep,
             critical,
             opts,
             curves,
@@ -1028,7 +1026,6 @@ impl Figure for Continuation<'_> {
             .border_style(RGBColor(160, 160, 160).stroke_width(o.pxu(1.0)))
             .draw()
             .map_err(de)?;
-        let _ = self.sweep;
         Ok(())
     }
 }

@@ -36,12 +36,27 @@ fn benchmark() -> CanonicalMatrices {
 const WEAVE_SPEED: f64 = 4.29238253634111;
 const CAPSIZE_SPEED: f64 = 6.02426201538837;
 
-/// Fresh empty directory for one test.
-fn test_dir(name: &str) -> PathBuf {
+/// Fresh empty directory for one test, removed when dropped.
+struct TestDir(PathBuf);
+
+impl std::ops::Deref for TestDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TestDir {
+    fn drop(&mut self) {
+        let _ = fs::remove_dir_all(&self.0);
+    }
+}
+
+fn test_dir(name: &str) -> TestDir {
     let d = std::env::temp_dir().join(format!("bikedyn-sweep-plot-{}-{name}", std::process::id()));
     let _ = fs::remove_dir_all(&d);
     fs::create_dir_all(&d).unwrap();
-    d
+    TestDir(d)
 }
 
 fn entries(dir: &Path) -> Vec<String> {
