@@ -6249,6 +6249,7 @@ pub fn all_quantities<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut
     out[192usize] = t1977;
     out[193usize] = t1136;
 }
+#[allow(clippy::approx_constant)]
 impl MultibodyModel for ThesisWhipple {
     const NAME: &'static str = "thesis_whipple";
     const COORDINATES: &'static [&'static str] = COORDINATES;

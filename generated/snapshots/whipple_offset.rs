@@ -6450,6 +6450,7 @@ pub fn all_quantities<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut
     out[192usize] = t2062;
     out[193usize] = t1221;
 }
+#[allow(clippy::approx_constant)]
 impl MultibodyModel for WhippleOffset {
     const NAME: &'static str = "whipple_offset";
     const COORDINATES: &'static [&'static str] = COORDINATES;

@@ -462,22 +462,17 @@ fn classify_fallback(z: &[C64; 4]) -> [Mode; 4] {
     if let Some(l) = classify_anchor(z) {
         return l;
     }
-    // two complex pairs: larger |im| is weave
-    let wmax = z.iter().fold(0.0f64, |m, x| m.max(x.im.abs()));
-    let mut l = [Mode::Other(0); 4];
-    let mut k = 2u8;
-    for i in 0..4 {
-        if z[i].im.abs() == wmax {
-            l[i] = Mode::Weave;
-        } else {
-            l[i] = Mode::Other(k);
-            k += 1;
+    // two complex pairs: the pair with the larger imaginary part is weave
+    let mut top = 0;
+    for i in 1..4 {
+        if z[i].im > z[top].im {
+            top = i;
         }
     }
-    // keep exactly one label per conjugate pair for the non-weave pair
-    let others: Vec<usize> = (0..4).filter(|&i| l[i] != Mode::Weave).collect();
-    for &i in &others {
-        l[i] = Mode::Other(2);
+    let mut l = [Mode::Other(2); 4];
+    l[top] = Mode::Weave;
+    if let Some(j) = (0..4).find(|&j| j != top && z[j] == z[top].conj()) {
+        l[j] = Mode::Weave;
     }
     l
 }

@@ -224,15 +224,36 @@ pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<
     })
 }
 
-fn real_count(cp: &CharPoly, v: f64) -> Result<usize, EigenError> {
-    Ok(cp.roots(v)?.iter().filter(|z| z.im == 0.0).count())
-}
-
 /// Grid intervals used to bracket `v_d`.
 const MERGE_GRID: usize = 512;
 
+/// `Some(true)`: both weave roots real; `Some(false)`: both complex.
+fn weave_state(l: &Labelled) -> Option<bool> {
+    let mut w = (0..4).filter(|&k| l.labels[k] == Mode::Weave).map(|k| l.roots[k]);
+    let (a, b) = (w.next()?, w.next()?);
+    if w.next().is_some() {
+        return None;
+    }
+    match (a.im == 0.0, b.im == 0.0) {
+        (true, true) => Some(true),
+        (false, false) => Some(false),
+        _ => None,
+    }
+}
+
+fn weave_mean(l: &Labelled) -> f64 {
+    let w: Vec<f64> = (0..4)
+        .filter(|&k| l.labels[k] == Mode::Weave)
+        .map(|k| l.roots[k].re)
+        .collect();
+    w.iter().sum::<f64>() / w.len().max(1) as f64
+}
+
 /// `(v_d, s_d)`: lowest speed in `[lo, hi]` where the two weave roots turn from real
-/// to complex, and the double root there.
+/// to complex, and the double root there. The grid cell is bisected on the state
+/// of the *weave-labelled* roots (labels carried by continuation from the cell's
+/// lower end, so another pair merging in the same cell cannot be mistaken for it),
+/// then `(s, v)` is polished by Newton on `p = p_s = 0`.
 fn weave_merge(cp: &CharPoly, lo: f64, hi: f64) -> Result<Option<(f64, f64)>, EigenError> {
     if !(hi > lo) {
         return Ok(None);
@@ -241,57 +262,37 @@ fn weave_merge(cp: &CharPoly, lo: f64, hi: f64) -> Result<Option<(f64, f64)>, Ei
         .map(|i| lo + (hi - lo) * (i as f64 / MERGE_GRID as f64))
         .collect();
     let lab = track(cp, &grid)?;
-    let weave_state = |l: &Labelled| -> Option<bool> {
-        // Some(true): both weave roots real; Some(false): both complex
-        let w: Vec<C64> = (0..4)
-            .filter(|&k| l.labels[k] == Mode::Weave)
-            .map(|k| l.roots[k])
-            .collect();
-        if w.len() != 2 {
-            return None;
-        }
-        match (w[0].im == 0.0, w[1].im == 0.0) {
-            (true, true) => Some(true),
-            (false, false) => Some(false),
-            _ => None,
-        }
-    };
     for i in 0..MERGE_GRID {
-        if weave_state(&lab[i]) == Some(true) && weave_state(&lab[i + 1]) == Some(false) {
-            let (mut a, mut b) = (grid[i], grid[i + 1]);
-            let na = real_count(cp, a)?;
-            for _ in 0..200 {
-                let m = 0.5 * (a + b);
-                if m <= a || m >= b {
-                    break;
-                }
-                if real_count(cp, m)? == na {
-                    a = m;
-                } else {
-                    b = m;
-                }
-            }
-            let vm = 0.5 * (a + b);
-            // start: mean of the closest pair of real roots at a
-            let z = cp.roots(a)?;
-            let reals: Vec<f64> = z.iter().filter(|x| x.im == 0.0).map(|x| x.re).collect();
-            let mut s0 = None;
-            let mut dbest = f64::INFINITY;
-            for p in 0..reals.len() {
-                for q in p + 1..reals.len() {
-                    let d = (reals[p] - reals[q]).abs();
-                    if d < dbest {
-                        dbest = d;
-                        s0 = Some(0.5 * (reals[p] + reals[q]));
-                    }
-                }
-            }
-            let Some(s0) = s0 else { return Ok(Some((vm, z[0].re))) };
-            return Ok(Some(match double_root_newton(cp, s0, vm) {
-                Some((v, s)) if (v - vm).abs() <= 1e-9 * vm.abs().max(1.0) => (v, s),
-                _ => (vm, s0),
-            }));
+        if weave_state(&lab[i]) != Some(true) || weave_state(&lab[i + 1]) != Some(false) {
+            continue;
         }
+        let (mut a, mut b) = (grid[i], grid[i + 1]);
+        let (mut la, mut lb) = (lab[i], lab[i + 1]);
+        for _ in 0..200 {
+            let m = 0.5 * (a + b);
+            if m <= a || m >= b {
+                break;
+            }
+            let lm = continue_to(cp, la, a, m)?.canonical();
+            if weave_state(&lm) == Some(true) {
+                a = m;
+                la = lm;
+            } else {
+                b = m;
+                lb = lm;
+            }
+        }
+        let vm = 0.5 * (a + b);
+        // the double root: real part of the (just formed) weave pair above the merge
+        // (below it the two weave-labelled roots need not be the merging ones, see
+        // the pair rule in the module docs)
+        let s0 = weave_mean(&lb);
+        return Ok(Some(match double_root_newton(cp, s0, vm) {
+            Some((v, s)) if (v - vm).abs() <= 1e-9 * vm.abs().max(1.0) && (s - s0).abs() <= 1e-3 * (1.0 + s0.abs()) => {
+                (v, s)
+            }
+            _ => (vm, s0),
+        }));
     }
     Ok(None)
 }
@@ -312,9 +313,9 @@ fn double_root_newton(cp: &CharPoly, mut s: f64, mut v: f64) -> Option<(f64, f64
         if !(s.is_finite() && v.is_finite()) {
             return None;
         }
-        if dv.abs() <= 1e-16 * v.abs().max(1.0) && ds.abs() <= 1e-15 * s.abs().max(1.0) {
+        if dv.abs() <= 4e-15 * v.abs().max(1.0) && ds.abs() <= 1e-12 * s.abs().max(1.0) {
             return Some((v, s));
         }
     }
-    Some((v, s))
+    None
 }

@@ -343,7 +343,7 @@ fn companion(a: f64, b: f64, c: f64, d: f64) -> Option<[C64; 4]> {
         for j in 0..4 {
             if !used[j] {
                 let dist = (z[j] - z[i].conj()).norm();
-                if best.map_or(true, |(_, bd)| dist < bd) {
+                if best.is_none_or(|(_, bd)| dist < bd) {
                     best = Some((j, dist));
                 }
             }
