@@ -649,11 +649,18 @@ mod tests {
         m.parameter("I", "inertia (kg m^2)");
         m.parameter("g", "gravity (m/s^2)");
         m.parameter("c", "damping (N m s)");
+        m.parameter("F", "horizontal push on the bob (N)");
         m.gravity("g", Axis::Z);
         let f = m.frame("arm", GROUND, vec![(Axis::Y, th)]);
         let pivot = m.point("pivot", None, vec![(GROUND, vec3(x.clone(), num(0), num(0)))]);
         let bob = m.point("bob", Some(pivot), vec![(f, vec3(num(0), num(0), -l))]);
-        m.body("bob", f, param("m"), inertia_wheel(param("I"), param("I")), bob);
+        let body = m.body("bob", f, param("m"), inertia_wheel(param("I"), param("I")), bob);
+        m.force(Force::AtMassCentre {
+            name: "push".into(),
+            body,
+            frame: GROUND,
+            force: vec3(param("F"), num(0), num(0)),
+        });
         m.holonomic(crate::model::Holonomic::Residual {
             name: "drive".into(),
             expr: x - crate::expr::time(),
@@ -701,6 +708,20 @@ mod tests {
         assert!(is_zero(
             &q("gravity_forces").outputs[0] + &mm * &g * &l * Symbol::SIN.call((&th,))
         ));
+        // Applied: damper -c theta' and the push F at the bob (virtual work
+        // F dx_bob with x_bob = x - L sin(theta)).
+        let (c, f, dth) = (
+            Atom::var(symbol!("bikedyn_pendulum::p_c")),
+            Atom::var(symbol!("bikedyn_pendulum::p_F")),
+            Atom::var(symbol!("bikedyn_pendulum::dq_theta")),
+        );
+        let applied = &q("applied_forces").outputs;
+        assert!(
+            is_zero(&applied[0] + &c * &dth + &f * &l * Symbol::COS.call((&th,))),
+            "Q_theta = {}",
+            applied[0]
+        );
+        assert!(is_zero(&applied[1] - &f), "Q_x = {}", applied[1]);
         // Rheonomic constraint x - t: Cq = [0, 1], Ct = -1.
         assert!(q("holonomic_jacobian").outputs[0].is_zero());
         assert!(is_zero(&q("holonomic_time_derivative").outputs[0] + Atom::num(1)));
