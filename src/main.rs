@@ -8,7 +8,7 @@ use bikedyn::runtime::plot::{plot_continuation, plot_stability_map, PlotOptions}
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
 use bikedyn::runtime::verify::VerifyOptions;
 use bikedyn::runtime::CanonicalMatrices;
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -34,6 +34,24 @@ enum Format {
 enum FormName {
     Benchmark,
     Thesis,
+}
+
+/// Which bicycle to analyse.
+#[derive(Args)]
+struct BikeArg {
+    /// Built-in bicycle (thesis, benchmark) or parameter file.
+    #[arg(long = "bike", default_value = "thesis")]
+    spec: String,
+}
+
+/// Table/CSV/JSON output of a command.
+#[derive(Args)]
+struct OutputArgs {
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    format: Format,
+    /// Write the table/CSV/JSON to this file instead of standard output.
+    #[arg(long)]
+    output: Option<PathBuf>,
 }
 
 #[derive(Subcommand)]
@@ -63,34 +81,28 @@ enum Command {
     },
     /// Canonical matrices M0, C1, K0, K2 (Meijaard et al. 2007 form).
     Canonical {
-        /// Built-in bicycle (thesis, benchmark) or parameter file.
-        #[arg(long, default_value = "thesis")]
-        bike: String,
+        #[command(flatten)]
+        bike: BikeArg,
         #[arg(long)]
         json: bool,
     },
     /// Eigenvalues and modes over forward speed.
     Eig {
-        /// Built-in bicycle (thesis, benchmark) or parameter file.
-        #[arg(long, default_value = "thesis")]
-        bike: String,
+        #[command(flatten)]
+        bike: BikeArg,
         /// Speeds START:STOP:STEP (m/s).
         #[arg(long, default_value = "0:10:0.5")]
         speeds: String,
-        #[arg(long, value_enum, default_value_t = Format::Table)]
-        format: Format,
-        /// Write the table/CSV/JSON to this file instead of standard output.
-        #[arg(long)]
-        output: Option<PathBuf>,
+        #[command(flatten)]
+        out: OutputArgs,
         /// Continuation diagram (.svg or .png).
         #[arg(long)]
         plot: Option<PathBuf>,
     },
     /// Weave and capsize speeds and the self-stable speed interval(s).
     Stability {
-        /// Built-in bicycle (thesis, benchmark) or parameter file.
-        #[arg(long, default_value = "thesis")]
-        bike: String,
+        #[command(flatten)]
+        bike: BikeArg,
         /// Upper end of the searched speed range (m/s).
         #[arg(long, default_value_t = 10.0)]
         speed_max: f64,
@@ -99,9 +111,8 @@ enum Command {
     },
     /// Stability over one parameter, or over a grid of two (a stability map).
     Sweep {
-        /// Built-in bicycle (thesis, benchmark) or parameter file.
-        #[arg(long, default_value = "thesis")]
-        bike: String,
+        #[command(flatten)]
+        bike: BikeArg,
         /// Parameter symbol (thesis: Rt, x4, d4, ...; benchmark: c, lam, w, ...).
         #[arg(long)]
         param: String,
@@ -117,10 +128,8 @@ enum Command {
         /// Upper end of the searched speed range (m/s).
         #[arg(long, default_value_t = 10.0)]
         speed_max: f64,
-        #[arg(long, value_enum, default_value_t = Format::Table)]
-        format: Format,
-        #[arg(long)]
-        output: Option<PathBuf>,
+        #[command(flatten)]
+        out: OutputArgs,
         /// Stability map plot (.svg or .png), two-parameter sweeps only.
         #[arg(long)]
         plot: Option<PathBuf>,
@@ -360,7 +369,10 @@ fn run(cli: Cli) -> Result<bool> {
             }
             Ok(passed)
         }
-        Command::Canonical { bike, json } => {
+        Command::Canonical {
+            bike: BikeArg { spec: bike },
+            json,
+        } => {
             let b = load(&bike)?;
             let c = b.canonical()?;
             if json {
@@ -371,10 +383,9 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(true)
         }
         Command::Eig {
-            bike,
+            bike: BikeArg { spec: bike },
             speeds,
-            format,
-            output: out,
+            out: OutputArgs { format, output: out },
             plot,
         } => {
             let b = load(&bike)?;
@@ -399,7 +410,11 @@ fn run(cli: Cli) -> Result<bool> {
             }
             Ok(true)
         }
-        Command::Stability { bike, speed_max, json } => {
+        Command::Stability {
+            bike: BikeArg { spec: bike },
+            speed_max,
+            json,
+        } => {
             let b = load(&bike)?;
             let crit = critical(&b.canonical()?, speed_max)?;
             if json {
@@ -410,14 +425,13 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(true)
         }
         Command::Sweep {
-            bike,
+            bike: BikeArg { spec: bike },
             param,
             values,
             param2,
             values2,
             speed_max,
-            format,
-            output: out,
+            out: OutputArgs { format, output: out },
             plot,
         } => {
             let b = load(&bike)?;

@@ -11,7 +11,8 @@ use std::collections::HashMap;
 use std::time::{Duration, Instant};
 use symbolica::prelude::*;
 
-/// Which inputs a generated function takes (besides the parameters).
+/// Which inputs a generated function takes besides the parameters: this is
+/// its signature, which must match the corresponding `MultibodyModel` method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Inputs {
     pub time: bool,

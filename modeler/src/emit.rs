@@ -292,11 +292,9 @@ fn emit_function(
         }
     };
     let mut body = Vec::new();
-    // Inputs actually used.
-    let mut used = vec![false; dag.nodes.len()];
-    for (i, n) in dag.nodes.iter().enumerate() {
+    // Load the inputs the expressions use.
+    for n in &dag.nodes {
         if let Node::Input(inp) = n {
-            used[i] = true;
             let stmt = match inp {
                 Input::Param(k) => {
                     let n = &names.params[*k];
@@ -403,23 +401,15 @@ fn emit_function(
         };
         body.push(quote!(let #t: T = #e;));
     }
-    let _ = used;
     let name = ident(q.name);
     let doc = q.doc;
-    let t_arg = if q.inputs.time { quote!(t: T) } else { quote!(_t: T) };
-    let dp_arg = if q.inputs.rates {
-        quote!(dp: &[T])
-    } else {
-        quote!(_dp: &[T])
-    };
+    // The declared inputs are the signature (that of `MultibodyModel`).
+    let t_arg = if q.inputs.time { quote!(t: T,) } else { quote!() };
+    let dp_arg = if q.inputs.rates { quote!(dp: &[T],) } else { quote!() };
     let tokens = match q.shape {
         Shape::Scalar => {
             let r = var(outs[0], &dag.nodes);
-            let args = if q.inputs.rates {
-                quote!(param: &[T], p: &[T], #dp_arg)
-            } else {
-                quote!(param: &[T], p: &[T])
-            };
+            let args = quote!(param: &[T], #t_arg p: &[T], #dp_arg);
             quote! {
                 #[doc = #doc]
                 #[allow(unused_variables, non_snake_case, clippy::all)]
@@ -435,16 +425,7 @@ fn emit_function(
                 let v = var(o, &dag.nodes);
                 quote!(out[#k] = #v;)
             });
-            let args = match (q.inputs.time, q.inputs.rates) {
-                _ if q.name == "mass_matrix" || q.name == "gravity_forces" || q.name == "point_positions" => {
-                    quote!(param: &[T], p: &[T], out: &mut [T])
-                }
-                (_, false) => quote!(param: &[T], #t_arg, p: &[T], out: &mut [T]),
-                (_, true) if q.name == "quadratic_velocity_forces" => {
-                    quote!(param: &[T], p: &[T], dp: &[T], out: &mut [T])
-                }
-                (_, true) => quote!(param: &[T], #t_arg, p: &[T], dp: &[T], out: &mut [T]),
-            };
+            let args = quote!(param: &[T], #t_arg p: &[T], #dp_arg out: &mut [T]);
             quote! {
                 #[doc = #doc]
                 #[allow(unused_variables, non_snake_case, clippy::all)]

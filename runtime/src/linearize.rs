@@ -10,7 +10,9 @@
 //! cross-check it.
 
 use crate::canonical::CanonicalMatrices;
-use crate::constraints::{dependent_velocities, solve_configuration, solve_velocities, ConstraintError, NewtonOptions};
+use crate::constraints::{
+    constraint_matrices, dependent_velocities, solve_configuration, ConstraintError, NewtonOptions,
+};
 use crate::linalg::solve_in_place;
 use crate::model::MultibodyModel;
 use crate::scalar::{Dual, Scalar};
@@ -49,41 +51,49 @@ pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
         p[j] = q[k];
     }
     solve_configuration::<M, T>(param, t, &mut p, &NewtonOptions::default())?;
+    // One elimination on D_dep gives E = [I; -Ddep^-1 Dind] and the
+    // dependent velocities (eq. 40-45); a second, after gamma, gives
+    // F = [0; -Ddep^-1 gamma].
+    let nc = M::HOLONOMIC.len() + M::NONHOLONOMIC.len();
+    let cm = constraint_matrices::<M, T>(param, t, &p);
+    let depv = dependent_velocities::<M>();
+    let nd = depv.len();
+    let singular = |s: crate::linalg::Singular| ConstraintError::SingularJacobian {
+        what: "coordinate partitioning",
+        column: s.column,
+        pivot: s.pivot,
+    };
+    let mut a = vec![T::zero(); nd * nd];
+    // Right-hand sides: columns [Dind (ni columns) | d].
+    let mut rhs = vec![T::zero(); nd * (ni + 1)];
+    for i in 0..nc {
+        for (k, &j) in depv.iter().enumerate() {
+            a[i * nd + k] = cm.d[i * nq + j];
+        }
+        for (k, &j) in ind.iter().enumerate() {
+            rhs[i * (ni + 1) + k] = cm.d[i * nq + j];
+        }
+        rhs[i * (ni + 1) + ni] = cm.d_rhs[i];
+    }
+    let a_dep = a.clone();
+    solve_in_place(&mut a, nd, &mut rhs, ni + 1).map_err(singular)?;
     let mut dp = vec![T::zero(); nq];
     for (k, &j) in ind.iter().enumerate() {
         dp[j] = dq[k];
     }
-    solve_velocities::<M, T>(param, t, &p, &mut dp)?;
-
-    // E = [I; -Ddep^-1 Dind], F = [0; -Ddep^-1 gamma] (eq. 43-45).
+    for (r, &j) in depv.iter().enumerate() {
+        let mut v = rhs[r * (ni + 1) + ni];
+        for k in 0..ni {
+            v -= rhs[r * (ni + 1) + k] * dq[k];
+        }
+        dp[j] = v;
+    }
     let nh = M::HOLONOMIC.len();
-    let nnh = M::NONHOLONOMIC.len();
-    let nc = nh + nnh;
-    let mut dmat = vec![T::zero(); nc * nq];
-    M::holonomic_jacobian(param, t, &p, &mut dmat[..nh * nq]);
-    M::nonholonomic_matrix(param, t, &p, &mut dmat[nh * nq..]);
     let mut gamma = vec![T::zero(); nc];
     M::holonomic_convective(param, t, &p, &dp, &mut gamma[..nh]);
     M::nonholonomic_convective(param, t, &p, &dp, &mut gamma[nh..]);
-    let depv = dependent_velocities::<M>();
-    let nd = depv.len();
-    let mut a = vec![T::zero(); nd * nd];
-    // Right-hand sides: columns [Dind (ni columns) | gamma].
-    let mut rhs = vec![T::zero(); nd * (ni + 1)];
-    for i in 0..nc {
-        for (k, &j) in depv.iter().enumerate() {
-            a[i * nd + k] = dmat[i * nq + j];
-        }
-        for (k, &j) in ind.iter().enumerate() {
-            rhs[i * (ni + 1) + k] = dmat[i * nq + j];
-        }
-        rhs[i * (ni + 1) + ni] = gamma[i];
-    }
-    solve_in_place(&mut a, nd, &mut rhs, ni + 1).map_err(|s| ConstraintError::SingularJacobian {
-        what: "coordinate partitioning",
-        column: s.column,
-        pivot: s.pivot,
-    })?;
+    let mut a = a_dep;
+    solve_in_place(&mut a, nd, &mut gamma, 1).map_err(singular)?;
     let mut e = vec![T::zero(); nq * ni];
     let mut f = vec![T::zero(); nq];
     for (k, &j) in ind.iter().enumerate() {
@@ -93,7 +103,7 @@ pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
         for k in 0..ni {
             e[j * ni + k] = -rhs[r * (ni + 1) + k];
         }
-        f[j] = -rhs[r * (ni + 1) + ni];
+        f[j] = -gamma[r];
     }
 
     let mut mass = vec![T::zero(); nq * nq];
