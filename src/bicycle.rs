@@ -1,12 +1,16 @@
 //! Bicycles as users name them (built-in names or parameter files), mapped to
 //! the generated model that represents them and to their canonical matrices.
 
-use crate::generated::{ThesisWhipple, WhippleOffset};
+use crate::generated::with_model;
+use crate::models::{effect_parameters, fits, model_names, models};
 use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::linearize::{canonical_matrices, LinearizeError};
 use bikedyn_runtime::parameters::{
     BenchmarkParameters, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
 };
+use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+use bikedyn_runtime::MultibodyModel;
+use std::collections::BTreeMap;
 use std::path::Path;
 use thiserror::Error;
 
@@ -34,6 +38,18 @@ pub enum BicycleError {
     },
     #[error("`{spec}` is neither a built-in bicycle (thesis, benchmark) nor an existing file")]
     NotFound { spec: String },
+    #[error("unknown model `{name}` (models: {known})")]
+    UnknownModel { name: String, known: String },
+    #[error("model `{model}` cannot represent `{bike}`: it has no parameter {missing} (see `bikedyn models`)")]
+    ModelDoesNotFit {
+        model: String,
+        bike: String,
+        missing: String,
+    },
+    #[error("no generated model has every parameter `{bike}` sets ({nonzero})")]
+    NoModelFits { bike: String, nonzero: String },
+    #[error("the canonical form M0, C1, K0, K2 holds for the Whipple bicycle; with {effects} the linear equations depend on speed otherwise")]
+    NotCanonical { effects: String },
 }
 
 /// A resolved bicycle.
@@ -45,6 +61,9 @@ pub struct Bicycle {
     pub parameters: ParameterSet,
     /// Validation warnings (e.g. triangle inequality of inertia tensors).
     pub warnings: Vec<ParameterWarning>,
+    /// Effect parameters given in the file, by symbol (absent: the model's
+    /// default, at which the effect is absent).
+    pub effects: BTreeMap<String, f64>,
 }
 
 impl Bicycle {
@@ -62,14 +81,113 @@ impl Bicycle {
                 let w = p.validate()?;
                 (ParameterSet::Benchmark(p), w)
             }
-            path if Path::new(path).exists() => ParameterSet::load(path)?,
+            path if Path::new(path).exists() => {
+                let extra: Vec<&str> = effect_parameters().iter().map(|p| p.name).collect();
+                let (set, effects, warnings) = ParameterSet::load_with_extra(path, &extra)?;
+                return Ok(Bicycle {
+                    name: spec.to_string(),
+                    parameters: set,
+                    warnings,
+                    effects,
+                });
+            }
             _ => return Err(BicycleError::NotFound { spec: spec.to_string() }),
         };
         Ok(Bicycle {
             name: spec.to_string(),
             parameters,
             warnings,
+            effects: BTreeMap::new(),
         })
+    }
+
+    /// Parameters this bicycle sets to a non-zero value: thesis symbols and
+    /// effect parameters (with their values).
+    pub fn nonzero_parameters(&self) -> Result<Vec<(&'static str, f64)>, BicycleError> {
+        let t = self.thesis()?;
+        let mut out: Vec<(&'static str, f64)> = ThesisParameters::SYMBOLS
+            .iter()
+            .filter_map(|&s| t.get(s).filter(|&v| v != 0.0).map(|v| (s, v)))
+            .collect();
+        for p in effect_parameters() {
+            if let Some(&v) = self.effects.get(p.name) {
+                if Some(v) != p.default && v != 0.0 {
+                    out.push((p.name, v));
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The model to run this bicycle through: `name` if given (it must have
+    /// every parameter the bicycle sets), otherwise the smallest driven-speed
+    /// model that has them all (the thesis model for a bicycle with its fork
+    /// mass centre on the steer axis and no effects).
+    pub fn model(&self, name: Option<&str>) -> Result<&'static ModelInfo, BicycleError> {
+        let nonzero = self.nonzero_parameters()?;
+        match name {
+            Some(n) => {
+                let info = models()
+                    .iter()
+                    .find(|m| m.name == n)
+                    .ok_or_else(|| BicycleError::UnknownModel {
+                        name: n.to_string(),
+                        known: model_names().join(", "),
+                    })?;
+                let missing: Vec<String> = nonzero
+                    .iter()
+                    .filter(|(s, _)| info.parameter(s).is_none())
+                    .map(|(s, v)| format!("`{s}` (= {v})"))
+                    .collect();
+                if missing.is_empty() {
+                    Ok(info)
+                } else {
+                    Err(BicycleError::ModelDoesNotFit {
+                        model: n.to_string(),
+                        bike: self.name.clone(),
+                        missing: missing.join(", "),
+                    })
+                }
+            }
+            None => models()
+                .iter()
+                .filter(|m| !m.free_speed && fits(m, &nonzero))
+                .min_by_key(|m| m.parameters.len())
+                .ok_or_else(|| BicycleError::NoModelFits {
+                    bike: self.name.clone(),
+                    nonzero: nonzero.iter().map(|(s, _)| *s).collect::<Vec<_>>().join(", "),
+                }),
+        }
+    }
+
+    /// Lookup of every parameter by symbol: thesis form, then benchmark
+    /// form, then the effect parameters given (absent ones: the model default).
+    pub fn lookup(&self) -> Result<impl Fn(&str) -> Option<f64> + '_, BicycleError> {
+        let t = self.thesis()?;
+        Ok(move |s: &str| t.get(s).or_else(|| self.effects.get(s).copied()))
+    }
+
+    /// Canonical matrices through a chosen model (`None`: the default model).
+    pub fn canonical_with(&self, model: Option<&str>) -> Result<CanonicalMatrices, BicycleError> {
+        let info = self.model(model)?;
+        let active: Vec<String> = self
+            .nonzero_parameters()?
+            .into_iter()
+            .filter(|(s, _)| info.parameter(s).is_some_and(|p| p.effect.is_some()))
+            .map(|(s, v)| format!("{s} = {v}"))
+            .collect();
+        if !active.is_empty() {
+            return Err(BicycleError::NotCanonical {
+                effects: active.join(", "),
+            });
+        }
+        let lookup = self.lookup()?;
+        with_model(info.name, Canonical(&lookup))
+            .expect("registered model")
+            .map_err(|source| BicycleError::Linearize {
+                bike: self.name.clone(),
+                source,
+            })
     }
 
     /// Thesis-form parameters (converted if given in benchmark form).
@@ -77,17 +195,21 @@ impl Bicycle {
         Ok(self.parameters.to_thesis()?)
     }
 
-    /// Canonical matrices from the generated multibody equations.
+    /// Canonical matrices from the generated multibody equations, through
+    /// the default model.
     pub fn canonical(&self) -> Result<CanonicalMatrices, BicycleError> {
-        canonical_of(&self.thesis()?).map_err(|source| BicycleError::Linearize {
-            bike: self.name.clone(),
-            source,
-        })
+        self.canonical_with(None)
     }
 
     /// The same bicycle with one parameter changed. `symbol` is a thesis
     /// symbol (`Rt`, `x4`, `d4`, ...) or a benchmark symbol (`c`, `lam`, ...).
     pub fn with_parameter(&self, symbol: &str, value: f64) -> Result<Bicycle, BicycleError> {
+        if effect_parameters().iter().any(|p| p.name == symbol) {
+            let mut b = self.clone();
+            b.effects.insert(symbol.to_string(), value);
+            b.name = format!("{} ({symbol} = {value})", self.name);
+            return Ok(b);
+        }
         let parameters = if ThesisParameters::SYMBOLS.contains(&symbol) {
             ParameterSet::Thesis(set_field(&self.thesis()?, symbol, value)?)
         } else if BenchmarkParameters::SYMBOLS.contains(&symbol) {
@@ -104,6 +226,7 @@ impl Bicycle {
             name: format!("{} ({symbol} = {value})", self.name),
             parameters,
             warnings,
+            effects: self.effects.clone(),
         })
     }
 
@@ -113,6 +236,13 @@ impl Bicycle {
             .ok()
             .and_then(|t| t.get(symbol))
             .or_else(|| self.parameters.to_benchmark().ok().and_then(|b| b.get(symbol)))
+            .or_else(|| self.effects.get(symbol).copied())
+            .or_else(|| {
+                effect_parameters()
+                    .iter()
+                    .find(|p| p.name == symbol)
+                    .and_then(|p| p.default)
+            })
     }
 }
 
@@ -131,13 +261,23 @@ fn set_field<P: serde::Serialize + serde::de::DeserializeOwned>(
     })
 }
 
-/// Canonical matrices of thesis-form parameters: the thesis model when the
-/// fork mass centre is on the steer axis (`d4 = 0`), the offset variant
-/// otherwise.
-pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, LinearizeError> {
-    if p.fork_com_offset == 0.0 {
-        canonical_matrices::<ThesisWhipple>(|s| p.get(s))
-    } else {
-        canonical_matrices::<WhippleOffset>(|s| p.get(s))
+struct Canonical<'a, F: Fn(&str) -> Option<f64>>(&'a F);
+impl<F: Fn(&str) -> Option<f64>> ModelVisitor for Canonical<'_, F> {
+    type Output = Result<CanonicalMatrices, LinearizeError>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        canonical_matrices::<M>(self.0)
     }
+}
+
+/// Canonical matrices of thesis-form parameters, through the model that fits
+/// them (the thesis model when the fork mass centre is on the steer axis,
+/// the offset variant otherwise; chosen from the registry by parameters).
+pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleError> {
+    Bicycle {
+        name: "parameters".into(),
+        parameters: ParameterSet::Thesis(*p),
+        warnings: Vec::new(),
+        effects: BTreeMap::new(),
+    }
+    .canonical()
 }

@@ -9,6 +9,13 @@ pub mod generated;
 
 pub use generated::{ThesisWhipple, WhippleOffset};
 
+/// The registry of generated models: `MODELS`, `SOURCES`, `with_model`, and
+/// the runtime's `ModelInfo` and `ModelVisitor`.
+pub mod registry {
+    pub use crate::generated::{with_model, MODELS, SOURCES};
+    pub use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+}
+
 pub mod bench;
 pub mod bicycle;
 pub mod models;

@@ -36,12 +36,16 @@ enum FormName {
     Thesis,
 }
 
-/// Which bicycle to analyse.
+/// Which bicycle to analyse, and through which model.
 #[derive(Args)]
 struct BikeArg {
     /// Built-in bicycle (thesis, benchmark) or parameter file.
     #[arg(long = "bike", default_value = "thesis")]
     spec: String,
+    /// Generated model to run it through (see `bikedyn models`; default: the
+    /// smallest driven-speed model with every parameter the bicycle sets).
+    #[arg(long)]
+    model: Option<String>,
 }
 
 /// Table/CSV/JSON output of a command.
@@ -63,6 +67,12 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "bikedyn-report")]
         out: PathBuf,
+    },
+    /// List the generated models: coordinates, parameters and effects.
+    Models {
+        /// JSON output: a list of {name, doc, base, free_speed, effects, coordinates, parameters}.
+        #[arg(long)]
+        json: bool,
     },
     /// Check every generated derivative against finite differences.
     Verify {
@@ -158,10 +168,17 @@ enum ParamsCommand {
         #[arg(long)]
         output: Option<PathBuf>,
     },
-    /// Print a bicycle's parameters (TOML) and its validation warnings.
+    /// Print a bicycle's parameters (TOML: geometry, inertia and the effect
+    /// parameters of its model, each with its unit) and its validation warnings.
     Show {
+        /// Built-in bicycle or parameter file (also accepted as `--bike`).
+        #[arg(value_name = "FILE", conflicts_with = "bike")]
+        file: Option<String>,
         #[arg(long, default_value = "thesis")]
         bike: String,
+        /// Model whose effect parameters are listed (default: the one that fits).
+        #[arg(long)]
+        model: Option<String>,
     },
 }
 
@@ -248,6 +265,57 @@ fn axis_label(symbol: &str) -> String {
     }
 }
 
+fn models_text(ms: &[bikedyn::registry::ModelInfo]) -> String {
+    let mut s = String::new();
+    for m in ms {
+        s += &format!("{}\n  {}\n", m.name, m.doc);
+        s += &format!(
+            "  base {}, {} speed; effects: {}\n",
+            m.base,
+            if m.free_speed { "free" } else { "driven" },
+            if m.effects.is_empty() {
+                "none".to_string()
+            } else {
+                m.effects.join(", ")
+            }
+        );
+        let coords: Vec<String> = m
+            .coordinates
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                if m.independent.contains(&i) {
+                    format!("{c}*")
+                } else {
+                    c.to_string()
+                }
+            })
+            .collect();
+        s += &format!("  coordinates (* independent): {}\n", coords.join(" "));
+        let params: Vec<&str> = m.parameters.iter().map(|p| p.name).collect();
+        s += &format!("  parameters: {}\n\n", params.join(" "));
+    }
+    s
+}
+
+/// A bicycle's parameters as TOML (its own form), followed by the effect
+/// parameters of its model with their values, defaults and units.
+fn params_show_text(b: &Bicycle, model: Option<&str>) -> Result<String> {
+    let info = b.model(model)?;
+    let mut s = b.parameters.to_toml_string();
+    let effects: Vec<_> = info.parameters.iter().filter(|p| p.effect.is_some()).collect();
+    s += &format!("# model: {} ({})\n", info.name, info.doc);
+    if effects.is_empty() {
+        s += "# this model has no effect parameters (see `bikedyn models`)\n";
+    }
+    for p in effects {
+        let v = b.effects.get(p.name).copied().or(p.default).unwrap_or(f64::NAN);
+        let line = format!("{} = {v:?}", p.name);
+        s += &format!("{line:<32} # {} [effect {}]\n", p.doc, p.effect.unwrap_or(""));
+    }
+    Ok(s)
+}
+
 fn canonical_text(c: &CanonicalMatrices) -> String {
     let m = |name: &str, x: &nalgebra::Matrix2<f64>| {
         format!(
@@ -280,7 +348,7 @@ fn run(cli: Cli) -> Result<bool> {
         Command::Report { out } => {
             std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
             let mut ok = true;
-            for m in bikedyn::models::MODELS {
+            for m in bikedyn::models::model_names() {
                 let r = bikedyn::models::verify_model(m, &VerifyOptions::default()).expect("known model");
                 println!("verify {m}: {}", if r.passed { "passed" } else { "FAILED" });
                 ok &= r.passed;
@@ -320,7 +388,7 @@ fn run(cli: Cli) -> Result<bool> {
         } => {
             let names: Vec<&str> = match &model {
                 Some(m) => vec![m.as_str()],
-                None => bikedyn::models::MODELS.to_vec(),
+                None => bikedyn::models::model_names(),
             };
             let opts = VerifyOptions {
                 states,
@@ -329,8 +397,12 @@ fn run(cli: Cli) -> Result<bool> {
             };
             let mut reports = Vec::new();
             for n in names {
-                let r = bikedyn::models::verify_model(n, &opts)
-                    .with_context(|| format!("unknown model `{n}` (models: {})", bikedyn::models::MODELS.join(", ")))?;
+                let r = bikedyn::models::verify_model(n, &opts).with_context(|| {
+                    format!(
+                        "unknown model `{n}` (models: {})",
+                        bikedyn::models::model_names().join(", ")
+                    )
+                })?;
                 reports.push(r);
             }
             let passed = reports.iter().all(|r| r.passed);
@@ -369,12 +441,22 @@ fn run(cli: Cli) -> Result<bool> {
             }
             Ok(passed)
         }
+        Command::Models { json } => {
+            let ms = bikedyn::models::models();
+            if json {
+                let v: Vec<_> = ms.iter().map(bikedyn::models::model_json).collect();
+                println!("{}", serde_json::to_string_pretty(&v)?);
+            } else {
+                print!("{}", models_text(ms));
+            }
+            Ok(true)
+        }
         Command::Canonical {
-            bike: BikeArg { spec: bike },
+            bike: BikeArg { spec: bike, model },
             json,
         } => {
             let b = load(&bike)?;
-            let c = b.canonical()?;
+            let c = b.canonical_with(model.as_deref())?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&canonical_json(&c))?);
             } else {
@@ -383,13 +465,13 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(true)
         }
         Command::Eig {
-            bike: BikeArg { spec: bike },
+            bike: BikeArg { spec: bike, model },
             speeds,
             out: OutputArgs { format, output: out },
             plot,
         } => {
             let b = load(&bike)?;
-            let c = b.canonical()?;
+            let c = b.canonical_with(model.as_deref())?;
             let speeds = parse_range(&speeds, "--speeds")?;
             let sweep = eigen_sweep(&c, &speeds)?;
             let text = match format {
@@ -411,12 +493,12 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(true)
         }
         Command::Stability {
-            bike: BikeArg { spec: bike },
+            bike: BikeArg { spec: bike, model },
             speed_max,
             json,
         } => {
             let b = load(&bike)?;
-            let crit = critical(&b.canonical()?, speed_max)?;
+            let crit = critical(&b.canonical_with(model.as_deref())?, speed_max)?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&stability_json(&bike, &crit))?);
             } else {
@@ -425,7 +507,7 @@ fn run(cli: Cli) -> Result<bool> {
             Ok(true)
         }
         Command::Sweep {
-            bike: BikeArg { spec: bike },
+            bike: BikeArg { spec: bike, model },
             param,
             values,
             param2,
@@ -447,7 +529,7 @@ fn run(cli: Cli) -> Result<bool> {
                         |x, y| {
                             b.with_parameter(&param, x)
                                 .and_then(|b| b.with_parameter(&p2, y))
-                                .and_then(|b| b.canonical())
+                                .and_then(|b| b.canonical_with(model.as_deref()))
                         },
                         &opts,
                     )?;
@@ -477,7 +559,10 @@ fn run(cli: Cli) -> Result<bool> {
                     }
                     let s = parameter_sweep(
                         ParamAxis::new(param.clone(), xs),
-                        |x| b.with_parameter(&param, x).and_then(|b| b.canonical()),
+                        |x| {
+                            b.with_parameter(&param, x)
+                                .and_then(|b| b.canonical_with(model.as_deref()))
+                        },
                         &opts,
                     )?;
                     match format {
@@ -505,9 +590,9 @@ fn run(cli: Cli) -> Result<bool> {
                 emit(&text, &out)?;
                 Ok(true)
             }
-            ParamsCommand::Show { bike } => {
-                let b = load(&bike)?;
-                print!("{}", b.parameters.to_toml_string());
+            ParamsCommand::Show { file, bike, model } => {
+                let b = load(file.as_deref().unwrap_or(&bike))?;
+                print!("{}", params_show_text(&b, model.as_deref())?);
                 Ok(true)
             }
         },

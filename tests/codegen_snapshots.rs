@@ -33,6 +33,19 @@ fn generated_snapshots_are_fresh() {
             Err(e) => stale.push(format!("{} cannot be read: {e}", path.display())),
         }
     }
+    // A snapshot of a model that is no longer generated is stale too.
+    if let Ok(entries) = std::fs::read_dir(&dir) {
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().trim_end_matches(".rs").to_string();
+            if !bikedyn::generated::SOURCES.iter().any(|(n, _)| *n == name) {
+                if update {
+                    std::fs::remove_file(e.path()).unwrap();
+                } else {
+                    stale.push(format!("{} has no generated model", e.path().display()));
+                }
+            }
+        }
+    }
     assert!(
         stale.is_empty(),
         "stale generated snapshots:\n  {}\nrun `UPDATE_SNAPSHOTS=1 cargo test --test codegen_snapshots` and review the diff",

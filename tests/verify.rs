@@ -6,7 +6,8 @@ use std::process::Command;
 
 #[test]
 fn every_generated_derivative_of_every_model_matches_finite_differences() {
-    for m in bikedyn::models::MODELS {
+    // Walks the registry: a new model is verified without touching this test.
+    for m in bikedyn::models::model_names() {
         let r = bikedyn::models::verify_model(
             m,
             &VerifyOptions {
@@ -24,7 +25,8 @@ fn every_generated_derivative_of_every_model_matches_finite_differences() {
             "{m} failed verification: {:#?}",
             r.quantities.iter().filter(|q| !q.passed).collect::<Vec<_>>()
         );
-        assert_eq!(r.quantities.len(), 13);
+        assert_eq!(r.quantities.len(), 16);
+        assert!(r.quantities.iter().any(|q| q.name.starts_with("energy balance")));
     }
 }
 
@@ -86,6 +88,29 @@ mod broken_impl {
 
     impl MultibodyModel for Broken {
         const NAME: &'static str = "broken";
+        const DOC: &'static str = "thesis model with deliberately broken derivatives";
+        const BASE: &'static str = W::BASE;
+        const FREE_SPEED: bool = W::FREE_SPEED;
+        const EFFECTS: &'static [&'static str] = W::EFFECTS;
+        const PARAMETER_INFO: &'static [bikedyn::runtime::model::ParameterInfo] = W::PARAMETER_INFO;
+        const FORCES: &'static [bikedyn::runtime::model::ForceInfo] = W::FORCES;
+        const FORWARD_SPEED_PARAMETER: Option<usize> = W::FORWARD_SPEED_PARAMETER;
+        const SPEED_COORDINATE: Option<usize> = W::SPEED_COORDINATE;
+        const GRAVITY_PARAMETER: Option<usize> = W::GRAVITY_PARAMETER;
+        const STATES: &'static [&'static str] = W::STATES;
+        const STATE_DOCS: &'static [&'static str] = W::STATE_DOCS;
+        fn state_rates<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::state_rates(a, t, p, dp, o)
+        }
+        fn upright_configuration<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
+            W::upright_configuration(a, p, o)
+        }
+        fn applied_force_terms<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::applied_force_terms(a, t, p, dp, o)
+        }
+        fn forward_speed<T: Scalar>(a: &[T], p: &[T], dp: &[T]) -> T {
+            W::forward_speed(a, p, dp)
+        }
         const COORDINATES: &'static [&'static str] = W::COORDINATES;
         const PARAMETERS: &'static [&'static str] = W::PARAMETERS;
         const HOLONOMIC: &'static [&'static str] = W::HOLONOMIC;
@@ -170,4 +195,126 @@ fn verification_catches_wrong_derivatives() {
     // all_quantities still agrees with the unmodified functions it was compared to,
     // except where the broken ones differ.
     assert!(!failed.contains(&"Qv") && !failed.contains(&"B"), "{failed:?}");
+}
+
+/// The steer damper of the effect library with its sign flipped: a force
+/// that feeds energy in although it is declared dissipative.
+struct PumpingDamper;
+
+mod pumping_impl {
+    use super::PumpingDamper;
+    use bikedyn::generated::ThesisExtendedFree as W;
+    use bikedyn::runtime::{MultibodyModel, Scalar};
+
+    fn flip<T: Scalar>(o: &mut [T]) {
+        for x in o.iter_mut() {
+            *x = -*x;
+        }
+    }
+
+    impl MultibodyModel for PumpingDamper {
+        const NAME: &'static str = "pumping_damper";
+        const DOC: &'static str = W::DOC;
+        const BASE: &'static str = W::BASE;
+        const FREE_SPEED: bool = W::FREE_SPEED;
+        const EFFECTS: &'static [&'static str] = W::EFFECTS;
+        const PARAMETER_INFO: &'static [bikedyn::runtime::model::ParameterInfo] = W::PARAMETER_INFO;
+        const FORCES: &'static [bikedyn::runtime::model::ForceInfo] = W::FORCES;
+        const FORWARD_SPEED_PARAMETER: Option<usize> = W::FORWARD_SPEED_PARAMETER;
+        const SPEED_COORDINATE: Option<usize> = W::SPEED_COORDINATE;
+        const GRAVITY_PARAMETER: Option<usize> = W::GRAVITY_PARAMETER;
+        const STATES: &'static [&'static str] = W::STATES;
+        const STATE_DOCS: &'static [&'static str] = W::STATE_DOCS;
+        fn state_rates<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::state_rates(a, t, p, dp, o)
+        }
+        fn upright_configuration<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
+            W::upright_configuration(a, p, o)
+        }
+        const COORDINATES: &'static [&'static str] = W::COORDINATES;
+        const PARAMETERS: &'static [&'static str] = W::PARAMETERS;
+        const HOLONOMIC: &'static [&'static str] = W::HOLONOMIC;
+        const NONHOLONOMIC: &'static [&'static str] = W::NONHOLONOMIC;
+        const POINTS: &'static [&'static str] = W::POINTS;
+        const INDEPENDENT: &'static [usize] = W::INDEPENDENT;
+        const DEPENDENT: &'static [usize] = W::DEPENDENT;
+        const INITIAL_GUESS: &'static [f64] = W::INITIAL_GUESS;
+        const ALL_QUANTITIES_LAYOUT: &'static [(&'static str, usize, usize)] = W::ALL_QUANTITIES_LAYOUT;
+        const FLOPS: &'static [(&'static str, usize)] = W::FLOPS;
+        fn mass_matrix<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
+            W::mass_matrix(a, p, o)
+        }
+        fn quadratic_velocity_forces<T: Scalar>(a: &[T], p: &[T], dp: &[T], o: &mut [T]) {
+            W::quadratic_velocity_forces(a, p, dp, o)
+        }
+        fn gravity_forces<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
+            W::gravity_forces(a, p, o)
+        }
+        fn applied_forces<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::applied_forces(a, t, p, dp, o);
+            flip(o)
+        }
+        fn applied_force_terms<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::applied_force_terms(a, t, p, dp, o);
+            flip(o)
+        }
+        fn forward_speed<T: Scalar>(a: &[T], p: &[T], dp: &[T]) -> T {
+            W::forward_speed(a, p, dp)
+        }
+        fn holonomic_residuals<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
+            W::holonomic_residuals(a, t, p, o)
+        }
+        fn holonomic_jacobian<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
+            W::holonomic_jacobian(a, t, p, o)
+        }
+        fn holonomic_time_derivative<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
+            W::holonomic_time_derivative(a, t, p, o)
+        }
+        fn holonomic_convective<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::holonomic_convective(a, t, p, dp, o)
+        }
+        fn nonholonomic_velocities<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::nonholonomic_velocities(a, t, p, dp, o)
+        }
+        fn nonholonomic_matrix<T: Scalar>(a: &[T], t: T, p: &[T], o: &mut [T]) {
+            W::nonholonomic_matrix(a, t, p, o)
+        }
+        fn nonholonomic_convective<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::nonholonomic_convective(a, t, p, dp, o)
+        }
+        fn kinetic_energy<T: Scalar>(a: &[T], p: &[T], dp: &[T]) -> T {
+            W::kinetic_energy(a, p, dp)
+        }
+        fn potential_energy<T: Scalar>(a: &[T], p: &[T]) -> T {
+            W::potential_energy(a, p)
+        }
+        fn point_positions<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
+            W::point_positions(a, p, o)
+        }
+        fn all_quantities<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
+            W::all_quantities(a, t, p, dp, o)
+        }
+    }
+}
+
+#[test]
+fn verification_catches_a_dissipative_force_that_pumps_energy() {
+    use bikedyn::generated::ThesisExtendedFree as W;
+    use bikedyn::runtime::verify::{verify, with_effects_switched_on};
+    let param = with_effects_switched_on::<W>(&bikedyn::models::default_parameters::<W>());
+    let opts = VerifyOptions {
+        states: 5,
+        seed: 3,
+        ..Default::default()
+    };
+    let good = verify::<W>(&param, &opts);
+    assert!(good.passed, "{:#?}", good.quantities);
+    let r = verify::<PumpingDamper>(&param, &opts);
+    let failed: Vec<&str> = r
+        .quantities
+        .iter()
+        .filter(|q| !q.passed)
+        .map(|q| q.name.as_str())
+        .collect();
+    assert!(failed.iter().any(|n| n.starts_with("dissipative")), "{failed:?}");
 }

@@ -40,11 +40,17 @@ pub struct Quantity {
     pub shape: Shape,
     /// Output expressions (row-major).
     pub outputs: Vec<Atom>,
+    /// Included in `all_quantities` (the shared evaluation of everything the
+    /// equations of motion need).
+    pub shared: bool,
 }
 
 /// The symbols standing for the inputs of generated code.
 pub struct Symbols {
     pub params: Vec<Symbol>,
+    /// Extra first-order states; generated code reads them after the
+    /// parameters, in the `param` slice.
+    pub states: Vec<Symbol>,
     pub coords: Vec<Symbol>,
     pub rates: Vec<Symbol>,
     pub time: Symbol,
@@ -57,6 +63,17 @@ pub struct Derived {
     pub quantities: Vec<Quantity>,
     /// Wall time of the symbolic derivation.
     pub elapsed: Duration,
+}
+
+/// Inverse cosine and tangent as opaque functions: they appear only in
+/// closed-form upright values, which are never differentiated; the emitter
+/// maps them to `Scalar::acos` and `Scalar::atan`.
+pub fn acos_symbol() -> Symbol {
+    symbol!("bikedyn::acos")
+}
+/// See [`acos_symbol`].
+pub fn atan_symbol() -> Symbol {
+    symbol!("bikedyn::atan")
 }
 
 type V3 = [Atom; 3];
@@ -111,6 +128,12 @@ struct Deriver<'a> {
     sym: Symbols,
     param_index: HashMap<&'a str, usize>,
     coord_index: HashMap<&'a str, usize>,
+    state_index: HashMap<&'a str, usize>,
+    /// Kinematics, filled once frames and points are derived (geometry
+    /// itself never refers to them: validation forbids it).
+    rot: Vec<M3>,
+    omega_global: Vec<V3>,
+    points: Vec<V3>,
 }
 
 impl<'a> Deriver<'a> {
@@ -127,7 +150,26 @@ impl<'a> Deriver<'a> {
             Expr::Sin(a) => Symbol::SIN.call((&self.atom(a),)),
             Expr::Cos(a) => Symbol::COS.call((&self.atom(a),)),
             Expr::Sqrt(a) => Symbol::SQRT.call((&self.atom(a),)),
+            Expr::Exp(a) => Symbol::EXP.call((&self.atom(a),)),
+            Expr::Acos(a) => acos_symbol().call((&self.atom(a),)),
+            Expr::Atan(a) => atan_symbol().call((&self.atom(a),)),
+            Expr::Position(p, k) => self.points[*p][*k as usize].clone(),
+            Expr::Velocity(p, k) => self.time_rate(&self.points[*p][*k as usize]),
+            Expr::FrameAxis(f, axis, k) => self.rot[*f][*k as usize][*axis as usize].clone(),
+            Expr::AngularVelocity(f, k) => self.omega_global[*f][*k as usize].clone(),
+            Expr::MaterialVelocity(b, p, k) => self.material_velocity(*b, *p)[*k as usize].clone(),
+            Expr::State(n) => Atom::var(self.sym.states[self.state_index[n.as_str()]]),
         }
+    }
+    /// Velocity of the material point of body `b` at point `p`:
+    /// `v_G + w x (r_P - r_G)`.
+    fn material_velocity(&self, b: usize, p: usize) -> V3 {
+        let body = &self.m.bodies[b];
+        let rg = &self.points[body.mass_centre.0];
+        let vg: V3 = std::array::from_fn(|i| self.time_rate(&rg[i]));
+        let rel: V3 = std::array::from_fn(|i| &self.points[p][i] - &rg[i]);
+        let wxr = cross(&self.omega_global[body.frame.0], &rel);
+        std::array::from_fn(|i| &vg[i] + &wxr[i])
     }
     fn vec(&self, v: &[Expr; 3]) -> V3 {
         std::array::from_fn(|i| self.atom(&v[i]))
@@ -150,6 +192,7 @@ pub fn derive(model: &Model) -> Derived {
     let mk = |kind: &str, n: &str| symbol!(&format!("bikedyn_{ns}::{kind}_{n}"));
     let sym = Symbols {
         params: model.parameters.iter().map(|p| mk("p", &p.name)).collect(),
+        states: model.states.iter().map(|p| mk("z", &p.name)).collect(),
         coords: model.coordinates.iter().map(|c| mk("q", &c.name)).collect(),
         rates: model.coordinates.iter().map(|c| mk("dq", &c.name)).collect(),
         time: mk("t", "time"),
@@ -168,11 +211,22 @@ pub fn derive(model: &Model) -> Derived {
             .enumerate()
             .map(|(i, p)| (p.name.as_str(), i))
             .collect(),
+        state_index: model
+            .states
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (p.name.as_str(), i))
+            .collect(),
         sym,
+        rot: Vec::new(),
+        omega_global: Vec::new(),
+        points: Vec::new(),
     };
+    let mut d = d;
     let nq = model.coordinates.len();
-    let q_at = |j: usize| d.sym.coords[j];
-    let dq = |j: usize| Atom::var(d.sym.rates[j]);
+    let (coord_syms, rate_syms) = (d.sym.coords.clone(), d.sym.rates.clone());
+    let q_at = |j: usize| coord_syms[j];
+    let dq = |j: usize| Atom::var(rate_syms[j]);
 
     // Kinematics: frame rotation matrices (global) and body-axis angular velocities.
     let mut rot: Vec<M3> = Vec::with_capacity(d.m.frames.len());
@@ -209,6 +263,9 @@ pub fn derive(model: &Model) -> Derived {
         }
         points.push(r);
     }
+    d.omega_global = rot.iter().zip(&omega_local).map(|(a, w)| mat_vec(a, w)).collect();
+    d.rot = rot.clone();
+    d.points = points.clone();
     // Jacobians H_i = dRG_i/dp (3 x nq) and Gl_i = d(omega_local)/dp' (3 x nq).
     let jac = |v: &V3, s: &dyn Fn(usize) -> Symbol| -> Vec<V3> {
         (0..nq)
@@ -283,22 +340,63 @@ pub fn derive(model: &Model) -> Derived {
         }
         None => (vec![zero(); nq], zero()),
     };
-    // Applied forces.
+    // Applied forces, one generalized-force vector per declared force
+    // (virtual work), and their sum.
     let mut applied = vec![zero(); nq];
+    let mut force_terms = Vec::with_capacity(d.m.forces.len() * nq);
     for f in &d.m.forces {
-        match f {
+        let mut q = vec![zero(); nq];
+        match &f.force {
             Force::Generalized { coordinate, expr, .. } => {
-                let j = d.coord_index[coordinate.as_str()];
-                applied[j] = &applied[j] + d.atom(expr);
+                q[d.coord_index[coordinate.as_str()]] = d.atom(expr);
             }
             Force::AtMassCentre { body, frame, force, .. } => {
                 let fg = mat_vec(&rot[frame.0], &d.vec(force));
                 for a in 0..nq {
-                    applied[a] = &applied[a] + dot(&body_h[body.0][a], &fg);
+                    q[a] = dot(&body_h[body.0][a], &fg);
+                }
+            }
+            Force::AtPoint { point, force, .. } => {
+                let fg = d.vec(force);
+                let hp = jac(&points[point.0], &|j| q_at(j));
+                for a in 0..nq {
+                    q[a] = dot(&hp[a], &fg);
+                }
+            }
+            Force::OnBodyAtPoint { body, point, force, .. } => {
+                let fg = d.vec(force);
+                let vm = d.material_velocity(body.0, point.0);
+                let jm = jac(&vm, &|j| d.sym.rates[j]);
+                for a in 0..nq {
+                    q[a] = dot(&jm[a], &fg);
+                }
+            }
+            Force::Torque { body, torque, .. } => {
+                let tg = d.vec(torque);
+                let gw = jac(&d.omega_global[d.m.bodies[body.0].frame.0], &|j| d.sym.rates[j]);
+                for a in 0..nq {
+                    q[a] = dot(&gw[a], &tg);
                 }
             }
         }
+        for a in 0..nq {
+            applied[a] = &applied[a] + &q[a];
+        }
+        force_terms.extend(q);
     }
+    // The upright configuration: closed-form values where the model gives
+    // them, the coordinate's own value (from `p`) elsewhere.
+    let upright: Vec<Atom> =
+        d.m.coordinates
+            .iter()
+            .enumerate()
+            .map(|(j, c)| match &c.upright {
+                Some(e) => d.atom(e),
+                None => Atom::var(coord_syms[j]),
+            })
+            .collect();
+    let state_rates: Vec<Atom> = d.m.states.iter().map(|st| d.atom(&st.rate)).collect();
+    let forward_speed = d.m.forward_speed.as_ref().map(|e| d.atom(e)).unwrap_or_else(zero);
     // Holonomic constraints: Res, Cq, Ct, dCqdp = d(Cq p')/dp p'.
     let res: Vec<Atom> =
         d.m.holonomic
@@ -387,6 +485,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: pos,
             shape: buf(nq, nq),
             outputs: mass,
+            shared: true,
         },
         Quantity {
             name: "quadratic_velocity_forces",
@@ -394,6 +493,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: no_t,
             shape: buf(nq, 1),
             outputs: qv,
+            shared: true,
         },
         Quantity {
             name: "gravity_forces",
@@ -401,6 +501,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: pos,
             shape: buf(nq, 1),
             outputs: gravity,
+            shared: true,
         },
         Quantity {
             name: "applied_forces",
@@ -408,6 +509,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: all,
             shape: buf(nq, 1),
             outputs: applied,
+            shared: true,
         },
         Quantity {
             name: "holonomic_residuals",
@@ -415,6 +517,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: t_only,
             shape: buf(nh, 1),
             outputs: res,
+            shared: true,
         },
         Quantity {
             name: "holonomic_jacobian",
@@ -422,6 +525,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: t_only,
             shape: buf(nh, nq),
             outputs: cq,
+            shared: true,
         },
         Quantity {
             name: "holonomic_time_derivative",
@@ -429,6 +533,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: t_only,
             shape: buf(nh, 1),
             outputs: ct,
+            shared: true,
         },
         Quantity {
             name: "holonomic_convective",
@@ -436,6 +541,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: all,
             shape: buf(nh, 1),
             outputs: dcqdp,
+            shared: true,
         },
         Quantity {
             name: "nonholonomic_velocities",
@@ -443,6 +549,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: all,
             shape: buf(nnh, 1),
             outputs: vel,
+            shared: true,
         },
         Quantity {
             name: "nonholonomic_matrix",
@@ -450,6 +557,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: t_only,
             shape: buf(nnh, nq),
             outputs: bmat,
+            shared: true,
         },
         Quantity {
             name: "nonholonomic_convective",
@@ -457,6 +565,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: all,
             shape: buf(nnh, 1),
             outputs: dbdp,
+            shared: true,
         },
         Quantity {
             name: "kinetic_energy",
@@ -464,6 +573,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: no_t,
             shape: Shape::Scalar,
             outputs: vec![kinetic],
+            shared: true,
         },
         Quantity {
             name: "potential_energy",
@@ -471,6 +581,7 @@ pub fn derive(model: &Model) -> Derived {
             inputs: pos,
             shape: Shape::Scalar,
             outputs: vec![potential],
+            shared: true,
         },
         Quantity {
             name: "point_positions",
@@ -478,13 +589,46 @@ pub fn derive(model: &Model) -> Derived {
             inputs: pos,
             shape: buf(d.m.points_of_interest.len(), 3),
             outputs: poi,
+            shared: true,
+        },
+        Quantity {
+            name: "applied_force_terms",
+            doc: "Generalized force of each declared force (row-major nforces x nq), in the order of FORCES; their sum is applied_forces.",
+            inputs: all,
+            shape: buf(d.m.forces.len(), nq),
+            outputs: force_terms,
+            shared: false,
+        },
+        Quantity {
+            name: "upright_configuration",
+            doc: "The physical upright configuration: coordinates with a closed-form upright value get it, the others keep their value in `p`.",
+            inputs: pos,
+            shape: buf(nq, 1),
+            outputs: upright,
+            shared: false,
+        },
+        Quantity {
+            name: "state_rates",
+            doc: "Rates of the extra first-order states (read after the parameters in `param`).",
+            inputs: all,
+            shape: buf(d.m.states.len(), 1),
+            outputs: state_rates,
+            shared: false,
+        },
+        Quantity {
+            name: "forward_speed",
+            doc: "Forward speed of the bicycle (m/s) as the model declares it.",
+            inputs: no_t,
+            shape: Shape::Scalar,
+            outputs: vec![forward_speed],
+            shared: false,
         },
     ];
     // Every buffer quantity in one function, so that they share common
     // subexpressions and trigonometric evaluations.
     let all_outputs: Vec<Atom> = quantities
         .iter()
-        .filter(|q| matches!(q.shape, Shape::Buffer { .. }))
+        .filter(|q| q.shared && matches!(q.shape, Shape::Buffer { .. }))
         .flat_map(|q| q.outputs.clone())
         .collect();
     let n_all = all_outputs.len();
@@ -495,6 +639,7 @@ pub fn derive(model: &Model) -> Derived {
         inputs: all,
         shape: buf(n_all, 1),
         outputs: all_outputs,
+        shared: false,
     });
     let Deriver { sym, .. } = d;
     Derived {

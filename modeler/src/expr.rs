@@ -33,6 +33,32 @@ pub enum Expr {
     Cos(Box<Expr>),
     /// Square root.
     Sqrt(Box<Expr>),
+    /// Exponential.
+    Exp(Box<Expr>),
+    /// Inverse cosine (principal value).
+    Acos(Box<Expr>),
+    /// Inverse tangent (principal value).
+    Atan(Box<Expr>),
+    /// A global component (0 = X, 1 = Y, 2 = Z) of a declared point's
+    /// position, resolved by the derivation from the point's declaration.
+    Position(usize, u8),
+    /// A global component of a declared point's velocity (the time rate of
+    /// its position as declared: for a geometric point such as a wheel's
+    /// contact, its travel velocity).
+    Velocity(usize, u8),
+    /// A global component of a frame's unit axis: `FrameAxis(frame, axis,
+    /// component)` is component `component` of the frame's `axis` in ground
+    /// axes (a direction cosine).
+    FrameAxis(usize, u8, u8),
+    /// A global component of a frame's angular velocity.
+    AngularVelocity(usize, u8),
+    /// `MaterialVelocity(body, point, k)`: global component `k` of the
+    /// velocity of the material point of `body` that coincides with `point`
+    /// (e.g. the rim point at a wheel's contact: zero when rolling without slip).
+    MaterialVelocity(usize, usize, u8),
+    /// An extra first-order state of the model (e.g. a lagged tyre force),
+    /// by name; its rate is declared with `ModelBuilder::state`.
+    State(String),
 }
 
 /// A parameter.
@@ -55,6 +81,36 @@ pub fn time() -> Expr {
 pub fn num(n: i64) -> Expr {
     Expr::Num(n, 1)
 }
+/// The exact value of a finite `f64` as a rational constant (its binary
+/// expansion; e.g. `exact(FRAC_PI_2)` emits back to exactly `FRAC_PI_2`).
+pub fn exact(x: f64) -> Expr {
+    assert!(x.is_finite(), "exact() needs a finite number");
+    if x == 0.0 {
+        return num(0);
+    }
+    let (mut m, mut e) = {
+        let bits = x.abs().to_bits();
+        let exp = ((bits >> 52) & 0x7ff) as i64;
+        let frac = bits & ((1u64 << 52) - 1);
+        if exp == 0 {
+            (frac as i64, -1074)
+        } else {
+            ((frac | (1u64 << 52)) as i64, exp - 1075)
+        }
+    };
+    while m % 2 == 0 && e < 0 {
+        m /= 2;
+        e += 1;
+    }
+    let sign = if x < 0.0 { -1 } else { 1 };
+    assert!((-62..=10).contains(&e), "exact(): {x} is out of range");
+    if e >= 0 {
+        Expr::Num(sign * m * (1i64 << e), 1)
+    } else {
+        Expr::Num(sign * m, 1i64 << (-e))
+    }
+}
+
 /// A rational constant `n / d`.
 pub fn ratio(n: i64, d: i64) -> Expr {
     Expr::Num(n, d)
@@ -76,6 +132,23 @@ impl Expr {
     /// Integer power.
     pub fn powi(self, n: i32) -> Expr {
         Expr::Pow(Box::new(self), n)
+    }
+    /// Exponential.
+    pub fn exp(self) -> Expr {
+        Expr::Exp(Box::new(self))
+    }
+    /// Inverse cosine.
+    pub fn acos(self) -> Expr {
+        Expr::Acos(Box::new(self))
+    }
+    /// Inverse tangent.
+    pub fn atan(self) -> Expr {
+        Expr::Atan(Box::new(self))
+    }
+    /// Hyperbolic tangent, written `1 - 2 / (exp(2 x) + 1)` so that generated
+    /// code needs only `exp` (and stays finite for large |x|).
+    pub fn tanh(self) -> Expr {
+        num(1) - num(2) / ((num(2) * self).exp() + num(1))
     }
     /// True for the exact constant zero.
     pub fn is_zero(&self) -> bool {
@@ -100,7 +173,24 @@ impl Expr {
                 out.insert(("time", String::new()));
             }
             Expr::Add(v) | Expr::Mul(v) => v.iter().for_each(|e| e.names(out)),
-            Expr::Pow(e, _) | Expr::Sin(e) | Expr::Cos(e) | Expr::Sqrt(e) => e.names(out),
+            Expr::Pow(e, _)
+            | Expr::Sin(e)
+            | Expr::Cos(e)
+            | Expr::Sqrt(e)
+            | Expr::Exp(e)
+            | Expr::Acos(e)
+            | Expr::Atan(e) => e.names(out),
+            // Kinematic leaves depend on every coordinate (and rate) their
+            // point or frame does; the derivation checks them.
+            Expr::Position(..) | Expr::FrameAxis(..) => {
+                out.insert(("kinematics", String::new()));
+            }
+            Expr::Velocity(..) | Expr::AngularVelocity(..) | Expr::MaterialVelocity(..) => {
+                out.insert(("kinematic rate", String::new()));
+            }
+            Expr::State(n) => {
+                out.insert(("state", n.clone()));
+            }
         }
     }
 }
@@ -188,5 +278,50 @@ pub fn inertia_wheel(i_diametral: Expr, i_axial: Expr) -> Tensor3 {
         [i_diametral.clone(), num(0), num(0)],
         [num(0), i_axial, num(0)],
         [num(0), num(0), i_diametral],
+    ]
+}
+
+/// Dot product of two 3-vectors.
+pub fn dot3(a: &Vec3, b: &Vec3) -> Expr {
+    a[0].clone() * b[0].clone() + a[1].clone() * b[1].clone() + a[2].clone() * b[2].clone()
+}
+
+/// Global position of a point, as expressions.
+pub fn position(p: crate::model::PointId) -> Vec3 {
+    [0u8, 1, 2].map(|k| Expr::Position(p.0, k))
+}
+
+/// Global velocity of a point (time rate of its declared position).
+pub fn velocity(p: crate::model::PointId) -> Vec3 {
+    [0u8, 1, 2].map(|k| Expr::Velocity(p.0, k))
+}
+
+/// Unit axis `axis` of `frame`, in ground components.
+pub fn frame_axis(frame: crate::model::FrameId, axis: crate::model::Axis) -> Vec3 {
+    [0u8, 1, 2].map(|k| Expr::FrameAxis(frame.0, axis.index() as u8, k))
+}
+
+/// Angular velocity of `frame`, in ground components.
+pub fn angular_velocity(frame: crate::model::FrameId) -> Vec3 {
+    [0u8, 1, 2].map(|k| Expr::AngularVelocity(frame.0, k))
+}
+
+/// `sqrt(x^2 + eps^2)`: a magnitude that is smooth at zero (so that exact
+/// derivatives exist at rest, e.g. in a linearization at zero speed).
+pub fn smooth_norm(v: &Vec3, eps: Expr) -> Expr {
+    (dot3(v, v) + eps.powi(2)).sqrt()
+}
+
+/// Velocity (ground components) of the material point of `body` at `point`.
+pub fn material_velocity(body: crate::model::BodyId, point: crate::model::PointId) -> Vec3 {
+    [0u8, 1, 2].map(|k| Expr::MaterialVelocity(body.0, point.0, k))
+}
+
+/// Cross product of two 3-vectors.
+pub fn cross3(a: &Vec3, b: &Vec3) -> Vec3 {
+    [
+        a[1].clone() * b[2].clone() - a[2].clone() * b[1].clone(),
+        a[2].clone() * b[0].clone() - a[0].clone() * b[2].clone(),
+        a[0].clone() * b[1].clone() - a[1].clone() * b[0].clone(),
     ]
 }

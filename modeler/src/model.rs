@@ -61,11 +61,43 @@ pub struct Coordinate {
     pub role: Role,
     /// Initial guess for the constraint solver (rad or m).
     pub guess: f64,
+    /// The coordinate's value in the physical upright configuration as an
+    /// expression in parameters and the other coordinates, when the model
+    /// knows it in closed form (e.g. the frame pitch from the geometry). The
+    /// constraint solver starts there and the runtime checks that it lands
+    /// on this branch (not a flipped frame or the top of a rim).
+    pub upright: Option<Expr>,
 }
 
 /// A parameter.
 #[derive(Clone, Debug)]
 pub struct Parameter {
+    pub name: String,
+    /// Meaning and unit, e.g. "steer-axis viscous damping (N m s/rad)".
+    pub doc: String,
+    /// Value when a bicycle's parameter file does not give it (effect
+    /// parameters: the value at which the effect is absent). `None`: the
+    /// bicycle must give it.
+    pub default: Option<f64>,
+    /// The effect that declared this parameter, if any.
+    pub effect: Option<String>,
+}
+
+/// An extra first-order state (beyond the coordinates and their rates),
+/// e.g. a tyre's lagged lateral force: `dz/dt = rate(param, t, p, p', z)`.
+#[derive(Clone, Debug)]
+pub struct State {
+    pub name: String,
+    /// Meaning and unit.
+    pub doc: String,
+    pub rate: Expr,
+    /// The effect that declared it.
+    pub effect: Option<String>,
+}
+
+/// An effect applied to a model (see [`crate::effects`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EffectInfo {
     pub name: String,
     pub doc: String,
 }
@@ -146,6 +178,46 @@ pub enum Force {
         frame: FrameId,
         force: Vec3,
     },
+    /// A force (ground components) whose virtual work is `F . dr_P`, with
+    /// `r_P` the declared position of `point`. For a point fixed in a body
+    /// this is a force on that body; for a geometric point such as a wheel's
+    /// contact it works on the point's travel (power `F . v_P`).
+    AtPoint { name: String, point: PointId, force: Vec3 },
+    /// A torque (ground components) on a body: virtual work `T . dtheta_body`.
+    Torque { name: String, body: BodyId, torque: Vec3 },
+    /// A force (ground components) on the material point of `body` that
+    /// coincides with `point` (e.g. a tyre force on the rim at the contact):
+    /// virtual work `F . dr` of that material point, power `F . v_material`.
+    OnBodyAtPoint {
+        name: String,
+        body: BodyId,
+        point: PointId,
+        force: Vec3,
+    },
+}
+
+/// An applied force with its provenance.
+#[derive(Clone, Debug)]
+pub struct AppliedForce {
+    pub force: Force,
+    /// The effect that declared it, if any.
+    pub effect: Option<String>,
+    /// A dissipative force never does positive work (`p'^T Q <= 0` at every
+    /// state); `bikedyn verify` checks it.
+    pub dissipative: bool,
+}
+
+impl AppliedForce {
+    /// Name of the force.
+    pub fn name(&self) -> &str {
+        match &self.force {
+            Force::Generalized { name, .. }
+            | Force::AtMassCentre { name, .. }
+            | Force::AtPoint { name, .. }
+            | Force::Torque { name, .. }
+            | Force::OnBodyAtPoint { name, .. } => name,
+        }
+    }
 }
 
 /// A frozen, validated model.
@@ -155,6 +227,15 @@ pub struct Model {
     pub doc: String,
     /// Source files the model is declared in (for the generated header).
     pub sources: Vec<String>,
+    /// The base model this one is declared from (its own name for a base).
+    pub base: String,
+    /// True when forward speed is a degree of freedom (no driving constraint).
+    pub free_speed: bool,
+    /// Effects applied, in order.
+    pub effects: Vec<EffectInfo>,
+    /// Forward speed of the bicycle (m/s) as an expression in parameters,
+    /// coordinates and rates (e.g. the driving parameter `V`, or `Rt psi'`).
+    pub forward_speed: Option<Expr>,
     pub coordinates: Vec<Coordinate>,
     pub parameters: Vec<Parameter>,
     pub frames: Vec<Frame>,
@@ -162,7 +243,9 @@ pub struct Model {
     pub bodies: Vec<Body>,
     pub holonomic: Vec<Holonomic>,
     pub nonholonomic: Vec<Nonholonomic>,
-    pub forces: Vec<Force>,
+    pub forces: Vec<AppliedForce>,
+    /// Extra first-order states.
+    pub states: Vec<State>,
     /// Points whose global positions are emitted.
     pub points_of_interest: Vec<PointId>,
     /// Gravity: parameter name and the global axis it acts against (Z up).
@@ -259,16 +342,23 @@ impl std::error::Error for ModelError {}
 #[derive(Clone, Debug)]
 pub struct ModelBuilder {
     m: Model,
+    /// The effect being applied (see [`ModelBuilder::begin_effect`]).
+    effect: Option<String>,
 }
 
 impl Model {
     /// Start declaring a model.
     pub fn builder(name: &str) -> ModelBuilder {
         ModelBuilder {
+            effect: None,
             m: Model {
                 name: name.to_string(),
                 doc: String::new(),
                 sources: Vec::new(),
+                base: name.to_string(),
+                free_speed: false,
+                effects: Vec::new(),
+                forward_speed: None,
                 coordinates: Vec::new(),
                 parameters: Vec::new(),
                 frames: vec![Frame {
@@ -281,10 +371,16 @@ impl Model {
                 holonomic: Vec::new(),
                 nonholonomic: Vec::new(),
                 forces: Vec::new(),
+                states: Vec::new(),
                 points_of_interest: Vec::new(),
                 gravity: None,
             },
         }
+    }
+
+    /// Parameter by name.
+    pub fn parameter(&self, name: &str) -> Option<&Parameter> {
+        self.parameters.iter().find(|p| p.name == name)
     }
 
     /// Index of a coordinate.
@@ -333,16 +429,77 @@ impl ModelBuilder {
             doc: doc.into(),
             role,
             guess,
+            upright: None,
         });
         Expr::Coord(name.into())
     }
-    /// Declare a parameter.
+    /// Declare a parameter the bicycle must give.
     pub fn parameter(&mut self, name: &str, doc: &str) -> Expr {
         self.m.parameters.push(Parameter {
             name: name.into(),
             doc: doc.into(),
+            default: None,
+            effect: self.effect.clone(),
         });
         Expr::Param(name.into())
+    }
+    /// Declare a parameter with a default value (effect parameters: the
+    /// value at which the effect is absent, usually 0).
+    pub fn parameter_with_default(&mut self, name: &str, doc: &str, default: f64) -> Expr {
+        self.m.parameters.push(Parameter {
+            name: name.into(),
+            doc: doc.into(),
+            default: Some(default),
+            effect: self.effect.clone(),
+        });
+        Expr::Param(name.into())
+    }
+    /// The coordinate's exact value in the physical upright configuration
+    /// (see [`Coordinate::upright`]).
+    pub fn upright_value(&mut self, coordinate: &str, value: Expr) {
+        if let Some(c) = self.m.coordinates.iter_mut().find(|c| c.name == coordinate) {
+            c.upright = Some(value);
+        }
+    }
+    /// Change a coordinate's role (for model variants, e.g. free speed).
+    pub fn set_role(&mut self, coordinate: &str, role: Role) {
+        if let Some(c) = self.m.coordinates.iter_mut().find(|c| c.name == coordinate) {
+            c.role = role;
+        }
+    }
+    /// Mark the model as a variant of `base` (shown in the registry).
+    pub fn set_base(&mut self, base: &str) {
+        self.m.base = base.to_string();
+    }
+    /// Declare that forward speed is a degree of freedom.
+    pub fn set_free_speed(&mut self, free: bool) {
+        self.m.free_speed = free;
+    }
+    /// The forward speed of the bicycle (m/s) as an expression.
+    pub fn forward_speed(&mut self, speed: Expr) {
+        self.m.forward_speed = Some(speed);
+    }
+    /// Rename the model (variants built from another model's declaration).
+    pub fn set_name(&mut self, name: &str) {
+        self.m.name = name.to_string();
+    }
+    /// Start applying an effect: parameters and forces declared until
+    /// [`ModelBuilder::end_effect`] belong to it.
+    pub fn begin_effect(&mut self, name: &str, doc: &str) {
+        self.m.effects.push(EffectInfo {
+            name: name.into(),
+            doc: doc.into(),
+        });
+        self.effect = Some(name.to_string());
+    }
+    /// Stop attributing declarations to the current effect.
+    pub fn end_effect(&mut self) {
+        self.effect = None;
+    }
+    /// The model as declared so far (read-only; effects inspect bodies,
+    /// points and parameters through it).
+    pub fn model(&self) -> &Model {
+        &self.m
     }
     /// Declare a frame reached from `parent` by elementary rotations.
     pub fn frame(&mut self, name: &str, parent: FrameId, rotations: Vec<(Axis, Expr)>) -> FrameId {
@@ -389,9 +546,43 @@ impl ModelBuilder {
     pub fn nonholonomic(&mut self, c: Nonholonomic) {
         self.m.nonholonomic.push(c);
     }
-    /// Add an applied force.
+    /// Remove a nonholonomic constraint by name (effects that replace one,
+    /// e.g. tyre slip replacing a wheel's lateral no-slip condition); false
+    /// when there is none of that name.
+    pub fn remove_nonholonomic(&mut self, name: &str) -> bool {
+        let before = self.m.nonholonomic.len();
+        self.m.nonholonomic.retain(|n| match n {
+            Nonholonomic::ContactVelocity { name: k, .. } | Nonholonomic::Linear { name: k, .. } => k != name,
+        });
+        self.m.nonholonomic.len() < before
+    }
+    /// Declare an extra first-order state with its rate `dz/dt`; returns the
+    /// state as an expression.
+    pub fn state(&mut self, name: &str, doc: &str, rate: Expr) -> Expr {
+        self.m.states.push(State {
+            name: name.into(),
+            doc: doc.into(),
+            rate,
+            effect: self.effect.clone(),
+        });
+        Expr::State(name.into())
+    }
+    /// Add an applied force (conservative or of unknown sign of power).
     pub fn force(&mut self, f: Force) {
-        self.m.forces.push(f);
+        self.m.forces.push(AppliedForce {
+            force: f,
+            effect: self.effect.clone(),
+            dissipative: false,
+        });
+    }
+    /// Add a dissipative force: its power `p'^T Q` is never positive
+    /// (checked by `bikedyn verify`).
+    pub fn dissipative_force(&mut self, f: Force) {
+        self.m.forces.push(AppliedForce {
+            force: f,
+            effect: self.effect.clone(),
+            dissipative: true,
+        });
     }
     /// Emit the global position of this point.
     pub fn point_of_interest(&mut self, p: PointId) {
@@ -486,7 +677,7 @@ pub fn validate(m: &Model) -> Vec<Diagnostic> {
         }
     }
     for f in &m.forces {
-        match f {
+        match &f.force {
             Force::Generalized { name, coordinate, expr } => {
                 uses.push((expr, format!("force `{name}`"), false));
                 if !coords.contains(coordinate.as_str()) {
@@ -497,18 +688,42 @@ pub fn validate(m: &Model) -> Vec<Diagnostic> {
                     });
                 }
             }
-            Force::AtMassCentre { name, force, .. } => {
+            Force::AtMassCentre { name, force, .. } | Force::AtPoint { name, force, .. } => {
+                for e in force {
+                    uses.push((e, format!("force `{name}`"), false));
+                }
+            }
+            Force::Torque { name, torque, .. } => {
+                for e in torque {
+                    uses.push((e, format!("force `{name}`"), false));
+                }
+            }
+            Force::OnBodyAtPoint { name, force, .. } => {
                 for e in force {
                     uses.push((e, format!("force `{name}`"), false));
                 }
             }
         }
     }
+    for st in &m.states {
+        uses.push((&st.rate, format!("rate of state `{}`", st.name), false));
+    }
+    for c in &m.coordinates {
+        if let Some(e) = &c.upright {
+            uses.push((e, format!("upright value of `{}`", c.name), true));
+        }
+    }
+    duplicates("state", m.states.iter().map(|c| c.name.as_str()), &mut out);
+    let states: BTreeSet<&str> = m.states.iter().map(|c| c.name.as_str()).collect();
+    if let Some(v) = &m.forward_speed {
+        uses.push((v, "the forward speed".to_string(), false));
+    }
     for (e, used_in, geometry) in uses {
         let mut names = BTreeSet::new();
         e.names(&mut names);
         for (kind, name) in names {
             let ok = match kind {
+                "state" => states.contains(name.as_str()) && !geometry,
                 "parameter" => params.contains(name.as_str()),
                 "coordinate" | "rate" => coords.contains(name.as_str()),
                 _ => true,
@@ -520,6 +735,8 @@ pub fn validate(m: &Model) -> Vec<Diagnostic> {
                     name,
                     used_in: used_in.clone(),
                 });
+            } else if geometry && (kind == "kinematics" || kind == "kinematic rate") {
+                out.push(Diagnostic::RateInGeometry { item: used_in.clone() });
             } else if geometry && kind == "time" {
                 out.push(Diagnostic::TimeDependentGeometry { item: used_in.clone() });
             } else if geometry && kind == "rate" {
@@ -636,13 +853,13 @@ mod tests {
     #[test]
     fn the_thesis_models_validate() {
         let models = crate::models::all().unwrap();
-        assert_eq!(models.len(), 2);
-        let thesis = &models[0];
+        let thesis = models.iter().find(|m| m.name == "thesis_whipple").unwrap();
         assert_eq!(thesis.coordinates.len(), 9);
         assert_eq!(thesis.holonomic.len(), 3);
         assert_eq!(thesis.nonholonomic.len(), 4);
         let names: Vec<&str> = thesis.coordinates.iter().map(|c| c.name.as_str()).collect();
         assert_eq!(names, ["xc", "yc", "phi", "theta", "psi", "beta", "gamma", "eps", "xi"]);
-        assert!(models[1].parameters.iter().any(|p| p.name == "d4"));
+        let offset = models.iter().find(|m| m.name == "whipple_offset").unwrap();
+        assert!(offset.parameters.iter().any(|p| p.name == "d4"));
     }
 }

@@ -14,6 +14,7 @@ pub mod model;
 pub mod output;
 pub mod parameters;
 pub mod plot;
+pub mod registry;
 pub mod scalar;
 pub mod sweep;
 pub mod verify;

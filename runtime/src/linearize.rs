@@ -30,6 +30,22 @@ pub enum LinearizeError {
     NotRollSteer { model: &'static str, n: usize },
     #[error("the reduced mass matrix is singular")]
     SingularMass,
+    /// The constraint solver converged to a root that is not the physical
+    /// upright configuration: refusing is better than returning the
+    /// matrices of another mechanism.
+    #[error("the constraint solution is not the physical upright bicycle: {coordinate} = {value:.6} rad, but {what} gives {expected:.6} rad")]
+    OffBranch {
+        coordinate: &'static str,
+        value: f64,
+        expected: f64,
+        what: &'static str,
+    },
+    #[error("model `{model}` declares no forward speed (no speed parameter and no speed coordinate)")]
+    NoForwardSpeed { model: &'static str },
+    #[error("model `{model}` has {n} independent coordinates or states, more than the linearization supports")]
+    TooManyIndependent { model: &'static str, n: usize },
+    #[error("model `{model}` has extra states (e.g. tyre forces): its linearization is a state-space model, not M, C, K (use state_space_at_speed)")]
+    HasStates { model: &'static str },
 }
 
 /// Evaluate the reduced equations `Ec = Mi q'' - Qi` (thesis `EcMov.m`) at
@@ -43,10 +59,42 @@ pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
     dq: &[T],
     ddq: &[T],
 ) -> Result<(Vec<T>, Vec<T>), ConstraintError> {
+    reduced_system::<M, T>(param, t, q, dq, ddq).map(|s| (s.ec, s.mi))
+}
+
+/// The reduced equations with the full configuration and velocities they
+/// were evaluated at.
+pub struct ReducedSystem<T> {
+    /// `Ec = Mi q'' - Qi`.
+    pub ec: Vec<T>,
+    /// `Mi`, row-major `nind x nind`.
+    pub mi: Vec<T>,
+    /// All coordinates (dependent ones solved).
+    pub p: Vec<T>,
+    /// All velocities (dependent ones solved).
+    pub dp: Vec<T>,
+}
+
+/// [`reduced_equations`], also returning `p` and `p'`.
+pub fn reduced_system<M: MultibodyModel, T: Scalar>(
+    param: &[T],
+    t: T,
+    q: &[T],
+    dq: &[T],
+    ddq: &[T],
+) -> Result<ReducedSystem<T>, ConstraintError> {
     let nq = M::nq();
     let ind = M::INDEPENDENT;
     let ni = ind.len();
-    let mut p: Vec<T> = M::INITIAL_GUESS.iter().map(|&x| T::cst(x)).collect();
+    // Start from the model's physical upright configuration (closed-form
+    // frame pitch and rim angle), so Newton lands on the physical branch.
+    let paramf: Vec<f64> = param.iter().map(|x| x.re()).collect();
+    let mut guess = vec![0.0; nq];
+    M::upright_configuration(&paramf, M::INITIAL_GUESS, &mut guess);
+    if guess.iter().any(|x| !x.is_finite()) {
+        guess.copy_from_slice(M::INITIAL_GUESS);
+    }
+    let mut p: Vec<T> = guess.iter().map(|&x| T::cst(x)).collect();
     for (k, &j) in ind.iter().enumerate() {
         p[j] = q[k];
     }
@@ -151,7 +199,7 @@ pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
         }
         ec[a_] = s;
     }
-    Ok((ec, mi))
+    Ok(ReducedSystem { ec, mi, p, dp })
 }
 
 /// `M`, `C`, `K` of `M q'' + C q' + K q = 0` (thesis eq. 48-50) about
@@ -163,26 +211,202 @@ pub struct Linearization {
     pub stiffness: DMatrix<f64>,
 }
 
-/// Exact linearization (dual numbers) at `param` (which fixes the speed).
+/// Exact linearization (dual numbers) about upright straight running of a
+/// driven-speed model, at `param` (which fixes the speed): `M`, `C`, `K` in
+/// the two independent coordinates (roll, steer).
 pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, LinearizeError> {
-    const N: usize = 4;
     let ni = M::INDEPENDENT.len();
     if ni != 2 {
         return Err(LinearizeError::NotRollSteer { model: M::NAME, n: ni });
     }
+    linearize_about::<M, 4>(param, &[0.0; 2])
+}
+
+/// Exact linearization about the steady motion with all independent
+/// coordinates zero and independent rates `dq0` (for a free-speed model,
+/// the rear wheel's spin rate), over all independent coordinates. `N` must
+/// be twice their number (dual directions: coordinates, then rates).
+fn linearize_about<M: MultibodyModel, const N: usize>(
+    param: &[f64],
+    dq0: &[f64],
+) -> Result<Linearization, LinearizeError> {
+    let ni = M::INDEPENDENT.len();
+    assert_eq!(2 * ni, N, "dual width is twice the independent coordinates");
     let pd: Vec<Dual<N>> = param.iter().map(|&x| Dual::cst(x)).collect();
-    let q = [Dual::<N>::variable(0.0, 0), Dual::variable(0.0, 1)];
-    let dq = [Dual::<N>::variable(0.0, 2), Dual::variable(0.0, 3)];
-    let ddq = [Dual::<N>::zero(); 2];
-    let (ec, mi) = reduced_equations::<M, Dual<N>>(&pd, Dual::zero(), &q, &dq, &ddq)?;
-    let mass = DMatrix::from_fn(2, 2, |i, j| mi[i * 2 + j].re);
-    let stiffness = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[j]);
-    let damping = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[2 + j]);
+    let q: Vec<Dual<N>> = (0..ni).map(|k| Dual::variable(0.0, k)).collect();
+    let dq: Vec<Dual<N>> = (0..ni).map(|k| Dual::variable(dq0[k], ni + k)).collect();
+    let ddq = vec![Dual::<N>::zero(); ni];
+    let sys = reduced_system::<M, Dual<N>>(&pd, Dual::zero(), &q, &dq, &ddq)?;
+    check_physical_branch::<M>(param, &sys.p.iter().map(|x| x.re).collect::<Vec<_>>())?;
+    let (ec, mi) = (sys.ec, sys.mi);
     Ok(Linearization {
-        mass,
-        damping,
-        stiffness,
+        mass: DMatrix::from_fn(ni, ni, |i, j| mi[i * ni + j].re),
+        stiffness: DMatrix::from_fn(ni, ni, |i, j| ec[i].eps[j]),
+        damping: DMatrix::from_fn(ni, ni, |i, j| ec[i].eps[ni + j]),
     })
+}
+
+/// Check that a solved upright configuration is the physical one: every
+/// dependent coordinate equals the model's closed-form upright value
+/// ([`MultibodyModel::upright_configuration`]) to 1e-8 rad. Another root of
+/// the constraints (a flipped frame, the top of the rim) gives the matrices
+/// of another mechanism, so it is refused.
+pub fn check_physical_branch<M: MultibodyModel>(param: &[f64], p: &[f64]) -> Result<(), LinearizeError> {
+    let mut up = vec![0.0; M::nq()];
+    M::upright_configuration(param, p, &mut up);
+    for &j in M::DEPENDENT {
+        let d = (p[j] - up[j] + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+        if up[j].is_finite() && !(d.abs() <= 1e-8) {
+            return Err(LinearizeError::OffBranch {
+                coordinate: M::COORDINATES[j],
+                value: p[j],
+                expected: up[j],
+                what: "the model's closed-form upright configuration",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Positions, within the independent coordinates, of roll and steer: all
+/// independent coordinates except the one that carries the forward speed.
+pub fn lateral_indices<M: MultibodyModel>() -> Vec<usize> {
+    (0..M::INDEPENDENT.len())
+        .filter(|&k| Some(M::INDEPENDENT[k]) != M::SPEED_COORDINATE)
+        .collect()
+}
+
+/// Exact linearization about upright straight running at forward speed
+/// `speed` (m/s), over all independent coordinates, for any model: a driven
+/// model gets the speed through its speed parameter, a free-speed model
+/// through the rate of its speed coordinate (found from the model's own
+/// forward-speed expression). `param` is the full parameter vector (a driven
+/// model's speed entry is overwritten).
+pub fn linearize_at_speed<M: MultibodyModel>(param: &[f64], speed: f64) -> Result<Linearization, LinearizeError> {
+    if !M::STATES.is_empty() {
+        return Err(LinearizeError::HasStates { model: M::NAME });
+    }
+    let (param, dq0) = speed_setup::<M>(param, speed)?;
+    match M::INDEPENDENT.len() {
+        2 => linearize_about::<M, 4>(&param, &dq0),
+        3 => linearize_about::<M, 6>(&param, &dq0),
+        n => Err(LinearizeError::TooManyIndependent { model: M::NAME, n }),
+    }
+}
+
+/// A linear state-space model `x' = A x` about upright straight running.
+#[derive(Clone, Debug)]
+pub struct StateSpace {
+    /// State names: the independent coordinates, their rates (`d` + name),
+    /// then the model's extra states.
+    pub names: Vec<String>,
+    pub a: DMatrix<f64>,
+}
+
+/// Exact linearization of a model with extra first-order states (or any
+/// model) at forward speed `speed`: `x = [q, q', z]` with `q` the
+/// independent coordinates and `z` the extra states (at zero, their steady
+/// value in straight running). `q''` comes from the reduced equations, `z'`
+/// from the model's state rates evaluated with the full velocities.
+pub fn state_space_at_speed<M: MultibodyModel>(param: &[f64], speed: f64) -> Result<StateSpace, LinearizeError> {
+    let ni = M::INDEPENDENT.len();
+    let nz = M::STATES.len();
+    let (param, dq0) = speed_setup::<M>(param, speed)?;
+    let a = match 2 * ni + nz {
+        4 => state_space_dual::<M, 4>(&param, &dq0)?,
+        6 => state_space_dual::<M, 6>(&param, &dq0)?,
+        8 => state_space_dual::<M, 8>(&param, &dq0)?,
+        10 => state_space_dual::<M, 10>(&param, &dq0)?,
+        12 => state_space_dual::<M, 12>(&param, &dq0)?,
+        14 => state_space_dual::<M, 14>(&param, &dq0)?,
+        n => return Err(LinearizeError::TooManyIndependent { model: M::NAME, n }),
+    };
+    let mut names: Vec<String> = M::INDEPENDENT.iter().map(|&j| M::COORDINATES[j].to_string()).collect();
+    names.extend(M::INDEPENDENT.iter().map(|&j| format!("d{}", M::COORDINATES[j])));
+    names.extend(M::STATES.iter().map(|s| s.to_string()));
+    Ok(StateSpace { names, a })
+}
+
+fn state_space_dual<M: MultibodyModel, const N: usize>(
+    param: &[f64],
+    dq0: &[f64],
+) -> Result<DMatrix<f64>, LinearizeError> {
+    let ni = M::INDEPENDENT.len();
+    let nz = M::STATES.len();
+    let np = M::PARAMETERS.len();
+    let mut pd: Vec<Dual<N>> = param.iter().map(|&x| Dual::cst(x)).collect();
+    for k in 0..nz {
+        pd[np + k] = Dual::variable(param[np + k], 2 * ni + k);
+    }
+    let q: Vec<Dual<N>> = (0..ni).map(|k| Dual::variable(0.0, k)).collect();
+    let dq: Vec<Dual<N>> = (0..ni).map(|k| Dual::variable(dq0[k], ni + k)).collect();
+    let sys = reduced_system::<M, Dual<N>>(&pd, Dual::zero(), &q, &dq, &vec![Dual::zero(); ni])?;
+    // q'' = Mi^-1 Qi = -Mi^-1 Ec(q'' = 0).
+    let mut mi = sys.mi.clone();
+    let mut rhs: Vec<Dual<N>> = sys.ec.iter().map(|&e| -e).collect();
+    solve_in_place(&mut mi, ni, &mut rhs, 1).map_err(|_| LinearizeError::SingularMass)?;
+    let mut zdot = vec![Dual::<N>::zero(); nz];
+    M::state_rates(&pd, Dual::zero(), &sys.p, &sys.dp, &mut zdot);
+    let n = 2 * ni + nz;
+    let mut a = DMatrix::zeros(n, n);
+    for k in 0..ni {
+        a[(k, ni + k)] = 1.0;
+    }
+    for r in 0..ni {
+        for c in 0..n {
+            a[(ni + r, c)] = rhs[r].eps[c];
+        }
+    }
+    for r in 0..nz {
+        for c in 0..n {
+            a[(2 * ni + r, c)] = zdot[r].eps[c];
+        }
+    }
+    Ok(a)
+}
+
+/// The parameter vector and independent rates for steady running at `speed`.
+fn speed_setup<M: MultibodyModel>(param: &[f64], speed: f64) -> Result<(Vec<f64>, Vec<f64>), LinearizeError> {
+    let ni = M::INDEPENDENT.len();
+    let mut param = param.to_vec();
+    let mut dq0 = vec![0.0; ni];
+    if let Some(k) = M::FORWARD_SPEED_PARAMETER {
+        param[k] = speed;
+    } else if let Some(c) = M::SPEED_COORDINATE {
+        // Forward speed is linear in the rates: its slope in the speed
+        // coordinate's rate, at the upright configuration.
+        let mut p: Vec<f64> = M::INITIAL_GUESS.to_vec();
+        for &j in M::INDEPENDENT {
+            p[j] = 0.0;
+        }
+        solve_configuration::<M, f64>(&param, 0.0, &mut p, &NewtonOptions::default())?;
+        let mut unit = vec![0.0; M::nq()];
+        unit[c] = 1.0;
+        let slope = M::forward_speed(&param, &p, &unit);
+        if !(slope.abs() > 0.0) || !slope.is_finite() {
+            return Err(LinearizeError::NoForwardSpeed { model: M::NAME });
+        }
+        let k = M::INDEPENDENT
+            .iter()
+            .position(|&j| j == c)
+            .expect("the speed coordinate is independent");
+        dq0[k] = speed / slope;
+    } else if speed != 0.0 {
+        return Err(LinearizeError::NoForwardSpeed { model: M::NAME });
+    }
+    Ok((param, dq0))
+}
+
+/// The roll-steer block of a linearization (see [`lateral_indices`]).
+pub fn lateral_block<M: MultibodyModel>(lin: &Linearization) -> Linearization {
+    let idx = lateral_indices::<M>();
+    let n = idx.len();
+    let pick = |m: &DMatrix<f64>| DMatrix::from_fn(n, n, |i, j| m[(idx[i], idx[j])]);
+    Linearization {
+        mass: pick(&lin.mass),
+        damping: pick(&lin.damping),
+        stiffness: pick(&lin.stiffness),
+    }
 }
 
 /// The thesis's finite-difference linearization (forward differences, step
@@ -211,21 +435,32 @@ pub fn linearize_finite_difference<M: MultibodyModel>(param: &[f64], h: f64) -> 
     Ok(lin)
 }
 
-/// Fill a model's parameter vector by name from `lookup`, with the forward
-/// speed `V`.
+/// Fill a model's parameter vector by name from `lookup`; the forward-speed
+/// parameter of a driven model gets `speed`, and a parameter `lookup` does
+/// not know takes the model's default (effect parameters: absent). A model
+/// with extra states gets them appended, at zero (see
+/// [`MultibodyModel::STATES`]).
 pub fn parameter_vector<M: MultibodyModel>(
     lookup: impl Fn(&str) -> Option<f64>,
     speed: f64,
 ) -> Result<Vec<f64>, LinearizeError> {
-    M::PARAMETERS
+    let mut v: Vec<f64> = M::PARAMETER_INFO
         .iter()
-        .map(|&n| {
-            if n == "V" { Some(speed) } else { lookup(n) }.ok_or_else(|| LinearizeError::MissingParameter {
+        .enumerate()
+        .map(|(i, info)| {
+            if Some(i) == M::FORWARD_SPEED_PARAMETER {
+                Some(speed)
+            } else {
+                lookup(info.name).or(info.default)
+            }
+            .ok_or_else(|| LinearizeError::MissingParameter {
                 model: M::NAME,
-                name: n.to_string(),
+                name: info.name.to_string(),
             })
         })
-        .collect()
+        .collect::<Result<_, _>>()?;
+    v.extend(M::STATES.iter().map(|_| 0.0));
+    Ok(v)
 }
 
 /// Canonical matrices of Meijaard et al. (2007) from a generated model:
@@ -233,15 +468,22 @@ pub fn parameter_vector<M: MultibodyModel>(
 /// because the reduced equations are quadratic in the forward speed. The
 /// thesis's steer angle gamma is minus the benchmark's delta, so the
 /// off-diagonal entries change sign.
+///
+/// Works for driven and free-speed models alike (the roll-steer block of
+/// [`linearize_at_speed`]); the gravity parameter is the one the model
+/// declares.
 pub fn canonical_matrices<M: MultibodyModel>(
     lookup: impl Fn(&str) -> Option<f64>,
 ) -> Result<CanonicalMatrices, LinearizeError> {
-    let g = lookup("g").ok_or_else(|| LinearizeError::MissingParameter {
-        model: M::NAME,
-        name: "g".into(),
-    })?;
-    let l0 = linearize::<M>(&parameter_vector::<M>(&lookup, 0.0)?)?;
-    let l1 = linearize::<M>(&parameter_vector::<M>(&lookup, 1.0)?)?;
+    let param = parameter_vector::<M>(&lookup, 0.0)?;
+    let g = M::GRAVITY_PARAMETER
+        .map(|k| param[k])
+        .ok_or(LinearizeError::MissingParameter {
+            model: M::NAME,
+            name: "gravity".into(),
+        })?;
+    let l0 = lateral_block::<M>(&linearize_at_speed::<M>(&param, 0.0)?);
+    let l1 = lateral_block::<M>(&linearize_at_speed::<M>(&param, 1.0)?);
     let flip = |m: &DMatrix<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);
     Ok(CanonicalMatrices {
         m0: flip(&l0.mass),

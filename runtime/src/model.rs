@@ -13,11 +13,61 @@
 
 use crate::scalar::Scalar;
 
+/// A parameter of a generated model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ParameterInfo {
+    pub name: &'static str,
+    /// Meaning and unit.
+    pub doc: &'static str,
+    /// Value used when a bicycle does not give the parameter (for an
+    /// effect's parameters: the value at which the effect is absent).
+    pub default: Option<f64>,
+    /// The effect that declared it.
+    pub effect: Option<&'static str>,
+}
+
+/// An applied force of a generated model (one row of
+/// [`MultibodyModel::applied_force_terms`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ForceInfo {
+    pub name: &'static str,
+    pub effect: Option<&'static str>,
+    /// Its power `p'^T Q` is never positive.
+    pub dissipative: bool,
+}
+
 /// A generated model. All functions are associated (no `self`): a model is a
 /// type, its code is monomorphised for each scalar.
 pub trait MultibodyModel: Send + Sync + 'static {
     /// Model name, as declared in the modeler.
     const NAME: &'static str;
+    /// One-line description.
+    const DOC: &'static str;
+    /// The base model it is declared from (itself for a base model).
+    const BASE: &'static str;
+    /// True when forward speed is a degree of freedom.
+    const FREE_SPEED: bool;
+    /// Effects of the library applied to it.
+    const EFFECTS: &'static [&'static str];
+    /// Every parameter with its meaning, default and effect, in the order
+    /// of [`MultibodyModel::PARAMETERS`].
+    const PARAMETER_INFO: &'static [ParameterInfo];
+    /// Applied forces, in the order of `applied_force_terms`.
+    const FORCES: &'static [ForceInfo];
+    /// Index of the parameter that imposes the forward speed (driven
+    /// models), if any.
+    const FORWARD_SPEED_PARAMETER: Option<usize>;
+    /// Index of the independent coordinate whose rate carries the forward
+    /// speed (free-speed models), if any.
+    const SPEED_COORDINATE: Option<usize>;
+    /// Index of the gravitational-acceleration parameter, if any.
+    const GRAVITY_PARAMETER: Option<usize>;
+    /// Extra first-order states (e.g. lagged tyre forces). Generated code
+    /// reads them from the `param` slice after the parameters: slices passed
+    /// to a model with states hold `PARAMETERS.len() + STATES.len()` values.
+    const STATES: &'static [&'static str];
+    /// Meaning and unit of each extra state.
+    const STATE_DOCS: &'static [&'static str];
     /// Generalized coordinates, in order.
     const COORDINATES: &'static [&'static str];
     /// Parameters, in the order of the `param` slices.
@@ -86,4 +136,15 @@ pub trait MultibodyModel: Send + Sync + 'static {
     fn all_quantities<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
     /// Global positions of the points of interest, `3 x npoints` (x, y, z per point).
     fn point_positions<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
+    /// Generalized force of each applied force, `nforces x nq` (their sum is
+    /// `applied_forces`).
+    fn applied_force_terms<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
+    /// Forward speed of the bicycle (m/s) as the model declares it.
+    fn forward_speed<T: Scalar>(param: &[T], p: &[T], dp: &[T]) -> T;
+    /// The physical upright configuration: coordinates the model gives in
+    /// closed form (e.g. frame pitch and the front contact's rim angle from
+    /// the geometry) take that value, the others keep their value in `p`.
+    fn upright_configuration<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
+    /// Rates of the extra states, `STATES.len()` values.
+    fn state_rates<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
 }

@@ -35,6 +35,9 @@ pub trait Scalar:
     fn sin(self) -> Self;
     fn cos(self) -> Self;
     fn sqrt(self) -> Self;
+    fn exp(self) -> Self;
+    fn acos(self) -> Self;
+    fn atan(self) -> Self;
     fn powi(self, n: i32) -> Self;
     /// `(sin, cos)` in one call (generated code pairs them).
     fn sin_cos(self) -> (Self, Self);
@@ -68,6 +71,18 @@ impl Scalar for f64 {
     #[inline(always)]
     fn sqrt(self) -> Self {
         f64::sqrt(self)
+    }
+    #[inline(always)]
+    fn exp(self) -> Self {
+        f64::exp(self)
+    }
+    #[inline(always)]
+    fn acos(self) -> Self {
+        f64::acos(self)
+    }
+    #[inline(always)]
+    fn atan(self) -> Self {
+        f64::atan(self)
     }
     #[inline(always)]
     fn powi(self, n: i32) -> Self {
@@ -206,6 +221,19 @@ impl<const N: usize> Scalar for Dual<N> {
         self.chain(r, 0.5 / r)
     }
     #[inline(always)]
+    fn exp(self) -> Self {
+        let e = self.re.exp();
+        self.chain(e, e)
+    }
+    #[inline(always)]
+    fn acos(self) -> Self {
+        self.chain(self.re.acos(), -1.0 / (1.0 - self.re * self.re).sqrt())
+    }
+    #[inline(always)]
+    fn atan(self) -> Self {
+        self.chain(self.re.atan(), 1.0 / (1.0 + self.re * self.re))
+    }
+    #[inline(always)]
     fn powi(self, n: i32) -> Self {
         let p = self.re.powi(n - 1);
         self.chain(p * self.re, n as f64 * p)
@@ -316,6 +344,18 @@ impl Scalar for Counted {
     fn sqrt(self) -> Self {
         Counted::tick(1);
         Counted(self.0.sqrt())
+    }
+    fn exp(self) -> Self {
+        Counted::tick(1);
+        Counted(self.0.exp())
+    }
+    fn acos(self) -> Self {
+        Counted::tick(1);
+        Counted(self.0.acos())
+    }
+    fn atan(self) -> Self {
+        Counted::tick(1);
+        Counted(self.0.atan())
     }
     fn powi(self, n: i32) -> Self {
         Counted::tick(1);

@@ -2,6 +2,8 @@
 //! generated primal quantities, at random states (a user-facing check: run it
 //! after changing a model).
 
+use crate::constraints::{constraint_matrices, solve_configuration, solve_velocities, NewtonOptions};
+use crate::linalg::solve_in_place;
 use crate::model::MultibodyModel;
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::Serialize;
@@ -85,6 +87,12 @@ impl Acc {
             if !(e <= self.worst) {
                 self.worst = if e.is_nan() { f64::INFINITY } else { e.max(self.worst) };
             }
+        }
+    }
+    /// Record an error already made relative.
+    fn record(&mut self, e: f64) {
+        if !(e <= self.worst) {
+            self.worst = if e.is_nan() { f64::INFINITY } else { e };
         }
     }
     fn done(self) -> QuantityCheck {
@@ -276,8 +284,24 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         let vs = (0..nq).map(|a| (dp[a] * qg[a]).abs()).sum::<f64>().max(1e-12);
         a_pow_g.compare(&[pg / vs], &[-dvdt / vs]);
     }
+    let (a_energy, a_dissipative, a_terms) = power_checks::<M>(param, opts, &mut rng);
     let quantities: Vec<QuantityCheck> = [
-        a_cq, a_ct, a_dcq, a_b, a_dbdp, a_qv, a_qg, a_sym, a_psd, a_t, a_pow_v, a_pow_g, a_all,
+        a_cq,
+        a_ct,
+        a_dcq,
+        a_b,
+        a_dbdp,
+        a_qv,
+        a_qg,
+        a_sym,
+        a_psd,
+        a_t,
+        a_pow_v,
+        a_pow_g,
+        a_all,
+        a_terms,
+        a_energy,
+        a_dissipative,
     ]
     .into_iter()
     .map(Acc::done)
@@ -289,4 +313,125 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
         passed: quantities.iter().all(|q| q.passed),
         quantities,
     }
+}
+
+/// The parameter vector `verify` uses for a model: `base` with every effect
+/// parameter that defaults to 0 (effect absent) set to a test value, so that
+/// the effects' forces are exercised. Test values are moderate multiples of
+/// typical magnitudes; the identities hold for any value.
+pub fn with_effects_switched_on<M: MultibodyModel>(base: &[f64]) -> Vec<f64> {
+    let np = M::PARAMETER_INFO.len();
+    M::PARAMETER_INFO
+        .iter()
+        .zip(base)
+        .map(|(info, &x)| match (info.effect, info.default) {
+            (Some(_), Some(d)) if d == 0.0 && x == 0.0 => 0.1,
+            _ => x,
+        })
+        .chain(base[np..].iter().copied())
+        .collect()
+}
+
+/// Power checks along motions that satisfy the constraints: the energy
+/// balance `d(T + V)/dt = p'^T Qext + (power of the constraint forces)` by a
+/// central difference in time, each dissipative force's power `p'^T Q_f <= 0`,
+/// and `applied_forces` = the sum of `applied_force_terms`.
+fn power_checks<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions, rng: &mut Rng) -> (Acc, Acc, Acc) {
+    let nq = M::nq();
+    let nh = M::HOLONOMIC.len();
+    let nc = nh + M::NONHOLONOMIC.len();
+    let nf = M::FORCES.len();
+    let np = M::PARAMETERS.len();
+    let mut param = param.to_vec();
+    let mut a_energy = Acc::new("energy balance d(T+V)/dt = p'^T Qext + constraint power", 1e-5);
+    let mut a_dis = Acc::new("dissipative forces: power p'^T Q_f <= 0", 1e-12);
+    let mut a_terms = Acc::new("applied_forces = sum of applied_force_terms", 1e-12);
+    for _ in 0..opts.states {
+        // A configuration on the constraint manifold near upright running.
+        let mut p: Vec<f64> = vec![0.0; nq];
+        M::upright_configuration(&param, M::INITIAL_GUESS, &mut p);
+        for &j in M::INDEPENDENT {
+            p[j] = rng.uniform(-0.4, 0.4);
+        }
+        let t = rng.uniform(0.0, 2.0);
+        // Extra states (e.g. tyre forces) at random values, so that the
+        // forces that depend on them do work.
+        for z in param[np..].iter_mut() {
+            *z = rng.uniform(-20.0, 20.0);
+        }
+        let param = &param[..];
+        for (j, x) in p.iter_mut().enumerate() {
+            if !M::INDEPENDENT.contains(&j) && !M::DEPENDENT.contains(&j) {
+                *x += rng.uniform(-0.5, 0.5);
+            }
+        }
+        let mut dp = vec![0.0; nq];
+        for &j in M::INDEPENDENT {
+            dp[j] = rng.uniform(-3.0, 3.0);
+        }
+        if solve_configuration::<M, f64>(param, t, &mut p, &NewtonOptions::default()).is_err()
+            || solve_velocities::<M, f64>(param, t, &p, &mut dp).is_err()
+        {
+            continue;
+        }
+        // Accelerations and multipliers: [M D^T; D 0] [p''; lambda] = [Q; -gamma].
+        let mut mass = vec![0.0; nq * nq];
+        M::mass_matrix(param, &p, &mut mass);
+        let (mut qv, mut qg, mut qe) = (vec![0.0; nq], vec![0.0; nq], vec![0.0; nq]);
+        M::quadratic_velocity_forces(param, &p, &dp, &mut qv);
+        M::gravity_forces(param, &p, &mut qg);
+        M::applied_forces(param, t, &p, &dp, &mut qe);
+        let mut terms = vec![0.0; nf * nq];
+        M::applied_force_terms(param, t, &p, &dp, &mut terms);
+        let summed: Vec<f64> = (0..nq).map(|a| (0..nf).map(|f| terms[f * nq + a]).sum()).collect();
+        a_terms.compare(&summed, &qe);
+        let cm = constraint_matrices::<M, f64>(param, t, &p);
+        let mut gamma = vec![0.0; nc];
+        M::holonomic_convective(param, t, &p, &dp, &mut gamma[..nh]);
+        M::nonholonomic_convective(param, t, &p, &dp, &mut gamma[nh..]);
+        let n = nq + nc;
+        let mut a = vec![0.0; n * n];
+        let mut b = vec![0.0; n];
+        for r in 0..nq {
+            for c in 0..nq {
+                a[r * n + c] = mass[r * nq + c];
+            }
+            for i in 0..nc {
+                a[r * n + nq + i] = cm.d[i * nq + r];
+                a[(nq + i) * n + r] = cm.d[i * nq + r];
+            }
+            b[r] = qv[r] + qg[r] + qe[r];
+        }
+        for i in 0..nc {
+            b[nq + i] = -gamma[i];
+        }
+        if solve_in_place(&mut a, n, &mut b, 1).is_err() {
+            continue;
+        }
+        let (ddp, lambda) = b.split_at(nq);
+        // T and V along the motion to second order, p(s) = p + s p' + s^2/2 p'';
+        // the central difference of T + V is then exact to O(h^2).
+        let energies = |s: f64| {
+            let q: Vec<f64> = (0..nq).map(|j| p[j] + s * dp[j] + 0.5 * s * s * ddp[j]).collect();
+            let v: Vec<f64> = (0..nq).map(|j| dp[j] + s * ddp[j]).collect();
+            (M::kinetic_energy(param, &q, &v), M::potential_energy(param, &q))
+        };
+        let h = 2e-5;
+        let ((t1, v1), (t0, v0)) = (energies(h), energies(-h));
+        let (dt_dt, dv_dt) = ((t1 - t0) / (2.0 * h), (v1 - v0) / (2.0 * h));
+        let de_dt = dt_dt + dv_dt;
+        let p_ext: f64 = (0..nq).map(|j| dp[j] * qe[j]).sum();
+        // Constraint forces -D^T lambda do work only where D p' != 0 (the
+        // driving constraint): power -(D p') . lambda = -d . lambda.
+        let p_con: f64 = -(0..nc).map(|i| cm.d_rhs[i] * lambda[i]).sum::<f64>();
+        let scale = p_ext.abs() + p_con.abs() + dt_dt.abs() + dv_dt.abs() + 1e-9;
+        a_energy.record((de_dt - p_ext - p_con).abs() / scale);
+        for (f, info) in M::FORCES.iter().enumerate() {
+            if info.dissipative {
+                let pw: f64 = (0..nq).map(|j| dp[j] * terms[f * nq + j]).sum();
+                a_dis.record(pw.max(0.0) / scale);
+            }
+        }
+    }
+    (a_energy, a_dis, a_terms)
 }

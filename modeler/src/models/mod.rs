@@ -1,12 +1,27 @@
 //! The zoo of models. Each model is one file that declares it with the
-//! [`crate::model`] API; `build.rs` derives and emits every model in [`all`].
-
-pub mod thesis_whipple;
-pub mod whipple_offset;
+//! [`crate::model`] API and exposes `pub fn model()`; `build.rs` derives and
+//! emits every model listed here, and emits the registry the runtime and
+//! the CLI use. Adding a model is writing its file and adding one name to
+//! the list below.
 
 use crate::model::{Model, ModelError};
 
-/// Every model that `build.rs` generates code for.
-pub fn all() -> Result<Vec<Model>, ModelError> {
-    Ok(vec![thesis_whipple::model()?, whipple_offset::model()?])
+macro_rules! models {
+    ($($name:ident),* $(,)?) => {
+        $(pub mod $name;)*
+        /// Every model that `build.rs` generates code for, in registry order.
+        pub fn all() -> Result<Vec<Model>, ModelError> {
+            Ok(vec![$($name::model()?),*])
+        }
+    };
 }
+
+models!(
+    thesis_whipple,
+    whipple_offset,
+    thesis_whipple_free,
+    whipple_offset_free,
+    thesis_extended,
+    thesis_extended_free,
+    thesis_tyre_free,
+);

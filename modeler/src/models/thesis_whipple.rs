@@ -4,28 +4,43 @@
 //! on flat ground, nine coordinates `p = [xc yc phi theta psi beta gamma eps xi]`.
 //! Axes: X forward, Y left, Z up.
 
-use crate::expr::{inertia_wheel, inertia_xz, num, time, vec3};
-use crate::model::{
-    Axis, BodyId, FrameId, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, PointId, Role, GROUND,
-};
+use crate::effects::BicycleParts;
+use crate::expr::{exact, inertia_wheel, inertia_xz, num, rate, time, vec3};
+use crate::model::{Axis, BodyId, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, Role, GROUND};
 use std::f64::consts::PI;
 
-/// Handles a variant of this model needs to modify it.
-pub struct WhippleParts {
-    pub fork_frame: FrameId,
-    /// RG4: the point of the steer axis where the thesis puts the fork's mass centre.
-    pub steer_point: PointId,
-    pub fork: BodyId,
+const SOURCE: &str = "modeler/src/models/thesis_whipple.rs";
+
+/// How forward speed enters a bicycle model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Speed {
+    /// Imposed by the driving constraint `psi - V t / Rt = 0` (thesis eq. 26):
+    /// independent coordinates roll and steer, parameter `V`.
+    Driven,
+    /// A degree of freedom: no driving constraint, the rear wheel rotation
+    /// `psi` is an independent coordinate (roll, rear wheel rotation, steer),
+    /// and the forward speed `Rt psi'` can change.
+    Free,
 }
 
-/// Declare the thesis model under `name` (variants start from here).
-pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
-    let mut m = Model::builder(name)
-        .doc("Whipple bicycle of Martin Recuero (2009), section 3: 9 coordinates, driving constraint psi = V t / Rt")
-        .source("modeler/src/models/thesis_whipple.rs");
-    if source != "modeler/src/models/thesis_whipple.rs" {
+/// Declare the thesis model under `name`, from the model file `source`
+/// (variants start from here and add to the returned builder).
+pub fn declare(name: &str, source: &str, speed: Speed) -> (ModelBuilder, BicycleParts) {
+    let doc = match speed {
+        Speed::Driven => {
+            "Whipple bicycle of Martin Recuero (2009), section 3: 9 coordinates, driving constraint psi = V t / Rt"
+        }
+        Speed::Free => "Whipple bicycle of Martin Recuero (2009), section 3, with free forward speed (no driving constraint; rear wheel rotation psi independent)",
+    };
+    let mut m = Model::builder(name).doc(doc).source(SOURCE);
+    if source != SOURCE {
         m = m.source(source);
     }
+    m.set_base("thesis_whipple");
+    let psi_role = match speed {
+        Speed::Driven => Role::Dependent,
+        Speed::Free => Role::Independent,
+    };
 
     // 3.2 Coordinates: rear contact (xc, yc), yaw phi, roll theta, rear wheel
     // rotation psi, frame pitch beta, steer gamma, front wheel rotation eps,
@@ -34,7 +49,12 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
     let yc = m.coordinate("yc", Role::Ignorable, 0.0, "rear contact point, global Y (m)");
     let phi = m.coordinate("phi", Role::Ignorable, 0.0, "yaw (rad)");
     let theta = m.coordinate("theta", Role::Independent, 0.0, "roll (rad), positive leaning right");
-    let psi = m.coordinate("psi", Role::Dependent, 0.0, "rear wheel rotation (rad)");
+    let psi = m.coordinate(
+        "psi",
+        psi_role,
+        0.0,
+        "rear wheel rotation (rad), increasing when rolling forward",
+    );
     let beta = m.coordinate(
         "beta",
         Role::Dependent,
@@ -56,7 +76,7 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
     );
 
     // Parameters (section 4.4, Parametros.m).
-    let v = m.parameter("V", "forward speed imposed by the driving constraint (m/s)");
+    let v = (speed == Speed::Driven).then(|| m.parameter("V", "forward speed imposed by the driving constraint (m/s)"));
     let rt = m.parameter("Rt", "rear wheel radius (m)");
     let rd = m.parameter("Rd", "front wheel radius (m)");
     let x3 = m.parameter("x3", "rear-frame mass centre from the rear wheel centre, frame x (m)");
@@ -83,6 +103,20 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
     let i5y = m.parameter("I5y", "front wheel moment about its axle (kg m^2)");
     m.parameter("g", "gravitational acceleration (m/s^2)");
     m.gravity("g", Axis::Z);
+
+    // The physical upright configuration in closed form: the frame pitch
+    // that puts both wheels on the ground with the front wheel ahead
+    // (Rt - sin(beta) P + cos(beta) Q = Rd, P = x4 + x5 > 0, Q = z4 + z5),
+    // beta = atan(Q / P) - asin((Rd - Rt) / hypot(P, Q)), and the rim angle
+    // of the lowest point of the front rim, xi = pi/2 - beta - eps.
+    {
+        let (p, q) = (x4.clone() + x5.clone(), z4.clone() + z5.clone());
+        let d = rd.clone() - rt.clone();
+        let r2 = p.clone().powi(2) + q.clone().powi(2);
+        let beta_up = (q / p).atan() - (d.clone() / (r2 - d.powi(2)).sqrt()).atan();
+        m.upright_value("beta", beta_up.clone());
+        m.upright_value("xi", exact(PI / 2.0) - beta_up - crate::expr::coord("eps"));
+    }
 
     // 3.3 Rotations (eq. 4): Ai1 = A_phi, Ai2 = A_phi A_theta, A2 = Ai2 A_psi,
     // A3 = Ai2 A_beta, A4 = A3 A_gam, A5 = A4 A_eps.
@@ -121,11 +155,10 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
     m.point_of_interest(front_contact);
 
     // Bodies: mass, inertia tensor in body axes, mass centre.
-    m.body("rear_wheel", rear_wheel_frame, m2, inertia_wheel(i2x, i2y), g2);
-    m.body("rear_frame", frame, m3, inertia_xz(i3x, i3y, i3z, i3zx), g3);
+    let rear_wheel: BodyId = m.body("rear_wheel", rear_wheel_frame, m2, inertia_wheel(i2x, i2y), g2);
+    let rear_frame = m.body("rear_frame", frame, m3, inertia_xz(i3x, i3y, i3z, i3zx), g3);
     let fork = m.body("fork", fork_frame, m4, inertia_xz(i4x, i4y, i4z, i4xz), g4);
     let front_wheel = m.body("front_wheel", front_wheel_frame, m5, inertia_wheel(i5x, i5y), g5);
-    let rear_wheel = crate::model::BodyId(0);
 
     // 3.6 Constraints. Front contact on the ground and lowest point of the rim
     // (eq. 21-22); driving constraint psi - V t / Rt = 0 (eq. 26, as coded).
@@ -140,10 +173,19 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
         axis: Axis::Z,
         coordinate: "xi".into(),
     });
-    m.holonomic(Holonomic::Residual {
-        name: "driving".into(),
-        expr: psi - v * time() / rt,
-    });
+    match v {
+        Some(v) => {
+            m.holonomic(Holonomic::Residual {
+                name: "driving".into(),
+                expr: psi - v.clone() * time() / rt.clone(),
+            });
+            m.forward_speed(v);
+        }
+        None => {
+            m.set_free_speed(true);
+            m.forward_speed(rt.clone() * rate("psi"));
+        }
+    }
     // Rolling without slip (eq. 23-25).
     for (name, body, point, axis) in [
         ("rear_rolling_x", rear_wheel, rear_contact, Axis::X),
@@ -160,17 +202,35 @@ pub fn declare(name: &str, source: &str) -> (ModelBuilder, WhippleParts) {
     }
     (
         m,
-        WhippleParts {
-            fork_frame,
-            steer_point: g4,
+        BicycleParts {
+            rear_wheel,
+            rear_frame,
             fork,
+            front_wheel,
+            rear_frame_axes: frame,
+            fork_axes: fork_frame,
+            rear_wheel_axes: rear_wheel_frame,
+            front_wheel_axes: front_wheel_frame,
+            rear_hub: g2,
+            front_hub: g5,
+            steer_point: g4,
+            rear_frame_mass_centre: g3,
+            rear_contact,
+            front_contact,
+            rear_contact_lateral: "yc".into(),
+            yaw: "phi".into(),
+            roll: "theta".into(),
+            steer: "gamma".into(),
+            rear_wheel_rotation: "psi".into(),
+            front_wheel_rotation: "eps".into(),
+            rear_wheel_radius: rt,
+            front_wheel_radius: crate::expr::param("Rd"),
+            gravity: crate::expr::param("g"),
         },
     )
 }
 
 /// The thesis model.
 pub fn model() -> Result<Model, ModelError> {
-    declare("thesis_whipple", "modeler/src/models/thesis_whipple.rs")
-        .0
-        .build()
+    declare("thesis_whipple", SOURCE, Speed::Driven).0.build()
 }

@@ -102,8 +102,24 @@ impl ParameterSet {
         text: &str,
         path: impl AsRef<Path>,
     ) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
+        Self::from_toml_str_with_extra(text, path, &[]).map(|(set, _, w)| (set, w))
+    }
+
+    /// Like [`from_toml_str`](Self::from_toml_str), also accepting the
+    /// symbols in `extra` (e.g. effect parameters such as `c_steer`), which
+    /// are returned by name. Any other unknown symbol is still an error
+    /// naming the file and line.
+    pub fn from_toml_str_with_extra(
+        text: &str,
+        path: impl AsRef<Path>,
+        extra: &[&str],
+    ) -> Result<(ParameterSet, BTreeMap<String, f64>, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
-        let fields = parse_toml_fields(text, path)?;
+        let mut fields = parse_toml_fields(text, path, extra)?;
+        let extras: BTreeMap<String, f64> = extra
+            .iter()
+            .filter_map(|&e| fields.values.remove(e).map(|(v, _)| (e.to_string(), v)))
+            .collect();
         let line_of = |f: &str| fields.values.get(f).map(|&(_, line)| line);
         let set = match fields.form {
             Form::Thesis => ParameterSet::Thesis(ThesisParameters::from_lookup(|sym| match fields.values.get(sym) {
@@ -120,7 +136,23 @@ impl ParameterSet {
             })?),
         };
         let warnings = set.validate().map_err(|e| e.located(path, line_of))?;
-        Ok((set, warnings))
+        Ok((set, extras, warnings))
+    }
+
+    /// Read and validate a parameter file, accepting the `extra` symbols in
+    /// TOML files (see [`from_toml_str_with_extra`](Self::from_toml_str_with_extra)).
+    #[allow(clippy::type_complexity)]
+    pub fn load_with_extra(
+        path: impl AsRef<Path>,
+        extra: &[&str],
+    ) -> Result<(ParameterSet, BTreeMap<String, f64>, Vec<ParameterWarning>), ParameterError> {
+        let path = path.as_ref();
+        let text = read(path)?;
+        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
+            Self::from_toml_str_with_extra(&text, path, extra)
+        } else {
+            Self::from_text_str(&text, path).map(|(s, w)| (s, BTreeMap::new(), w))
+        }
     }
 
     /// Parse and validate a benchmark text file (`name = value` or
@@ -332,7 +364,7 @@ fn toml_type(value: &DeValue<'_>) -> &'static str {
     }
 }
 
-fn parse_toml_fields(text: &str, path: &Path) -> Result<TomlFields, ParameterError> {
+fn parse_toml_fields(text: &str, path: &Path, extra: &[&str]) -> Result<TomlFields, ParameterError> {
     let pb = || path.to_path_buf();
     let line = |span: std::ops::Range<usize>| line_of_offset(text, span.start);
     let doc = DeTable::parse(text).map_err(|e| ParameterError::Toml {
@@ -401,14 +433,16 @@ fn parse_toml_fields(text: &str, path: &Path) -> Result<TomlFields, ParameterErr
         if name == "form" {
             continue;
         }
-        if !form.symbols().contains(&name) {
+        if !form.symbols().contains(&name) && !extra.contains(&name) {
             return Err(ParameterError::UnknownField {
                 path: pb(),
                 line: l,
                 field: name.to_string(),
-                why: match form {
-                    Form::Thesis => "not a thesis-form symbol",
-                    Form::Benchmark => "not a benchmark-form symbol",
+                why: match (form, extra.is_empty()) {
+                    (Form::Thesis, true) => "not a thesis-form symbol",
+                    (Form::Benchmark, true) => "not a benchmark-form symbol",
+                    (Form::Thesis, false) => "neither a thesis-form symbol nor an effect parameter of any model",
+                    (Form::Benchmark, false) => "neither a benchmark-form symbol nor an effect parameter of any model",
                 },
             });
         }

@@ -1,0 +1,24 @@
+//! Steer-axis viscous damping: a torque `-c_steer gamma'` between the fork
+//! and the rear frame (bearing and headset seals, cable drag).
+
+use super::{BicycleParts, Effect};
+use crate::expr::rate;
+use crate::model::{Force, ModelBuilder};
+
+fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
+    let c = m.parameter_with_default("c_steer", "steer-axis viscous damping coefficient (N m s/rad)", 0.0);
+    m.dissipative_force(Force::Generalized {
+        name: "steer_damping".into(),
+        coordinate: parts.steer.clone(),
+        expr: -(c * rate(&parts.steer)),
+    });
+}
+
+/// The effect.
+pub fn effect() -> Effect {
+    Effect {
+        name: "steer_damping",
+        doc: "steer-axis viscous damping, torque -c_steer gamma'",
+        apply,
+    }
+}

@@ -1,0 +1,49 @@
+//! The run-time view of a set of generated models: what each model is
+//! ([`ModelInfo`]) and how to run generic code on a model chosen by name
+//! ([`ModelVisitor`]; the generated registry's `with_model(name, visitor)`
+//! matches the name and calls `visitor.visit::<ThatModel>()`).
+
+use crate::model::{MultibodyModel, ParameterInfo};
+
+/// What a generated model is, for listings and model selection.
+#[derive(Clone, Copy, Debug)]
+pub struct ModelInfo {
+    pub name: &'static str,
+    pub doc: &'static str,
+    pub base: &'static str,
+    pub free_speed: bool,
+    pub effects: &'static [&'static str],
+    pub coordinates: &'static [&'static str],
+    pub independent: &'static [usize],
+    pub parameters: &'static [ParameterInfo],
+    /// Extra first-order states (e.g. lagged tyre forces).
+    pub states: &'static [&'static str],
+}
+
+impl ModelInfo {
+    /// The record of model `M`.
+    pub const fn of<M: MultibodyModel>() -> ModelInfo {
+        ModelInfo {
+            name: M::NAME,
+            doc: M::DOC,
+            base: M::BASE,
+            free_speed: M::FREE_SPEED,
+            effects: M::EFFECTS,
+            coordinates: M::COORDINATES,
+            independent: M::INDEPENDENT,
+            parameters: M::PARAMETER_INFO,
+            states: M::STATES,
+        }
+    }
+
+    /// The parameter called `name`.
+    pub fn parameter(&self, name: &str) -> Option<&'static ParameterInfo> {
+        self.parameters.iter().find(|p| p.name == name)
+    }
+}
+
+/// Generic code to run on a model chosen at run time.
+pub trait ModelVisitor {
+    type Output;
+    fn visit<M: MultibodyModel>(self) -> Self::Output;
+}

@@ -1,0 +1,235 @@
+//! The effect library through parameters, models and the CLI (issue 6,
+//! points 4, 6, 7): effect parameters in parameter files, model selection,
+//! `bikedyn models`, `bikedyn params show`, and the physics of an effect in
+//! the linearization.
+
+use bikedyn::bicycle::{Bicycle, BicycleError};
+use bikedyn::generated::{ThesisExtended, ThesisWhipple};
+use bikedyn::models::{default_bicycle, model_names};
+use bikedyn::registry::ModelInfo;
+use bikedyn_runtime::linearize::{canonical_matrices, lateral_block, linearize_at_speed, parameter_vector};
+use bikedyn_runtime::parameters::ThesisParameters;
+use std::process::{Command, Output};
+
+fn bikedyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
+}
+
+fn thesis_file_with(extra: &str, name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("bikedyn-effects-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    let text = format!("{}{extra}", ThesisParameters::thesis_bicycle().to_toml_string());
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn built_in_bicycles_have_every_effect_absent() {
+    for name in ["thesis", "benchmark"] {
+        let b = Bicycle::resolve(name).unwrap();
+        let nonzero = b.nonzero_parameters().unwrap();
+        for info in bikedyn::models::effect_parameters() {
+            assert!(!nonzero.iter().any(|(s, _)| *s == info.name), "{name}: {}", info.name);
+            assert_eq!(b.value(info.name), info.default, "{name}: {}", info.name);
+        }
+    }
+    assert_eq!(
+        Bicycle::resolve("thesis").unwrap().model(None).unwrap().name,
+        "thesis_whipple"
+    );
+    assert_eq!(
+        Bicycle::resolve("benchmark").unwrap().model(None).unwrap().name,
+        "whipple_offset"
+    );
+}
+
+#[test]
+fn a_parameter_file_carries_effect_parameters() {
+    let path = thesis_file_with("c_steer = 0.25\nCrr_rear = 0.008\n", "damped.toml");
+    let b = Bicycle::resolve(path.to_str().unwrap()).unwrap();
+    assert_eq!(b.effects.get("c_steer"), Some(&0.25));
+    assert_eq!(b.value("Crr_rear"), Some(0.008));
+    // The smallest model with those parameters: the thesis model with effects.
+    assert_eq!(b.model(None).unwrap().name, "thesis_extended");
+    // Through a model without them: refused, naming the parameter.
+    let err = b.model(Some("thesis_whipple")).unwrap_err();
+    assert!(err.to_string().contains("c_steer"), "{err}");
+    // The canonical form does not hold with steer damping.
+    assert!(matches!(b.canonical(), Err(BicycleError::NotCanonical { .. })));
+}
+
+#[test]
+fn an_unknown_symbol_names_the_file_and_line() {
+    let path = thesis_file_with("c_stear = 0.25\n", "typo.toml");
+    let err = Bicycle::resolve(path.to_str().unwrap()).unwrap_err().to_string();
+    let line = ThesisParameters::thesis_bicycle().to_toml_string().lines().count() + 1;
+    assert!(err.contains("typo.toml"), "{err}");
+    assert!(err.contains(&format!("{line}")), "{err}");
+    assert!(err.contains("c_stear"), "{err}");
+}
+
+/// Steer damping adds `c` to the steer-steer entry of the damping matrix,
+/// at every speed, and nothing else.
+#[test]
+fn steer_damping_adds_its_coefficient_to_the_steer_damping() {
+    let p = ThesisParameters::thesis_bicycle();
+    let c = canonical_matrices::<ThesisWhipple>(|s| p.get(s)).unwrap();
+    let coefficient = 0.37;
+    let param =
+        parameter_vector::<ThesisExtended>(|s| if s == "c_steer" { Some(coefficient) } else { p.get(s) }, 0.0).unwrap();
+    for v in [1.0, 4.0, 7.5] {
+        let lin = lateral_block::<ThesisExtended>(&linearize_at_speed::<ThesisExtended>(&param, v).unwrap());
+        let want = c.damping(v);
+        assert!((lin.damping[(0, 0)] - want[(0, 0)]).abs() < 1e-12);
+        assert!(
+            (lin.damping[(0, 1)] + want[(0, 1)]).abs() < 1e-12,
+            "thesis steer is -delta"
+        );
+        assert!((lin.damping[(1, 1)] - want[(1, 1)] - coefficient).abs() < 1e-12);
+        assert!((lin.stiffness[(1, 1)] - c.stiffness(v)[(1, 1)]).abs() < 1e-10);
+    }
+}
+
+#[test]
+fn with_every_effect_absent_the_extended_model_is_the_thesis_model() {
+    let p = default_bicycle(&ModelInfo::of::<ThesisExtended>());
+    let a = canonical_matrices::<ThesisWhipple>(|s| p.get(s)).unwrap();
+    let b = canonical_matrices::<ThesisExtended>(|s| p.get(s)).unwrap();
+    assert!((a.m0 - b.m0).abs().max() < 1e-12);
+    assert!((a.c1 - b.c1).abs().max() < 1e-9, "{} {}", a.c1, b.c1);
+    assert!((a.k0 - b.k0).abs().max() < 1e-12);
+    assert!((a.k2 - b.k2).abs().max() < 1e-9);
+}
+
+#[test]
+fn models_json_lists_every_registered_model() {
+    let out = bikedyn(&["models", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let names: Vec<&str> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, model_names());
+    for m in v.as_array().unwrap() {
+        for key in [
+            "name",
+            "doc",
+            "base",
+            "free_speed",
+            "effects",
+            "coordinates",
+            "parameters",
+            "states",
+        ] {
+            assert!(!m[key].is_null(), "{key} missing in {m}");
+        }
+    }
+    let ext = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"] == "thesis_extended_free")
+        .unwrap();
+    assert_eq!(ext["free_speed"], true);
+    assert!(ext["effects"].as_array().unwrap().iter().any(|e| e == "steer_damping"));
+}
+
+#[test]
+fn params_show_lists_effect_parameters_with_units() {
+    let path = thesis_file_with("c_steer = 0.25\n", "show.toml");
+    let out = bikedyn(&["params", "show", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Rt = 0.3199"), "{text}");
+    assert!(text.contains("(m)"), "{text}");
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("c_steer = 0.25"))
+        .expect("c_steer listed");
+    assert!(line.contains("N m s/rad"), "{line}");
+    assert!(text.lines().any(|l| l.starts_with("Crr_rear = 0.0")), "{text}");
+}
+
+#[test]
+fn commands_take_a_model() {
+    let out = bikedyn(&[
+        "stability",
+        "--bike",
+        "thesis",
+        "--model",
+        "thesis_whipple_free",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let free: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let out = bikedyn(&["stability", "--bike", "thesis", "--json"]);
+    let driven: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (a, b) = (
+        free["weave_speed"].as_f64().unwrap(),
+        driven["weave_speed"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() < 1e-9, "{a} vs {b}");
+    let out = bikedyn(&["canonical", "--bike", "benchmark", "--model", "thesis_whipple"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("d4"));
+    let out = bikedyn(&["canonical", "--model", "no_such_model"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("thesis_whipple_free"));
+}
+
+/// Tyre slip with relaxation: as the tyres stiffen (cornering stiffness up,
+/// relaxation length down) the weave eigenvalue of the tyre model tends to
+/// the no-slip model's. A physical check of the effect, its extra states and
+/// the state-space linearization.
+#[test]
+fn stiff_tyres_recover_the_rolling_without_slip_weave() {
+    use bikedyn::generated::{ThesisTyreFree, ThesisWhippleFree};
+    use bikedyn_runtime::linearize::state_space_at_speed;
+    use bikedyn_runtime::MultibodyModel;
+    let p = ThesisParameters::thesis_bicycle();
+    let v = 5.0;
+    let c = canonical_matrices::<ThesisWhippleFree>(|s| p.get(s)).unwrap();
+    let weave = bikedyn_runtime::eigen::eigenvalues(&c, v)
+        .unwrap()
+        .into_iter()
+        .filter(|z| z.im > 0.0)
+        .max_by(|a, b| a.im.total_cmp(&b.im))
+        .unwrap();
+    assert_eq!(ThesisTyreFree::STATES.len(), 2);
+    let mut last_err = f64::INFINITY;
+    for (ca, sigma) in [(14.0, 0.2), (200.0, 0.02), (3000.0, 0.002)] {
+        let param = parameter_vector::<ThesisTyreFree>(
+            |s| match s {
+                "Ca_rear" | "Ca_front" => Some(ca),
+                "sigma_rear" | "sigma_front" => Some(sigma),
+                _ => p.get(s),
+            },
+            0.0,
+        )
+        .unwrap();
+        let ss = state_space_at_speed::<ThesisTyreFree>(&param, v).unwrap();
+        assert_eq!(ss.a.nrows(), 12);
+        let schur = nalgebra::linalg::Schur::try_new(ss.a.clone(), 1e-14, 10_000).expect("Schur converges");
+        let eig = schur.complex_eigenvalues();
+        let near = eig
+            .iter()
+            .filter(|z| z.im > 0.5)
+            .min_by(|a, b| (*a - weave).norm().total_cmp(&(*b - weave).norm()))
+            .copied()
+            .unwrap();
+        let err = (near - weave).norm() / weave.norm();
+        println!("C_alpha {ca:>6} /rad, sigma {sigma} m: weave {near:.4} (no slip {weave:.4}), relative difference {err:.2e}");
+        assert!(
+            err < last_err,
+            "the weave approaches the no-slip weave as tyres stiffen"
+        );
+        last_err = err;
+    }
+    assert!(
+        last_err < 0.02,
+        "stiff tyres: weave within 2 % of rolling without slip ({last_err:.3})"
+    );
+}
