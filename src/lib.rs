@@ -11,4 +11,5 @@ pub use generated::{ThesisWhipple, WhippleOffset};
 
 pub mod bench;
 pub mod bicycle;
+pub mod fit;
 pub mod models;
