@@ -335,7 +335,9 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
     let pr = &problem.p;
     let mut omega = pr[2];
     let sigma = pr[1];
-    if !(omega.is_finite() && sigma.is_finite()) || omega.abs() < 1e-9 {
+    // At least half a cycle in the window, or it is not an oscillation.
+    let span = tau[n - 1];
+    if !(omega.is_finite() && sigma.is_finite()) || omega.abs() * span < std::f64::consts::PI {
         return Err(FitError::NoOscillation);
     }
     let mut params: Vec<f64> = pr.iter().copied().collect();

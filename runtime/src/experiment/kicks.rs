@@ -164,7 +164,10 @@ pub fn find_kicks(
             score[k] = r[k + w] - r[k];
         }
     }
-    let sigma = robust_sigma(&score[..n - w]).max(1e-12);
+    // Noise of the score from the high-frequency noise of the rate (the
+    // spread of the score itself is inflated by the responses): the
+    // difference of two averages of 2h+1 samples.
+    let sigma = (noise * (2.0 / (2 * h + 1) as f64).sqrt()).max(1e-12);
     let mut thr = opt.threshold_sigmas * sigma;
     if opt.single {
         // One kick: the first change of at least half the largest one (the
@@ -172,7 +175,7 @@ pub fn find_kicks(
         // The record is mostly response here, so the robust spread is
         // inflated: only ask the kick to stand out of it by a few.
         let max = score.iter().fold(0.0f64, |a, b| a.max(b.abs()));
-        if max < 0.5 * thr {
+        if max < thr {
             return Vec::new();
         }
         thr = 0.5 * max;
@@ -210,7 +213,7 @@ pub fn find_kicks(
         while start + 1 < n && sign * (r[start + 1] - r[start]) > 0.0 && start < kick + 4 * w {
             start += 1;
         }
-        let mut k = window(t, roll, &r, steer, gaps, kick, start, noise, opt);
+        let mut k = window(t, roll, &r, steer, gaps, kick, start, sigma, opt);
         k.jump = jump;
         pos = k.end.max(start + w);
         out.push(k);
@@ -263,20 +266,31 @@ fn window(
     }
     if let Some(s) = steer {
         // Steer stop: within 2 % of the largest steer of the record (and
-        // beyond 20 deg, far outside a weave response) and not moving.
+        // beyond 20 deg, far outside a weave response), pinned for three
+        // rise times (a smooth extreme of an oscillation turns back sooner).
         let ext = s.iter().fold(0.0f64, |a, &b| a.max(b.abs()));
-        if let Some(k) =
-            (start + m..n).find(|&k| s[k].abs() > 0.98 * ext && ext > 0.35 && (s[k] - s[k - m]).abs() < 0.01 * ext)
-        {
-            bound(&mut lim, k - m, WindowEnd::SteerStop);
+        let pinned = |k: usize| s[k].abs() > 0.98 * ext;
+        if ext > 0.35 {
+            if let Some(k) = (start..n.saturating_sub(3 * m)).find(|&k| (k..k + 3 * m).all(pinned)) {
+                bound(&mut lim, k, WindowEnd::SteerStop);
+            }
         }
     }
     let (mut end, mut reason) = lim;
-    // Half-cycles of the roll rate after the start.
+    // Half-cycles of the roll rate after the start: zero crossings with
+    // hysteresis (the rate must leave a band of two noise levels on the
+    // other side), so noise near zero does not split a half-cycle.
+    let band = 2.0 * noise;
     let mut crossings = vec![start];
+    let mut state = r[start].signum();
+    let mut last_zero = start;
     for k in start + 1..end {
-        if r[k - 1].signum() != r[k].signum() && r[k] != 0.0 {
-            crossings.push(k);
+        if r[k - 1].signum() != r[k].signum() {
+            last_zero = k;
+        }
+        if state != 0.0 && r[k] * state < -band {
+            crossings.push(last_zero);
+            state = -state;
         }
     }
     let mut half_cycles = 0;
@@ -299,7 +313,7 @@ fn window(
         }
         // Decayed into noise or below a fraction of the first peak; or
         // forced again (a peak twice the one before).
-        if pk < (4.0 * noise).max(opt.min_relative_amplitude * first_peak) || (half_cycles > 0 && pk > 2.0 * prev_peak)
+        if pk < (3.0 * noise).max(opt.min_relative_amplitude * first_peak) || (half_cycles > 0 && pk > 2.0 * prev_peak)
         {
             stopped = true;
             break;

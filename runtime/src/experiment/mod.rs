@@ -171,7 +171,19 @@ fn fit_window(
     let mean = finite_v.iter().sum::<f64>() / finite_v.len().max(1) as f64;
     let mut fits = Vec::new();
     let mut failed = Vec::new();
-    let speed_ok = finite_v.len() == vs.len() && !vs.is_empty();
+    // The speed-varying form needs a speed that changes measurably over the
+    // window: a linear trend of the speed, significant at three standard
+    // errors (a constant speed leaves the slopes unidentifiable).
+    let trend = if finite_v.len() == vs.len() && vs.len() > 3 {
+        speed_trend(ts, vs)
+    } else {
+        None
+    };
+    let speed_ok = trend.is_some();
+    let v_lin: Vec<f64> = match trend {
+        Some((a, b, _)) => ts.iter().map(|x| a + b * (x - ts[0])).collect(),
+        None => Vec::new(),
+    };
     let forms = [
         (FitForm::RollAngle, rs, false),
         (FitForm::RollRate, qs, false),
@@ -180,10 +192,10 @@ fn fit_window(
     ];
     for (form, y, varying) in forms {
         if varying && !speed_ok {
-            failed.push((form, "no speed over the whole window".to_string()));
+            failed.push((form, "speed not measurably changing over the window".to_string()));
             continue;
         }
-        match fit::fit(form, ts, y, varying.then_some(vs)) {
+        match fit::fit(form, ts, y, varying.then_some(v_lin.as_slice())) {
             Ok(f) => fits.push(f),
             Err(e) => failed.push((form, e.to_string())),
         }
@@ -217,6 +229,23 @@ fn fit_window(
     }
 }
 
+/// Linear trend `v = a + b (t - t0)` of the speed over a window, if its slope
+/// is significant at three standard errors: `(a, b, stderr of b)`.
+fn speed_trend(t: &[f64], v: &[f64]) -> Option<(f64, f64, f64)> {
+    let n = t.len() as f64;
+    let tm = t.iter().sum::<f64>() / n;
+    let vm = v.iter().sum::<f64>() / n;
+    let stt: f64 = t.iter().map(|x| (x - tm).powi(2)).sum();
+    let b = t.iter().zip(v).map(|(x, y)| (x - tm) * (y - vm)).sum::<f64>() / stt;
+    let a = vm + b * (t[0] - tm);
+    let ss: f64 = t.iter().zip(v).map(|(x, y)| (y - a - b * (x - t[0])).powi(2)).sum();
+    // Neighbouring speed samples are correlated (smoothing, sample-and-hold
+    // between magnet passes): count at most ten independent samples.
+    let n_ind = n.min(10.0);
+    let se = (ss / (n - 2.0) / stt * n / n_ind).sqrt();
+    (b.abs() > 3.0 * se).then_some((a, b, se))
+}
+
 /// Process one thesis-style run with the set's calibration.
 pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOptions) -> RunReport {
     let ang = angles::angles(run, cal, opt.angle_method);
@@ -240,8 +269,16 @@ pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOpti
         .collect();
     let mut ko = opt.kicks.clone();
     ko.single = true;
-    // Before the settled time the orientation is not trustworthy.
-    let k0 = t.partition_point(|&x| x < cal.settled_from);
+    // Before the settled time the orientation is not trustworthy, and the
+    // kick comes after the release, which ends the launch at the highest
+    // speed (FORMAT.md: launch, release, then the kick).
+    let release =
+        sp.v.iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite())
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, _)| sp.t[i] + offset.value);
+    let k0 = t.partition_point(|&x| x < cal.settled_from.max(release.unwrap_or(f64::NEG_INFINITY)));
     let found = kicks::find_kicks(
         &t[k0..],
         &ang.roll[k0..],
