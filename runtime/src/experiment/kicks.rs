@@ -37,6 +37,12 @@ pub struct KickOptions {
     pub min_relative_amplitude: f64,
     /// Keep only the strongest kick (thesis-style runs have one).
     pub single: bool,
+    /// Largest relative change of speed over a window: beyond it even the
+    /// eigenvalue linear in speed is a poor description (the weave
+    /// frequency of the thesis bicycle grows from 3.7 to 10 rad/s between
+    /// 3.4 and 6.4 m/s). Shorter windows cost more in precision than the
+    /// speed change costs in bias on `shared/data/dev`.
+    pub max_speed_change: f64,
 }
 
 impl Default for KickOptions {
@@ -48,6 +54,7 @@ impl Default for KickOptions {
             fall_angle: 0.5,
             min_relative_amplitude: 0.15,
             single: false,
+            max_speed_change: 0.3,
         }
     }
 }
@@ -70,6 +77,8 @@ pub enum WindowEnd {
     SteerStop,
     /// The roll rate stopped oscillating (capsize drift).
     Drift,
+    /// The speed changed by more than [`KickOptions::max_speed_change`].
+    SpeedChange,
 }
 
 /// One detected kick and its free-response window (sample indices, end

@@ -297,6 +297,7 @@ pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOpti
             k.start += k0;
             k.end += k0;
             k.index += k0;
+            limit_speed_change(&mut k, &v, opt.kicks.max_speed_change);
             fit_window(&run.dir, &k, t, &ang.roll, &rate, &v, FitForm::RollAngle, Some(offset))
         })
         .collect();
@@ -326,6 +327,19 @@ pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOpti
     }
 }
 
+/// End a window where the speed has changed by more than `frac` from its
+/// value at the start.
+fn limit_speed_change(k: &mut Kick, v: &[f64], frac: f64) {
+    let v0 = v[k.start];
+    if !v0.is_finite() {
+        return;
+    }
+    if let Some(j) = (k.start..k.end).find(|&j| (v[j] - v0).abs() > frac * v0.abs()) {
+        k.end = j;
+        k.end_reason = kicks::WindowEnd::SpeedChange;
+    }
+}
+
 /// Process one TU Delft log (many kicks).
 pub fn process_tudelft(log: &TudelftLog, opt: &PipelineOptions) -> RunReport {
     let mut ko = opt.kicks.clone();
@@ -338,9 +352,11 @@ pub fn process_tudelft(log: &TudelftLog, opt: &PipelineOptions) -> RunReport {
     let kicks = found
         .iter()
         .map(|k| {
+            let mut k = k.clone();
+            limit_speed_change(&mut k, &log.speed, opt.kicks.max_speed_change);
             fit_window(
                 &log.path,
-                k,
+                &k,
                 &log.t,
                 &log.roll,
                 &log.roll_rate,
