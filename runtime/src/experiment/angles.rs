@@ -64,6 +64,8 @@ pub struct Calibration {
     /// Whether the misalignment about the vertical came from observed steer
     /// motion (see [`Calibration::with_steer_axis`]); otherwise it is zero.
     pub yaw_from_steer_axis: bool,
+    /// The steer axis in frame-sensor coordinates, when observed.
+    pub steer_axis: Option<Vector3<f64>>,
 }
 
 fn mat(q: &UnitQuaternion<f64>) -> Matrix3<f64> {
@@ -167,6 +169,7 @@ impl Calibration {
             thesis_offsets: (0.0, 0.0),
             noise: (0.0, 0.0),
             yaw_from_steer_axis: false,
+            steer_axis: None,
         };
         c.finish(cal, k0);
         c
@@ -190,26 +193,36 @@ impl Calibration {
     /// without enough steer motion.
     pub fn steer_axis(&self, runs: &[&ThesisRun]) -> Option<Vector3<f64>> {
         let c = self.handlebar.inverse() * self.frame;
-        let mut s = Matrix3::zeros();
-        let mut total = 0.0;
-        let mut count = 0usize;
+        let mut incs: Vec<Vector3<f64>> = Vec::new();
         for run in runs {
             let n = run.frame.q.len();
-            let dt = (run.frame.t[n - 1] - run.frame.t[0]) / (n.max(2) - 1) as f64;
-            let m = ((0.1 / dt).round() as usize).max(1);
-            let rel: Vec<Rotation3<f64>> = (0..n)
-                .map(|k| run.frame.q[k].to_rotation_matrix().inverse() * run.handlebar.q[k].to_rotation_matrix() * c)
+            let k0 = run.frame.t.partition_point(|&t| t < self.settled_from);
+            if n < k0 + 10 {
+                continue;
+            }
+            let rel: Vec<UnitQuaternion<f64>> = (k0..n)
+                .map(|k| run.frame.q[k].inverse() * run.handlebar.q[k] * UnitQuaternion::from_rotation_matrix(&c))
                 .collect();
-            for k in (m..n).step_by(m) {
-                let r = (rel[k - m].inverse() * rel[k]).scaled_axis();
+            // Relative to the run's mean: full steer amplitudes (much larger
+            // than the noise), while the drift stays small within a run.
+            let reference = mean_rotation(&rel);
+            for q in &rel {
+                incs.push((reference.inverse() * q).scaled_axis());
+            }
+        }
+        // Most increments are sensor noise; keep those well above it (three
+        // median increment sizes).
+        let sizes: Vec<f64> = incs.iter().map(|r| r.norm()).collect();
+        let noise = median(&sizes);
+        let mut s = Matrix3::zeros();
+        let mut count = 0usize;
+        for r in &incs {
+            if r.norm() > 3.0 * noise {
                 s += r * r.transpose();
-                total += r.norm_squared();
                 count += 1;
             }
         }
-        // Increments of about a degree per tenth of a second on average are
-        // needed for the axis to stand above the noise.
-        if count == 0 || total < count as f64 * 1e-4 {
+        if count < 5 {
             return None;
         }
         let eig = s.symmetric_eigen();
@@ -237,6 +250,7 @@ impl Calibration {
             frame,
             handlebar,
             yaw_from_steer_axis: true,
+            steer_axis: Some(*axis),
             ..self.clone()
         };
         c.finish(cal, k0);

@@ -197,8 +197,11 @@ pub fn speed_profile(sw: &SwitchRecord, meta: &RunMeta) -> SpeedProfile {
     if t.len() >= 3 * n_mag {
         for _ in 0..2 {
             let mut ratios: Vec<Vec<f64>> = vec![Vec::new(); n_mag];
+            // Skip the start of the launch, where the speed changes too fast
+            // within two wheel turns for the local linear fit.
+            let vmax = v.iter().copied().filter(|x| x.is_finite()).fold(0.0, f64::max);
             for i in 0..t.len() {
-                if seg[i] == seg[0] && v[i].is_finite() {
+                if seg[i] == seg[0] && v[i].is_finite() && v[i] > 0.5 * vmax {
                     ratios[phase[i]].push(v[i] * dt[i] / meta.wheel_circumference_m);
                 }
             }
