@@ -1,6 +1,7 @@
 //! Measured runs (issue 8): the pipeline on synthetic runs with known truth,
 //! on `shared/data/dev`, on the TU Delft kick logs, and on corrupt inputs.
 
+use bikedyn_runtime::experiment::angles::AngleMethod;
 use bikedyn_runtime::experiment::{
     self,
     read::{self, ReadError, RunKind},
@@ -178,6 +179,50 @@ fn synthetic_runs_recover_misalignment_kick_eigenvalue_speed_and_clock() {
         println!("  magnet spacing: largest error {:.5} of the circumference", best);
         assert!(best < 0.001);
     }
+}
+
+/// Issue 8, point 2: the two angle methods against the true roll and steer
+/// of a synthetic run (dev-like sensors). The direct method is the default:
+/// its steer error must be below the thesis method's, and its roll as good.
+#[test]
+fn angle_methods_compared_on_a_synthetic_run() {
+    let dir = tmp("angles");
+    let truths = synthetic_set(&dir);
+    let opt = PipelineOptions {
+        frame_pitch: ResponseSpec::default().frame_pitch,
+        ..PipelineOptions::default()
+    };
+    let runs: Vec<PathBuf> = (1..=3).map(|i| dir.join(format!("run{i:02}"))).collect();
+    let (cal, _) = experiment::process_set(&runs, &dir.join("calibration"), &opt, &noop).unwrap();
+    let mut rms = [[0.0; 2]; 2];
+    let mut count = 0.0;
+    for (i, (spec, _)) in truths.iter().enumerate() {
+        let run = read::read_run(&runs[i]).unwrap();
+        let traj = spec.trajectory();
+        let d = experiment::angles::angles(&run, &cal, AngleMethod::Direct);
+        let th = experiment::angles::angles(&run, &cal, AngleMethod::Thesis);
+        for k in 0..d.t.len() {
+            if d.t[k] < cal.settled_from {
+                continue;
+            }
+            let j = ((d.t[k] * spec.rate_hz).round() as usize).min(traj.t.len() - 1);
+            for (m, a) in [&d, &th].iter().enumerate() {
+                rms[m][0] += (a.roll[k] - traj.roll[j]).powi(2);
+                rms[m][1] += (a.steer[k] - traj.steer[j]).powi(2);
+            }
+            count += 1.0;
+        }
+    }
+    let r = |x: f64| (x / count).sqrt().to_degrees();
+    println!(
+        "rms error (deg): direct roll {:.3} steer {:.3}; thesis roll {:.3} steer {:.3}",
+        r(rms[0][0]),
+        r(rms[0][1]),
+        r(rms[1][0]),
+        r(rms[1][1])
+    );
+    assert!(r(rms[0][1]) < r(rms[1][1]));
+    assert!(r(rms[0][0]) < 1.2 * r(rms[1][0]) + 0.05);
 }
 
 fn write_good_run(dir: &Path, seed: u64) {
