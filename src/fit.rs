@@ -337,3 +337,82 @@ pub fn plots(out: &FitOutcome, dir: &Path) -> Result<()> {
     }
     Ok(())
 }
+
+/// `bikedyn bench` section: time to process one thesis-style run end to end
+/// (read, angles, speed, clock, kick, fits) and one TU Delft log, on one
+/// core. Uses `../shared` when present, else a synthetic run written to a
+/// temporary folder (and no TU Delft figure).
+pub fn bench_experiment(quick: bool) -> Result<()> {
+    use bikedyn_runtime::experiment::angles::Calibration;
+    use bikedyn_runtime::experiment::synth::{rest_trajectory, write_run, ResponseSpec, SensorModel};
+    use std::time::Instant;
+    let reps = if quick { 5 } else { 30 };
+    println!("\n== measured runs (bikedyn fit), median of {reps}, one thread ==");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared");
+    let (run_dir, cal_dir, log) = if root.join("data/dev/run01").is_dir() {
+        (
+            root.join("data/dev/run01"),
+            root.join("data/dev/calibration"),
+            Some(root.join("realdata/tudelft_sbw_kicks/logs/eigen_normal_sil6.5n2_16.2kph.log")),
+        )
+    } else {
+        let d = std::env::temp_dir().join(format!("bikedyn-bench-{}", std::process::id()));
+        let spec = ResponseSpec::default();
+        let s = SensorModel::default();
+        write_run(
+            &d.join("calibration"),
+            "calibration",
+            read::RunKind::Calibration,
+            &rest_trajectory(10.0, spec.frame_pitch, 0.3),
+            &s,
+            1,
+        )?;
+        write_run(&d.join("run01"), "run01", read::RunKind::Run, &spec.trajectory(), &s, 2)?;
+        (d.join("run01"), d.join("calibration"), None)
+    };
+    let opt = PipelineOptions::default();
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let cal_run = read::read_run(&cal_dir)?;
+    let mut times = Vec::new();
+    for _ in 0..reps {
+        let t = Instant::now();
+        std::hint::black_box(Calibration::estimate(&cal_run, opt.frame_pitch));
+        times.push(t.elapsed().as_secs_f64());
+    }
+    println!(
+        "calibration run (misalignment estimate, read excluded): {:>8.2} ms",
+        1e3 * median(times)
+    );
+    let cal = Calibration::estimate(&cal_run, opt.frame_pitch);
+    let mut times = Vec::new();
+    for _ in 0..reps {
+        let t = Instant::now();
+        let run = read::read_run(&run_dir)?;
+        std::hint::black_box(experiment::process_thesis_run(&run, &cal, &opt));
+        times.push(t.elapsed().as_secs_f64());
+    }
+    println!(
+        "thesis-style run, end to end ({}): {:>8.2} ms",
+        run_dir.display(),
+        1e3 * median(times)
+    );
+    if let Some(log) = log.filter(|l| l.is_file()) {
+        let mut times = Vec::new();
+        let mut kicks = 0;
+        for _ in 0..reps.min(10) {
+            let t = Instant::now();
+            let l = read::read_tudelft(&log)?;
+            kicks = experiment::process_tudelft(&l, &opt).kicks.len();
+            times.push(t.elapsed().as_secs_f64());
+        }
+        println!(
+            "TU Delft log, end to end ({kicks} kicks, {}): {:>8.2} ms",
+            log.display(),
+            1e3 * median(times)
+        );
+    }
+    Ok(())
+}

@@ -214,10 +214,32 @@ fn linear_part(tau: &[f64], y: &[f64], s: f64, w: f64) -> Option<(f64, [f64; 3])
     let mut a = nalgebra::Matrix3::zeros();
     let mut b = nalgebra::Vector3::zeros();
     let mut yy = 0.0;
+    // e^((s + i w) tau) by recurrence on uniformly sampled windows (the grid
+    // search calls this hundreds of times per fit); exact otherwise.
+    let n = tau.len();
+    let dt = if n > 1 { tau[1] - tau[0] } else { 0.0 };
+    let uniform = n > 1 && (tau[n - 1] - tau[0] - dt * (n - 1) as f64).abs() < 1e-9 * (1.0 + tau[n - 1].abs());
+    let (step_re, step_im) = {
+        let e = (s * dt).exp();
+        let (sn, cs) = (w * dt).sin_cos();
+        (e * cs, e * sn)
+    };
+    let (mut z_re, mut z_im) = {
+        let e = (s * tau[0]).exp();
+        let (sn, cs) = (w * tau[0]).sin_cos();
+        (e * cs, e * sn)
+    };
     for (k, &t) in tau.iter().enumerate() {
-        let e = (s * t).exp();
-        let (sn, cs) = (w * t).sin_cos();
-        let x = nalgebra::Vector3::new(1.0, e * cs, e * sn);
+        let (ec, es) = if uniform {
+            let out = (z_re, z_im);
+            (z_re, z_im) = (z_re * step_re - z_im * step_im, z_re * step_im + z_im * step_re);
+            out
+        } else {
+            let e = (s * t).exp();
+            let (sn, cs) = (w * t).sin_cos();
+            (e * cs, e * sn)
+        };
+        let x = nalgebra::Vector3::new(1.0, ec, es);
         a += x * x.transpose();
         b += x * y[k];
         yy += y[k] * y[k];
