@@ -5,7 +5,9 @@
 use crate::bicycle::Bicycle;
 use anyhow::{Context, Result};
 use bikedyn_runtime::experiment::{
-    self, angles::AngleMethod, compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
+    self,
+    angles::{AngleMethod, Calibration},
+    compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
 };
 use bikedyn_runtime::CanonicalMatrices;
 use clap::Args;
@@ -49,6 +51,8 @@ pub struct FitOutcome {
     pub errors: Vec<String>,
     /// Canonical matrices of the bicycle, when given.
     pub canonical: Option<CanonicalMatrices>,
+    /// Calibration of each set (folder and estimate).
+    pub calibrations: Vec<(PathBuf, Calibration)>,
 }
 
 /// Run the pipeline on the inputs.
@@ -95,6 +99,7 @@ pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
     }
     let tick = || bar.inc(1);
     let mut reports = Vec::new();
+    let mut calibrations = Vec::new();
     for input in inputs {
         match input {
             Input::Log(path) => {
@@ -123,7 +128,8 @@ pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
                     continue;
                 };
                 match experiment::process_set(&runs, &cal, &opt, &tick) {
-                    Ok((_, results)) => {
+                    Ok((c, results)) => {
+                        calibrations.push((cal.clone(), c));
                         for r in results {
                             match r {
                                 Ok(rep) => reports.push(rep),
@@ -141,6 +147,7 @@ pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
         reports,
         errors,
         canonical,
+        calibrations,
     })
 }
 
@@ -221,6 +228,38 @@ pub fn residuals(out: &FitOutcome) -> Vec<compare::Residual> {
     rows
 }
 
+/// Misalignment and noise of each calibration, one line per sensor.
+pub fn calibration_text(out: &FitOutcome) -> String {
+    let mut s = String::new();
+    for (dir, c) in &out.calibrations {
+        let (f, h) = c.misalignment_angles();
+        let d = |a: [f64; 3]| {
+            format!(
+                "{:+.2} {:+.2} {:+.2}",
+                a[0].to_degrees(),
+                a[1].to_degrees(),
+                a[2].to_degrees()
+            )
+        };
+        s += &format!(
+            "calibration {}: settled from {:.2} s; misalignment (deg, about x y z): frame {}, handlebar {}{}; \
+             noise at rest (deg): roll {:.3}, steer {:.3}\n",
+            dir.display(),
+            c.settled_from,
+            d(f),
+            d(h),
+            if c.yaw_from_steer_axis {
+                " (about the vertical from the observed steer axis)"
+            } else {
+                " (none about the vertical: no steer motion seen)"
+            },
+            c.noise.0.to_degrees(),
+            c.noise.1.to_degrees()
+        );
+    }
+    s
+}
+
 /// Text table of the kicks.
 pub fn kicks_table(out: &FitOutcome) -> String {
     let header: Vec<String> = [
@@ -294,6 +333,7 @@ pub fn command(args: &FitArgs) -> Result<bool> {
         }
     }
     if args.json {
+        eprint!("{}", calibration_text(&out));
         let list: Vec<Value> = out
             .reports
             .iter()
@@ -302,6 +342,7 @@ pub fn command(args: &FitArgs) -> Result<bool> {
             .collect();
         println!("{}", serde_json::to_string_pretty(&list)?);
     } else {
+        print!("{}", calibration_text(&out));
         print!("{}", kicks_table(&out));
         let rows = residuals(&out);
         if !rows.is_empty() {

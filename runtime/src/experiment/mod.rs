@@ -152,6 +152,7 @@ pub enum RunError {
     },
 }
 
+#[allow(clippy::too_many_arguments)]
 fn fit_window(
     run: &Path,
     k: &Kick,
