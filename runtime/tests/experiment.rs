@@ -225,6 +225,77 @@ fn angle_methods_compared_on_a_synthetic_run() {
     assert!(r(rms[0][0]) < 1.2 * r(rms[1][0]) + 0.05);
 }
 
+/// Issue 8: runs made from the linearized benchmark bicycle (all modes in
+/// the response, speed decaying slowly) give back its frozen-speed weave
+/// eigenvalue at the window's mean speed within 5 % of its modulus (the
+/// capsize mode's slow drift and the 0.1 m/s^2 deceleration are not in
+/// eq. 94; observed below 3 %).
+#[test]
+fn linear_model_runs_give_the_models_weave_eigenvalue() {
+    use bikedyn_runtime::benchmark_oracle::meijaard_canonical;
+    use bikedyn_runtime::experiment::{compare::predicted_weave, synth::linear_model_trajectory};
+    use bikedyn_runtime::parameters::BenchmarkParameters;
+    let c = meijaard_canonical(&BenchmarkParameters::benchmark_bicycle());
+    let lam = std::f64::consts::PI / 10.0;
+    let dir = tmp("linear");
+    let sensors = SensorModel::default();
+    write_run(
+        &dir.join("calibration"),
+        "calibration",
+        RunKind::Calibration,
+        &rest_trajectory(10.0, -lam, 0.4),
+        &sensors,
+        21,
+    )
+    .unwrap();
+    let speeds = [4.6, 5.2, 5.8];
+    let mut runs = Vec::new();
+    for (i, &v0) in speeds.iter().enumerate() {
+        let spec = ResponseSpec {
+            launch_speed: v0,
+            deceleration: 0.1,
+            frame_pitch: -lam,
+            geometry: (1.02, 0.08, lam),
+            roll_rate_jump: 0.5,
+            ..ResponseSpec::default()
+        };
+        let traj = linear_model_trajectory(&c, &spec).unwrap();
+        let d = dir.join(format!("run{:02}", i + 1));
+        write_run(&d, "r", RunKind::Run, &traj, &sensors, 30 + i as u64).unwrap();
+        runs.push(d);
+    }
+    let opt = PipelineOptions {
+        frame_pitch: -lam,
+        ..PipelineOptions::default()
+    };
+    let (_, reports) = experiment::process_set(&runs, &dir.join("calibration"), &opt, &noop).unwrap();
+    for rep in reports {
+        let rep = rep.unwrap();
+        let k = &rep.kicks[0];
+        let f = k
+            .chosen_fit()
+            .unwrap_or_else(|| panic!("{:?} {:?} {:?} {:?}", k.kick_time, k.window, k.window_end, k.failed));
+        let p = predicted_weave(&c, k.mean_speed).unwrap();
+        let rel = (f.eigenvalue[0] - p[0]).hypot(f.eigenvalue[1] - p[1]) / p[0].hypot(p[1]);
+        println!(
+            "v {:.2} ({:.2}-{:.2}): measured {:.3}{:+.3}i +- {:.3},{:.3} ({}, r2 {:.4}), model {:.3}{:+.3}i, {:.1} %",
+            k.mean_speed,
+            k.speed_interval[0],
+            k.speed_interval[1],
+            f.eigenvalue[0],
+            f.eigenvalue[1],
+            f.eigenvalue_stderr[0],
+            f.eigenvalue_stderr[1],
+            f.form.name(),
+            f.r2,
+            p[0],
+            p[1],
+            100.0 * rel
+        );
+        assert!(rel < 0.05);
+    }
+}
+
 fn write_good_run(dir: &Path, seed: u64) {
     let spec = ResponseSpec {
         after_kick: 2.0,

@@ -332,7 +332,10 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
         eq94,
         p: DVector::from_vec(p0),
     };
-    let (problem, report) = LevenbergMarquardt::new().with_patience(200).minimize(problem);
+    // Patience: MINPACK's limit is patience x (parameters + 1) evaluations;
+    // ill-conditioned windows (a slow drift under a fast decay) need more
+    // than the default.
+    let (problem, report) = LevenbergMarquardt::new().with_patience(500).minimize(problem);
     if !report.termination.was_successful() {
         return Err(FitError::NotConverged {
             reason: format!("{:?}", report.termination),

@@ -206,10 +206,16 @@ fn fit_window(
         _ => FitForm::SpeedVaryingRollRate,
     };
     let pick = |f: FitForm| fits.iter().position(|x| x.form == f);
-    let chosen = match (pick(primary), pick(varying)) {
+    let better = |c: Option<usize>, v: Option<usize>| match (c, v) {
         (Some(c), Some(v)) => Some(if fits[v].bic < fits[c].bic { v } else { c }),
         (c, v) => c.or(v),
     };
+    // If no fit on the primary signal converged, report the other signal's.
+    let (other, other_varying) = match primary {
+        FitForm::RollAngle => (FitForm::RollRate, FitForm::SpeedVaryingRollRate),
+        _ => (FitForm::RollAngle, FitForm::SpeedVaryingRollAngle),
+    };
+    let chosen = better(pick(primary), pick(varying)).or_else(|| better(pick(other), pick(other_varying)));
     KickFit {
         run: run.to_path_buf(),
         kick_time: k.time,

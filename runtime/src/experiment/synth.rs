@@ -2,7 +2,8 @@
 //! the bicycle into the files of `shared/data/FORMAT.md`, with the sensors'
 //! imperfections, and a simple launch-kick-response motion for tests.
 
-use super::read::RunKind;
+pub use super::read::RunKind;
+use crate::CanonicalMatrices;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use serde::Serialize;
 use std::fmt::Write as _;
@@ -465,4 +466,53 @@ pub fn rest_trajectory(duration: f64, frame_pitch: f64, yaw: f64) -> Trajectory 
         steer: vec![0.0; n],
         rear_wheel_angle: vec![0.0; n],
     }
+}
+
+/// The response of the linearized bicycle to a kick, with the launch and
+/// the speed of `spec` (its `weave`, `steer_ratio` and `capsize` are not
+/// used): `M0 q'' + v C1 q' + (g K0 + v^2 K2) q = 0` with `q = [roll,
+/// delta]` (Meijaard et al. 2007; thesis steer `gamma = -delta`) integrated
+/// by fourth-order Runge-Kutta at the instantaneous speed, from upright with
+/// the roll rate `spec.roll_rate_jump` at the kick. All modes (weave,
+/// capsize, castering) are in it, as in a measured run; the yaw follows the
+/// rolling kinematics. `None` if the mass matrix is singular.
+pub fn linear_model_trajectory(c: &CanonicalMatrices, spec: &ResponseSpec) -> Option<Trajectory> {
+    let end = spec.kick_time() + spec.after_kick;
+    let n = (end * spec.rate_hz).round() as usize + 1;
+    let dt = 1.0 / spec.rate_hz;
+    let tk = spec.kick_time();
+    let (w, trail, lam) = spec.geometry;
+    let r_wheel = 2.010 / std::f64::consts::TAU;
+    let mut x = nalgebra::Vector4::zeros();
+    let mut kicked = false;
+    let mut tr = Trajectory::default();
+    let (mut yaw, mut psi) = (1.0, 0.0);
+    for k in 0..n {
+        let t = k as f64 * dt;
+        let v = spec.speed(t);
+        if !kicked && t >= tk {
+            x[2] = spec.roll_rate_jump;
+            kicked = true;
+        }
+        let (roll, delta, delta_rate) = (x[0], x[1], x[3]);
+        tr.t.push(t);
+        tr.yaw.push(yaw);
+        tr.roll.push(roll);
+        tr.pitch.push(spec.frame_pitch);
+        tr.steer.push(-delta);
+        tr.rear_wheel_angle.push(psi);
+        // Steer gamma = -delta: turning left raises the yaw.
+        yaw += (v * (-delta) + trail * (-delta_rate)) * lam.cos() / w * dt;
+        psi += v / r_wheel * dt;
+        if kicked {
+            let a = |s: f64| c.state_matrix(spec.speed(s));
+            let (a0, a1, a2) = (a(t)?, a(t + 0.5 * dt)?, a(t + dt)?);
+            let k1 = a0 * x;
+            let k2 = a1 * (x + 0.5 * dt * k1);
+            let k3 = a1 * (x + 0.5 * dt * k2);
+            let k4 = a2 * (x + dt * k3);
+            x += dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+        }
+    }
+    Some(tr)
 }
