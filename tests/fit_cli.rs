@@ -75,6 +75,28 @@ fn dev_set_fits_every_run_near_the_model() {
     assert!(reliable >= 8, "only {reliable} reliable fits");
 }
 
+/// `--plot` writes one response plot per kick and the continuation diagram
+/// with the measured eigenvalues.
+#[test]
+fn plots_are_written() {
+    let Some(run) = shared("data/dev/run03") else { return };
+    let d = std::env::temp_dir().join(format!("bikedyn-fitplot-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    let out = bikedyn(&[
+        "fit",
+        run.to_str().unwrap(),
+        "--bike",
+        "thesis",
+        "--plot",
+        d.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for f in ["run03_kick01.svg", "continuation_measured.svg"] {
+        let svg = std::fs::read_to_string(d.join(f)).unwrap();
+        assert!(svg.contains("<svg") && svg.contains("polyline"), "{f}");
+    }
+}
+
 /// A TU Delft log: many kicks, times on the row-index clock, no clock offset.
 #[test]
 fn tudelft_log_json() {
