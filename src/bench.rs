@@ -267,5 +267,6 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         el,
         el / (designs * speeds) as f64 * 1e9
     );
+    crate::fit::bench_experiment(quick)?;
     Ok(())
 }

@@ -18,4 +18,5 @@ pub mod registry {
 
 pub mod bench;
 pub mod bicycle;
+pub mod fit;
 pub mod models;

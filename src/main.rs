@@ -60,6 +60,8 @@ struct OutputArgs {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Measured weave eigenvalues from raw logs (thesis-style run sets, TU Delft kick logs).
+    Fit(bikedyn::fit::FitArgs),
     /// The main job on embedded defaults: verify the generated models, print
     /// the canonical matrices and self-stable speeds of the built-in bicycles,
     /// and write eigenvalue tables and continuation diagrams to a folder.
@@ -596,6 +598,7 @@ fn run(cli: Cli) -> Result<bool> {
                 Ok(true)
             }
         },
+        Command::Fit(args) => bikedyn::fit::command(&args),
         Command::Bench { quick } => {
             bikedyn::bench::run(quick)?;
             Ok(true)

@@ -8,6 +8,7 @@ pub mod benchmark_oracle;
 pub mod canonical;
 pub mod constraints;
 pub mod eigen;
+pub mod experiment;
 pub mod linalg;
 pub mod linearize;
 pub mod model;

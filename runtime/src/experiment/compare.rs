@@ -1,0 +1,108 @@
+//! Measured against predicted weave eigenvalues (driven-speed linearization:
+//! the canonical matrices at constant forward speed).
+
+use crate::eigen::{eigen_sweep, Mode};
+use crate::CanonicalMatrices;
+use serde::Serialize;
+
+/// The model's weave eigenvalue `[real, imag]` (imag > 0) at speed `v`
+/// (m/s); `None` below the speed where the weave roots become complex.
+pub fn predicted_weave(c: &CanonicalMatrices, v: f64) -> Option<[f64; 2]> {
+    let sweep = eigen_sweep(c, &[v]).ok()?;
+    let p = sweep.points.first()?;
+    (0..4)
+        .filter(|&k| p.modes[k] == Mode::Weave && p.eigenvalues[k].im > 0.0)
+        .map(|k| [p.eigenvalues[k].re, p.eigenvalues[k].im])
+        .next()
+}
+
+/// Prediction over a speed interval.
+#[derive(Clone, Debug, Serialize)]
+pub struct Prediction {
+    /// Weave eigenvalue at the mean speed.
+    pub at_mean_speed: [f64; 2],
+    /// Range of the real part over the interval `[low, high]`.
+    pub real_range: [f64; 2],
+    /// Range of the imaginary part over the interval.
+    pub imag_range: [f64; 2],
+}
+
+/// Prediction at `mean` and over `[lo, hi]` (m/s).
+pub fn predict(c: &CanonicalMatrices, mean: f64, lo: f64, hi: f64) -> Option<Prediction> {
+    let at = predicted_weave(c, mean)?;
+    let speeds: Vec<f64> = (0..=10).map(|i| lo + (hi - lo) * i as f64 / 10.0).collect();
+    let sweep = eigen_sweep(c, &speeds).ok()?;
+    let mut re = [f64::INFINITY, f64::NEG_INFINITY];
+    let mut im = re;
+    for p in &sweep.points {
+        for k in 0..4 {
+            if p.modes[k] == Mode::Weave && p.eigenvalues[k].im > 0.0 {
+                re = [re[0].min(p.eigenvalues[k].re), re[1].max(p.eigenvalues[k].re)];
+                im = [im[0].min(p.eigenvalues[k].im), im[1].max(p.eigenvalues[k].im)];
+            }
+        }
+    }
+    if !re[0].is_finite() {
+        re = [at[0], at[0]];
+        im = [at[1], at[1]];
+    }
+    Some(Prediction {
+        at_mean_speed: at,
+        real_range: re,
+        imag_range: im,
+    })
+}
+
+/// One row of the residual table.
+#[derive(Clone, Debug, Serialize)]
+pub struct Residual {
+    /// Run (path) and kick time (s).
+    pub run: String,
+    /// Kick time (s).
+    pub kick_time: f64,
+    /// Mean speed (m/s).
+    pub mean_speed: f64,
+    /// Measured `[re, im]`.
+    pub measured: [f64; 2],
+    /// Standard errors.
+    pub stderr: [f64; 2],
+    /// Predicted at the mean speed.
+    pub predicted: [f64; 2],
+    /// `(measured - predicted) / stderr` for real and imaginary parts.
+    pub z: [f64; 2],
+}
+
+/// Plain-text residual table.
+pub fn format_residuals(rows: &[Residual]) -> String {
+    let header: Vec<String> = [
+        "run",
+        "kick t (s)",
+        "v (m/s)",
+        "measured",
+        "predicted",
+        "diff re",
+        "diff im",
+        "z re",
+        "z im",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let body: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| {
+            vec![
+                r.run.clone(),
+                format!("{:.2}", r.kick_time),
+                format!("{:.2}", r.mean_speed),
+                format!("{:.3}{:+.3}i", r.measured[0], r.measured[1]),
+                format!("{:.3}{:+.3}i", r.predicted[0], r.predicted[1]),
+                format!("{:+.3}", r.measured[0] - r.predicted[0]),
+                format!("{:+.3}", r.measured[1] - r.predicted[1]),
+                format!("{:+.1}", r.z[0]),
+                format!("{:+.1}", r.z[1]),
+            ]
+        })
+        .collect();
+    crate::output::format_table(&header, &body)
+}

@@ -1,0 +1,409 @@
+//! Least-squares fits of a free response (Levenberg-Marquardt, crate
+//! `levenberg-marquardt`), standard errors from the Jacobian, r^2, AIC/BIC.
+//!
+//! Forms (`tau = t - t0`, `t0` the window start):
+//! * [`FitForm::RollAngle`], thesis eq. 94: `A e^(a tau) cos(b tau + phi) + c`;
+//!   eigenvalue `a + i b`.
+//! * [`FitForm::RollRate`], Kooijman et al. (2008):
+//!   `c1 + e^(sigma tau) (c2 cos(omega tau) + c3 sin(omega tau))`.
+//! * [`FitForm::SpeedVarying`] on either signal: the eigenvalue varies
+//!   linearly with speed, `s(v) = s0 + s1 (v - v_mean)`, so the phase and the
+//!   log-envelope are `omega0 tau + omega1 I(tau)` and `sigma0 tau +
+//!   sigma1 I(tau)` with `I(tau) = int_0^tau (v - v_mean)`. Reported
+//!   eigenvalue: `sigma0 + i omega0` at the window's mean speed.
+//!
+//! Residuals of a measured response are correlated in time (unmodelled
+//! dynamics, filtering), so the Jacobian standard errors are inflated by
+//! `sqrt(n / n_eff)` with `n_eff = n (1 - rho) / (1 + rho)` from the lag-one
+//! autocorrelation `rho` of the residuals.
+
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+
+/// Which function was fitted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FitForm {
+    /// Thesis eq. 94 on roll angle.
+    RollAngle,
+    /// Kooijman form on roll rate.
+    RollRate,
+    /// Eigenvalue linear in speed, on roll angle.
+    SpeedVaryingRollAngle,
+    /// Eigenvalue linear in speed, on roll rate.
+    SpeedVaryingRollRate,
+}
+
+impl FitForm {
+    /// Name used in JSON and tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            FitForm::RollAngle => "eq94_roll_angle",
+            FitForm::RollRate => "kooijman_roll_rate",
+            FitForm::SpeedVaryingRollAngle => "speed_varying_roll_angle",
+            FitForm::SpeedVaryingRollRate => "speed_varying_roll_rate",
+        }
+    }
+    fn speed_varying(self) -> bool {
+        matches!(self, FitForm::SpeedVaryingRollAngle | FitForm::SpeedVaryingRollRate)
+    }
+}
+
+/// Result of one fit.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FitResult {
+    /// Form.
+    pub form: FitForm,
+    /// Eigenvalue `[real, imag]` (1/s, rad/s), imag > 0.
+    pub eigenvalue: [f64; 2],
+    /// Its standard errors.
+    pub eigenvalue_stderr: [f64; 2],
+    /// d(eigenvalue)/d(speed) `[real, imag]` (1/m) for speed-varying forms.
+    pub slope: Option<[f64; 2]>,
+    /// Standard errors of the slope.
+    pub slope_stderr: Option<[f64; 2]>,
+    /// Coefficient of determination.
+    pub r2: f64,
+    /// Residual root mean square (signal units).
+    pub rms: f64,
+    /// Akaike information criterion (Gaussian likelihood).
+    pub aic: f64,
+    /// Bayesian information criterion.
+    pub bic: f64,
+    /// Number of samples.
+    pub n: usize,
+    /// All parameters (form order; see the module docs).
+    pub params: Vec<f64>,
+    /// Window start `t0` (s) the fit's `tau` is measured from.
+    pub t0: f64,
+    /// Lag-one autocorrelation of the residuals.
+    pub residual_autocorrelation: f64,
+}
+
+impl FitResult {
+    /// Fitted curve at times `t` (same clock as the data; `integral` is
+    /// `I(tau)` for speed-varying forms).
+    pub fn evaluate(&self, t: &[f64], integral: Option<&[f64]>) -> Vec<f64> {
+        let tau: Vec<f64> = t.iter().map(|x| x - self.t0).collect();
+        let p = Problem {
+            tau,
+            y: vec![0.0; t.len()],
+            integral: integral.filter(|_| self.form.speed_varying()).map(|i| i.to_vec()),
+            eq94: matches!(self.form, FitForm::RollAngle),
+            p: DVector::from_vec(self.params.clone()),
+        };
+        p.model()
+    }
+}
+
+/// Why a fit failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error, serde::Serialize)]
+pub enum FitError {
+    /// Too few samples for the parameters.
+    #[error("{n} samples are too few for {k} parameters")]
+    TooFewSamples {
+        /// Samples.
+        n: usize,
+        /// Parameters.
+        k: usize,
+    },
+    /// The data show no oscillation.
+    #[error("no oscillation in the window")]
+    NoOscillation,
+    /// LM did not converge or gave a degenerate solution.
+    #[error("the fit did not converge ({reason})")]
+    NotConverged {
+        /// Termination reason.
+        reason: String,
+    },
+}
+
+/// The least-squares problem for every form. Parameters:
+/// eq. 94: `[A, a, b, phi, c]`; Kooijman: `[c, sigma, omega, p, q]`;
+/// speed-varying: `[c, sigma0, omega0, p, q, sigma1, omega1]`.
+struct Problem {
+    tau: Vec<f64>,
+    y: Vec<f64>,
+    integral: Option<Vec<f64>>,
+    eq94: bool,
+    p: DVector<f64>,
+}
+
+impl Problem {
+    fn phases(&self, k: usize) -> (f64, f64) {
+        let p = &self.p;
+        let tau = self.tau[k];
+        let (mut s, mut w) = (p[1] * tau, p[2] * tau);
+        if let Some(i) = &self.integral {
+            s += p[5] * i[k];
+            w += p[6] * i[k];
+        }
+        (s, w)
+    }
+    fn model(&self) -> Vec<f64> {
+        let p = &self.p;
+        (0..self.tau.len())
+            .map(|k| {
+                let (s, w) = self.phases(k);
+                let e = s.exp();
+                if self.eq94 {
+                    p[0] * e * (w + p[3]).cos() + p[4]
+                } else {
+                    p[0] + e * (p[3] * w.cos() + p[4] * w.sin())
+                }
+            })
+            .collect()
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.p.copy_from(x);
+    }
+    fn params(&self) -> DVector<f64> {
+        self.p.clone()
+    }
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let m = self.model();
+        let r = DVector::from_iterator(m.len(), m.iter().zip(&self.y).map(|(a, b)| a - b));
+        r.iter().all(|x| x.is_finite()).then_some(r)
+    }
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let n = self.tau.len();
+        let k = self.p.len();
+        let p = &self.p;
+        let mut j = DMatrix::zeros(n, k);
+        for i in 0..n {
+            let (s, w) = self.phases(i);
+            let e = s.exp();
+            let tau = self.tau[i];
+            // d/ds and d/dw of the oscillating part.
+            let (d_ds, d_dw);
+            if self.eq94 {
+                let (sn, cs) = (w + p[3]).sin_cos();
+                j[(i, 0)] = e * cs;
+                j[(i, 3)] = -p[0] * e * sn;
+                j[(i, 4)] = 1.0;
+                d_ds = p[0] * e * cs;
+                d_dw = -p[0] * e * sn;
+            } else {
+                let (sn, cs) = w.sin_cos();
+                j[(i, 0)] = 1.0;
+                j[(i, 3)] = e * cs;
+                j[(i, 4)] = e * sn;
+                d_ds = e * (p[3] * cs + p[4] * sn);
+                d_dw = e * (-p[3] * sn + p[4] * cs);
+            }
+            j[(i, 1)] = d_ds * tau;
+            j[(i, 2)] = d_dw * tau;
+            if let Some(int) = &self.integral {
+                j[(i, 5)] = d_ds * int[i];
+                j[(i, 6)] = d_dw * int[i];
+            }
+        }
+        j.iter().all(|x| x.is_finite()).then_some(j)
+    }
+}
+
+/// Linear least squares of `y ~ c + e^(s tau) (p cos w tau + q sin w tau)`
+/// for fixed `s`, `w`: returns `(ssr, [c, p, q])`.
+fn linear_part(tau: &[f64], y: &[f64], s: f64, w: f64) -> Option<(f64, [f64; 3])> {
+    let mut a = nalgebra::Matrix3::zeros();
+    let mut b = nalgebra::Vector3::zeros();
+    let mut yy = 0.0;
+    // e^((s + i w) tau) by recurrence on uniformly sampled windows (the grid
+    // search calls this hundreds of times per fit); exact otherwise.
+    let n = tau.len();
+    let dt = if n > 1 { tau[1] - tau[0] } else { 0.0 };
+    let uniform = n > 1 && (tau[n - 1] - tau[0] - dt * (n - 1) as f64).abs() < 1e-9 * (1.0 + tau[n - 1].abs());
+    let (step_re, step_im) = {
+        let e = (s * dt).exp();
+        let (sn, cs) = (w * dt).sin_cos();
+        (e * cs, e * sn)
+    };
+    let (mut z_re, mut z_im) = {
+        let e = (s * tau[0]).exp();
+        let (sn, cs) = (w * tau[0]).sin_cos();
+        (e * cs, e * sn)
+    };
+    for (k, &t) in tau.iter().enumerate() {
+        let (ec, es) = if uniform {
+            let out = (z_re, z_im);
+            (z_re, z_im) = (z_re * step_re - z_im * step_im, z_re * step_im + z_im * step_re);
+            out
+        } else {
+            let e = (s * t).exp();
+            let (sn, cs) = (w * t).sin_cos();
+            (e * cs, e * sn)
+        };
+        let x = nalgebra::Vector3::new(1.0, ec, es);
+        a += x * x.transpose();
+        b += x * y[k];
+        yy += y[k] * y[k];
+    }
+    let sol = a.cholesky()?.solve(&b);
+    let ssr = yy - sol.dot(&b);
+    Some((ssr, [sol[0], sol[1], sol[2]]))
+}
+
+/// Dominant angular frequency from the mean spacing of zero crossings of the
+/// detrended signal (rad/s).
+fn crossing_frequency(tau: &[f64], y: &[f64]) -> Option<f64> {
+    let m = y.iter().sum::<f64>() / y.len() as f64;
+    let mut crossings = Vec::new();
+    for k in 1..y.len() {
+        let (a, b) = (y[k - 1] - m, y[k] - m);
+        if a == 0.0 || a.signum() != b.signum() {
+            let f = if a == b { 0.0 } else { a / (a - b) };
+            crossings.push(tau[k - 1] + f * (tau[k] - tau[k - 1]));
+        }
+    }
+    if crossings.len() < 2 {
+        return None;
+    }
+    let half = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+    (half > 0.0).then(|| std::f64::consts::PI / half)
+}
+
+fn lag1_autocorrelation(r: &[f64]) -> f64 {
+    let n = r.len();
+    let m = r.iter().sum::<f64>() / n as f64;
+    let c0: f64 = r.iter().map(|x| (x - m).powi(2)).sum();
+    let c1: f64 = (1..n).map(|k| (r[k] - m) * (r[k - 1] - m)).sum();
+    if c0 > 0.0 {
+        c1 / c0
+    } else {
+        0.0
+    }
+}
+
+/// Fit `form` to samples `(t, y)`. For speed-varying forms `speed` gives the
+/// speed (m/s) at each sample.
+pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result<FitResult, FitError> {
+    let n = t.len();
+    let k = if form.speed_varying() { 7 } else { 5 };
+    if n < 3 * k {
+        return Err(FitError::TooFewSamples { n, k });
+    }
+    let t0 = t[0];
+    let tau: Vec<f64> = t.iter().map(|x| x - t0).collect();
+    let w_hat = crossing_frequency(&tau, y).ok_or(FitError::NoOscillation)?;
+    // Coarse grid on (sigma, omega) with the linear parameters solved exactly.
+    let mut best: Option<(f64, f64, f64, [f64; 3])> = None;
+    for i in 0..=20 {
+        let w = w_hat * (0.6 + 0.05 * i as f64);
+        for j in 0..=24 {
+            let s = w_hat * (-1.2 + 0.075 * j as f64);
+            if let Some((ssr, lin)) = linear_part(&tau, y, s, w) {
+                if best.as_ref().is_none_or(|b| ssr < b.0) {
+                    best = Some((ssr, s, w, lin));
+                }
+            }
+        }
+    }
+    let (_, s0, w0, [c, p, q]) = best.ok_or(FitError::NoOscillation)?;
+    let eq94 = matches!(form, FitForm::RollAngle);
+    let integral = if form.speed_varying() {
+        let v = speed.expect("speed-varying fit needs the speed");
+        let vm = v.iter().sum::<f64>() / n as f64;
+        let mut int = vec![0.0; n];
+        for i in 1..n {
+            int[i] = int[i - 1] + 0.5 * (v[i] + v[i - 1] - 2.0 * vm) * (tau[i] - tau[i - 1]);
+        }
+        Some(int)
+    } else {
+        None
+    };
+    let mut p0 = if eq94 {
+        vec![p.hypot(q), s0, w0, (-q).atan2(p), c]
+    } else {
+        vec![c, s0, w0, p, q]
+    };
+    if form.speed_varying() {
+        p0.extend([0.0, 0.0]);
+    }
+    let problem = Problem {
+        tau: tau.clone(),
+        y: y.to_vec(),
+        integral: integral.clone(),
+        eq94,
+        p: DVector::from_vec(p0),
+    };
+    // Patience: MINPACK's limit is patience x (parameters + 1) evaluations;
+    // ill-conditioned windows (a slow drift under a fast decay) need more
+    // than the default.
+    let (problem, report) = LevenbergMarquardt::new().with_patience(500).minimize(problem);
+    if !report.termination.was_successful() {
+        return Err(FitError::NotConverged {
+            reason: format!("{:?}", report.termination),
+        });
+    }
+    let r = problem.residuals().ok_or(FitError::NotConverged {
+        reason: "non-finite residuals".into(),
+    })?;
+    let jac = problem.jacobian().ok_or(FitError::NotConverged {
+        reason: "non-finite Jacobian".into(),
+    })?;
+    let ssr = r.norm_squared();
+    let ym = y.iter().sum::<f64>() / n as f64;
+    let sst: f64 = y.iter().map(|v| (v - ym).powi(2)).sum();
+    let rho = lag1_autocorrelation(r.as_slice());
+    let inflation = if rho > 0.0 { (1.0 + rho) / (1.0 - rho) } else { 1.0 };
+    let s2 = ssr / (n - k) as f64;
+    let cov = (jac.transpose() * &jac).try_inverse().ok_or(FitError::NotConverged {
+        reason: "singular normal matrix".into(),
+    })? * (s2 * inflation);
+    let se = |i: usize| cov[(i, i)].max(0.0).sqrt();
+    let pr = &problem.p;
+    let mut omega = pr[2];
+    let sigma = pr[1];
+    // At least half a cycle in the window, or it is not an oscillation.
+    let span = tau[n - 1];
+    if !(omega.is_finite() && sigma.is_finite()) || omega.abs() * span < std::f64::consts::PI {
+        return Err(FitError::NoOscillation);
+    }
+    let mut params: Vec<f64> = pr.iter().copied().collect();
+    // Report imag > 0: flip the sign of omega (and the sine/phase terms).
+    if omega < 0.0 {
+        omega = -omega;
+        params[2] = omega;
+        if eq94 {
+            params[3] = -params[3];
+        } else {
+            params[4] = -params[4];
+        }
+        if form.speed_varying() {
+            params[6] = -params[6];
+        }
+    }
+    let ln = (ssr / n as f64).max(1e-300).ln();
+    Ok(FitResult {
+        form,
+        eigenvalue: [sigma, omega],
+        eigenvalue_stderr: [se(1), se(2)],
+        slope: form.speed_varying().then(|| [params[5], params[6]]),
+        slope_stderr: form.speed_varying().then(|| [se(5), se(6)]),
+        r2: 1.0 - ssr / sst,
+        rms: (ssr / n as f64).sqrt(),
+        aic: n as f64 * ln + 2.0 * k as f64,
+        bic: n as f64 * ln + k as f64 * (n as f64).ln(),
+        n,
+        params,
+        t0,
+        residual_autocorrelation: rho,
+    })
+}
+
+/// `I(tau) = int_0^tau (v - v_mean)` for plotting a speed-varying fit.
+pub fn speed_integral(t: &[f64], v: &[f64]) -> Vec<f64> {
+    let n = t.len();
+    let vm = v.iter().sum::<f64>() / n.max(1) as f64;
+    let mut int = vec![0.0; n];
+    for i in 1..n {
+        int[i] = int[i - 1] + 0.5 * (v[i] + v[i - 1] - 2.0 * vm) * (t[i] - t[i - 1]);
+    }
+    int
+}

@@ -1,0 +1,493 @@
+//! Measured runs: from raw logs to measured weave eigenvalues with standard
+//! errors (thesis sections 5-7; Kooijman et al. 2008).
+//!
+//! Pipeline of a thesis-style run ([`process_thesis_run`]): read and check
+//! ([`read`]), misalignments from the calibration run and roll/steer angles
+//! ([`angles`]), speed from the reed switch ([`speed`]), clock offset of the
+//! two loggers ([`sync`]), kick and free-response window ([`kicks`]), fits
+//! ([`fit`]). A TU Delft log ([`process_tudelft`]) skips the first four:
+//! it records roll, roll rate and speed directly. [`compare`] sets the
+//! measured eigenvalues against the model; [`synth`] writes synthetic runs.
+
+pub mod angles;
+pub mod compare;
+pub mod fit;
+pub mod kicks;
+pub mod plot;
+pub mod read;
+pub mod speed;
+pub mod sync;
+pub mod synth;
+
+use angles::{AngleMethod, Angles, Calibration};
+use fit::{FitForm, FitResult};
+use kicks::{Kick, KickOptions};
+use read::{ReadError, RunKind, ThesisRun, TudelftLog};
+use serde::Serialize;
+use speed::SpeedProfile;
+use std::path::{Path, PathBuf};
+use sync::ClockOffset;
+
+/// Options of the pipeline.
+#[derive(Clone, Debug)]
+pub struct PipelineOptions {
+    /// Angle method (default [`AngleMethod::Direct`]).
+    pub angle_method: AngleMethod,
+    /// Kick detection and windows.
+    pub kicks: KickOptions,
+    /// Frame pitch at rest from the model's constraint solution (rad).
+    pub frame_pitch: f64,
+    /// Refine the clock offset from the data (else keep the nominal one).
+    pub refine_clock: bool,
+}
+
+impl Default for PipelineOptions {
+    fn default() -> Self {
+        PipelineOptions {
+            angle_method: AngleMethod::Direct,
+            kicks: KickOptions::default(),
+            // Thesis bicycle (ThesisParameters::frame_pitch).
+            frame_pitch: -0.315,
+            refine_clock: true,
+        }
+    }
+}
+
+/// Fit results of one kick.
+#[derive(Clone, Debug, Serialize)]
+pub struct KickFit {
+    /// Run folder or log file.
+    pub run: PathBuf,
+    /// Kick time (s; IMU clock, or row index x 0.01 s for TU Delft logs).
+    pub kick_time: f64,
+    /// Fit window `[start, end]` (s).
+    pub window: [f64; 2],
+    /// Why the window ends.
+    pub window_end: kicks::WindowEnd,
+    /// Speed interval covered by the window `[low, high]` (m/s).
+    pub speed_interval: [f64; 2],
+    /// Mean speed over the window (m/s).
+    pub mean_speed: f64,
+    /// Every fit that converged.
+    pub fits: Vec<FitResult>,
+    /// Fits that failed, with the reason.
+    pub failed: Vec<(FitForm, String)>,
+    /// Index in `fits` of the reported fit (constant or speed-varying form
+    /// on the primary signal, smaller BIC).
+    pub chosen: Option<usize>,
+    /// Clock offset of the run (thesis-style runs).
+    pub clock_offset: Option<ClockOffset>,
+    /// Samples of the window (for plots): time, roll (rad), roll rate
+    /// (rad/s), speed (m/s).
+    #[serde(skip)]
+    pub samples: Samples,
+}
+
+/// The window's samples.
+#[derive(Clone, Debug, Default)]
+pub struct Samples {
+    /// Time (s).
+    pub t: Vec<f64>,
+    /// Roll (rad).
+    pub roll: Vec<f64>,
+    /// Roll rate (rad/s).
+    pub roll_rate: Vec<f64>,
+    /// Speed (m/s).
+    pub speed: Vec<f64>,
+}
+
+impl KickFit {
+    /// The reported fit.
+    pub fn chosen_fit(&self) -> Option<&FitResult> {
+        self.chosen.map(|i| &self.fits[i])
+    }
+}
+
+/// Result of one run or log.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunReport {
+    /// Run folder or log file.
+    pub run: PathBuf,
+    /// Kicks found, with their fits.
+    pub kicks: Vec<KickFit>,
+    /// Quaternions normalised (frame, handlebar).
+    pub renormalised: [usize; 2],
+    /// Gaps in the records (reported, never interpolated across).
+    pub gaps: Vec<String>,
+    /// Clock offset.
+    pub clock_offset: Option<ClockOffset>,
+    /// Magnet spacing (fractions of the circumference) with standard errors.
+    pub magnet_spacing: Option<(Vec<f64>, Vec<f64>)>,
+    /// Reed-switch bounces merged.
+    pub bounces: usize,
+    /// Notes (e.g. no kick found).
+    pub notes: Vec<String>,
+    /// Angles on the IMU clock (thesis runs), for plots.
+    #[serde(skip)]
+    pub angles: Option<Angles>,
+    /// Speed profile (DAQ clock), for plots.
+    #[serde(skip)]
+    pub speed: Option<SpeedProfile>,
+}
+
+/// Why a run could not be processed.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// A reading problem (file and line named).
+    #[error(transparent)]
+    Read(#[from] ReadError),
+    /// A thesis-style run without a calibration run.
+    #[error("{}: no calibration run (expected {} or --calibration)", run.display(), expected.display())]
+    NoCalibration {
+        /// The run.
+        run: PathBuf,
+        /// Where it was looked for.
+        expected: PathBuf,
+    },
+    /// The named path is neither a run, a set nor a log.
+    #[error("{}: not a run folder (run.toml), a set of runs, or a log file", path.display())]
+    NotARun {
+        /// The path.
+        path: PathBuf,
+    },
+}
+
+#[allow(clippy::too_many_arguments)]
+fn fit_window(
+    run: &Path,
+    k: &Kick,
+    t: &[f64],
+    roll: &[f64],
+    rate: &[f64],
+    speed: &[f64],
+    primary: FitForm,
+    offset: Option<ClockOffset>,
+) -> KickFit {
+    let (a, b) = (k.start, k.end);
+    let (ts, rs, qs, vs) = (&t[a..b], &roll[a..b], &rate[a..b], &speed[a..b]);
+    let finite_v: Vec<f64> = vs.iter().copied().filter(|v| v.is_finite()).collect();
+    let (lo, hi) = finite_v
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+    let mean = finite_v.iter().sum::<f64>() / finite_v.len().max(1) as f64;
+    let mut fits = Vec::new();
+    let mut failed = Vec::new();
+    // The speed-varying form needs a speed that changes measurably over the
+    // window: a linear trend of the speed, significant at three standard
+    // errors (a constant speed leaves the slopes unidentifiable).
+    let trend = if finite_v.len() == vs.len() && vs.len() > 3 {
+        speed_trend(ts, vs)
+    } else {
+        None
+    };
+    let speed_ok = trend.is_some();
+    let v_lin: Vec<f64> = match trend {
+        Some((a, b, _)) => ts.iter().map(|x| a + b * (x - ts[0])).collect(),
+        None => Vec::new(),
+    };
+    let forms = [
+        (FitForm::RollAngle, rs, false),
+        (FitForm::RollRate, qs, false),
+        (FitForm::SpeedVaryingRollAngle, rs, true),
+        (FitForm::SpeedVaryingRollRate, qs, true),
+    ];
+    for (form, y, varying) in forms {
+        if varying && !speed_ok {
+            failed.push((form, "speed not measurably changing over the window".to_string()));
+            continue;
+        }
+        match fit::fit(form, ts, y, varying.then_some(v_lin.as_slice())) {
+            Ok(f) => fits.push(f),
+            Err(e) => failed.push((form, e.to_string())),
+        }
+    }
+    let varying = match primary {
+        FitForm::RollAngle => FitForm::SpeedVaryingRollAngle,
+        _ => FitForm::SpeedVaryingRollRate,
+    };
+    let pick = |f: FitForm| fits.iter().position(|x| x.form == f);
+    let better = |c: Option<usize>, v: Option<usize>| match (c, v) {
+        (Some(c), Some(v)) => Some(if fits[v].bic < fits[c].bic { v } else { c }),
+        (c, v) => c.or(v),
+    };
+    // If no fit on the primary signal converged, report the other signal's.
+    let (other, other_varying) = match primary {
+        FitForm::RollAngle => (FitForm::RollRate, FitForm::SpeedVaryingRollRate),
+        _ => (FitForm::RollAngle, FitForm::SpeedVaryingRollAngle),
+    };
+    let chosen = better(pick(primary), pick(varying)).or_else(|| better(pick(other), pick(other_varying)));
+    KickFit {
+        run: run.to_path_buf(),
+        kick_time: k.time,
+        window: [t[a], t[b.max(a + 1) - 1]],
+        window_end: k.end_reason,
+        speed_interval: if lo.is_finite() { [lo, hi] } else { [f64::NAN, f64::NAN] },
+        mean_speed: mean,
+        fits,
+        failed,
+        chosen,
+        clock_offset: offset,
+        samples: Samples {
+            t: ts.to_vec(),
+            roll: rs.to_vec(),
+            roll_rate: qs.to_vec(),
+            speed: vs.to_vec(),
+        },
+    }
+}
+
+/// Linear trend `v = a + b (t - t0)` of the speed over a window, if its slope
+/// is significant at three standard errors: `(a, b, stderr of b)`.
+fn speed_trend(t: &[f64], v: &[f64]) -> Option<(f64, f64, f64)> {
+    let n = t.len() as f64;
+    let tm = t.iter().sum::<f64>() / n;
+    let vm = v.iter().sum::<f64>() / n;
+    let stt: f64 = t.iter().map(|x| (x - tm).powi(2)).sum();
+    let b = t.iter().zip(v).map(|(x, y)| (x - tm) * (y - vm)).sum::<f64>() / stt;
+    let a = vm + b * (t[0] - tm);
+    let ss: f64 = t.iter().zip(v).map(|(x, y)| (y - a - b * (x - t[0])).powi(2)).sum();
+    // Neighbouring speed samples are correlated (smoothing, sample-and-hold
+    // between magnet passes): count at most ten independent samples.
+    let n_ind = n.min(10.0);
+    let se = (ss / (n - 2.0) / stt * n / n_ind).sqrt();
+    (b.abs() > 3.0 * se).then_some((a, b, se))
+}
+
+/// Process one thesis-style run with the set's calibration.
+pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOptions) -> RunReport {
+    let ang = angles::angles(run, cal, opt.angle_method);
+    let sp = speed::speed_profile(&run.switch, &run.meta);
+    let offset = if opt.refine_clock {
+        sync::estimate_offset(&ang, &sp, run.meta.nominal_offset_s, cal.settled_from.max(ang.t[0]))
+    } else {
+        ClockOffset {
+            value: run.meta.nominal_offset_s,
+            stderr: sync::NOMINAL_OFFSET_HALF_RANGE / 3f64.sqrt(),
+            from_data: false,
+        }
+    };
+    let t = &ang.t;
+    let dt = (t[t.len() - 1] - t[0]) / (t.len().max(2) - 1) as f64;
+    let h = ((opt.kicks.smoothing / dt / 2.0).round() as usize).max(1);
+    let rate = kicks::derivative(t, &ang.roll, h);
+    let v: Vec<f64> = t
+        .iter()
+        .map(|&x| sp.at(x - offset.value).map(|s| s.0).unwrap_or(f64::NAN))
+        .collect();
+    let mut ko = opt.kicks.clone();
+    ko.single = true;
+    // Before the settled time the orientation is not trustworthy, and the
+    // kick comes after the release, which ends the launch at the highest
+    // speed (FORMAT.md: launch, release, then the kick).
+    let release =
+        sp.v.iter()
+            .enumerate()
+            .filter(|(_, v)| v.is_finite())
+            .max_by(|a, b| a.1.total_cmp(b.1))
+            .map(|(i, _)| sp.t[i] + offset.value);
+    let k0 = t.partition_point(|&x| x < cal.settled_from.max(release.unwrap_or(f64::NEG_INFINITY)));
+    let found = kicks::find_kicks(
+        &t[k0..],
+        &ang.roll[k0..],
+        &rate[k0..],
+        Some(&ang.steer[k0..]),
+        &run.frame.gaps,
+        &ko,
+    );
+    let mut notes = Vec::new();
+    if found.is_empty() {
+        notes.push("no kick found".to_string());
+    }
+    let kicks = found
+        .into_iter()
+        .map(|mut k| {
+            k.start += k0;
+            k.end += k0;
+            k.index += k0;
+            limit_speed_change(&mut k, &v, opt.kicks.max_speed_change);
+            fit_window(&run.dir, &k, t, &ang.roll, &rate, &v, FitForm::RollAngle, Some(offset))
+        })
+        .collect();
+    let mut gaps: Vec<String> = Vec::new();
+    for (rec, g) in [(&run.frame.path, &run.frame.gaps), (&run.switch.path, &run.switch.gaps)] {
+        for x in g {
+            gaps.push(format!(
+                "{}:{}: gap {:.4}-{:.4} s",
+                rec.display(),
+                x.line,
+                x.start,
+                x.end
+            ));
+        }
+    }
+    RunReport {
+        run: run.dir.clone(),
+        kicks,
+        renormalised: [run.frame.renormalised, run.handlebar.renormalised],
+        gaps,
+        clock_offset: Some(offset),
+        magnet_spacing: Some((sp.spacing.clone(), sp.spacing_stderr.clone())),
+        bounces: sp.bounces,
+        notes,
+        angles: Some(ang),
+        speed: Some(sp),
+    }
+}
+
+/// End a window where the speed has changed by more than `frac` from its
+/// value at the start.
+fn limit_speed_change(k: &mut Kick, v: &[f64], frac: f64) {
+    let v0 = v[k.start];
+    if !v0.is_finite() {
+        return;
+    }
+    if let Some(j) = (k.start..k.end).find(|&j| (v[j] - v0).abs() > frac * v0.abs()) {
+        k.end = j;
+        k.end_reason = kicks::WindowEnd::SpeedChange;
+    }
+}
+
+/// Process one TU Delft log (many kicks).
+pub fn process_tudelft(log: &TudelftLog, opt: &PipelineOptions) -> RunReport {
+    let mut ko = opt.kicks.clone();
+    ko.single = false;
+    let found = kicks::find_kicks(&log.t, &log.roll, &log.roll_rate, Some(&log.steer), &[], &ko);
+    let mut notes = Vec::new();
+    if found.is_empty() {
+        notes.push("no kick found".to_string());
+    }
+    let kicks = found
+        .iter()
+        .map(|k| {
+            let mut k = k.clone();
+            limit_speed_change(&mut k, &log.speed, opt.kicks.max_speed_change);
+            fit_window(
+                &log.path,
+                &k,
+                &log.t,
+                &log.roll,
+                &log.roll_rate,
+                &log.speed,
+                FitForm::RollRate,
+                None,
+            )
+        })
+        .collect();
+    RunReport {
+        run: log.path.clone(),
+        kicks,
+        renormalised: [0, 0],
+        gaps: Vec::new(),
+        clock_offset: None,
+        magnet_spacing: None,
+        bounces: 0,
+        notes,
+        angles: None,
+        speed: None,
+    }
+}
+
+/// What a path on the command line stands for.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Input {
+    /// A thesis-style set: runs and the calibration folder.
+    Set {
+        /// Run folders.
+        runs: Vec<PathBuf>,
+        /// Calibration folder, if present.
+        calibration: Option<PathBuf>,
+    },
+    /// A TU Delft log file.
+    Log(PathBuf),
+}
+
+fn is_run_dir(p: &Path) -> bool {
+    p.join("run.toml").is_file()
+}
+
+fn kind_of(p: &Path) -> Option<RunKind> {
+    read::read_meta(&p.join("run.toml")).ok().map(|m| m.kind)
+}
+
+/// Classify a command-line path: a set folder (all its runs; calibration =
+/// `calibration/` or the folder whose run.toml says so), a run folder (the
+/// calibration beside it), a log file, or a folder of log files.
+pub fn classify(path: &Path) -> Result<Vec<Input>, RunError> {
+    if path.is_file() {
+        return Ok(vec![Input::Log(path.to_path_buf())]);
+    }
+    if is_run_dir(path) {
+        let cal = path.parent().map(|p| p.join("calibration")).filter(|c| is_run_dir(c));
+        if kind_of(path) == Some(RunKind::Calibration) {
+            return Ok(vec![Input::Set {
+                runs: vec![],
+                calibration: Some(path.to_path_buf()),
+            }]);
+        }
+        return Ok(vec![Input::Set {
+            runs: vec![path.to_path_buf()],
+            calibration: cal,
+        }]);
+    }
+    let Ok(rd) = std::fs::read_dir(path) else {
+        return Err(RunError::NotARun {
+            path: path.to_path_buf(),
+        });
+    };
+    let mut entries: Vec<PathBuf> = rd.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    entries.sort();
+    let mut runs = Vec::new();
+    let mut calibration = None;
+    let mut logs = Vec::new();
+    for e in entries {
+        if is_run_dir(&e) {
+            let named = e.file_name().is_some_and(|n| n == "calibration");
+            if named || (calibration.is_none() && kind_of(&e) == Some(RunKind::Calibration)) {
+                calibration = Some(e);
+            } else {
+                runs.push(e);
+            }
+        } else if e.is_file() && e.extension().is_some_and(|x| x == "log") {
+            logs.push(Input::Log(e));
+        }
+    }
+    if runs.is_empty() && logs.is_empty() {
+        return Err(RunError::NotARun {
+            path: path.to_path_buf(),
+        });
+    }
+    let mut out = Vec::new();
+    if !runs.is_empty() {
+        out.push(Input::Set { runs, calibration });
+    }
+    out.extend(logs);
+    Ok(out)
+}
+
+/// Process a set of thesis-style runs: calibration (completed with the
+/// steer axis seen in the runs), then every run; a corrupt run gives its
+/// error and the others go on. `progress` is called after each run.
+pub fn process_set(
+    runs: &[PathBuf],
+    calibration: &Path,
+    opt: &PipelineOptions,
+    progress: &(dyn Fn() + Sync),
+) -> Result<(Calibration, Vec<Result<RunReport, RunError>>), RunError> {
+    let cal_run = read::read_run(calibration)?;
+    let read: Vec<Result<ThesisRun, RunError>> =
+        runs.iter().map(|r| read::read_run(r).map_err(RunError::from)).collect();
+    let mut cal = Calibration::estimate(&cal_run, opt.frame_pitch);
+    let good: Vec<&ThesisRun> = read.iter().filter_map(|r| r.as_ref().ok()).collect();
+    if let Some(axis) = cal.steer_axis(&good) {
+        cal = cal.with_steer_axis(&cal_run, &axis);
+    }
+    let out = read
+        .into_iter()
+        .map(|r| {
+            let rep = r.map(|run| process_thesis_run(&run, &cal, opt));
+            progress();
+            rep
+        })
+        .collect();
+    Ok((cal, out))
+}

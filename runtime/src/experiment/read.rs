@@ -1,0 +1,650 @@
+//! Reading measured runs: the thesis-style run folders of
+//! `shared/data/FORMAT.md` and the TU Delft steer-by-wire kick logs.
+//!
+//! The reader tolerates a byte-order mark, CRLF line ends, `#` comment lines,
+//! blank lines, surrounding spaces and header variants (`time_s`, `time`, `t`;
+//! `q0..q3`, `qw,qx,qy,qz`, `w,x,y,z`; case-insensitive). Everything else that
+//! is wrong is an error naming the file and the line: a run with one is
+//! reported and skipped by the pipeline; the other runs still go through.
+
+use nalgebra::{Quaternion, UnitQuaternion};
+use std::path::{Path, PathBuf};
+
+/// Quaternion norms within this distance of 1 are taken as they are (the
+/// files print 7 decimals, so rounding alone gives ~1e-7).
+pub const QUAT_ROUNDING_TOL: f64 = 1e-4;
+/// Quaternion norms within this distance of 1 are normalised and counted;
+/// farther ones are an error (a corrupt row, not a rounding effect).
+pub const QUAT_NORMALISE_TOL: f64 = 0.05;
+/// A time step longer than this many nominal sample periods is a gap.
+pub const GAP_FACTOR: f64 = 1.5;
+
+/// A problem in a measured file. Every variant names the file; row problems
+/// name the line (1-based, counting header and comment lines).
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    /// The file could not be read.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// File.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// No header line.
+    #[error("{}: empty file (no header line)", path.display())]
+    Empty {
+        /// File.
+        path: PathBuf,
+    },
+    /// A header without a needed column.
+    #[error("{}:{line}: header has no column `{column}` (found: {found})", path.display())]
+    MissingColumn {
+        /// File.
+        path: PathBuf,
+        /// Line of the header.
+        line: usize,
+        /// Needed column.
+        column: &'static str,
+        /// The header as read.
+        found: String,
+    },
+    /// A row with the wrong number of fields (not the last line).
+    #[error("{}:{line}: malformed row: expected {expected} fields, found {found}", path.display())]
+    FieldCount {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// Fields in the header.
+        expected: usize,
+        /// Fields in the row.
+        found: usize,
+    },
+    /// A field that is not a number.
+    #[error("{}:{line}: malformed row: column `{column}`: `{text}` is not a number", path.display())]
+    NotANumber {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// Column name from the header.
+        column: String,
+        /// The field.
+        text: String,
+    },
+    /// NaN or infinity.
+    #[error("{}:{line}: column `{column}` is {text} (not a finite number)", path.display())]
+    NotFinite {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// Column name.
+        column: String,
+        /// The field.
+        text: String,
+    },
+    /// A time stamp earlier than the one before.
+    #[error("{}:{line}: time {t} s goes back from {previous} s at line {previous_line}", path.display())]
+    NonMonotonicTime {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// Time stamp (s).
+        t: f64,
+        /// Previous time stamp (s).
+        previous: f64,
+        /// Its line.
+        previous_line: usize,
+    },
+    /// The same time stamp twice.
+    #[error("{}:{line}: time {t} s duplicates line {previous_line}", path.display())]
+    DuplicateTime {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// Time stamp (s).
+        t: f64,
+        /// Line of the first one.
+        previous_line: usize,
+    },
+    /// A quaternion whose norm is far from 1.
+    #[error("{}:{line}: quaternion norm {norm:.6} is more than {tol} from 1", path.display())]
+    QuaternionNorm {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// Its norm.
+        norm: f64,
+        /// Tolerance ([`QUAT_NORMALISE_TOL`]).
+        tol: f64,
+    },
+    /// The last row is cut off (no line end and too few fields, or a field cut
+    /// in the middle).
+    #[error("{}:{line}: file is truncated (last row incomplete: `{text}`)", path.display())]
+    Truncated {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// The incomplete row.
+        text: String,
+    },
+    /// A header but no data.
+    #[error("{}: no data rows", path.display())]
+    NoData {
+        /// File.
+        path: PathBuf,
+    },
+    /// The two IMU files of a run disagree.
+    #[error("{}:{line}: time stamp {t} s differs from {other} (the IMU files share one clock)", path.display())]
+    ClockMismatch {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// Its time stamp (s).
+        t: f64,
+        /// The other file.
+        other: String,
+    },
+    /// The two IMU files have different lengths.
+    #[error("{}: {rows} rows, but {other} has {other_rows} (one file is truncated)", path.display())]
+    LengthMismatch {
+        /// File.
+        path: PathBuf,
+        /// Its rows.
+        rows: usize,
+        /// Other file.
+        other: String,
+        /// Its rows.
+        other_rows: usize,
+    },
+    /// A bad `run.toml`.
+    #[error("{}: {message}", path.display())]
+    Metadata {
+        /// File.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// A stretch where samples are missing: never interpolated across.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Gap {
+    /// Last time stamp before the gap (s).
+    pub start: f64,
+    /// First time stamp after the gap (s).
+    pub end: f64,
+    /// Line of the first row after the gap.
+    pub line: usize,
+}
+
+/// One numeric table: columns in the order asked for, with each row's line.
+struct Table {
+    cols: Vec<Vec<f64>>,
+    lines: Vec<usize>,
+}
+
+fn normalise_name(s: &str) -> String {
+    s.trim().trim_matches('"').to_ascii_lowercase().replace([' ', '-'], "_")
+}
+
+/// Read a comma-separated numeric table. `wanted` lists, per column, the
+/// accepted header names (first = canonical name used in messages).
+fn read_table(path: &Path, wanted: &[&[&'static str]]) -> Result<Table, ReadError> {
+    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let text = String::from_utf8_lossy(&bytes);
+    let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let ends_with_newline = text.ends_with('\n');
+    let all: Vec<&str> = text.split('\n').collect();
+    // Index of the last non-empty line, for truncation checks.
+    let last_nonempty = all.iter().rposition(|l| !l.trim().is_empty());
+    let mut header: Option<(usize, Vec<usize>, usize)> = None; // (line, indices, n_fields)
+    let mut cols: Vec<Vec<f64>> = vec![Vec::new(); wanted.len()];
+    let mut lines = Vec::new();
+    for (i, raw) in all.iter().enumerate() {
+        let line_no = i + 1;
+        let l = raw.trim_end_matches('\r').trim();
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = l.split(',').map(|f| f.trim()).collect();
+        let Some((_, idx, n_fields)) = &header else {
+            let names: Vec<String> = fields.iter().map(|f| normalise_name(f)).collect();
+            let mut idx = Vec::new();
+            for w in wanted {
+                match names.iter().position(|n| w.iter().any(|a| a == n)) {
+                    Some(k) => idx.push(k),
+                    None => {
+                        return Err(ReadError::MissingColumn {
+                            path: path.to_path_buf(),
+                            line: line_no,
+                            column: w[0],
+                            found: l.to_string(),
+                        })
+                    }
+                }
+            }
+            header = Some((line_no, idx, fields.len()));
+            continue;
+        };
+        let is_last = Some(i) == last_nonempty;
+        let truncated = |text: &str| ReadError::Truncated {
+            path: path.to_path_buf(),
+            line: line_no,
+            text: text.to_string(),
+        };
+        if fields.len() != *n_fields {
+            if is_last && !ends_with_newline && fields.len() < *n_fields {
+                return Err(truncated(l));
+            }
+            return Err(ReadError::FieldCount {
+                path: path.to_path_buf(),
+                line: line_no,
+                expected: *n_fields,
+                found: fields.len(),
+            });
+        }
+        for (c, &k) in idx.iter().enumerate() {
+            let f = fields[k];
+            let v: f64 = match f.parse() {
+                Ok(v) => v,
+                Err(_) => {
+                    if is_last && !ends_with_newline {
+                        return Err(truncated(l));
+                    }
+                    return Err(ReadError::NotANumber {
+                        path: path.to_path_buf(),
+                        line: line_no,
+                        column: wanted[c][0].to_string(),
+                        text: f.to_string(),
+                    });
+                }
+            };
+            if !v.is_finite() {
+                return Err(ReadError::NotFinite {
+                    path: path.to_path_buf(),
+                    line: line_no,
+                    column: wanted[c][0].to_string(),
+                    text: f.to_string(),
+                });
+            }
+            cols[c].push(v);
+        }
+        lines.push(line_no);
+    }
+    if header.is_none() {
+        return Err(ReadError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    if lines.is_empty() {
+        return Err(ReadError::NoData {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(Table { cols, lines })
+}
+
+/// Check strictly increasing time stamps; return the gaps longer than
+/// [`GAP_FACTOR`] nominal periods.
+fn check_time(path: &Path, t: &[f64], lines: &[usize], period: f64) -> Result<Vec<Gap>, ReadError> {
+    let mut gaps = Vec::new();
+    for k in 1..t.len() {
+        let dt = t[k] - t[k - 1];
+        if dt == 0.0 {
+            return Err(ReadError::DuplicateTime {
+                path: path.to_path_buf(),
+                line: lines[k],
+                t: t[k],
+                previous_line: lines[k - 1],
+            });
+        }
+        if dt < 0.0 {
+            return Err(ReadError::NonMonotonicTime {
+                path: path.to_path_buf(),
+                line: lines[k],
+                t: t[k],
+                previous: t[k - 1],
+                previous_line: lines[k - 1],
+            });
+        }
+        if dt > GAP_FACTOR * period {
+            gaps.push(Gap {
+                start: t[k - 1],
+                end: t[k],
+                line: lines[k],
+            });
+        }
+    }
+    Ok(gaps)
+}
+
+/// Orientation record of one IMU.
+#[derive(Clone, Debug)]
+pub struct ImuRecord {
+    /// Source file.
+    pub path: PathBuf,
+    /// Time stamps on the IMU clock (s).
+    pub t: Vec<f64>,
+    /// Sensor orientation, `v_global = R(q) v_sensor`, global Z up.
+    pub q: Vec<UnitQuaternion<f64>>,
+    /// Rows whose quaternion was normalised (norm off by more than rounding,
+    /// within [`QUAT_NORMALISE_TOL`]).
+    pub renormalised: usize,
+    /// Missing stretches.
+    pub gaps: Vec<Gap>,
+    /// Line of each row.
+    pub lines: Vec<usize>,
+}
+
+/// Read `imu_frame.csv` / `imu_handlebar.csv`. `rate_hz` is the nominal rate
+/// (for gap detection).
+pub fn read_imu(path: &Path, rate_hz: f64) -> Result<ImuRecord, ReadError> {
+    let tab = read_table(
+        path,
+        &[
+            &["time_s", "time", "t", "timestamp", "time_sec"],
+            &["q0", "qw", "w", "quat_w"],
+            &["q1", "qx", "x", "quat_x"],
+            &["q2", "qy", "y", "quat_y"],
+            &["q3", "qz", "z", "quat_z"],
+        ],
+    )?;
+    let t = tab.cols[0].clone();
+    let gaps = check_time(path, &t, &tab.lines, 1.0 / rate_hz)?;
+    let mut q = Vec::with_capacity(t.len());
+    let mut renormalised = 0;
+    for k in 0..t.len() {
+        let raw = Quaternion::new(tab.cols[1][k], tab.cols[2][k], tab.cols[3][k], tab.cols[4][k]);
+        let n = raw.norm();
+        if (n - 1.0).abs() > QUAT_NORMALISE_TOL {
+            return Err(ReadError::QuaternionNorm {
+                path: path.to_path_buf(),
+                line: tab.lines[k],
+                norm: n,
+                tol: QUAT_NORMALISE_TOL,
+            });
+        }
+        if (n - 1.0).abs() > QUAT_ROUNDING_TOL {
+            renormalised += 1;
+        }
+        q.push(UnitQuaternion::from_quaternion(raw));
+    }
+    Ok(ImuRecord {
+        path: path.to_path_buf(),
+        t,
+        q,
+        renormalised,
+        gaps,
+        lines: tab.lines,
+    })
+}
+
+/// Voltage record of the reed switch.
+#[derive(Clone, Debug)]
+pub struct SwitchRecord {
+    /// Source file.
+    pub path: PathBuf,
+    /// Time stamps on the DAQ clock (s).
+    pub t: Vec<f64>,
+    /// Switch output (V).
+    pub volts: Vec<f64>,
+    /// Missing stretches.
+    pub gaps: Vec<Gap>,
+}
+
+/// Read `speed_switch.csv`.
+pub fn read_switch(path: &Path, rate_hz: f64) -> Result<SwitchRecord, ReadError> {
+    let tab = read_table(
+        path,
+        &[
+            &["time_s", "time", "t", "timestamp", "time_sec"],
+            &["volts", "voltage", "v", "volt", "voltage_v", "volts_v"],
+        ],
+    )?;
+    let t = tab.cols[0].clone();
+    let gaps = check_time(path, &t, &tab.lines, 1.0 / rate_hz)?;
+    Ok(SwitchRecord {
+        path: path.to_path_buf(),
+        t,
+        volts: tab.cols[1].clone(),
+        gaps,
+    })
+}
+
+/// Whether a folder is a run or the calibration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RunKind {
+    /// Launch and kick.
+    Run,
+    /// Bicycle held upright at rest, handlebar straight.
+    Calibration,
+}
+
+/// The parts of `run.toml` the pipeline uses.
+#[derive(Clone, Debug)]
+pub struct RunMeta {
+    /// Run name.
+    pub name: String,
+    /// Run or calibration.
+    pub kind: RunKind,
+    /// Nominal `t_imu - t_daq` (s).
+    pub nominal_offset_s: f64,
+    /// IMU rate (Hz).
+    pub imu_rate_hz: f64,
+    /// IMU files (frame first, handlebar second).
+    pub imu_files: [String; 2],
+    /// DAQ rate (Hz).
+    pub switch_rate_hz: f64,
+    /// Reed-switch file.
+    pub switch_file: String,
+    /// Magnets on the wheel.
+    pub magnets: usize,
+    /// Circumference of the wheel carrying the magnets (m).
+    pub wheel_circumference_m: f64,
+    /// Supply (and closed-switch) voltage (V), if given.
+    pub supply_v: Option<f64>,
+}
+
+/// Read `run.toml`.
+pub fn read_meta(path: &Path) -> Result<RunMeta, ReadError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ReadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let meta = |message: String| ReadError::Metadata {
+        path: path.to_path_buf(),
+        message,
+    };
+    let v: toml::Table = text.parse().map_err(|e: toml::de::Error| meta(e.to_string()))?;
+    let num = |sec: &str, key: &str| -> Result<f64, ReadError> {
+        let x = v
+            .get(sec)
+            .and_then(|s| s.get(key))
+            .ok_or_else(|| meta(format!("missing [{sec}] {key}")))?;
+        let x = x
+            .as_float()
+            .or_else(|| x.as_integer().map(|i| i as f64))
+            .ok_or_else(|| meta(format!("[{sec}] {key} is not a number")))?;
+        if !x.is_finite() {
+            return Err(meta(format!("[{sec}] {key} is not finite")));
+        }
+        Ok(x)
+    };
+    let kind = match v.get("kind").and_then(|k| k.as_str()) {
+        Some("run") | None => RunKind::Run,
+        Some("calibration") => RunKind::Calibration,
+        Some(other) => {
+            return Err(meta(format!(
+                "kind = \"{other}\" (expected \"run\" or \"calibration\")"
+            )))
+        }
+    };
+    let imu_files = match v.get("imu").and_then(|s| s.get("files")).and_then(|f| f.as_array()) {
+        Some(a) if a.len() == 2 && a.iter().all(|x| x.is_str()) => [
+            a[0].as_str().unwrap_or_default().to_string(),
+            a[1].as_str().unwrap_or_default().to_string(),
+        ],
+        Some(_) => return Err(meta("[imu] files must list two file names (frame, handlebar)".into())),
+        None => ["imu_frame.csv".into(), "imu_handlebar.csv".into()],
+    };
+    let magnets = num("speed_switch", "magnets")?;
+    if !(magnets >= 1.0 && magnets.fract() == 0.0) {
+        return Err(meta(format!(
+            "[speed_switch] magnets = {magnets} is not a positive integer"
+        )));
+    }
+    let circ = num("speed_switch", "wheel_circumference_m")?;
+    if !(circ > 0.0) {
+        return Err(meta(format!(
+            "[speed_switch] wheel_circumference_m = {circ} is not positive"
+        )));
+    }
+    let imu_rate_hz = num("imu", "rate_hz")?;
+    let switch_rate_hz = num("speed_switch", "rate_hz")?;
+    if !(imu_rate_hz > 0.0 && switch_rate_hz > 0.0) {
+        return Err(meta("sample rates must be positive".into()));
+    }
+    Ok(RunMeta {
+        name: v
+            .get("name")
+            .and_then(|n| n.as_str())
+            .map(str::to_string)
+            .unwrap_or_else(|| {
+                path.parent()
+                    .and_then(|p| p.file_name())
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default()
+            }),
+        kind,
+        nominal_offset_s: num("clocks", "nominal_offset_s")?,
+        imu_rate_hz,
+        imu_files,
+        switch_rate_hz,
+        switch_file: v
+            .get("speed_switch")
+            .and_then(|s| s.get("file"))
+            .and_then(|f| f.as_str())
+            .unwrap_or("speed_switch.csv")
+            .to_string(),
+        magnets: magnets as usize,
+        wheel_circumference_m: circ,
+        supply_v: num("speed_switch", "supply_v").ok(),
+    })
+}
+
+/// A thesis-style run folder, read and checked.
+#[derive(Clone, Debug)]
+pub struct ThesisRun {
+    /// The folder.
+    pub dir: PathBuf,
+    /// `run.toml`.
+    pub meta: RunMeta,
+    /// Frame (body 3) IMU.
+    pub frame: ImuRecord,
+    /// Handlebar (body 4) IMU.
+    pub handlebar: ImuRecord,
+    /// Reed switch.
+    pub switch: SwitchRecord,
+}
+
+/// Read a run folder (or the calibration folder).
+pub fn read_run(dir: &Path) -> Result<ThesisRun, ReadError> {
+    let meta = read_meta(&dir.join("run.toml"))?;
+    let frame = read_imu(&dir.join(&meta.imu_files[0]), meta.imu_rate_hz)?;
+    let handlebar = read_imu(&dir.join(&meta.imu_files[1]), meta.imu_rate_hz)?;
+    if frame.t.len() != handlebar.t.len() {
+        // The shorter one ends early: name it.
+        let (short, long) = if frame.t.len() < handlebar.t.len() {
+            (&frame, &handlebar)
+        } else {
+            (&handlebar, &frame)
+        };
+        return Err(ReadError::LengthMismatch {
+            path: short.path.clone(),
+            rows: short.t.len(),
+            other: long.path.display().to_string(),
+            other_rows: long.t.len(),
+        });
+    }
+    // Same clock: stamps agree to the printed resolution.
+    let tol = 0.25 / meta.imu_rate_hz;
+    for k in 0..frame.t.len() {
+        if (frame.t[k] - handlebar.t[k]).abs() > tol {
+            return Err(ReadError::ClockMismatch {
+                path: handlebar.path.clone(),
+                line: handlebar.lines[k],
+                t: handlebar.t[k],
+                other: frame.path.display().to_string(),
+            });
+        }
+    }
+    let switch = read_switch(&dir.join(&meta.switch_file), meta.switch_rate_hz)?;
+    Ok(ThesisRun {
+        dir: dir.to_path_buf(),
+        meta,
+        frame,
+        handlebar,
+        switch,
+    })
+}
+
+/// Sample period of the TU Delft logs (s): they have no time column.
+pub const TUDELFT_PERIOD_S: f64 = 0.01;
+
+/// A TU Delft steer-by-wire kick log.
+#[derive(Clone, Debug)]
+pub struct TudelftLog {
+    /// Source file.
+    pub path: PathBuf,
+    /// Data-row index times 0.01 s (first data row at 0).
+    pub t: Vec<f64>,
+    /// Forward speed (m/s).
+    pub speed: Vec<f64>,
+    /// Roll (lean) angle (rad).
+    pub roll: Vec<f64>,
+    /// Roll rate from the IMU gyro (rad/s).
+    pub roll_rate: Vec<f64>,
+    /// Handlebar angle (rad).
+    pub steer: Vec<f64>,
+    /// Fork angle (rad).
+    pub fork: Vec<f64>,
+    /// Line of each row.
+    pub lines: Vec<usize>,
+}
+
+/// Read a TU Delft log (13-column CSV with header; columns found by name).
+pub fn read_tudelft(path: &Path) -> Result<TudelftLog, ReadError> {
+    let tab = read_table(
+        path,
+        &[
+            &["speed", "speed_m_s", "speed_(m/s)"],
+            &["lean_angle", "roll_angle", "lean"],
+            &["lean_rate", "roll_rate"],
+            &["hand_angle", "handlebar_angle", "steer_angle"],
+            &["fork_angle"],
+        ],
+    )?;
+    let n = tab.lines.len();
+    Ok(TudelftLog {
+        path: path.to_path_buf(),
+        t: (0..n).map(|k| k as f64 * TUDELFT_PERIOD_S).collect(),
+        speed: tab.cols[0].clone(),
+        roll: tab.cols[1].clone(),
+        roll_rate: tab.cols[2].clone(),
+        steer: tab.cols[3].clone(),
+        fork: tab.cols[4].clone(),
+        lines: tab.lines,
+    })
+}
