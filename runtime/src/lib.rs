@@ -15,6 +15,7 @@ pub mod output;
 pub mod parameters;
 pub mod plot;
 pub mod scalar;
+pub mod simulate;
 pub mod sweep;
 pub mod verify;
 

@@ -1,0 +1,253 @@
+//! Nonlinear simulation (issue 7): constraint residuals, energy, small-amplitude
+//! agreement with the linearized equations, events, kicks and pulses.
+
+use bikedyn::models::default_parameters;
+use bikedyn::ThesisWhipple;
+use bikedyn_runtime::linearize::linearize;
+use bikedyn_runtime::simulate::{
+    simulate, Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, StopReason, TorquePulse,
+};
+use bikedyn_runtime::MultibodyModel;
+use nalgebra::{Matrix2, Matrix4, Vector4};
+
+type M = ThesisWhipple;
+
+fn thesis_at(speed: f64) -> Vec<f64> {
+    let mut p = default_parameters::<M>();
+    p[M::parameter_index("V").unwrap()] = speed;
+    p
+}
+
+/// Linear solution `x(t) = exp(A t) x0` of `M q'' + C q' + K q = 0`.
+fn linear_response(speed: f64, x0: Vector4<f64>, t: f64) -> Vector4<f64> {
+    let lin = linearize::<M>(&thesis_at(speed)).unwrap();
+    let m = Matrix2::from_fn(|i, j| lin.mass[(i, j)]);
+    let c = Matrix2::from_fn(|i, j| lin.damping[(i, j)]);
+    let k = Matrix2::from_fn(|i, j| lin.stiffness[(i, j)]);
+    let mi = m.try_inverse().unwrap();
+    let (mk, mc) = (-mi * k, -mi * c);
+    let a = Matrix4::new(
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        mk[(0, 0)],
+        mk[(0, 1)],
+        mc[(0, 0)],
+        mc[(0, 1)],
+        mk[(1, 0)],
+        mk[(1, 1)],
+        mc[(1, 0)],
+        mc[(1, 1)],
+    );
+    (a * t).exp() * x0
+}
+
+fn max_deviation_from_linear(speed: f64, roll_rate: f64) -> (f64, f64) {
+    let ic = InitialConditions {
+        roll_rate,
+        speed,
+        ..Default::default()
+    };
+    let opts = SimOptions {
+        rtol: 1e-11,
+        atol: 1e-13,
+        output_interval: 0.05,
+        ..Default::default()
+    };
+    let sim = simulate::<M>(&thesis_at(speed), &ic, &Inputs::default(), 3.0, &opts).unwrap();
+    let roll = sim.coordinate("theta").unwrap();
+    let steer = sim.coordinate("gamma").unwrap();
+    let (mut dev, mut amp) = (0.0f64, 0.0f64);
+    for (i, &t) in sim.t.iter().enumerate() {
+        let x = linear_response(speed, Vector4::new(0.0, 0.0, roll_rate, 0.0), t);
+        dev = dev.max((x[0] - roll[i]).abs()).max((x[1] - steer[i]).abs());
+        amp = amp.max(x[0].abs()).max(x[1].abs());
+    }
+    (dev, amp)
+}
+
+/// Small amplitude: the nonlinear response matches the linear solution at the
+/// same speed, and the deviation is second order in the amplitude.
+#[test]
+fn small_amplitude_matches_linear_solution() {
+    for speed in [3.0, 4.5, 7.0] {
+        let (d1, a1) = max_deviation_from_linear(speed, 0.01);
+        let (d2, _) = max_deviation_from_linear(speed, 0.02);
+        println!(
+            "V = {speed}: amplitude {a1:.3e} rad, max deviation {d1:.3e} rad; doubled: {d2:.3e} (ratio {:.2})",
+            d2 / d1
+        );
+        assert!(d1 < 1e-2 * a1, "deviation {d1} vs amplitude {a1}");
+        // Quadratic (or cubic, by symmetry) growth: ratio 4 to 8, not 2.
+        assert!(d2 / d1 > 3.5 && d2 / d1 < 8.5, "ratio {}", d2 / d1);
+    }
+}
+
+/// The holonomic residual stays below 1e-9 throughout a large-amplitude run,
+/// and the velocity constraints hold to rounding.
+#[test]
+fn constraint_residual_stays_at_solver_tolerance() {
+    let ic = InitialConditions {
+        roll: 0.2,
+        steer: -0.3,
+        roll_rate: 0.5,
+        speed: 5.0,
+        ..Default::default()
+    };
+    let sim = simulate::<M>(&thesis_at(5.0), &ic, &Inputs::default(), 5.0, &SimOptions::default()).unwrap();
+    assert_eq!(sim.stop, StopReason::Completed);
+    println!(
+        "max holonomic residual {:.3e}, max velocity residual {:.3e}, {} rhs evaluations",
+        sim.max_constraint_residual(),
+        sim.max_velocity_residual(),
+        sim.stats.rhs_evaluations
+    );
+    assert!(sim.max_constraint_residual() < 1e-9);
+    assert!(sim.max_velocity_residual() < 1e-9);
+    // The driving constraint holds the speed exactly.
+    for s in &sim.speed {
+        assert!((s - 5.0).abs() < 1e-9, "speed {s}");
+    }
+}
+
+/// Below the weave speed the bicycle falls: the run stops at the roll limit,
+/// located to within the integration tolerance.
+#[test]
+fn slow_bicycle_falls_and_the_event_is_located() {
+    let ic = InitialConditions {
+        roll: 0.05,
+        speed: 1.0,
+        ..Default::default()
+    };
+    let opts = SimOptions {
+        events: Events {
+            roll_limit: Some(0.8),
+            steer_limit: None,
+        },
+        ..Default::default()
+    };
+    let sim = simulate::<M>(&thesis_at(1.0), &ic, &Inputs::default(), 20.0, &opts).unwrap();
+    match sim.stop {
+        StopReason::Fell { time, roll } => {
+            assert!((roll.abs() - 0.8).abs() < 1e-8, "roll at event {roll}");
+            assert!(time < 20.0);
+            assert_eq!(*sim.t.last().unwrap(), time);
+        }
+        s => panic!("expected a fall, got {s:?}"),
+    }
+}
+
+/// A steer stop ends the run when the handlebar swings to its limit.
+#[test]
+fn steer_stop_event() {
+    let ic = InitialConditions {
+        steer_rate: 3.0,
+        speed: 1.0,
+        ..Default::default()
+    };
+    let opts = SimOptions {
+        events: Events {
+            roll_limit: None,
+            steer_limit: Some(0.3),
+        },
+        ..Default::default()
+    };
+    let sim = simulate::<M>(&thesis_at(1.0), &ic, &Inputs::default(), 10.0, &opts).unwrap();
+    assert!(matches!(sim.stop, StopReason::SteerStop { steer, .. } if (steer.abs() - 0.3).abs() < 1e-8));
+}
+
+/// A kick to the right at the saddle makes the roll rate jump positive, with
+/// the position unchanged and the constraints still satisfied; its velocity
+/// jump is linear in the impulse.
+#[test]
+fn kick_at_the_saddle_rolls_the_bicycle_right() {
+    let run = |j: f64| {
+        let inputs = Inputs {
+            kicks: vec![Kick::at_saddle(0.5, j)],
+            pulses: vec![],
+        };
+        simulate::<M>(
+            &thesis_at(4.5),
+            &InitialConditions::default(),
+            &inputs,
+            1.0,
+            &SimOptions::default(),
+        )
+        .unwrap()
+    };
+    let jump = |sim: &bikedyn_runtime::simulate::Simulation| {
+        let i = (1..sim.t.len())
+            .find(|&i| sim.t[i] == sim.t[i - 1])
+            .expect("kick sample pair");
+        let j = M::coordinate_index("theta").unwrap();
+        assert_eq!(sim.p[i][j], sim.p[i - 1][j]);
+        (sim.dp[i][j] - sim.dp[i - 1][j], sim.constraint_residual[i])
+    };
+    let (d1, r1) = jump(&run(2.0));
+    let (d2, _) = jump(&run(4.0));
+    println!("roll-rate jump {d1} rad/s for 2 N s");
+    assert!(d1 > 0.1, "roll-rate jump {d1}");
+    assert!((d2 / d1 - 2.0).abs() < 1e-9);
+    assert!(r1 < 1e-9);
+}
+
+/// A steer-torque pulse produces a response; a roll-torque pulse to the right
+/// rolls the bicycle right.
+#[test]
+fn torque_pulses_act_with_the_right_sign() {
+    let pulse = |target, shape| Inputs {
+        kicks: vec![],
+        pulses: vec![TorquePulse {
+            target,
+            shape,
+            start: 0.2,
+            duration: 0.1,
+            amplitude: 5.0,
+        }],
+    };
+    let run = |inputs: &Inputs| {
+        simulate::<M>(
+            &thesis_at(4.5),
+            &InitialConditions::default(),
+            inputs,
+            0.4,
+            &SimOptions::default(),
+        )
+        .unwrap()
+    };
+    let s = run(&pulse(PulseTarget::Roll, PulseShape::HalfSine));
+    let roll = s.coordinate("theta").unwrap();
+    assert!(*roll.last().unwrap() > 1e-3);
+    let s = run(&pulse(PulseTarget::Steer, PulseShape::Rectangular));
+    let steer = s.coordinate("gamma").unwrap();
+    // Positive steer torque turns the handlebar left (positive gamma) at first.
+    let i = s.t.iter().position(|&t| t >= 0.3).unwrap();
+    assert!(steer[i] > 1e-3, "steer {}", steer[i]);
+}
+
+/// Bad inputs are errors, never panics.
+#[test]
+fn bad_inputs_are_errors() {
+    let p = thesis_at(4.5);
+    let ic = InitialConditions::default();
+    let o = SimOptions::default();
+    assert!(simulate::<M>(&p, &ic, &Inputs::default(), -1.0, &o).is_err());
+    assert!(simulate::<M>(&p, &ic, &Inputs::default(), f64::NAN, &o).is_err());
+    assert!(simulate::<M>(&p[..3], &ic, &Inputs::default(), 1.0, &o).is_err());
+    let bad = InitialConditions {
+        roll: f64::INFINITY,
+        ..ic
+    };
+    assert!(simulate::<M>(&p, &bad, &Inputs::default(), 1.0, &o).is_err());
+    let o2 = SimOptions { rtol: 0.0, ..o };
+    assert!(simulate::<M>(&p, &ic, &Inputs::default(), 1.0, &o2).is_err());
+    // Roll beyond 90 degrees: no ground contact.
+    let fallen = InitialConditions { roll: 2.0, ..ic };
+    let e = simulate::<M>(&p, &fallen, &Inputs::default(), 1.0, &o);
+    assert!(e.is_err(), "{e:?}");
+}
