@@ -12,6 +12,8 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod cli_simulate;
+
 #[derive(Parser)]
 #[command(
     name = "bikedyn",
@@ -139,6 +141,8 @@ enum Command {
         #[command(subcommand)]
         command: ParamsCommand,
     },
+    /// Nonlinear simulation (time histories to CSV and a plot).
+    Simulate(cli_simulate::SimulateArgs),
     /// Print timing and operation-count figures of the generated code.
     Bench {
         /// Fewer repetitions (for a quick look).
@@ -511,6 +515,7 @@ fn run(cli: Cli) -> Result<bool> {
                 Ok(true)
             }
         },
+        Command::Simulate(args) => cli_simulate::run(args),
         Command::Bench { quick } => {
             bikedyn::bench::run(quick)?;
             Ok(true)

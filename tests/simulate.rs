@@ -251,3 +251,74 @@ fn bad_inputs_are_errors() {
     let e = simulate::<M>(&p, &fallen, &Inputs::default(), 1.0, &o);
     assert!(e.is_err(), "{e:?}");
 }
+
+fn cli(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_bikedyn"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// `bikedyn simulate` writes the documented CSV columns and a plot.
+#[test]
+fn cli_simulate_writes_csv_and_plot() {
+    let dir = std::env::temp_dir().join(format!("bikedyn-sim-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("run.csv");
+    let svg = dir.join("run.svg");
+    let out = cli(&[
+        "simulate",
+        "--speed",
+        "4.5",
+        "--roll-rate",
+        "10",
+        "--kick",
+        "0.5:2",
+        "--pulse",
+        "steer:1:0.2:0.5:halfsine",
+        "--duration",
+        "2",
+        "--out",
+        csv.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains("stop: completed"), "{stdout}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let mut expected = vec!["t"];
+    expected.extend(M::COORDINATES);
+    let rates: Vec<String> = M::COORDINATES.iter().map(|c| format!("d{c}")).collect();
+    expected.extend(rates.iter().map(|s| s.as_str()));
+    expected.extend(["speed", "kinetic_energy", "potential_energy", "constraint_residual"]);
+    assert_eq!(header, expected);
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert!(rows.len() > 200);
+    assert!(rows
+        .iter()
+        .all(|r| r.len() == header.len() && r[header.len() - 1] < 1e-9));
+    assert_eq!(rows.last().unwrap()[0], 2.0);
+    let svg_text = std::fs::read_to_string(&svg).unwrap();
+    assert!(svg_text.contains("<svg") && svg_text.contains("roll"));
+
+    // A fall is reported; bad arguments are clear errors.
+    let out = cli(&["simulate", "--speed", "1", "--roll", "5", "--duration", "20"]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("fell: roll reached 57.30 deg"));
+    for bad in [
+        vec!["simulate", "--speed", "4", "--duration", "1", "--kick", "x:1"],
+        vec!["simulate", "--speed", "4", "--duration", "1", "--pulse", "yaw:0:1:1"],
+        vec!["simulate", "--speed", "4", "--duration", "-1"],
+        vec!["simulate", "--speed", "4", "--duration", "1", "--model", "nope"],
+        vec!["simulate", "--speed", "4", "--duration", "1", "--plot", "x.gif"],
+    ] {
+        let out = cli(&bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("error:"));
+    }
+}

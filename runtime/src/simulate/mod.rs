@@ -409,11 +409,13 @@ pub fn initial_state<M: MultibodyModel>(
                 }
                 y[k] = (ic.speed - s0) / s1;
             }
-            _ => return Err(SimulateError::InvalidInput(format!(
+            _ => {
+                return Err(SimulateError::InvalidInput(format!(
                 "model `{}` has no speed parameter and {} independent coordinates besides roll and steer (expected 1)",
                 M::NAME,
                 others.len()
-            ))),
+            )))
+            }
         }
     }
     // Check that the configuration exists.
