@@ -262,5 +262,6 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         el,
         el / (designs * speeds) as f64 * 1e9
     );
+    crate::bench_simulate::run(quick)?;
     Ok(())
 }

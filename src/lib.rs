@@ -10,5 +10,6 @@ pub mod generated;
 pub use generated::{ThesisWhipple, WhippleOffset};
 
 pub mod bench;
+pub mod bench_simulate;
 pub mod bicycle;
 pub mod models;

@@ -56,6 +56,7 @@
 mod inputs;
 mod rhs;
 
+pub mod fit;
 pub mod plot;
 pub mod trajectory;
 
