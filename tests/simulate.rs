@@ -425,3 +425,35 @@ fn weave_fit_versus_amplitude() {
         }
     }
 }
+
+/// The physical side of a synthetic run: launch, release, kick, free response;
+/// continuous angles, monotonic rear wheel, seeded (same seed, same run).
+#[test]
+fn synthetic_run_trajectory() {
+    use bikedyn_runtime::simulate::trajectory::{trajectory_for_run, RunPlan};
+    let plan = RunPlan::random(7);
+    assert!(plan.speed >= 3.0 && plan.speed <= 7.0 && plan.launch_duration >= 2.0);
+    let (tr, sim) = trajectory_for_run::<M>(&thesis_at(plan.speed), &plan, &SimOptions::default()).unwrap();
+    let (tr2, _) = trajectory_for_run::<M>(&thesis_at(plan.speed), &plan, &SimOptions::default()).unwrap();
+    assert_eq!(tr, tr2);
+    assert!(sim.max_constraint_residual() < 1e-9);
+    let n = tr.t.len();
+    assert!(tr.t.windows(2).all(|w| w[1] > w[0]));
+    assert!(tr.rear_wheel_angle.windows(2).all(|w| w[1] >= w[0]));
+    let end = plan.launch_duration + plan.kick_delay + plan.free_duration;
+    if sim.stop == StopReason::Completed {
+        assert!((tr.t[n - 1] - end).abs() < 1e-9, "{} vs {end}", tr.t[n - 1]);
+    }
+    // Angles continuous (no jump larger than a 1 ms step allows).
+    for v in [&tr.roll, &tr.steer, &tr.yaw, &tr.pitch] {
+        assert!(v.windows(2).all(|w| (w[1] - w[0]).abs() < 0.02));
+    }
+    // Upright-ish during the launch, a clear response after the kick.
+    let release = tr.t.iter().position(|&t| t >= plan.launch_duration).unwrap();
+    assert!(tr.roll[..release].iter().all(|r| r.abs() < 2f64.to_radians()));
+    let peak = tr.roll[release..].iter().fold(0.0f64, |m, r| m.max(r.abs()));
+    assert!(peak > 2f64.to_radians(), "peak roll after the kick {peak}");
+    // Speed ramps from rest to the release speed.
+    assert_eq!(tr.speed[0], 0.0);
+    assert!((tr.speed[release] - plan.speed).abs() < 1e-9);
+}
