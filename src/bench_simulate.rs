@@ -4,7 +4,9 @@
 
 use crate::generated::ThesisWhipple;
 use crate::models::default_parameters;
-use bikedyn_runtime::simulate::{simulate, InitialConditions, Inputs, Kick, SimOptions, Simulation};
+use bikedyn_runtime::simulate::{
+    initial_state, simulate, Evaluator, InitialConditions, Inputs, Kick, SimOptions, Simulation,
+};
 use bikedyn_runtime::MultibodyModel;
 use std::time::Instant;
 
@@ -53,6 +55,34 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
             n / secs
         );
     }
+    // The right-hand side alone, on the states of a run.
+    let ic = InitialConditions {
+        roll: 0.1,
+        roll_rate: 0.5,
+        speed: 4.5,
+        ..Default::default()
+    };
+    let (y0, p) = initial_state::<M>(&param, &ic)?;
+    let inputs = Inputs::default();
+    let eval = Evaluator::<M>::new(&p, &inputs)?;
+    let mut dy = vec![0.0; y0.len()];
+    let n = if quick { 20_000 } else { 400_000 };
+    let mut y = y0.clone();
+    let t = Instant::now();
+    for k in 0..n {
+        // Small steps along the motion so the Newton warm start is realistic.
+        let h = 1e-4 * ((k % 100) as f64);
+        for i in 0..y.len() {
+            y[i] = y0[i] + h * dy[i];
+        }
+        eval.derivative(h, &y, &mut dy)?;
+    }
+    let per = t.elapsed().as_secs_f64() / n as f64;
+    println!(
+        "  right-hand side alone (Newton with predictor, velocity solve, all_quantities, Mi q'' = Qi): {:.2} us per evaluation = {:.0} evaluations/s",
+        per * 1e6,
+        1.0 / per
+    );
     println!("  free speed and effect models: not in this build (issue 6); the same code runs them once registered");
     println!("  peer anchor: a Python/sympy implementation at about 0.2 ms per right-hand-side evaluation");
     Ok(())

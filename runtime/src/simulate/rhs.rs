@@ -236,6 +236,48 @@ pub(crate) struct Workspace {
     me: Vec<f64>,
     mi: Vec<f64>,
     depv: Vec<usize>,
+    /// Output of `all_quantities` and the offsets of the quantities used.
+    all: Vec<f64>,
+    off: AllOffsets,
+}
+
+/// Offsets into [`MultibodyModel::all_quantities`]'s output.
+#[derive(Clone, Copy, Debug)]
+struct AllOffsets {
+    mass: usize,
+    qv: usize,
+    qg: usize,
+    qe: usize,
+    hconv: usize,
+    nhconv: usize,
+}
+
+impl AllOffsets {
+    fn of<M: MultibodyModel>() -> (Self, usize) {
+        let find = |name: &str| {
+            M::ALL_QUANTITIES_LAYOUT
+                .iter()
+                .find(|(n, _, _)| *n == name)
+                .map(|(_, o, _)| *o)
+                .expect("every generated model lays out the standard quantities")
+        };
+        let len = M::ALL_QUANTITIES_LAYOUT
+            .iter()
+            .map(|(_, o, l)| o + l)
+            .max()
+            .unwrap_or(0);
+        (
+            AllOffsets {
+                mass: find("mass_matrix"),
+                qv: find("quadratic_velocity_forces"),
+                qg: find("gravity_forces"),
+                qe: find("applied_forces"),
+                hconv: find("holonomic_convective"),
+                nhconv: find("nonholonomic_convective"),
+            },
+            len,
+        )
+    }
 }
 
 impl Workspace {
@@ -246,7 +288,10 @@ impl Workspace {
         let ni = M::INDEPENDENT.len();
         let depv = dependent_velocities::<M>();
         let nd = depv.len();
+        let (off, all_len) = AllOffsets::of::<M>();
         Workspace {
+            all: vec![0.0; all_len],
+            off,
             p: M::INITIAL_GUESS.to_vec(),
             dp: vec![0.0; nq],
             ddq: vec![0.0; ni],
@@ -482,8 +527,13 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
             }
             w.dp[w.depv[r]] = v;
         }
-        M::holonomic_convective(param, t, &w.p, &w.dp, &mut w.gamma[..nh]);
-        M::nonholonomic_convective(param, t, &w.p, &w.dp, &mut w.gamma[nh..]);
+        // Everything that needs the full velocities in one call (shared
+        // common subexpressions).
+        M::all_quantities(param, t, &w.p, &w.dp, &mut w.all);
+        let o = w.off;
+        let nnh = nc - nh;
+        w.gamma[..nh].copy_from_slice(&w.all[o.hconv..o.hconv + nh]);
+        w.gamma[nh..].copy_from_slice(&w.all[o.nhconv..o.nhconv + nnh]);
         lu_solve(&w.ddep, nd, &w.piv, &mut w.gamma, 1);
         w.e.iter_mut().for_each(|x| *x = 0.0);
         w.f.iter_mut().for_each(|x| *x = 0.0);
@@ -497,10 +547,10 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
             }
             w.f[j] = -w.gamma[r];
         }
-        M::mass_matrix(param, &w.p, &mut w.mass);
-        M::quadratic_velocity_forces(param, &w.p, &w.dp, &mut w.qv);
-        M::gravity_forces(param, &w.p, &mut w.qg);
-        M::applied_forces(param, t, &w.p, &w.dp, &mut w.qe);
+        w.mass.copy_from_slice(&w.all[o.mass..o.mass + nq * nq]);
+        w.qv.copy_from_slice(&w.all[o.qv..o.qv + nq]);
+        w.qg.copy_from_slice(&w.all[o.qg..o.qg + nq]);
+        w.qe.copy_from_slice(&w.all[o.qe..o.qe + nq]);
         let (a, b) = self.segment.get();
         let inset = 1e-9 * (b - a).min(1.0);
         let (tr, ts) = self.inputs.torques(t.max(a + inset).min(b - inset));
@@ -547,7 +597,7 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
     }
 
     /// State derivative `dy` at `(t, y)`.
-    pub(crate) fn derivative(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimulateError> {
+    pub fn derivative(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimulateError> {
         let mut w = self.ws.borrow_mut();
         self.evaluate(t, y, &mut w)?;
         let l = &self.layout;
