@@ -13,6 +13,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod cli_simulate;
+mod cli_synth;
 
 #[derive(Parser)]
 #[command(
@@ -143,6 +144,8 @@ enum Command {
     },
     /// Nonlinear simulation (time histories to CSV and a plot).
     Simulate(cli_simulate::SimulateArgs),
+    /// Synthetic field runs: launch, release, kick, free response (trajectories and truth).
+    Synth(cli_synth::SynthArgs),
     /// Print timing and operation-count figures of the generated code.
     Bench {
         /// Fewer repetitions (for a quick look).
@@ -516,6 +519,7 @@ fn run(cli: Cli) -> Result<bool> {
             }
         },
         Command::Simulate(args) => cli_simulate::run(args),
+        Command::Synth(args) => cli_synth::run(args),
         Command::Bench { quick } => {
             bikedyn::bench::run(quick)?;
             Ok(true)
