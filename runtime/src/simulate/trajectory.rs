@@ -106,7 +106,7 @@ impl RunPlan {
     /// kick 0.6-1.4 s after release with 2-5 N s toward either side, 4-6 s of
     /// free response, samples every 1 ms.
     pub fn random(seed: u64) -> Self {
-        let mut s = seed ^ 0x5EED_0F_B1C7C1E;
+        let mut s = seed ^ 0x0005_EED0_FB1C_7C1E;
         let mut u = |lo: f64, hi: f64| lo + (hi - lo) * splitmix(&mut s);
         let side = if u(0.0, 1.0) < 0.5 { -1.0 } else { 1.0 };
         RunPlan {
