@@ -461,6 +461,12 @@ pub fn simulate<M: MultibodyModel>(
         if !(k.time.is_finite() && k.impulse.is_finite() && k.ahead.is_finite() && k.height.is_finite()) {
             return Err(SimulateError::InvalidInput(format!("bad kick {k:?}")));
         }
+        if !(k.time >= 0.0 && k.time < duration) {
+            return Err(SimulateError::InvalidInput(format!(
+                "kick at t = {} s is outside the run [0, {duration}) s",
+                k.time
+            )));
+        }
     }
     let (mut y, param) = initial_state::<M>(param, ic)?;
     let eval = Evaluator::<M>::new(&param, inputs)?;
