@@ -457,3 +457,116 @@ fn synthetic_run_trajectory() {
     assert_eq!(tr.speed[0], 0.0);
     assert!((tr.speed[release] - plan.speed).abs() < 1e-9);
 }
+
+/// A free-speed view of the thesis model for the energy test, until the
+/// registry's `thesis_whipple_free` (issue 6) lands: the same generated
+/// functions without the driving constraint (its last holonomic row), with
+/// the rear wheel angle psi independent.
+struct ThesisFreeView;
+
+impl MultibodyModel for ThesisFreeView {
+    const NAME: &'static str = "thesis_whipple (free-speed view)";
+    const COORDINATES: &'static [&'static str] = M::COORDINATES;
+    const PARAMETERS: &'static [&'static str] = M::PARAMETERS;
+    const HOLONOMIC: &'static [&'static str] = &["front_contact_height", "front_contact_lowest"];
+    const NONHOLONOMIC: &'static [&'static str] = M::NONHOLONOMIC;
+    const POINTS: &'static [&'static str] = M::POINTS;
+    const INDEPENDENT: &'static [usize] = &[3, 4, 6];
+    const DEPENDENT: &'static [usize] = &[5, 8];
+    const INITIAL_GUESS: &'static [f64] = M::INITIAL_GUESS;
+    const ALL_QUANTITIES_LAYOUT: &'static [(&'static str, usize, usize)] = M::ALL_QUANTITIES_LAYOUT;
+    const FLOPS: &'static [(&'static str, usize)] = M::FLOPS;
+    fn mass_matrix<T: bikedyn_runtime::Scalar>(param: &[T], p: &[T], out: &mut [T]) {
+        M::mass_matrix(param, p, out)
+    }
+    fn quadratic_velocity_forces<T: bikedyn_runtime::Scalar>(param: &[T], p: &[T], dp: &[T], out: &mut [T]) {
+        M::quadratic_velocity_forces(param, p, dp, out)
+    }
+    fn gravity_forces<T: bikedyn_runtime::Scalar>(param: &[T], p: &[T], out: &mut [T]) {
+        M::gravity_forces(param, p, out)
+    }
+    fn applied_forces<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) {
+        M::applied_forces(param, t, p, dp, out)
+    }
+    fn holonomic_residuals<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]) {
+        let mut full = [T::zero(); 3];
+        M::holonomic_residuals(param, t, p, &mut full);
+        out.copy_from_slice(&full[..2]);
+    }
+    fn holonomic_jacobian<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]) {
+        let mut full = [T::zero(); 27];
+        M::holonomic_jacobian(param, t, p, &mut full);
+        out.copy_from_slice(&full[..18]);
+    }
+    fn holonomic_time_derivative<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]) {
+        let mut full = [T::zero(); 3];
+        M::holonomic_time_derivative(param, t, p, &mut full);
+        out.copy_from_slice(&full[..2]);
+    }
+    fn holonomic_convective<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) {
+        let mut full = [T::zero(); 3];
+        M::holonomic_convective(param, t, p, dp, &mut full);
+        out.copy_from_slice(&full[..2]);
+    }
+    fn nonholonomic_velocities<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) {
+        M::nonholonomic_velocities(param, t, p, dp, out)
+    }
+    fn nonholonomic_matrix<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], out: &mut [T]) {
+        M::nonholonomic_matrix(param, t, p, out)
+    }
+    fn nonholonomic_convective<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) {
+        M::nonholonomic_convective(param, t, p, dp, out)
+    }
+    fn kinetic_energy<T: bikedyn_runtime::Scalar>(param: &[T], p: &[T], dp: &[T]) -> T {
+        M::kinetic_energy(param, p, dp)
+    }
+    fn potential_energy<T: bikedyn_runtime::Scalar>(param: &[T], p: &[T]) -> T {
+        M::potential_energy(param, p)
+    }
+    // The driving row sits last in the layout's holonomic blocks, so the
+    // first two entries of each are this view's rows.
+    fn all_quantities<T: bikedyn_runtime::Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) {
+        M::all_quantities(param, t, p, dp, out)
+    }
+    fn point_positions<T: bikedyn_runtime::Scalar>(param: &[T], p: &[T], out: &mut [T]) {
+        M::point_positions(param, p, out)
+    }
+}
+
+/// Issue 7, point 2: free speed, no dissipation: the total energy drifts by
+/// less than 1e-8 (relative) over 10 s, and the holonomic residual stays
+/// below 1e-9.
+#[test]
+fn free_speed_energy_drift_below_1e8_over_10_s() {
+    let ic = InitialConditions {
+        roll: 0.1,
+        steer: 0.05,
+        roll_rate: 0.3,
+        speed: 5.0,
+        ..Default::default()
+    };
+    let opts = SimOptions {
+        rtol: 1e-11,
+        atol: 1e-12,
+        ..Default::default()
+    };
+    let sim = simulate::<ThesisFreeView>(&thesis_at(0.0), &ic, &Inputs::default(), 10.0, &opts).unwrap();
+    assert_eq!(sim.stop, StopReason::Completed);
+    let drift = sim.relative_energy_drift();
+    let speed = &sim.speed;
+    println!(
+        "energy drift {drift:.3e}, residual {:.3e}, speed {:.4} -> {:.4} m/s, {} evaluations",
+        sim.max_constraint_residual(),
+        speed[0],
+        speed[speed.len() - 1],
+        sim.stats.rhs_evaluations
+    );
+    assert!((speed[0] - 5.0).abs() < 1e-12, "initial speed {}", speed[0]);
+    assert!(drift < 1e-8, "energy drift {drift}");
+    assert!(sim.max_constraint_residual() < 1e-9);
+    // The speed is free: it changes during the (energy-conserving) motion.
+    let (lo, hi) = speed
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(l, h), s| (l.min(*s), h.max(*s)));
+    assert!(hi - lo > 1e-4, "speed constant: {lo} {hi}");
+}

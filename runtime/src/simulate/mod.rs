@@ -366,7 +366,8 @@ pub fn initial_state<M: MultibodyModel>(
         }
     }
     let mut param = param.to_vec();
-    if let Some(k) = forward_speed_parameter::<M>() {
+    let driven = M::INDEPENDENT.len() == 2;
+    if let Some(k) = forward_speed_parameter::<M>().filter(|_| driven) {
         if k < param.len() {
             param[k] = ic.speed;
         }
@@ -393,7 +394,10 @@ pub fn initial_state<M: MultibodyModel>(
     // Free-speed model: the remaining independent rates (the rear wheel
     // rotation) set the forward speed; speed is affine in them, solve for it.
     let others: Vec<usize> = (0..l.ni()).filter(|&k| k != c.roll_ind && k != c.steer_ind).collect();
-    if forward_speed_parameter::<M>().is_none() {
+    // A model whose only independent coordinates are roll and steer is
+    // driven (its speed parameter was set above); one more independent
+    // coordinate (the rear wheel angle) makes the speed free.
+    if !others.is_empty() {
         match others.as_slice() {
             [k] => {
                 let k = l.rates() + *k;
