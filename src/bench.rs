@@ -268,5 +268,6 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         el / (designs * speeds) as f64 * 1e9
     );
     crate::fit::bench_experiment(quick)?;
+    crate::bench_simulate::run(quick)?;
     Ok(())
 }

@@ -17,6 +17,7 @@ pub mod registry {
 }
 
 pub mod bench;
+pub mod bench_simulate;
 pub mod bicycle;
 pub mod fit;
 pub mod models;

@@ -12,6 +12,9 @@ use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod cli_simulate;
+mod cli_synth;
+
 #[derive(Parser)]
 #[command(
     name = "bikedyn",
@@ -151,6 +154,10 @@ enum Command {
         #[command(subcommand)]
         command: ParamsCommand,
     },
+    /// Nonlinear simulation (time histories to CSV and a plot).
+    Simulate(cli_simulate::SimulateArgs),
+    /// Synthetic field runs: launch, release, kick, free response (trajectories and truth).
+    Synth(cli_synth::SynthArgs),
     /// Print timing and operation-count figures of the generated code.
     Bench {
         /// Fewer repetitions (for a quick look).
@@ -599,6 +606,8 @@ fn run(cli: Cli) -> Result<bool> {
             }
         },
         Command::Fit(args) => bikedyn::fit::command(&args),
+        Command::Simulate(args) => cli_simulate::run(args),
+        Command::Synth(args) => cli_synth::run(args),
         Command::Bench { quick } => {
             bikedyn::bench::run(quick)?;
             Ok(true)

@@ -121,3 +121,14 @@ pub fn model_json(m: &ModelInfo) -> serde_json::Value {
         })).collect::<Vec<_>>(),
     })
 }
+
+/// The free-speed variant of a model: same base and effects, free speed
+/// (itself if it already has free speed).
+pub fn free_speed_variant(info: &'static ModelInfo) -> Option<&'static ModelInfo> {
+    if info.free_speed {
+        return Some(info);
+    }
+    MODELS
+        .iter()
+        .find(|m| m.free_speed && m.base == info.base && m.effects == info.effects)
+}

@@ -17,6 +17,7 @@ pub mod parameters;
 pub mod plot;
 pub mod registry;
 pub mod scalar;
+pub mod simulate;
 pub mod sweep;
 pub mod verify;
 

@@ -228,15 +228,15 @@ impl PlotOptions {
         x * self.scale
     }
 
-    fn pxi(&self, x: f64) -> i32 {
+    pub(crate) fn pxi(&self, x: f64) -> i32 {
         (x * self.scale).round() as i32
     }
 
-    fn pxu(&self, x: f64) -> u32 {
+    pub(crate) fn pxu(&self, x: f64) -> u32 {
         (x * self.scale).round().max(1.0) as u32
     }
 
-    fn font(&self, rel: f64) -> TextStyle<'static> {
+    pub(crate) fn font(&self, rel: f64) -> TextStyle<'static> {
         TextStyle::from((FAMILY, self.font_size * self.scale * rel).into_font())
     }
 }
@@ -400,18 +400,18 @@ fn ensure_font(opts: &PlotOptions) -> Result<(), PlotError> {
 // ---------------------------------------------------------------------------
 // Rendering
 
-type DrawErr = String;
+pub(crate) type DrawErr = String;
 
-fn de<E: std::fmt::Display>(e: E) -> DrawErr {
+pub(crate) fn de<E: std::fmt::Display>(e: E) -> DrawErr {
     e.to_string()
 }
 
 /// A figure that can draw itself on any plotters backend.
-trait Figure {
+pub(crate) trait Figure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr>;
 }
 
-fn render(path: &Path, opts: &PlotOptions, fig: &impl Figure) -> Result<(), PlotError> {
+pub(crate) fn render(path: &Path, opts: &PlotOptions, fig: &impl Figure) -> Result<(), PlotError> {
     let format = ImageFormat::from_path(path)?;
     opts.check(path)?;
     ensure_font(opts)?;
@@ -474,7 +474,7 @@ const CLASS_NAMES: [&str; 4] = ["weave", "capsize", "castering", "other"];
 const CLASS_COLORS: [RGBColor; 4] = [WEAVE, CAPSIZE, CASTERING, OTHER];
 
 /// Tick label: shortest decimal of the value rounded to 6 significant places.
-fn tick(v: f64) -> String {
+pub(crate) fn tick(v: f64) -> String {
     if v == 0.0 || v.abs() < 1e-12 {
         return "0".into();
     }
@@ -593,7 +593,7 @@ fn label_area_width<DB: DrawingBackend>(
     widest_tick(root, &o.font(0.9), range, n) + o.pxu(5.0 + 8.0) + o.pxu(o.font_size * 1.9)
 }
 
-fn padded(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
+pub(crate) fn padded(lo: f64, hi: f64, frac: f64) -> (f64, f64) {
     if !(lo.is_finite() && hi.is_finite()) {
         return (-1.0, 1.0);
     }

@@ -1,0 +1,697 @@
+//! Integration of the full nonlinear equations of any generated model.
+//!
+//! # Formulation (thesis section 3.8, eq. 40-47)
+//!
+//! The state is `y = [q, q', g, z]` ([`StateLayout`]): the independent
+//! coordinates `q` of the model (`M::INDEPENDENT`: roll theta and steer gamma
+//! for a driven-speed model; theta, rear wheel rotation psi and gamma for a
+//! free-speed one) and their rates, the ignorable coordinates `g` (those that
+//! are neither independent nor dependent: `xc yc phi eps`), and extra
+//! first-order states `z` (none yet; appended last). At every evaluation of
+//! the right-hand side:
+//!
+//! 1. the dependent positions (`M::DEPENDENT`: pitch beta, the front contact
+//!    angle xi and, in driven models, psi) are solved from the holonomic
+//!    constraints `Res(p, t) = 0` by Newton's method, warm-started from the
+//!    previous evaluation, to a max-norm residual of 1e-13;
+//! 2. all non-independent velocities solve `D_dep p'_dep = d - D_ind q'` with
+//!    `D = [Cq; B]` (holonomic at velocity level, and the rolling
+//!    constraints), so the velocity constraints hold to rounding;
+//! 3. with `p' = E q' + ...` and `p'' = E q'' + F` (`E = [I; -D_dep^-1 D_ind]`,
+//!    `F = [0; -D_dep^-1 (dCq/dp p' p' ; dB/dp p' p')]`) the reduced equations
+//!    `Mi q'' = Qi`, `Mi = E^T M E`, `Qi = E^T (Qv + Qgrav + Qext + Qin - M F)`
+//!    give `q''`; `Qin` are the torque pulses of [`Inputs`];
+//! 4. the ignorable coordinates are integrated from their rates (the
+//!    dependent velocities of step 2); time is a state too (`t' = 1`), which
+//!    makes the system autonomous for the integrator (see [`StateLayout`]).
+//!
+//! # Drift control
+//!
+//! There is no constraint drift to stabilise: the dependent positions are
+//! never integrated but re-solved at every evaluation, so the holonomic
+//! residual stays at the Newton tolerance (reported for every output sample
+//! as `constraint_residual`, about 1e-15 in practice); the dependent
+//! velocities are solved from the constraint matrix, so the velocity-level
+//! residual is at rounding. The ignorable coordinates (position and heading)
+//! are not constrained by any holonomic equation; their error is the
+//! integrator's, controlled by the tolerances like every other state. This is
+//! the thesis's own coordinate partitioning; it is valid as long as `D_dep`
+//! is regular (it is, for every configuration with both wheels on the ground
+//! and the steer away from 90 degrees); a singular `D_dep` is reported as
+//! [`SimulateError::Singular`].
+//!
+//! # Integrator
+//!
+//! `ode_solvers` 0.6.2 (`Dop853`, Hairer's DOP853: explicit Runge-Kutta of
+//! order 8(5,3), adaptive step with error control, 7th-order dense output),
+//! chosen because it uses the workspace's nalgebra 0.34 (no second nalgebra,
+//! a few seconds of build time) and is a faithful port of Hairer's code. The
+//! Whipple model with or without mild dissipation is not stiff. A stiff
+//! method (BDF/SDIRK of diffsol, nalgebra 0.35) is not wired in: see the
+//! README's "Simulation" section.
+//!
+//! Kicks and pulse edges are breakpoints: the integration restarts there, so
+//! the error control never steps over a discontinuity.
+
+mod inputs;
+mod rhs;
+
+pub mod fit;
+pub mod plot;
+pub mod trajectory;
+
+pub use inputs::{Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, StopReason, TorquePulse};
+pub use rhs::{forward_speed, forward_speed_parameter, BicycleCoordinates, Evaluator, StateLayout};
+
+use std::io::Write;
+use std::path::Path;
+
+use ode_solvers::{DVector, Dop853, OutputType, System};
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::model::MultibodyModel;
+use crate::output::{write_atomic, OutputError};
+
+/// Why a simulation failed.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum SimulateError {
+    /// The model lacks a coordinate the simulation needs by name.
+    #[error("model `{model}` has no coordinate `{name}` (the simulation needs the thesis's coordinates xc yc phi theta psi beta gamma)")]
+    MissingCoordinate { model: &'static str, name: &'static str },
+    /// Roll and steer must be independent coordinates.
+    #[error("coordinate `{name}` of model `{model}` is not independent")]
+    NotIndependent { model: &'static str, name: &'static str },
+    #[error("model `{model}` takes {expected} parameters, {got} given")]
+    ParameterCount {
+        model: &'static str,
+        expected: usize,
+        got: usize,
+    },
+    #[error("model `{model}` needs parameter `{name}`")]
+    MissingParameter { model: &'static str, name: &'static str },
+    /// An option or input is out of range.
+    #[error("invalid input: {0}")]
+    InvalidInput(String),
+    #[error("non-finite value in {what}")]
+    NotFinite { what: String },
+    /// Newton did not satisfy the holonomic constraints.
+    #[error("holonomic constraints not satisfiable at t = {t} s (residual {residual:.3e} after {iterations} Newton iterations): the wheels cannot both touch the ground here")]
+    Constraint { t: f64, residual: f64, iterations: usize },
+    /// A matrix of the coordinate partitioning is singular.
+    #[error("{what} singular at t = {t} s (column {column}, pivot {pivot:.3e})")]
+    Singular {
+        t: f64,
+        what: &'static str,
+        column: usize,
+        pivot: f64,
+    },
+    /// The integrator gave up.
+    #[error("integrator failed at t = {t} s: {message}")]
+    Integrator { t: f64, message: String },
+}
+
+/// Integration options, with documented defaults.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SimOptions {
+    /// Relative tolerance (default 1e-8).
+    pub rtol: f64,
+    /// Absolute tolerance (default 1e-10).
+    pub atol: f64,
+    /// Output sample interval (s, default 0.01); samples come from the
+    /// integrator's dense output, the step size is independent of it.
+    pub output_interval: f64,
+    /// Events that stop the run.
+    pub events: Events,
+}
+
+impl Default for SimOptions {
+    fn default() -> Self {
+        SimOptions {
+            rtol: 1e-8,
+            atol: 1e-10,
+            output_interval: 0.01,
+            events: Events::default(),
+        }
+    }
+}
+
+/// Integrator statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SimStats {
+    /// Right-hand-side evaluations (including those of the output samples and
+    /// event location).
+    pub rhs_evaluations: u64,
+    pub accepted_steps: u64,
+    pub rejected_steps: u64,
+}
+
+/// A simulated run: samples of every coordinate and rate and the diagnostics.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Simulation {
+    /// Model name.
+    pub model: &'static str,
+    /// Coordinate names, in the order of `p` and `dp`.
+    pub coordinates: Vec<&'static str>,
+    /// Parameter vector used.
+    pub parameters: Vec<f64>,
+    /// Sample times (s). A kick gives two samples at its time: before and after.
+    pub t: Vec<f64>,
+    /// Coordinates at each sample.
+    pub p: Vec<Vec<f64>>,
+    /// Rates at each sample.
+    pub dp: Vec<Vec<f64>>,
+    /// Forward speed of the rear contact point (m/s).
+    pub speed: Vec<f64>,
+    /// Kinetic energy (J).
+    pub kinetic_energy: Vec<f64>,
+    /// Potential energy of gravity (J).
+    pub potential_energy: Vec<f64>,
+    /// Max-norm of the holonomic residuals `Res(p, t)` (m, rad).
+    pub constraint_residual: Vec<f64>,
+    /// Max-norm of the velocity constraints `D p' - d` (m/s, rad/s).
+    pub velocity_residual: Vec<f64>,
+    pub stop: StopReason,
+    pub stats: SimStats,
+    pub options: SimOptions,
+}
+
+impl Simulation {
+    /// Column of a coordinate by name.
+    pub fn coordinate(&self, name: &str) -> Option<Vec<f64>> {
+        let j = self.coordinates.iter().position(|c| *c == name)?;
+        Some(self.p.iter().map(|p| p[j]).collect())
+    }
+    /// Rate of a coordinate by name.
+    pub fn rate(&self, name: &str) -> Option<Vec<f64>> {
+        let j = self.coordinates.iter().position(|c| *c == name)?;
+        Some(self.dp.iter().map(|p| p[j]).collect())
+    }
+    /// Largest holonomic residual over the run.
+    pub fn max_constraint_residual(&self) -> f64 {
+        self.constraint_residual.iter().fold(0.0, |m, x| m.max(*x))
+    }
+    /// Largest velocity-constraint residual over the run.
+    pub fn max_velocity_residual(&self) -> f64 {
+        self.velocity_residual.iter().fold(0.0, |m, x| m.max(*x))
+    }
+    /// Largest relative change of the total energy `T + V` over the run,
+    /// `max |E(t) - E(0)| / |E(0)|` (after the last kick: kicks inject energy).
+    pub fn relative_energy_drift(&self) -> f64 {
+        let e: Vec<f64> = self
+            .kinetic_energy
+            .iter()
+            .zip(&self.potential_energy)
+            .map(|(k, v)| k + v)
+            .collect();
+        if e.is_empty() {
+            return 0.0;
+        }
+        // Start after the last duplicated (kick) time.
+        let start = (1..self.t.len())
+            .rev()
+            .find(|&i| self.t[i] == self.t[i - 1])
+            .unwrap_or(0);
+        let e0 = e[start];
+        e[start..].iter().fold(0.0f64, |m, x| m.max((x - e0).abs())) / e0.abs().max(f64::MIN_POSITIVE)
+    }
+
+    /// CSV header: `t`, every coordinate, `d` + every coordinate, `speed`,
+    /// `kinetic_energy`, `potential_energy`, `constraint_residual`.
+    pub fn csv_header(&self) -> Vec<String> {
+        let mut h = vec!["t".to_string()];
+        h.extend(self.coordinates.iter().map(|c| c.to_string()));
+        h.extend(self.coordinates.iter().map(|c| format!("d{c}")));
+        for s in ["speed", "kinetic_energy", "potential_energy", "constraint_residual"] {
+            h.push(s.into());
+        }
+        h
+    }
+
+    /// Write the CSV (see [`Simulation::csv_header`]).
+    pub fn write_csv<W: Write>(&self, w: W) -> Result<(), csv::Error> {
+        let mut c = csv::Writer::from_writer(w);
+        c.write_record(self.csv_header())?;
+        for i in 0..self.t.len() {
+            let mut row = vec![format!("{:.6}", self.t[i])];
+            row.extend(self.p[i].iter().map(|x| format!("{x:.12e}")));
+            row.extend(self.dp[i].iter().map(|x| format!("{x:.12e}")));
+            for x in [
+                self.speed[i],
+                self.kinetic_energy[i],
+                self.potential_energy[i],
+                self.constraint_residual[i],
+            ] {
+                row.push(format!("{x:.12e}"));
+            }
+            c.write_record(&row)?;
+        }
+        c.flush()?;
+        Ok(())
+    }
+
+    /// Write the CSV atomically to `path`.
+    pub fn save_csv(&self, path: impl AsRef<Path>) -> Result<(), OutputError> {
+        write_atomic(path, |w| self.write_csv(w))
+    }
+}
+
+/// The integrator's view of the model.
+struct Rhs<'e, 'a, M: MultibodyModel> {
+    eval: &'e Evaluator<'a, M>,
+    events: Events,
+}
+
+impl<M: MultibodyModel> System<f64, DVector<f64>> for Rhs<'_, '_, M> {
+    fn system(&self, _x: f64, y: &DVector<f64>, dy: &mut DVector<f64>) {
+        // Time is the state's clock component (see `StateLayout`).
+        let t = y[self.eval.layout.time()];
+        if self.eval.error.borrow().is_some() {
+            dy.fill(f64::NAN);
+            return;
+        }
+        if let Err(e) = self.eval.derivative(t, y.as_slice(), dy.as_mut_slice()) {
+            *self.eval.error.borrow_mut() = Some(e);
+            dy.fill(f64::NAN);
+        }
+    }
+    fn solout(&mut self, _t: f64, y: &DVector<f64>, _dy: &DVector<f64>) -> bool {
+        self.eval.error.borrow().is_some() || event_value(self.eval, &self.events, y.as_slice()).0 <= 0.0
+    }
+}
+
+/// Smallest event margin (`limit - |angle|`, rad) and which event it is
+/// (0 roll, 1 steer).
+fn event_value<M: MultibodyModel>(eval: &Evaluator<'_, M>, ev: &Events, y: &[f64]) -> (f64, usize) {
+    let c = &eval.coords;
+    let mut g = (f64::INFINITY, 0);
+    if let Some(l) = ev.roll_limit {
+        g = (l - y[c.roll_ind].abs(), 0);
+    }
+    if let Some(l) = ev.steer_limit {
+        let s = l - y[c.steer_ind].abs();
+        if s < g.0 {
+            g = (s, 1);
+        }
+    }
+    g
+}
+
+/// Integrate from `(t0, y0)` to `t1` and return the final state (no dense
+/// output).
+fn integrate_to<M: MultibodyModel>(
+    eval: &Evaluator<'_, M>,
+    t0: f64,
+    y0: &[f64],
+    t1: f64,
+    opts: &SimOptions,
+    stats: &mut SimStats,
+) -> Result<Vec<f64>, SimulateError> {
+    if t1 <= t0 {
+        return Ok(y0.to_vec());
+    }
+    let rhs = Rhs {
+        eval,
+        events: Events {
+            roll_limit: None,
+            steer_limit: None,
+        },
+    };
+    let mut s = Dop853::new(
+        rhs,
+        t0,
+        t1,
+        t1 - t0,
+        DVector::from_column_slice(y0),
+        opts.rtol,
+        opts.atol,
+    );
+    s.set_output(OutputType::Sparse);
+    let r = s.integrate();
+    if let Some(e) = eval.error.borrow_mut().take() {
+        return Err(e);
+    }
+    let st = r.map_err(|e| SimulateError::Integrator {
+        t: t0,
+        message: e.to_string(),
+    })?;
+    stats.accepted_steps += st.accepted_steps as u64;
+    stats.rejected_steps += st.rejected_steps as u64;
+    Ok(s.y_out()
+        .last()
+        .expect("the integrator outputs its end point")
+        .as_slice()
+        .to_vec())
+}
+
+/// The state vector for given initial conditions (consistent with all
+/// constraints), and the parameter vector with the speed set for a driven
+/// model.
+pub fn initial_state<M: MultibodyModel>(
+    param: &[f64],
+    ic: &InitialConditions,
+) -> Result<(Vec<f64>, Vec<f64>), SimulateError> {
+    for (name, x) in [
+        ("roll", ic.roll),
+        ("steer", ic.steer),
+        ("roll rate", ic.roll_rate),
+        ("steer rate", ic.steer_rate),
+        ("speed", ic.speed),
+        ("yaw", ic.yaw),
+    ] {
+        if !x.is_finite() {
+            return Err(SimulateError::NotFinite {
+                what: format!("initial {name}"),
+            });
+        }
+    }
+    let mut param = param.to_vec();
+    let driven = M::INDEPENDENT.len() == 2;
+    if let Some(k) = forward_speed_parameter::<M>().filter(|_| driven) {
+        if k < param.len() {
+            param[k] = ic.speed;
+        }
+    }
+    let inputs = Inputs::default();
+    let eval = Evaluator::<M>::new(&param, &inputs)?;
+    let l = &eval.layout;
+    let c = eval.coords;
+    let mut y = vec![0.0; l.len()];
+    for (k, &j) in l.independent.iter().enumerate() {
+        y[k] = M::INITIAL_GUESS[j];
+    }
+    for (k, &j) in l.ignorable.iter().enumerate() {
+        y[l.ignorables() + k] = M::INITIAL_GUESS[j];
+    }
+    y[l.time()] = 0.0;
+    y[c.roll_ind] = ic.roll;
+    y[c.steer_ind] = ic.steer;
+    y[l.rates() + c.roll_ind] = ic.roll_rate;
+    y[l.rates() + c.steer_ind] = ic.steer_rate;
+    if let Some(k) = l.ignorable.iter().position(|&j| j == c.yaw) {
+        y[l.ignorables() + k] = ic.yaw;
+    }
+    // Free-speed model: the remaining independent rates (the rear wheel
+    // rotation) set the forward speed; speed is affine in them, solve for it.
+    let others: Vec<usize> = (0..l.ni()).filter(|&k| k != c.roll_ind && k != c.steer_ind).collect();
+    // A model whose only independent coordinates are roll and steer is
+    // driven (its speed parameter was set above); one more independent
+    // coordinate (the rear wheel angle) makes the speed free.
+    if !others.is_empty() {
+        match others.as_slice() {
+            [k] => {
+                let k = l.rates() + *k;
+                y[k] = 0.0;
+                let (p0, dp0) = eval.full_state(0.0, &y)?;
+                let s0 = forward_speed(&c, &p0, &dp0);
+                y[k] = 1.0;
+                let (p1, dp1) = eval.full_state(0.0, &y)?;
+                let s1 = forward_speed(&c, &p1, &dp1) - s0;
+                if !(s1.abs() > 1e-12) {
+                    return Err(SimulateError::InvalidInput(
+                        "the free independent rate does not change the forward speed".into(),
+                    ));
+                }
+                y[k] = (ic.speed - s0) / s1;
+            }
+            _ => {
+                return Err(SimulateError::InvalidInput(format!(
+                "model `{}` has no speed parameter and {} independent coordinates besides roll and steer (expected 1)",
+                M::NAME,
+                others.len()
+            )))
+            }
+        }
+    }
+    // Check that the configuration exists.
+    eval.full_state(0.0, &y)?;
+    Ok((y, param))
+}
+
+/// Simulate model `M` with parameters `param` from `ic` for `duration`
+/// seconds with the perturbations `inputs`.
+pub fn simulate<M: MultibodyModel>(
+    param: &[f64],
+    ic: &InitialConditions,
+    inputs: &Inputs,
+    duration: f64,
+    opts: &SimOptions,
+) -> Result<Simulation, SimulateError> {
+    if !(duration > 0.0 && duration.is_finite()) {
+        return Err(SimulateError::InvalidInput(format!(
+            "duration must be positive, got {duration}"
+        )));
+    }
+    if !(opts.rtol > 0.0 && opts.rtol < 1.0 && opts.atol > 0.0) {
+        return Err(SimulateError::InvalidInput(format!(
+            "tolerances must be positive (rtol {} in (0, 1), atol {})",
+            opts.rtol, opts.atol
+        )));
+    }
+    if !(opts.output_interval > 0.0 && opts.output_interval.is_finite()) {
+        return Err(SimulateError::InvalidInput("output interval must be positive".into()));
+    }
+    if duration / opts.output_interval > 1e7 {
+        return Err(SimulateError::InvalidInput(
+            "more than 10^7 output samples: increase the output interval".into(),
+        ));
+    }
+    for p in &inputs.pulses {
+        if !(p.duration > 0.0 && p.duration.is_finite() && p.start.is_finite() && p.amplitude.is_finite()) {
+            return Err(SimulateError::InvalidInput(format!("bad torque pulse {p:?}")));
+        }
+    }
+    for k in &inputs.kicks {
+        if !(k.time.is_finite() && k.impulse.is_finite() && k.ahead.is_finite() && k.height.is_finite()) {
+            return Err(SimulateError::InvalidInput(format!("bad kick {k:?}")));
+        }
+        if !(k.time >= 0.0 && k.time < duration) {
+            return Err(SimulateError::InvalidInput(format!(
+                "kick at t = {} s is outside the run [0, {duration}) s",
+                k.time
+            )));
+        }
+    }
+    let (mut y, param) = initial_state::<M>(param, ic)?;
+    let eval = Evaluator::<M>::new(&param, inputs)?;
+    if event_value(&eval, &opts.events, &y).0 <= 0.0 {
+        return Err(SimulateError::InvalidInput(format!(
+            "the initial roll {:.4} rad or steer {:.4} rad is already at its limit ({:?})",
+            ic.roll, ic.steer, opts.events
+        )));
+    }
+    let rt = rhs::rolling_radius::<M>(&param, &eval.coords)?;
+    // Kick points in rear-frame axes, from the upright reference pitch.
+    let (p_up, _) = {
+        let mut yu = y.clone();
+        let c = &eval.coords;
+        yu[c.roll_ind] = 0.0;
+        yu[c.steer_ind] = 0.0;
+        eval.full_state(0.0, &yu)?
+    };
+    let beta0 = p_up[eval.coords.pitch];
+    let kick_point = |k: &Kick| {
+        // roll-frame vector from the rear wheel centre, rotated into frame axes (A_beta^T).
+        let (sb, cb) = beta0.sin_cos();
+        let (a, h) = (k.ahead, k.height - rt);
+        [cb * a - sb * h, 0.0, sb * a + cb * h]
+    };
+
+    let mut sim = Simulation {
+        model: M::NAME,
+        coordinates: M::COORDINATES.to_vec(),
+        parameters: param.clone(),
+        t: vec![],
+        p: vec![],
+        dp: vec![],
+        speed: vec![],
+        kinetic_energy: vec![],
+        potential_energy: vec![],
+        constraint_residual: vec![],
+        velocity_residual: vec![],
+        stop: StopReason::Completed,
+        stats: SimStats::default(),
+        options: *opts,
+    };
+    let push = |sim: &mut Simulation, t: f64, y: &[f64]| -> Result<(), SimulateError> {
+        let (p, dp) = eval.full_state(t, y)?;
+        let (r, v) = eval.residuals(t, &p, &dp);
+        sim.t.push(t);
+        sim.speed.push(forward_speed(&eval.coords, &p, &dp));
+        sim.kinetic_energy.push(M::kinetic_energy(&param, &p, &dp));
+        sim.potential_energy.push(M::potential_energy(&param, &p));
+        sim.constraint_residual.push(r);
+        sim.velocity_residual.push(v);
+        sim.p.push(p);
+        sim.dp.push(dp);
+        Ok(())
+    };
+
+    let mut cuts: Vec<f64> = inputs
+        .breakpoints()
+        .into_iter()
+        .filter(|&b| b > 0.0 && b < duration)
+        .collect();
+    cuts.push(duration);
+    let mut t0 = 0.0;
+    let mut first = true;
+    'segments: for &t1 in &cuts {
+        // Kicks at the segment start (those at or before 0 act at 0). The
+        // sample before a kick is the previous segment's last (or, at 0,
+        // pushed here); the kicked state starts the segment.
+        let kicks: Vec<&Kick> = inputs
+            .kicks
+            .iter()
+            .filter(|k| k.time == t0 || (first && k.time <= 0.0))
+            .collect();
+        let kicked = !kicks.is_empty();
+        if kicked && first {
+            push(&mut sim, t0, &y)?;
+        }
+        for k in kicks {
+            let (p, _) = eval.full_state(t0, &y)?;
+            let qhat = eval.lateral_impulse(&p, kick_point(k), k.impulse, rt);
+            eval.apply_impulse(t0, &mut y, &qhat)?;
+        }
+        let n = ((t1 - t0) / opts.output_interval - 1e-9).ceil().max(1.0);
+        let dx = (t1 - t0) / n;
+        eval.segment.set((t0, t1));
+        let rhs = Rhs {
+            eval: &eval,
+            events: opts.events,
+        };
+        // Integrate slightly past the segment end: ode_solvers 0.6.2 pushes
+        // an *extrapolated* dense sample at `x_end` whenever its next grid
+        // time is within 1e-9 of `x_end`, even from a step that ends before
+        // it. With the end off the grid the sample at `t1` is interpolated
+        // from the step that contains it.
+        let overshoot = (1e-6f64).min(0.01 * dx).max(1e-8);
+        let mut s = Dop853::new(
+            rhs,
+            t0,
+            t1 + overshoot,
+            dx,
+            DVector::from_column_slice(&y),
+            opts.rtol,
+            opts.atol,
+        );
+        s.set_output(OutputType::Dense);
+        let r = s.integrate();
+        if let Some(e) = eval.error.borrow_mut().take() {
+            return Err(e);
+        }
+        let st = r.map_err(|e| SimulateError::Integrator {
+            t: t0,
+            message: e.to_string(),
+        })?;
+        sim.stats.accepted_steps += st.accepted_steps as u64;
+        sim.stats.rejected_steps += st.rejected_steps as u64;
+        let (mut ts, ys) = (s.x_out().clone(), s.y_out().clone());
+        if let Some(last) = ts.last_mut() {
+            if (*last - t1).abs() <= 1e-9 * t1.abs().max(1.0) {
+                *last = t1;
+            }
+        }
+        // The first sample is the segment start: skip it unless this is the
+        // first segment or a kick changed the state.
+        let skip = if first || kicked { 0 } else { 1 };
+        let mut prev: Option<(f64, Vec<f64>)> = None;
+        for (t, yv) in ts.iter().zip(ys.iter()).skip(skip) {
+            let yv = yv.as_slice();
+            let (g, which) = event_value(&eval, &opts.events, yv);
+            if g <= 0.0 {
+                // Locate the crossing between the previous sample and this one.
+                let (ta, ya) = prev.clone().unwrap_or((t0, y.clone()));
+                let (te, ye) = locate_event(&eval, opts, ta, &ya, *t, &mut sim.stats)?;
+                if te > ta {
+                    push(&mut sim, te, &ye)?;
+                }
+                let c = &eval.coords;
+                sim.stop = if which == 0 {
+                    StopReason::Fell {
+                        time: te,
+                        roll: ye[c.roll_ind],
+                    }
+                } else {
+                    StopReason::SteerStop {
+                        time: te,
+                        steer: ye[c.steer_ind],
+                    }
+                };
+                break 'segments;
+            }
+            push(&mut sim, *t, yv)?;
+            prev = Some((*t, yv.to_vec()));
+        }
+        let last_t = *ts.last().expect("dense output has the start point");
+        if (last_t - t1).abs() > 1e-9 * t1.abs().max(1.0) {
+            // The dense output stopped short of the segment end (the step
+            // cap or an early stop); finish without output.
+            let ya = ys.last().expect("non-empty").as_slice().to_vec();
+            y = integrate_to(&eval, last_t, &ya, t1, opts, &mut sim.stats)?;
+        } else {
+            y = ys.last().expect("non-empty").as_slice().to_vec();
+        }
+        t0 = t1;
+        first = false;
+    }
+    sim.stats.rhs_evaluations = eval.evaluations.get();
+    Ok(sim)
+}
+
+/// Find the event time in `(ta, tb)` (margin positive at `ta`, not at `tb`)
+/// by the Illinois variant of regula falsi, re-integrating from `ta`.
+fn locate_event<M: MultibodyModel>(
+    eval: &Evaluator<'_, M>,
+    opts: &SimOptions,
+    ta: f64,
+    ya: &[f64],
+    tb: f64,
+    stats: &mut SimStats,
+) -> Result<(f64, Vec<f64>), SimulateError> {
+    let g = |y: &[f64]| event_value(eval, &opts.events, y).0;
+    let (mut a, mut ga) = (ta, g(ya));
+    let yb = integrate_to(eval, ta, ya, tb, opts, stats)?;
+    let (mut b, mut gb) = (tb, g(&yb));
+    if ga <= 0.0 {
+        return Ok((ta, ya.to_vec()));
+    }
+    let mut best = (tb, yb, gb.abs());
+    let mut side = 0;
+    for _ in 0..60 {
+        if (b - a) < 1e-10 {
+            break;
+        }
+        let tm = (a * gb - b * ga) / (gb - ga);
+        let tm = if tm.is_finite() && tm > a && tm < b {
+            tm
+        } else {
+            0.5 * (a + b)
+        };
+        let ym = integrate_to(eval, ta, ya, tm, opts, stats)?;
+        let gm = g(&ym);
+        let done = gm.abs() < 1e-12;
+        if gm.abs() < best.2 {
+            best = (tm, ym, gm.abs());
+        }
+        if gm <= 0.0 {
+            b = tm;
+            gb = gm;
+            if side == -1 {
+                ga *= 0.5;
+            }
+            side = -1;
+        } else {
+            a = tm;
+            ga = gm;
+            if side == 1 {
+                gb *= 0.5;
+            }
+            side = 1;
+        }
+        if done {
+            break;
+        }
+    }
+    Ok((best.0, best.1))
+}

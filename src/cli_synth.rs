@@ -1,0 +1,200 @@
+//! `bikedyn synth`: synthetic field runs (issue 7, point 6), the physical
+//! side. Each run is a hand-held launch, release, saddle kick and free
+//! response of the chosen model ([`trajectory_for_run`]); this command writes
+//! per run the orientation history (`<run>_trajectory.csv`: t, yaw, roll,
+//! pitch, steer, rear_wheel_angle in rad, speed in m/s, thesis conventions)
+//! and a truth file (`<run>_truth.json`: run plan, parameters, state at
+//! release, stop reason, frozen-speed eigenvalues at the mean speed after
+//! release).
+//!
+//! The sensor side is `experiment::synth::write_run`: every run becomes a
+//! run folder in the measured-run format of `../shared/data/FORMAT.md`
+//! (IMU quaternions, reed switch, run.toml) with sensor effects, beside a
+//! `calibration/` folder (the bicycle at rest). The truth (physical and
+//! sensor) goes to `truth/`, outside the set, so `bikedyn fit OUT` reads the
+//! set as it would a measured one.
+
+use anyhow::{bail, Context, Result};
+use bikedyn::bicycle::{canonical_of, Bicycle};
+use bikedyn::registry::{with_model, ModelVisitor};
+use bikedyn::runtime::eigen::eigenvalues;
+use bikedyn::runtime::experiment::synth::{rest_trajectory, write_run, RunKind, SensorModel, Trajectory};
+use bikedyn::runtime::linearize::parameter_vector;
+use bikedyn::runtime::output::{save_json, write_atomic};
+use bikedyn::runtime::simulate::trajectory::{trajectory_for_run, RunPlan, RunTrajectory};
+use bikedyn::runtime::simulate::{SimOptions, Simulation};
+use bikedyn::runtime::MultibodyModel;
+use clap::Args;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Arguments of `bikedyn synth`.
+#[derive(Args)]
+pub struct SynthArgs {
+    /// Built-in bicycle (thesis, benchmark) or parameter file.
+    #[arg(long, default_value = "thesis")]
+    bike: String,
+    /// Generated model (default: thesis_whipple, or whipple_offset when the
+    /// fork mass centre is off the steer axis).
+    #[arg(long)]
+    model: Option<String>,
+    /// Number of runs.
+    #[arg(long, default_value_t = 3)]
+    runs: usize,
+    /// Seed of the run plans (run k uses seed + k).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Output folder.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// A per-run clock offset: the nominal one plus up to +/- 0.3 s, as in
+/// FORMAT.md (SplitMix64 of the seed, so runs are reproducible).
+fn clock_offset(nominal: f64, seed: u64) -> f64 {
+    let mut z = seed.wrapping_add(0x9E3779B97F4A7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
+    z ^= z >> 31;
+    nominal + 0.6 * ((z >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+}
+
+fn sensor_trajectory(tr: &RunTrajectory) -> Trajectory {
+    Trajectory {
+        t: tr.t.clone(),
+        yaw: tr.yaw.clone(),
+        roll: tr.roll.clone(),
+        pitch: tr.pitch.clone(),
+        steer: tr.steer.clone(),
+        rear_wheel_angle: tr.rear_wheel_angle.clone(),
+    }
+}
+
+fn write_physical_run(dir: &Path, name: &str, tr: &RunTrajectory, truth: &serde_json::Value) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    write_atomic(dir.join(format!("{name}_trajectory.csv")), |w: &mut dyn Write| {
+        writeln!(w, "t,yaw,roll,pitch,steer,rear_wheel_angle,speed")?;
+        for i in 0..tr.t.len() {
+            writeln!(
+                w,
+                "{:.6},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.9e}",
+                tr.t[i], tr.yaw[i], tr.roll[i], tr.pitch[i], tr.steer[i], tr.rear_wheel_angle[i], tr.speed[i]
+            )?;
+        }
+        Ok::<(), std::io::Error>(())
+    })?;
+    save_json(dir.join(format!("{name}_truth.json")), truth)?;
+    Ok(())
+}
+
+fn one_run<M: MultibodyModel>(
+    lookup: &dyn Fn(&str) -> Option<f64>,
+    plan: &RunPlan,
+) -> Result<(RunTrajectory, Simulation, Vec<f64>)> {
+    let param = parameter_vector::<M>(lookup, plan.speed)?;
+    let (tr, sim) = trajectory_for_run::<M>(&param, plan, &SimOptions::default())?;
+    Ok((tr, sim, param))
+}
+
+struct OneRun<'a, F: Fn(&str) -> Option<f64>> {
+    lookup: &'a F,
+    plan: &'a RunPlan,
+}
+impl<F: Fn(&str) -> Option<f64>> ModelVisitor for OneRun<'_, F> {
+    #[allow(clippy::type_complexity)]
+    type Output = Result<(RunTrajectory, Simulation, Vec<f64>, &'static [&'static str])>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        let (t, s, pv) = one_run::<M>(self.lookup, self.plan)?;
+        Ok((t, s, pv, M::PARAMETERS))
+    }
+}
+
+/// Run `bikedyn synth`.
+pub fn run(a: SynthArgs) -> Result<bool> {
+    if a.runs == 0 || a.runs > 1000 {
+        bail!("--runs must be between 1 and 1000");
+    }
+    let bike = Bicycle::resolve(&a.bike)?;
+    let p = bike.thesis()?;
+    let canonical = canonical_of(&p)?;
+    let info = bike.model(a.model.as_deref())?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let lookup = bike.lookup()?;
+    // Sensors like the thesis's instrumentation (FORMAT.md), on this
+    // bicycle's rear wheel.
+    let sensors = SensorModel {
+        wheel_circumference: 2.0 * std::f64::consts::PI * p.rear_wheel_radius,
+        ..SensorModel::default()
+    };
+    for k in 0..a.runs {
+        let plan = RunPlan::random(a.seed.wrapping_add(k as u64));
+        let (tr, sim, param, names) = with_model(
+            info.name,
+            OneRun {
+                lookup: &lookup,
+                plan: &plan,
+            },
+        )
+        .expect("registered model")?;
+        let release = tr.t.iter().position(|&t| t >= plan.launch_duration).unwrap_or(0);
+        let mean_speed = tr.speed[release..].iter().sum::<f64>() / (tr.speed.len() - release).max(1) as f64;
+        let ev = eigenvalues(&canonical, mean_speed)?;
+        let name = format!("run{:02}", k + 1);
+        let truth = serde_json::json!({
+            "model": sim.model,
+            "bike": a.bike,
+            "plan": plan,
+            "parameters": names.iter().zip(&param).map(|(n, v)| (n.to_string(), serde_json::Value::from(*v))).collect::<serde_json::Map<_, _>>(),
+            "release": {
+                "time": plan.launch_duration,
+                "roll": tr.roll[release], "steer": tr.steer[release], "yaw": tr.yaw[release],
+                "roll_rate": sim.rate("theta").map(|r| r[0]), "steer_rate": sim.rate("gamma").map(|r| r[0]),
+                "speed": plan.speed,
+            },
+            "kick_time": plan.launch_duration + plan.kick_delay,
+            "stop": sim.stop.to_string(),
+            "max_constraint_residual": sim.max_constraint_residual(),
+            "mean_speed_after_release": mean_speed,
+            "frozen_speed_eigenvalues": ev.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
+        });
+        if k == 0 {
+            // The calibration run: the bicycle held at rest, upright, at the
+            // pitch of the model's upright configuration.
+            let pitch = tr.pitch.first().copied().unwrap_or(0.0);
+            let cal = rest_trajectory(10.0, pitch, 0.0);
+            let mut sensors = sensors.clone();
+            sensors.clock_offset = clock_offset(sensors.nominal_offset, a.seed);
+            write_run(
+                &a.out.join("calibration"),
+                "calibration",
+                RunKind::Calibration,
+                &cal,
+                &sensors,
+                a.seed,
+            )?;
+        }
+        let mut sensors = sensors.clone();
+        sensors.clock_offset = clock_offset(sensors.nominal_offset, a.seed.wrapping_add(1 + k as u64));
+        let sensor_truth = write_run(
+            &a.out.join(&name),
+            &name,
+            RunKind::Run,
+            &sensor_trajectory(&tr),
+            &sensors,
+            a.seed.wrapping_add(1 + k as u64),
+        )?;
+        let mut truth = truth;
+        truth["sensors"] = serde_json::to_value(&sensor_truth)?;
+        write_physical_run(&a.out.join("truth"), &name, &tr, &truth)?;
+        println!(
+            "{name}: release at {:.2} s, {:.2} m/s, kick {:+.2} N s at {:.2} s, {}",
+            plan.launch_duration,
+            plan.speed,
+            plan.kick_impulse,
+            plan.launch_duration + plan.kick_delay,
+            sim.stop
+        );
+    }
+    println!("wrote {} runs to {}", a.runs, a.out.display());
+    Ok(true)
+}
