@@ -66,17 +66,19 @@ fn a_front_wheel_that_cannot_reach_the_ground_is_a_typed_error_not_nan() {
     let mut t = ThesisParameters::thesis_bicycle();
     t.front_wheel_radius = 3.0; // far larger than the wheelbase allows
     let err = canonical_matrices::<W>(|s| t.get(s)).unwrap_err();
+    // Detected from the geometry before Newton runs (issue 10, point 1).
     match err {
-        LinearizeError::Constraint(ConstraintError::NotSatisfiable {
-            constraint, residual, ..
+        LinearizeError::Constraint(ConstraintError::NoGroundContact {
+            height_difference,
+            reach,
         }) => {
-            assert!(constraint.starts_with("front_contact"), "{constraint}");
-            assert!(residual.is_finite() && residual > 1e-3);
+            assert!((height_difference - (3.0 - t.rear_wheel_radius)).abs() < 1e-12);
+            assert!(reach.is_finite() && reach < height_difference);
         }
-        other => panic!("expected NotSatisfiable, got {other:?}"),
+        other => panic!("expected NoGroundContact, got {other:?}"),
     }
     let msg = canonical_matrices::<W>(|s| t.get(s)).unwrap_err().to_string();
-    assert!(msg.contains("no ground contact"), "{msg}");
+    assert!(msg.contains("cannot touch the ground"), "{msg}");
 }
 
 #[test]

@@ -49,6 +49,11 @@ pub enum ConstraintError {
         column: usize,
         pivot: f64,
     },
+    /// The front wheel cannot reach the ground ahead of the rear wheel: the
+    /// height difference of the wheel centres `Rd - Rt` is at least the
+    /// distance `reach` from the rear wheel centre to the front one.
+    #[error("the front wheel cannot touch the ground: |Rd - Rt| = {height_difference_abs:.6} m is not less than the distance between the wheel centres ({reach:.6} m)", height_difference_abs = height_difference.abs())]
+    NoGroundContact { height_difference: f64, reach: f64 },
     /// A parameter, coordinate or result is NaN or infinite.
     #[error("non-finite value in {what}")]
     NotFinite { what: &'static str },

@@ -30,12 +30,42 @@ pub enum LinearizeError {
     NotRollSteer { model: &'static str, n: usize },
     #[error("the reduced mass matrix is singular")]
     SingularMass,
+    /// The constraint solver converged to a root that is not the physical
+    /// upright configuration (issue 10, point 1): refusing is better than
+    /// returning the matrices of another bicycle.
+    #[error("the constraint solution is not the physical upright bicycle: {coordinate} = {value:.6} rad, but the geometry gives {expected:.6} rad ({what}); refusing rather than returning the matrices of another root")]
+    OffBranch {
+        coordinate: &'static str,
+        value: f64,
+        expected: f64,
+        what: &'static str,
+    },
+    /// A wheel of zero radius (a skate) that has a spin inertia: its spin
+    /// rate, and so its gyroscopic moment, would be infinite.
+    #[error("the {wheel} has zero radius ({radius_symbol} = 0) but a non-zero spin inertia ({inertia_symbol} = {inertia}): a skate wheel must have zero spin inertia")]
+    SkateWithSpinInertia {
+        wheel: &'static str,
+        radius_symbol: &'static str,
+        inertia_symbol: &'static str,
+        inertia: f64,
+    },
+    /// The parameters could not be converted for a derived computation.
+    #[error("{0}")]
+    Parameters(String),
+    /// The zero-radius limit could not be taken reliably (the matrices are
+    /// not the quadratic polynomial in the radius that the closed form says).
+    #[error("the zero-radius limit is not reliable here (departure from a quadratic in the radius: {departure:.3e}, relative to {scale:.3e})")]
+    ZeroRadiusLimit { departure: f64, scale: f64 },
 }
 
 /// Evaluate the reduced equations `Ec = Mi q'' - Qi` (thesis `EcMov.m`) at
 /// independent coordinates `q`, rates `dq`, accelerations `ddq`, with the
 /// ignorable coordinates at their initial guesses and time `t`. Returns
 /// `(Ec, Mi)` (`Mi` row-major `nind x nind`).
+///
+/// The constraint solver starts from the physical upright configuration
+/// ([`upright_guess`]), so the solution is the root with the front contact at
+/// the lowest point of the rim and the front wheel ahead of the rear one.
 pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
     param: &[T],
     t: T,
@@ -43,10 +73,122 @@ pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
     dq: &[T],
     ddq: &[T],
 ) -> Result<(Vec<T>, Vec<T>), ConstraintError> {
+    let paramf: Vec<f64> = param.iter().map(|x| x.re()).collect();
+    let guess = upright_guess::<M>(&paramf)?;
+    reduced_equations_from::<M, T>(param, t, &guess, q, dq, ddq).map(|(ec, mi, _)| (ec, mi))
+}
+
+/// Physical upright configuration of a bicycle model with the thesis's
+/// coordinates (frame pitch `beta`, rim angle `xi` of the front contact) and
+/// parameters (`Rt`, `Rd`, `x4`, `z4`, `x5`, `z5`): every coordinate at
+/// [`MultibodyModel::INITIAL_GUESS`] except
+///
+/// * `beta`, the root of `Rt - sin(b) (x4 + x5) + cos(b) (z4 + z5) = Rd` with
+///   the front wheel centre ahead of the rear one (the same root as
+///   `ThesisParameters::frame_pitch`): with `P = x4 + x5`, `Q = z4 + z5`,
+///   `R = hypot(P, Q)`, `beta = acos((Rd - Rt) / R) - atan2(P, Q)`;
+/// * `xi = pi/2 - beta - eps`, which puts the front contact at the lowest
+///   point of the rim (its height along the rim is `-Rd sin(xi + beta + eps)`
+///   relative to the wheel centre).
+///
+/// Models without these names get their initial guess unchanged. Error
+/// [`ConstraintError::NoGroundContact`] when `|Rd - Rt| >= R`.
+pub fn upright_guess<M: MultibodyModel>(param: &[f64]) -> Result<Vec<f64>, ConstraintError> {
+    let mut p = M::INITIAL_GUESS.to_vec();
+    if let Some((beta, xi)) = upright_pitch_and_rim_angle::<M>(param, &p)? {
+        p[M::coordinate_index("beta").expect("checked")] = beta;
+        p[M::coordinate_index("xi").expect("checked")] = xi;
+    }
+    Ok(p)
+}
+
+/// `(beta, xi)` of the physical upright configuration, `None` for a model
+/// without the thesis's names.
+fn upright_pitch_and_rim_angle<M: MultibodyModel>(
+    param: &[f64],
+    p: &[f64],
+) -> Result<Option<(f64, f64)>, ConstraintError> {
+    let get = |n: &str| M::parameter_index(n).and_then(|i| param.get(i).copied());
+    let (Some(rt), Some(rd), Some(x4), Some(z4), Some(x5), Some(z5)) =
+        (get("Rt"), get("Rd"), get("x4"), get("z4"), get("x5"), get("z5"))
+    else {
+        return Ok(None);
+    };
+    if M::coordinate_index("beta").is_none() || M::coordinate_index("xi").is_none() {
+        return Ok(None);
+    }
+    let eps = M::coordinate_index("eps").map_or(0.0, |i| p[i]);
+    let (pp, qq) = (x4 + x5, z4 + z5);
+    let reach = pp.hypot(qq);
+    let d = rd - rt;
+    if !(reach > d.abs()) {
+        return Err(ConstraintError::NoGroundContact {
+            height_difference: d,
+            reach,
+        });
+    }
+    let beta = wrap_angle((d / reach).acos() - pp.atan2(qq));
+    let xi = wrap_angle(std::f64::consts::FRAC_PI_2 - beta - eps);
+    Ok(Some((beta, xi)))
+}
+
+/// An angle in `(-pi, pi]`.
+fn wrap_angle(a: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    let r = a.rem_euclid(TAU);
+    if r > PI {
+        r - TAU
+    } else {
+        r
+    }
+}
+
+/// Check that a solved upright configuration `p` is the physical root: the
+/// frame pitch equals the geometric one (front wheel centre ahead of the
+/// rear one) and the front contact is the lowest point of the rim, to
+/// `1e-8` rad.
+fn check_physical_branch<M: MultibodyModel>(param: &[f64], p: &[f64]) -> Result<(), LinearizeError> {
+    let Some((beta, xi)) = upright_pitch_and_rim_angle::<M>(param, p)? else {
+        return Ok(());
+    };
+    let tol = 1e-8;
+    let ib = M::coordinate_index("beta").expect("checked");
+    let ix = M::coordinate_index("xi").expect("checked");
+    if !(wrap_angle(p[ib] - beta).abs() <= tol) {
+        return Err(LinearizeError::OffBranch {
+            coordinate: "beta",
+            value: p[ib],
+            expected: beta,
+            what: "frame pitch with the front wheel ahead of the rear wheel",
+        });
+    }
+    let rd = M::parameter_index("Rd").map_or(0.0, |i| param[i]);
+    if rd > 0.0 && !(wrap_angle(p[ix] - xi).abs() <= tol) {
+        return Err(LinearizeError::OffBranch {
+            coordinate: "xi",
+            value: p[ix],
+            expected: xi,
+            what: "front contact at the lowest point of the rim",
+        });
+    }
+    Ok(())
+}
+
+/// [`reduced_equations`] from the configuration guess `guess` (all
+/// coordinates; the independent ones are replaced by `q`). Also returns the
+/// solved coordinates (real parts).
+fn reduced_equations_from<M: MultibodyModel, T: Scalar>(
+    param: &[T],
+    t: T,
+    guess: &[f64],
+    q: &[T],
+    dq: &[T],
+    ddq: &[T],
+) -> Result<(Vec<T>, Vec<T>, Vec<f64>), ConstraintError> {
     let nq = M::nq();
     let ind = M::INDEPENDENT;
     let ni = ind.len();
-    let mut p: Vec<T> = M::INITIAL_GUESS.iter().map(|&x| T::cst(x)).collect();
+    let mut p: Vec<T> = guess.iter().map(|&x| T::cst(x)).collect();
     for (k, &j) in ind.iter().enumerate() {
         p[j] = q[k];
     }
@@ -151,7 +293,8 @@ pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
         }
         ec[a_] = s;
     }
-    Ok((ec, mi))
+    let solved = p.iter().map(|x| x.re()).collect();
+    Ok((ec, mi, solved))
 }
 
 /// `M`, `C`, `K` of `M q'' + C q' + K q = 0` (thesis eq. 48-50) about
@@ -174,7 +317,9 @@ pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, Line
     let q = [Dual::<N>::variable(0.0, 0), Dual::variable(0.0, 1)];
     let dq = [Dual::<N>::variable(0.0, 2), Dual::variable(0.0, 3)];
     let ddq = [Dual::<N>::zero(); 2];
-    let (ec, mi) = reduced_equations::<M, Dual<N>>(&pd, Dual::zero(), &q, &dq, &ddq)?;
+    let guess = upright_guess::<M>(param)?;
+    let (ec, mi, solved) = reduced_equations_from::<M, Dual<N>>(&pd, Dual::zero(), &guess, &q, &dq, &ddq)?;
+    check_physical_branch::<M>(param, &solved)?;
     let mass = DMatrix::from_fn(2, 2, |i, j| mi[i * 2 + j].re);
     let stiffness = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[j]);
     let damping = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[2 + j]);
