@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::{Bicycle, BUILT_IN};
-use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds};
+use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds, CrossingDirection, CrossingKind};
 use bikedyn::runtime::output;
 use bikedyn::runtime::plot::{plot_continuation, plot_stability_map, PlotOptions};
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
@@ -216,7 +216,9 @@ fn stability_json(name: &str, c: &CriticalSpeeds) -> serde_json::Value {
         "weave_real_pair_merge_speed": c.weave_real_pair_merge,
         "stable_intervals": c.stable_intervals,
         "crossings": c.crossings.iter().map(|x| serde_json::json!({
-            "speed": x.speed, "mode": x.mode.name(), "direction": format!("{:?}", x.direction).to_lowercase(), "frequency": x.frequency
+            "speed": x.speed, "mode": x.mode.name(), "direction": format!("{:?}", x.direction).to_lowercase(),
+            "kind": match x.kind { CrossingKind::RealRoot => "real_root", CrossingKind::ComplexPair => "complex_pair" },
+            "frequency": x.frequency
         })).collect::<Vec<_>>(),
     })
 }
@@ -235,6 +237,20 @@ fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
     }
     for [lo, hi] in &c.stable_intervals {
         s += &format!("  self-stable from {lo:.4} to {hi:.4} m/s\n");
+    }
+    if !c.crossings.is_empty() {
+        s += "  stability crossings (speed, mode, direction):\n";
+    }
+    for x in &c.crossings {
+        let dir = match x.direction {
+            CrossingDirection::Destabilizing => "becomes unstable",
+            CrossingDirection::Stabilizing => "becomes stable",
+        };
+        let kind = match x.kind {
+            CrossingKind::RealRoot => "real root through zero".to_string(),
+            CrossingKind::ComplexPair => format!("oscillation, {:.4} rad/s", x.frequency),
+        };
+        s += &format!("    {:.10} m/s  {:<17}  {dir} ({kind})\n", x.speed, x.mode.name());
     }
     s
 }

@@ -246,3 +246,177 @@ fn issue_10_3_skate_wheel_with_spin_inertia_is_refused() {
     let msg = canonical_of(&b.to_thesis().unwrap()).unwrap_err().to_string();
     assert!(msg.contains("front wheel") && msg.contains("IFyy"), "{msg}");
 }
+
+// ------------------------------------------------------------------ point 7
+
+use bikedyn::runtime::eigen::{eigen_sweep, CrossingKind, EigenPoint, Mode};
+use nalgebra::Complex;
+
+/// How many of each named mode a point carries: a real root counts 1 for its
+/// label, a merged pair's two roots count 1/2 each for both components.
+fn mode_census(p: &EigenPoint) -> Option<[f64; 3]> {
+    let mut n = [0.0; 3];
+    let idx = |m: Mode| match m {
+        Mode::Weave => Some(0),
+        Mode::Capsize => Some(1),
+        Mode::Castering => Some(2),
+        _ => None,
+    };
+    for m in p.modes {
+        match m.components() {
+            Some((a, b)) => {
+                n[idx(a)?] += 0.5;
+                n[idx(b)?] += 0.5;
+            }
+            None => n[idx(m)?] += 1.0,
+        }
+    }
+    Some(n)
+}
+
+/// Largest displacement of the best matching (least squared distance) of
+/// two equally long root lists.
+fn matched_displacement(a: &[Complex<f64>], b: &[Complex<f64>]) -> f64 {
+    fn perms(n: usize) -> Vec<Vec<usize>> {
+        if n == 0 {
+            return vec![vec![]];
+        }
+        let mut out = Vec::new();
+        for p in perms(n - 1) {
+            for k in 0..=p.len() {
+                let mut q = p.clone();
+                q.insert(k, n - 1);
+                out.push(q);
+            }
+        }
+        out
+    }
+    let mut best = (f64::INFINITY, 0.0);
+    for p in perms(a.len()) {
+        let cost: f64 = (0..a.len()).map(|i| (a[i] - b[p[i]]).norm_sqr()).sum();
+        let dmax = (0..a.len()).map(|i| (a[i] - b[p[i]]).norm()).fold(0.0, f64::max);
+        if cost < best.0 {
+            best = (cost, dmax);
+        }
+    }
+    best.1
+}
+
+/// Check that every named mode's trajectory is continuous over the sweep:
+/// between consecutive speeds, the roots carrying a label move no more than
+/// 4 times the largest displacement of the whole spectrum under its best
+/// matching (the local slope), plus rounding; and every point accounts for
+/// two weave roots, one capsize and one castering root (merged pairs count
+/// for both). Returns a description of the first violation.
+fn check_mode_continuity(points: &[EigenPoint]) -> Result<(), String> {
+    for p in points {
+        if let Some(n) = mode_census(p) {
+            if n != [2.0, 1.0, 1.0] {
+                return Err(format!(
+                    "v = {}: modes {:?} do not account for every mode",
+                    p.v, p.modes
+                ));
+            }
+        }
+    }
+    for w in points.windows(2) {
+        let (p, q) = (&w[0], &w[1]);
+        let global = matched_displacement(&p.eigenvalues, &q.eigenvalues);
+        let scale = 1.0 + p.eigenvalues.iter().map(|z| z.norm()).fold(0.0, f64::max);
+        for label in p.modes {
+            let a: Vec<_> = (0..4)
+                .filter(|&k| p.modes[k] == label)
+                .map(|k| p.eigenvalues[k])
+                .collect();
+            let b: Vec<_> = (0..4)
+                .filter(|&k| q.modes[k] == label)
+                .map(|k| q.eigenvalues[k])
+                .collect();
+            if a.len() != b.len() {
+                continue; // a merge or a split at this step
+            }
+            let d = matched_displacement(&a, &b);
+            if d > 4.0 * global + 1e-9 * scale {
+                return Err(format!(
+                    "{} jumps by {d:.4} between v = {} and v = {} (the spectrum moves by {global:.4}): {:?} -> {:?}",
+                    label.name(),
+                    p.v,
+                    q.v,
+                    a,
+                    b
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Issue 10, point 7: on the Bluenose recumbent (HumanControl) the labels
+/// used to swap at 0.33-0.34 m/s (capsize +4.02 -> -0.96) and at 9.68-9.69
+/// m/s; the root that goes unstable at 3.141 m/s was called weave with
+/// frequency 0 and no capsize speed was reported.
+#[test]
+fn issue_10_7_bluenose_labels_are_continuous_and_capsize_is_reported() {
+    let bike = Bicycle::resolve(fixture("BluenosePar.txt").to_str().unwrap()).unwrap();
+    let c = bike.canonical().unwrap();
+    let speeds: Vec<f64> = (0..=1000).map(|k| k as f64 * 0.01).collect();
+    let sweep = eigen_sweep(&c, &speeds).unwrap();
+    check_mode_continuity(&sweep.points).unwrap();
+    let crit = critical_speeds(&c, 0.0, 10.0).unwrap();
+    let vc = crit.capsize_speed.expect("a capsize speed");
+    assert!((vc - 3.1413834189).abs() < 1e-8, "{vc}");
+    let first = &crit.crossings[0];
+    assert_eq!((first.mode, first.kind), (Mode::Capsize, CrossingKind::RealRoot));
+    // The oscillation that stabilizes at 8.117 m/s is a weave root merged
+    // with the capsize root, named as such, and it is the weave speed.
+    let hopf = crit
+        .crossings
+        .iter()
+        .find(|x| x.kind == CrossingKind::ComplexPair)
+        .unwrap();
+    assert_eq!(hopf.mode, Mode::WeaveCapsize);
+    assert!((hopf.speed - 8.1174493573).abs() < 1e-8);
+    assert_eq!(crit.weave_speed, Some(hopf.speed));
+}
+
+/// Issue 10, point 7: on the thesis bicycle capsize and castering merge into
+/// a complex pair from 0.19 to 2.55 m/s; the pair is `capsize-castering`
+/// (it used to be two `capsize` roots, and castering vanished).
+#[test]
+fn issue_10_7_capsize_castering_pair_is_named() {
+    let c = Bicycle::resolve("thesis").unwrap().canonical().unwrap();
+    let sweep = eigen_sweep(&c, &[0.1, 1.0, 2.5, 2.6]).unwrap();
+    let count = |p: &EigenPoint, m: Mode| p.modes.iter().filter(|x| **x == m).count();
+    assert_eq!(count(&sweep.points[0], Mode::Castering), 1);
+    assert_eq!(count(&sweep.points[1], Mode::CapsizeCastering), 2);
+    assert_eq!(count(&sweep.points[1], Mode::Capsize), 0);
+    assert_eq!(count(&sweep.points[2], Mode::CapsizeCastering), 2);
+    assert_eq!(count(&sweep.points[3], Mode::Castering), 1);
+    assert_eq!(Mode::CapsizeCastering.name(), "capsize-castering");
+}
+
+/// Issue 10, point 7 (property test): over 10,000 random designs around the
+/// real files, every named mode's trajectory over 0-10 m/s is continuous and
+/// every mode is accounted for at every speed.
+#[test]
+fn issue_10_7_random_designs_have_continuous_mode_labels() {
+    let bases = bases();
+    let mut rng = Rng(7_2026_11_23);
+    let speeds: Vec<f64> = (0..=200).map(|k| k as f64 * 0.05).collect();
+    let (mut checked, mut refused) = (0, 0);
+    for case in 0..10_000 {
+        let (name, base) = &bases[case % bases.len()];
+        let d = random_design(base, &mut rng);
+        let c = meijaard_canonical(&d);
+        let Ok(sweep) = eigen_sweep(&c, &speeds) else {
+            refused += 1;
+            continue;
+        };
+        checked += 1;
+        if let Err(e) = check_mode_continuity(&sweep.points) {
+            panic!("case {case} around {name}: {e}\n{d:?}");
+        }
+    }
+    eprintln!("{checked} designs checked, {refused} refused by the eigen analysis");
+    assert!(checked >= 9_900, "{checked}");
+}

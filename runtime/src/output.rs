@@ -252,12 +252,7 @@ pub fn write_string_atomic(path: impl AsRef<Path>, contents: &str) -> Result<(),
 // Eigen sweeps
 
 fn mode_rank(m: Mode) -> u32 {
-    match m {
-        Mode::Weave => 0,
-        Mode::Capsize => 1,
-        Mode::Castering => 2,
-        Mode::Other(k) => 3 + k as u32,
-    }
+    m.rank() as u32
 }
 
 /// The eigenvalues of a point with their modes, in the stable output order:

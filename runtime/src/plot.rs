@@ -466,12 +466,14 @@ fn mode_class(m: Mode) -> usize {
         Mode::Weave => 0,
         Mode::Capsize => 1,
         Mode::Castering => 2,
-        Mode::Other(_) => 3,
+        Mode::WeaveCapsize | Mode::WeaveCastering | Mode::CapsizeCastering => 3,
+        Mode::Other(_) => 4,
     }
 }
 
-const CLASS_NAMES: [&str; 4] = ["weave", "capsize", "castering", "other"];
-const CLASS_COLORS: [RGBColor; 4] = [WEAVE, CAPSIZE, CASTERING, OTHER];
+const MERGED: RGBColor = RGBColor(204, 121, 167);
+const CLASS_NAMES: [&str; 5] = ["weave", "capsize", "castering", "merged pair", "other"];
+const CLASS_COLORS: [RGBColor; 5] = [WEAVE, CAPSIZE, CASTERING, MERGED, OTHER];
 
 /// Tick label: shortest decimal of the value rounded to 6 significant places.
 fn tick(v: f64) -> String {
@@ -617,7 +619,7 @@ struct Curve {
 /// the positive imaginary part per mode, as continuous pieces.
 fn continuation_curves(sweep: &EigenSweep) -> Vec<Curve> {
     let mut curves = Vec::new();
-    for class in 0..4 {
+    for class in 0..CLASS_NAMES.len() {
         let per_point: Vec<Vec<f64>> = sweep
             .points
             .iter()
