@@ -264,14 +264,15 @@ fn axis_label(symbol: &str) -> String {
     }
 }
 
+/// Canonical matrices for people: 12 significant digits relative to each
+/// matrix's largest entry, no negative zero (the JSON keeps full precision).
 fn canonical_text(c: &CanonicalMatrices) -> String {
     let m = |name: &str, x: &nalgebra::Matrix2<f64>| {
+        let e = output::format_matrix_entries(&[x[(0, 0)], x[(0, 1)], x[(1, 0)], x[(1, 1)]], 12);
+        let w = e.iter().map(String::len).max().unwrap_or(0);
         format!(
-            "{name} = [[{:.14}, {:.14}],\n      [{:.14}, {:.14}]]\n",
-            x[(0, 0)],
-            x[(0, 1)],
-            x[(1, 0)],
-            x[(1, 1)]
+            "{name} = [[{:>w$}, {:>w$}],\n      [{:>w$}, {:>w$}]]\n",
+            e[0], e[1], e[2], e[3]
         )
     };
     format!(

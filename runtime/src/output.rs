@@ -355,7 +355,12 @@ pub fn format_eigen_table(sweep: &EigenSweep) -> String {
         .map(|(p, r)| {
             let mut row = vec![format!("{:.3}", p.v)];
             for (s, m) in r {
-                let z = format!("{:+.5} {} {:.5}i", s.re, if s.im < 0.0 { '-' } else { '+' }, s.im.abs());
+                let z = format!(
+                    "{} {} {}i",
+                    format_fixed(s.re, 5, true),
+                    if s.im < 0.0 { '-' } else { '+' },
+                    format_fixed(s.im.abs(), 5, false)
+                );
                 row.push(if uniform { z } else { format!("{z} {}", m.name()) });
             }
             row
@@ -644,4 +649,84 @@ pub fn format_stability_map_table(m: &StabilityMap) -> String {
         }
     }
     format_table(&header, &rows)
+}
+
+// ---------------------------------------------------------------------------
+// Printed numbers (issue 10, point 8). JSON and CSV keep full precision
+// (shortest round-trip representation); text for people has a fixed number
+// of significant digits and never a negative zero.
+
+/// Remove the sign of a formatted number whose digits are all zero
+/// (`"-0.000"` -> `"0.000"`, `"+0.000"` stays unsigned-zero as `"+0.000"`
+/// only when `plus` formatting was asked for).
+fn drop_negative_zero(s: String) -> String {
+    let digits_zero = s
+        .chars()
+        .take_while(|c| *c != 'e' && *c != 'E')
+        .all(|c| matches!(c, '-' | '+' | '0' | '.'));
+    if digits_zero && s.starts_with('-') {
+        s[1..].to_string()
+    } else {
+        s
+    }
+}
+
+/// `x` with `digits` significant digits: plain decimals for `1e-4 <= |x| <
+/// 1e12`, scientific notation otherwise (so `1e-300` prints as
+/// `1.00000e-300`, not with 300 digits); `0` and `-0` print as `0`.
+///
+/// ```
+/// use bikedyn_runtime::output::format_significant;
+/// assert_eq!(format_significant(80.81721999999998, 6), "80.8172");
+/// assert_eq!(format_significant(-0.0, 6), "0");
+/// assert_eq!(format_significant(1e-300, 3), "1.00e-300");
+/// ```
+pub fn format_significant(x: f64, digits: usize) -> String {
+    let digits = digits.max(1);
+    if x == 0.0 {
+        return "0".to_string();
+    }
+    if !x.is_finite() {
+        return x.to_string();
+    }
+    let e = x.abs().log10().floor() as i32;
+    if !(-4..12).contains(&e) {
+        return drop_negative_zero(format!("{:.*e}", digits - 1, x));
+    }
+    let decimals = (digits as i32 - 1 - e).max(0) as usize;
+    drop_negative_zero(format!("{x:.decimals$}"))
+}
+
+/// `x` with a fixed number of decimals, and a `+` sign when `plus`; a value
+/// that rounds to zero prints without a minus sign.
+pub fn format_fixed(x: f64, decimals: usize, plus: bool) -> String {
+    let s = if plus {
+        format!("{x:+.decimals$}")
+    } else {
+        format!("{x:.decimals$}")
+    };
+    let s = drop_negative_zero(s);
+    if plus && !s.starts_with(['+', '-']) {
+        format!("+{s}")
+    } else {
+        s
+    }
+}
+
+/// The entries of a matrix with `digits` significant digits relative to its
+/// largest entry (all entries get the same number of decimals, so columns
+/// align and an entry that is zero to that precision prints as zero without
+/// a sign); scientific notation when the largest entry is below `1e-4` or at
+/// least `1e12`.
+pub fn format_matrix_entries(entries: &[f64], digits: usize) -> Vec<String> {
+    let max = entries.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if max == 0.0 || !max.is_finite() {
+        return entries.iter().map(|&x| format_significant(x, digits)).collect();
+    }
+    let e = max.log10().floor() as i32;
+    if !(-4..12).contains(&e) {
+        return entries.iter().map(|&x| format_significant(x, digits)).collect();
+    }
+    let decimals = (digits as i32 - 1 - e).max(0) as usize;
+    entries.iter().map(|&x| format_fixed(x, decimals, false)).collect()
 }

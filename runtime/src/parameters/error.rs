@@ -252,6 +252,20 @@ pub enum ParameterError {
         tilt: f64,
     },
 
+    /// The steer-axis tilt `lam` of a benchmark set is not within the stated
+    /// range `(-pi/2, pi/2)` rad (exclusive: `lam = pi/2` is a horizontal steer
+    /// axis, a degenerate bicycle). A value such as 18 was probably meant in
+    /// degrees; the message then gives it in radians.
+    #[error("parameter `{field}` = {value} rad is outside the steer-axis tilt range (-pi/2, pi/2) rad{hint}{origin}", hint = degrees_hint(*value))]
+    TiltOutOfRange {
+        /// The symbol (`lam`).
+        field: String,
+        /// The value (rad).
+        value: f64,
+        /// File and line, when read from a file.
+        origin: Origin,
+    },
+
     /// A parameter set was of the other form than the one required.
     #[error("{}: expected {expected}-form parameters, found {found}-form", path.display())]
     WrongForm {
@@ -262,6 +276,19 @@ pub enum ParameterError {
         /// The form found.
         found: &'static str,
     },
+}
+
+/// `"; if 18 is in degrees, that is 0.314159 rad"` for values that look like
+/// an angle in degrees (magnitude at most 360), else `""`.
+pub(crate) fn degrees_hint(value: f64) -> String {
+    if value.is_finite() && value.abs() >= 1.0 && value.abs() <= 360.0 {
+        format!(
+            "; it looks like degrees: {value} deg is {} rad",
+            crate::output::format_significant(value.to_radians(), 6)
+        )
+    } else {
+        String::new()
+    }
 }
 
 fn fmt_line(line: Option<usize>) -> String {
@@ -283,6 +310,13 @@ impl ParameterError {
             },
             ParameterError::NonPositive { field, value, origin } if origin.path.is_none() => {
                 ParameterError::NonPositive {
+                    origin: Origin::new(path, line_of(&field)),
+                    field,
+                    value,
+                }
+            }
+            ParameterError::TiltOutOfRange { field, value, origin } if origin.path.is_none() => {
+                ParameterError::TiltOutOfRange {
                     origin: Origin::new(path, line_of(&field)),
                     field,
                     value,
@@ -316,6 +350,7 @@ impl ParameterError {
             | ParameterError::WrongType { field, .. }
             | ParameterError::NotFinite { field, .. }
             | ParameterError::NonPositive { field, .. }
+            | ParameterError::TiltOutOfRange { field, .. }
             | ParameterError::InvalidUncertainty { field, .. } => Some(field),
             _ => None,
         }
@@ -331,7 +366,9 @@ impl ParameterError {
             | ParameterError::WrongType { line, .. }
             | ParameterError::InvalidUncertainty { line, .. }
             | ParameterError::InvalidForm { line, .. } => Some(*line),
-            ParameterError::NotFinite { origin, .. } | ParameterError::NonPositive { origin, .. } => origin.line,
+            ParameterError::NotFinite { origin, .. }
+            | ParameterError::NonPositive { origin, .. }
+            | ParameterError::TiltOutOfRange { origin, .. } => origin.line,
             _ => None,
         }
     }
@@ -379,6 +416,22 @@ pub enum ParameterWarning {
         /// What the name means.
         meaning: &'static str,
     },
+    /// A length so large that it was probably given in millimetres (more
+    /// than 10 m; a wheelbase of 1020 is 1.02 m).
+    LooksLikeMillimetres {
+        /// The symbol.
+        field: &'static str,
+        /// The value as given (read as metres).
+        value: f64,
+    },
+    /// A body's mass centre is below the ground plane when the bicycle is
+    /// upright.
+    MassCentreBelowGround {
+        /// `"rear frame"` or `"handlebar"`.
+        body: &'static str,
+        /// Height of the mass centre above the ground (< 0, m).
+        height: f64,
+    },
 }
 
 impl fmt::Display for ParameterWarning {
@@ -390,8 +443,23 @@ impl fmt::Display for ParameterWarning {
                 excess,
             } => write!(
                 f,
-                "principal moments of the {body} {principal:?} violate the triangle \
-                 inequality by {excess} kg m^2"
+                "principal moments of the {body} [{}, {}, {}] kg m^2 violate the triangle \
+                 inequality by {} kg m^2",
+                crate::output::format_significant(principal[0], 6),
+                crate::output::format_significant(principal[1], 6),
+                crate::output::format_significant(principal[2], 6),
+                crate::output::format_significant(*excess, 6),
+            ),
+            ParameterWarning::LooksLikeMillimetres { field, value } => write!(
+                f,
+                "`{field}` = {value} m is implausibly long for a bicycle; if it is in millimetres, \
+                 write {} (metres)",
+                crate::output::format_significant(value / 1000.0, 6)
+            ),
+            ParameterWarning::MassCentreBelowGround { body, height } => write!(
+                f,
+                "the {body} mass centre is {} m below the ground when upright",
+                crate::output::format_significant(-height, 6)
             ),
             ParameterWarning::Degenerate { body, what } => {
                 write!(f, "the {body} is degenerate: {what}")

@@ -1,0 +1,105 @@
+//! Regression tests of issue 10 through the command line (the points whose
+//! defect was in what the user sees).
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn bikedyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("bikedyn-cli10-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d.join(name)
+}
+
+/// The embedded benchmark TOML with one line replaced.
+fn benchmark_with(replace: &str, with: &str, name: &str) -> PathBuf {
+    let src = include_str!("../runtime/data/benchmark_bicycle.toml");
+    assert!(src.contains(replace), "{replace}");
+    let p = tmp(name);
+    std::fs::write(&p, src.replacen(replace, with, 1)).unwrap();
+    p
+}
+
+fn fixture(name: &str) -> String {
+    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Issue 10, point 2: `lam = 18.0` (degrees typed for radians) is refused
+/// with the range and the value in radians, naming file and line; `lam =
+/// pi/2` is refused too (it used to give a degenerate bicycle).
+#[test]
+fn issue_10_2_head_angle_in_degrees_is_refused() {
+    let p = benchmark_with("lam = 0.3141592653589793 ", "lam = 18.0 ", "lam18.toml");
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.contains("(-pi/2, pi/2)") && err.contains("0.314159 rad"), "{err}");
+    assert!(err.contains("lam18.toml, line 16"), "{err}");
+    let p = benchmark_with("lam = 0.3141592653589793 ", "lam = 1.5707963267948966 ", "lam90.toml");
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("`lam`"), "{}", text(&out.stderr));
+}
+
+/// Issue 10, point 2: a wheelbase of 1020 (millimetres) and a frame mass
+/// centre below the ground give warnings that name the field.
+#[test]
+fn issue_10_2_millimetres_and_mass_centre_below_ground_warn() {
+    let p = benchmark_with("w = 1.02 ", "w = 1020 ", "w1020.toml");
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    let err = text(&out.stderr);
+    assert!(err.contains("`w` = 1020 m") && err.contains("millimetres"), "{err}");
+    let p = benchmark_with("zB = -0.9 ", "zB = 0.2 ", "zb.toml");
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    assert!(out.status.success());
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("rear frame mass centre is 0.200000 m below the ground"),
+        "{err}"
+    );
+    // The benchmark bicycle itself gets no such warning.
+    let out = bikedyn(&["canonical", "--bike", "benchmark"]);
+    assert!(text(&out.stderr).is_empty(), "{}", text(&out.stderr));
+}
+
+/// Issue 10, point 7: `stability` lists every crossing with its mode; for the
+/// Bluenose the first is the capsize root at 3.1413834189 m/s.
+#[test]
+fn issue_10_7_stability_lists_crossings_with_modes() {
+    let out = bikedyn(&["stability", "--bike", &fixture("BluenosePar.txt")]);
+    assert!(out.status.success());
+    let s = text(&out.stdout);
+    assert!(s.contains("capsize speed v_c: 3.1413834189 m/s"), "{s}");
+    assert!(
+        s.contains("3.1413834189 m/s  capsize            becomes unstable (real root through zero)"),
+        "{s}"
+    );
+    assert!(s.contains("weave-capsize"), "{s}");
+    assert!(s.ends_with('\n'), "{s:?}");
+}
+
+/// Issue 10, point 8: matrices print with a fixed number of significant
+/// digits and no negative zero (they used to print `80.81721999999998`,
+/// `-80.94999999999999` and `-0.00000000000000`); JSON keeps full precision.
+#[test]
+fn issue_10_8_printed_numbers() {
+    let out = bikedyn(&["canonical", "--bike", "benchmark"]);
+    let s = text(&out.stdout);
+    assert!(s.contains("[[80.8172200000,  2.3194133221]"), "{s}");
+    assert!(s.contains("[[-80.9500000000,"), "{s}");
+    assert!(!s.contains("-0.000") && !s.contains("9999999"), "{s}");
+    let out = bikedyn(&["canonical", "--bike", "benchmark", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["M0"][0][0].as_f64().unwrap(), 80.81721999999998);
+    // Eigenvalue tables: no "-0.00000" (the Bluenose has a purely imaginary pair at rest).
+    let out = bikedyn(&["eig", "--bike", &fixture("BluenosePar.txt"), "--speeds", "0:0.1:0.1"]);
+    let s = text(&out.stdout);
+    assert!(s.contains("+0.00000 + 0.83122i") && !s.contains("-0.00000"), "{s}");
+}
