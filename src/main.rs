@@ -165,6 +165,9 @@ enum ParamsCommand {
     },
 }
 
+/// Most points a `START:STOP:STEP` range may have.
+const MAX_POINTS: usize = 10_000_000;
+
 fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
     let parts: Vec<&str> = s.split(':').collect();
     let nums: Vec<f64> = parts
@@ -178,10 +181,17 @@ fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
     match nums.as_slice() {
         [x] if x.is_finite() => Ok(vec![*x]),
         [a, b, h] if a.is_finite() && b.is_finite() && h.is_finite() && *h > 0.0 && b >= a => {
-            let n = ((b - a) / h + 1e-9).floor() as usize;
-            if n > 10_000_000 {
-                bail!("{what}: {} points is too many", n + 1);
+            // Count in floating point: `as usize` would saturate (and `+ 1`
+            // wrap) for a tiny step such as 1e-300.
+            let intervals = ((b - a) / h + 1e-9).floor();
+            if !(intervals < MAX_POINTS as f64) {
+                bail!(
+                    "{what}: `{s}` gives {} points, more than the limit of {MAX_POINTS} \
+                     (use a larger STEP or a shorter range)",
+                    output::format_significant(intervals + 1.0, 4)
+                );
             }
+            let n = intervals as usize;
             Ok((0..=n).map(|k| a + k as f64 * h).collect())
         }
         _ => bail!("{what}: `{s}` must be START:STOP:STEP with STEP > 0 and STOP >= START"),
@@ -535,12 +545,36 @@ fn run(cli: Cli) -> Result<bool> {
     }
 }
 
+/// The error and its causes, each cause once: a cause whose text the
+/// message already contains (errors that print their source) is skipped.
+/// Every part is cut to `MAX_PART` characters, so a junk input line is not
+/// echoed whole.
+fn error_message(e: &anyhow::Error) -> String {
+    const MAX_PART: usize = 400;
+    let mut msg = String::new();
+    for cause in e.chain() {
+        let mut part = cause.to_string();
+        if msg.contains(&part) {
+            continue;
+        }
+        let n = part.chars().count();
+        if n > MAX_PART {
+            part = part.chars().take(MAX_PART).collect::<String>() + &format!("... ({} more characters)", n - MAX_PART);
+        }
+        if !msg.is_empty() {
+            msg += ": ";
+        }
+        msg += &part;
+    }
+    msg
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_message(&e));
             ExitCode::from(2)
         }
     }

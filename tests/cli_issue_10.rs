@@ -55,7 +55,7 @@ fn issue_10_2_millimetres_and_mass_centre_below_ground_warn() {
     let p = benchmark_with("w = 1.02 ", "w = 1020 ", "w1020.toml");
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
     let err = text(&out.stderr);
-    assert!(err.contains("`w` = 1020 m") && err.contains("millimetres"), "{err}");
+    assert!(err.contains("`w` = 1020.0 m") && err.contains("millimetres"), "{err}");
     let p = benchmark_with("zB = -0.9 ", "zB = 0.2 ", "zb.toml");
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
     assert!(out.status.success());
@@ -102,4 +102,68 @@ fn issue_10_8_printed_numbers() {
     let out = bikedyn(&["eig", "--bike", &fixture("BluenosePar.txt"), "--speeds", "0:0.1:0.1"]);
     let s = text(&out.stdout);
     assert!(s.contains("+0.00000 + 0.83122i") && !s.contains("-0.00000"), "{s}");
+}
+
+/// Issue 10, point 6: each cause is printed once (the UTF-8 error used to
+/// read "...UTF-8: stream did not contain valid UTF-8" twice over).
+#[test]
+fn issue_10_6_cause_printed_once() {
+    let p = tmp("latin1.txt");
+    std::fs::write(&p, b"w = 1.02\n\xff\xfe\n").unwrap();
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    let err = text(&out.stderr);
+    assert_eq!(err.matches("valid UTF-8").count(), 1, "{err}");
+}
+
+/// Issue 10, point 6: a 10 MB junk line is not echoed whole.
+#[test]
+fn issue_10_6_junk_line_is_cut() {
+    let p = tmp("junk.txt");
+    std::fs::write(&p, format!("w = {}\n", "x".repeat(10_000_000))).unwrap();
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.len() < 2_000, "{} bytes of error", err.len());
+    assert!(err.contains("junk.txt:1") && err.contains("more characters"), "{err}");
+}
+
+/// Issue 10, point 6: `mB = 1e300` names the file, line and field (it used to
+/// end in "singular mass matrix M0 (det = NaN)"); `1e-300` is printed as
+/// such, not with 300 digits.
+#[test]
+fn issue_10_6_huge_and_tiny_values_name_file_and_field() {
+    let p = benchmark_with("mB = 85.0 ", "mB = 1e300 ", "mb_huge.toml");
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("`mB` = 1e300") && err.contains("mb_huge.toml, line 28"),
+        "{err}"
+    );
+    let p = benchmark_with("mB = 85.0 ", "mB = -1e-300 ", "mb_tiny.toml");
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    let err = text(&out.stderr);
+    assert!(err.contains("found -1e-300") && err.len() < 300, "{err}");
+}
+
+/// Issue 10, point 6: a file missing several fields reports all of them.
+#[test]
+fn issue_10_6_all_missing_fields_at_once() {
+    let p = tmp("two_fields.txt");
+    std::fs::write(&p, "w = 1.02\nc = 0.08\n").unwrap();
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("missing 24 parameters") && err.contains("`lam`") && err.contains("`IFyy`"),
+        "{err}"
+    );
+}
+
+/// Issue 10, point 5: a range of 1e300 points states the count and the
+/// limit (it used to say "0 points is too many").
+#[test]
+fn issue_10_5_too_many_points_says_how_many() {
+    let out = bikedyn(&["eig", "--speeds", "0:1:1e-300"]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.contains("1.000e300 points") && err.contains("limit of"), "{err}");
 }

@@ -420,3 +420,24 @@ fn issue_10_7_random_designs_have_continuous_mode_labels() {
     eprintln!("{checked} designs checked, {refused} refused by the eigen analysis");
     assert!(checked >= 9_900, "{checked}");
 }
+
+/// Issue 10, point 6: a singular-Jacobian message states the pivot against
+/// the matrix scale it was judged by (it used to read "singular ... (pivot
+/// 1.000e0)", which contradicts itself without the scale).
+#[test]
+fn issue_10_6_singular_message_states_its_scale() {
+    use bikedyn::runtime::constraints::ConstraintError;
+    let e = ConstraintError::SingularJacobian {
+        what: "holonomic constraints",
+        column: 1,
+        pivot: 1.0,
+        scale: 1e16,
+    };
+    let msg = e.to_string();
+    assert!(
+        msg.contains("1.000e0 is below 1e-14 times its largest entry 1.000e16"),
+        "{msg}"
+    );
+    let e = bikedyn::runtime::eigen::EigenError::SingularMassMatrix { det: 1e-20, scale: 1.0 };
+    assert!(e.to_string().contains("1e-12 times"), "{e}");
+}

@@ -43,11 +43,13 @@ pub enum ConstraintError {
         iterations: usize,
     },
     /// The constraint Jacobian with respect to the dependent coordinates is singular.
-    #[error("the constraint Jacobian is singular at column {column} (pivot {pivot:.3e}) for the {what}: the dependent coordinates are not determined by the constraints here")]
+    #[error("the constraint Jacobian is singular at column {column} for the {what}: its largest available pivot {pivot:.3e} is below 1e-14 times its largest entry {scale:.3e}, so the dependent coordinates are not determined by the constraints here")]
     SingularJacobian {
         what: &'static str,
         column: usize,
         pivot: f64,
+        /// Largest entry magnitude of the Jacobian.
+        scale: f64,
     },
     /// The front wheel cannot reach the ground ahead of the rear wheel: the
     /// height difference of the wheel centres `Rd - Rt` is at least the
@@ -64,6 +66,7 @@ fn singular(what: &'static str) -> impl Fn(Singular) -> ConstraintError {
         what,
         column: s.column,
         pivot: s.pivot,
+        scale: s.scale,
     }
 }
 

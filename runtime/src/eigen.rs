@@ -68,10 +68,12 @@ use quartic::{quartic_roots, sort_desc, C64};
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EigenError {
     /// `M0` is singular (or numerically so): the quartic is not of degree 4.
-    #[error("singular mass matrix M0 (det = {det:e})")]
+    #[error("singular mass matrix M0: det M0 = {det:.3e} is at most 1e-12 times |m11 m22| + |m12 m21| = {scale:.3e}")]
     SingularMassMatrix {
         /// Determinant of `M0`.
         det: f64,
+        /// `|m11 m22| + |m12 m21|`, the size of the determinant's terms.
+        scale: f64,
     },
     /// A matrix entry, `g`, or a speed is NaN or infinite.
     #[error("non-finite input: {what}")]
@@ -329,8 +331,16 @@ impl CharPoly {
         }
         let k4 = det2(&c.m0);
         let scale = (c.m0[(0, 0)] * c.m0[(1, 1)]).abs() + (c.m0[(0, 1)] * c.m0[(1, 0)]).abs();
+        if !(k4.is_finite() && scale.is_finite()) {
+            return Err(EigenError::NonFinite {
+                what: format!(
+                    "det M0 overflows double precision (M0 entries up to {:.3e})",
+                    c.m0.amax()
+                ),
+            });
+        }
         if !(k4.abs() > 1e-12 * scale) {
-            return Err(EigenError::SingularMassMatrix { det: k4 });
+            return Err(EigenError::SingularMassMatrix { det: k4, scale });
         }
         let (m, c1, k0, k2) = (&c.m0, &c.c1, &c.k0, &c.k2);
         let cp = CharPoly {

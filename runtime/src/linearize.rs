@@ -204,6 +204,7 @@ fn reduced_equations_from<M: MultibodyModel, T: Scalar>(
         what: "coordinate partitioning",
         column: s.column,
         pivot: s.pivot,
+        scale: s.scale,
     };
     let mut a = vec![T::zero(); nd * nd];
     // Right-hand sides: columns [Dind (ni columns) | d].

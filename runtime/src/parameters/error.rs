@@ -87,6 +87,15 @@ pub enum ParameterError {
         field: String,
     },
 
+    /// Several required parameters are absent (all are listed).
+    #[error("{}: missing {} parameters: {}", path.display(), fields.len(), fields.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", "))]
+    MissingFields {
+        /// The file.
+        path: PathBuf,
+        /// Every missing symbol, in the form's order.
+        fields: Vec<String>,
+    },
+
     /// A name that is not a parameter of the detected (or forced) form.
     #[error("{}:{line}: unknown parameter `{field}` ({why})", path.display())]
     UnknownField {
@@ -129,7 +138,7 @@ pub enum ParameterError {
     },
 
     /// A value is NaN or infinite.
-    #[error("parameter `{field}` is not finite: {value}{origin}")]
+    #[error("parameter `{field}` is not finite: {value:?}{origin}")]
     NotFinite {
         /// The symbol.
         field: String,
@@ -142,7 +151,7 @@ pub enum ParameterError {
     /// A wheelbase, `g`, rear-frame mass, radius, mass or diagonal inertia
     /// that is not > 0 (zeros are allowed only for degenerate bodies, see
     /// [`ParameterWarning::Degenerate`]).
-    #[error("parameter `{field}` must be positive, found {value}{origin}")]
+    #[error("parameter `{field}` must be positive, found {value:?}{origin}")]
     NonPositive {
         /// The symbol.
         field: String,
@@ -152,8 +161,22 @@ pub enum ParameterError {
         origin: Origin,
     },
 
+    /// A value so large in magnitude that the equations, which multiply up
+    /// to a dozen parameters, would overflow double precision.
+    #[error("parameter `{field}` = {value:?} is too large: at most {limit:e} in SI units, else the equations overflow double precision{origin}")]
+    TooLarge {
+        /// The symbol.
+        field: String,
+        /// The value.
+        value: f64,
+        /// The largest magnitude accepted.
+        limit: f64,
+        /// File and line, when read from a file.
+        origin: Origin,
+    },
+
     /// An uncertainty (`+/-std`) that is negative or not finite.
-    #[error("{}:{line}: uncertainty of `{field}` must be finite and >= 0, found {value}", path.display())]
+    #[error("{}:{line}: uncertainty of `{field}` must be finite and >= 0, found {value:?}", path.display())]
     InvalidUncertainty {
         /// The file.
         path: PathBuf,
@@ -168,7 +191,7 @@ pub enum ParameterError {
     /// A body's inertia tensor is not positive definite.
     #[error(
         "inertia tensor of the {body} is not positive definite \
-         (xx {ixx}, zz {izz}, xz {ixz}: xx*zz - xz^2 = {det}){origin}"
+         (xx {ixx:?}, zz {izz:?}, xz {ixz:?}: xx*zz - xz^2 = {det:?}){origin}"
     )]
     NonPhysicalInertia {
         /// The body (`"rear wheel"`, `"rear frame"`, `"handlebar"`, `"front wheel"`).
@@ -232,8 +255,8 @@ pub enum ParameterError {
     /// rear wheel centre to the front wheel centre in frame axes, or the only
     /// root puts the front wheel behind).
     #[error(
-        "no ground contact for the front wheel: Rd - Rt = {height_difference} but the \
-         front wheel centre is {reach} m from the rear wheel centre ({detail})"
+        "no ground contact for the front wheel: Rd - Rt = {height_difference:?} but the \
+         front wheel centre is {reach:?} m from the rear wheel centre ({detail})"
     )]
     NoGroundContact {
         /// `Rd - Rt` (m).
@@ -246,7 +269,7 @@ pub enum ParameterError {
 
     /// The steer axis is not tilted less than 90 degrees from vertical, so it
     /// does not meet the ground ahead of the wheels in the usual way.
-    #[error("steer-axis tilt {tilt} rad is not within (-pi/2, pi/2)")]
+    #[error("steer-axis tilt {tilt:?} rad is not within (-pi/2, pi/2)")]
     SteerAxisNotUpright {
         /// The steer-axis tilt `lam` from vertical (rad).
         tilt: f64,
@@ -256,7 +279,7 @@ pub enum ParameterError {
     /// range `(-pi/2, pi/2)` rad (exclusive: `lam = pi/2` is a horizontal steer
     /// axis, a degenerate bicycle). A value such as 18 was probably meant in
     /// degrees; the message then gives it in radians.
-    #[error("parameter `{field}` = {value} rad is outside the steer-axis tilt range (-pi/2, pi/2) rad{hint}{origin}", hint = degrees_hint(*value))]
+    #[error("parameter `{field}` = {value:?} rad is outside the steer-axis tilt range (-pi/2, pi/2) rad{hint}{origin}", hint = degrees_hint(*value))]
     TiltOutOfRange {
         /// The symbol (`lam`).
         field: String,
@@ -276,6 +299,20 @@ pub enum ParameterError {
         /// The form found.
         found: &'static str,
     },
+}
+
+/// `text` cut to at most `max` characters, with the number left out.
+pub(crate) fn cut(text: &str, max: usize) -> String {
+    let n = text.chars().count();
+    if n <= max {
+        text.to_string()
+    } else {
+        format!(
+            "{}... ({} more characters)",
+            text.chars().take(max).collect::<String>(),
+            n - max
+        )
+    }
 }
 
 /// `"; if 18 is in degrees, that is 0.314159 rad"` for values that look like
@@ -315,6 +352,17 @@ impl ParameterError {
                     value,
                 }
             }
+            ParameterError::TooLarge {
+                field,
+                value,
+                limit,
+                origin,
+            } if origin.path.is_none() => ParameterError::TooLarge {
+                origin: Origin::new(path, line_of(&field)),
+                field,
+                value,
+                limit,
+            },
             ParameterError::TiltOutOfRange { field, value, origin } if origin.path.is_none() => {
                 ParameterError::TiltOutOfRange {
                     origin: Origin::new(path, line_of(&field)),
@@ -351,6 +399,7 @@ impl ParameterError {
             | ParameterError::NotFinite { field, .. }
             | ParameterError::NonPositive { field, .. }
             | ParameterError::TiltOutOfRange { field, .. }
+            | ParameterError::TooLarge { field, .. }
             | ParameterError::InvalidUncertainty { field, .. } => Some(field),
             _ => None,
         }
@@ -368,7 +417,8 @@ impl ParameterError {
             | ParameterError::InvalidForm { line, .. } => Some(*line),
             ParameterError::NotFinite { origin, .. }
             | ParameterError::NonPositive { origin, .. }
-            | ParameterError::TiltOutOfRange { origin, .. } => origin.line,
+            | ParameterError::TiltOutOfRange { origin, .. }
+            | ParameterError::TooLarge { origin, .. } => origin.line,
             _ => None,
         }
     }
@@ -452,7 +502,7 @@ impl fmt::Display for ParameterWarning {
             ),
             ParameterWarning::LooksLikeMillimetres { field, value } => write!(
                 f,
-                "`{field}` = {value} m is implausibly long for a bicycle; if it is in millimetres, \
+                "`{field}` = {value:?} m is implausibly long for a bicycle; if it is in millimetres, \
                  write {} (metres)",
                 crate::output::format_significant(value / 1000.0, 6)
             ),
@@ -471,7 +521,7 @@ impl fmt::Display for ParameterWarning {
                 meaning,
             } => write!(
                 f,
-                "line {line}: `{field} = {value}` ({meaning}) is not a model parameter; kept aside"
+                "line {line}: `{field} = {value:?}` ({meaning}) is not a model parameter; kept aside"
             ),
         }
     }

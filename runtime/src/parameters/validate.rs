@@ -143,11 +143,22 @@ fn validate_common(
     positive: &[Field],
     bodies: &[Body],
 ) -> Result<Vec<ParameterWarning>, ParameterError> {
+    // The canonical matrices multiply up to four parameters per entry and the
+    // characteristic quartic up to four entries: 1e15^12 stays finite.
+    const LIMIT: f64 = 1e15;
     for (field, value) in values {
         if !value.is_finite() {
             return Err(ParameterError::NotFinite {
                 field: field.to_string(),
                 value,
+                origin: Default::default(),
+            });
+        }
+        if value.abs() > LIMIT {
+            return Err(ParameterError::TooLarge {
+                field: field.to_string(),
+                value,
+                limit: LIMIT,
                 origin: Default::default(),
             });
         }
