@@ -4,7 +4,7 @@ use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::{Bicycle, BUILT_IN};
 use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds, CrossingDirection, CrossingKind};
 use bikedyn::runtime::output;
-use bikedyn::runtime::plot::{plot_continuation, plot_stability_map, PlotOptions};
+use bikedyn::runtime::plot::{plot_continuation, plot_stability_map, ImageFormat, PlotOptions};
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
 use bikedyn::runtime::verify::VerifyOptions;
 use bikedyn::runtime::CanonicalMatrices;
@@ -165,10 +165,16 @@ enum ParamsCommand {
     },
 }
 
-/// Most points a `START:STOP:STEP` range may have.
+/// Most points a `START:STOP:STEP` range may have when all its results are
+/// held in memory (sweeps, tables, plots).
 const MAX_POINTS: usize = 10_000_000;
+/// Most speeds of `eig` with CSV or JSON output, which streams its rows (memory
+/// stays flat; the limit only bounds the run time, about 1 µs per speed).
+const MAX_STREAMED_POINTS: usize = 1_000_000_000;
 
-fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
+/// `START:STOP:STEP` (or one number) as `(start, step, count)`, with at most
+/// `limit` points.
+fn range_spec(s: &str, what: &str, limit: usize) -> Result<(f64, f64, usize)> {
     let parts: Vec<&str> = s.split(':').collect();
     let nums: Vec<f64> = parts
         .iter()
@@ -179,23 +185,27 @@ fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
         })
         .collect::<Result<_>>()?;
     match nums.as_slice() {
-        [x] if x.is_finite() => Ok(vec![*x]),
+        [x] if x.is_finite() => Ok((*x, 0.0, 1)),
         [a, b, h] if a.is_finite() && b.is_finite() && h.is_finite() && *h > 0.0 && b >= a => {
             // Count in floating point: `as usize` would saturate (and `+ 1`
             // wrap) for a tiny step such as 1e-300.
             let intervals = ((b - a) / h + 1e-9).floor();
-            if !(intervals < MAX_POINTS as f64) {
+            if !(intervals < limit as f64) {
                 bail!(
-                    "{what}: `{s}` gives {} points, more than the limit of {MAX_POINTS} \
+                    "{what}: `{s}` gives {} points, more than the limit of {limit} \
                      (use a larger STEP or a shorter range)",
                     output::format_significant(intervals + 1.0, 4)
                 );
             }
-            let n = intervals as usize;
-            Ok((0..=n).map(|k| a + k as f64 * h).collect())
+            Ok((*a, *h, intervals as usize + 1))
         }
         _ => bail!("{what}: `{s}` must be START:STOP:STEP with STEP > 0 and STOP >= START"),
     }
+}
+
+fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
+    let (a, h, n) = range_spec(s, what, MAX_POINTS)?;
+    Ok((0..n).map(|k| a + k as f64 * h).collect())
 }
 
 fn load(bike: &str) -> Result<Bicycle> {
@@ -416,22 +426,55 @@ fn run(cli: Cli) -> Result<bool> {
             plot,
         } => {
             let b = load(&bike)?;
-            let c = b.canonical()?;
-            let speeds = parse_range(&speeds, "--speeds")?;
-            let sweep = eigen_sweep(&c, &speeds)?;
-            let text = match format {
-                Format::Table => output::format_eigen_table(&sweep),
-                Format::Json => serde_json::to_string_pretty(&output::eigen_sweep_json(&sweep))? + "\n",
-                Format::Csv => {
-                    let mut buf = Vec::new();
-                    output::write_eigen_sweep_csv(&mut buf, &sweep)?;
-                    String::from_utf8(buf)?
-                }
+            // Every output is checked before any work (issue 10, point 4).
+            if let Some(p) = &out {
+                output::output_target(p)?;
+            }
+            if let Some(p) = &plot {
+                ImageFormat::from_path(p)?;
+                output::output_target(p)?;
+            }
+            let limit = match format {
+                Format::Table => MAX_POINTS,
+                Format::Csv | Format::Json => MAX_STREAMED_POINTS,
             };
-            emit(&text, &out)?;
+            let (start, step, n) = range_spec(&speeds, "--speeds", limit)?;
+            let c = b.canonical()?;
+            let speed = |k: usize| start + k as f64 * step;
+            let stream = |fmt: output::StreamFormat| -> Result<()> {
+                match &out {
+                    Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep(&c, n, speed, fmt, w))?,
+                    None => {
+                        let mut w = std::io::BufWriter::new(std::io::stdout().lock());
+                        output::stream_eigen_sweep(&c, n, speed, fmt, &mut w).map_err(|e| anyhow::anyhow!(e))?;
+                        std::io::Write::flush(&mut w)?;
+                    }
+                }
+                Ok(())
+            };
+            match format {
+                Format::Table => {
+                    let speeds: Vec<f64> = (0..n).map(speed).collect();
+                    emit(&output::format_eigen_table(&eigen_sweep(&c, &speeds)?), &out)?;
+                }
+                Format::Csv => stream(output::StreamFormat::Csv)?,
+                Format::Json => stream(output::StreamFormat::Json)?,
+            }
             if let Some(p) = plot {
-                let vmax = speeds.last().copied().unwrap_or(10.0).max(speeds[0] + 1e-9);
-                let crit = critical_speeds(&c, speeds[0], vmax).ok();
+                // A diagram needs no more than 20,001 points: longer ranges are
+                // plotted at evenly spaced speeds over the same interval.
+                const PLOT_POINTS: usize = 20_001;
+                let last = speed(n - 1);
+                let speeds: Vec<f64> = if n <= PLOT_POINTS {
+                    (0..n).map(speed).collect()
+                } else {
+                    (0..PLOT_POINTS)
+                        .map(|k| start + (last - start) * k as f64 / (PLOT_POINTS - 1) as f64)
+                        .collect()
+                };
+                let sweep = eigen_sweep(&c, &speeds)?;
+                let vmax = last.max(start + 1e-9);
+                let crit = critical_speeds(&c, start, vmax).ok();
                 plot_continuation(&p, &sweep, crit.as_ref(), &PlotOptions::default())?;
                 eprintln!("wrote {}", p.display());
             }

@@ -167,3 +167,122 @@ fn issue_10_5_too_many_points_says_how_many() {
     let err = text(&out.stderr);
     assert!(err.contains("1.000e300 points") && err.contains("limit of"), "{err}");
 }
+
+/// Issue 10, point 4: `--output` through a symbolic link writes the link's
+/// target and keeps the link; a character device (`/dev/null`) and a FIFO
+/// are written through, not replaced by a regular file; a directory is
+/// refused.
+#[cfg(unix)]
+#[test]
+fn issue_10_4_output_keeps_links_devices_and_fifos() {
+    use std::os::unix::fs::FileTypeExt;
+    let target = tmp("real.csv");
+    let link = tmp("link.csv");
+    let _ = std::fs::remove_file(&link);
+    let _ = std::fs::remove_file(&target);
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let out = bikedyn(&[
+        "eig",
+        "--speeds",
+        "0:1:0.5",
+        "--format",
+        "csv",
+        "--output",
+        link.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
+    assert!(std::fs::read_to_string(&target).unwrap().starts_with("v,re_1"));
+
+    let out = bikedyn(&["eig", "--speeds", "0:1:0.5", "--format", "csv", "--output", "/dev/null"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(std::fs::metadata("/dev/null").unwrap().file_type().is_char_device());
+
+    let fifo = tmp("pipe.csv");
+    let _ = std::fs::remove_file(&fifo);
+    if Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false)
+    {
+        let f2 = fifo.clone();
+        let reader = std::thread::spawn(move || std::fs::read_to_string(f2).unwrap());
+        let out = bikedyn(&[
+            "eig",
+            "--speeds",
+            "0:1:0.5",
+            "--format",
+            "json",
+            "--output",
+            fifo.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let got = reader.join().unwrap();
+        assert!(got.contains("mode_shapes"), "{got}");
+        assert!(std::fs::metadata(&fifo).unwrap().file_type().is_fifo());
+    } else {
+        eprintln!("SKIP: mkfifo not available");
+    }
+
+    let out = bikedyn(&[
+        "eig",
+        "--format",
+        "csv",
+        "--output",
+        std::env::temp_dir().to_str().unwrap(),
+    ]);
+    assert!(!out.status.success());
+    assert!(text(&out.stderr).contains("is a directory"), "{}", text(&out.stderr));
+}
+
+/// Issue 10, point 4: an unsupported plot format is reported before any
+/// output (it used to print the whole table and then fail).
+#[test]
+fn issue_10_4_outputs_are_validated_before_computing() {
+    let out = bikedyn(&["eig", "--speeds", "0:1:0.1", "--plot", tmp("x.gif").to_str().unwrap()]);
+    assert!(!out.status.success());
+    assert!(out.stdout.is_empty(), "{}", text(&out.stdout));
+    assert!(text(&out.stderr).contains("unsupported file extension"));
+    let out = bikedyn(&["eig", "--format", "csv", "--output", "/nonexistent-dir/e.csv"]);
+    assert!(!out.status.success() && out.stdout.is_empty());
+}
+
+/// Issue 10, points 5 and 9: `eig` streams CSV and JSON (several blocks
+/// here) with the same labels as one in-memory sweep, and both carry the
+/// mode shapes.
+#[test]
+fn issue_10_5_9_streamed_eig_output_with_mode_shapes() {
+    let out = bikedyn(&[
+        "eig",
+        "--bike",
+        "benchmark",
+        "--speeds",
+        "0:10:0.001",
+        "--format",
+        "json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let pts = v.as_array().unwrap();
+    assert_eq!(pts.len(), 10_001);
+    // v = 5 m/s, computed in the second block, matches a one-point request.
+    let one = bikedyn(&["eig", "--bike", "benchmark", "--speeds", "5", "--format", "json"]);
+    let one: serde_json::Value = serde_json::from_slice(&one.stdout).unwrap();
+    assert_eq!(pts[5000], one[0]);
+    let shapes = pts[5000]["mode_shapes"].as_array().unwrap();
+    assert_eq!(shapes.len(), 4);
+    assert_eq!(shapes[0]["roll_amplitude"].as_f64().unwrap(), 1.0);
+    let out = bikedyn(&[
+        "eig",
+        "--bike",
+        "benchmark",
+        "--speeds",
+        "0:10:0.001",
+        "--format",
+        "csv",
+    ]);
+    let s = text(&out.stdout);
+    assert_eq!(s.lines().count(), 10_002);
+    assert!(s.starts_with("v,re_1,im_1,mode_1,roll_amp_1,roll_phase_1,steer_amp_1,steer_phase_1,re_2"));
+}

@@ -441,3 +441,35 @@ fn issue_10_6_singular_message_states_its_scale() {
     let e = bikedyn::runtime::eigen::EigenError::SingularMassMatrix { det: 1e-20, scale: 1.0 };
     assert!(e.to_string().contains("1e-12 times"), "{e}");
 }
+
+/// Issue 10, point 9: the mode shapes (roll normalised to 1) are eigenvectors:
+/// `(M0 s^2 + v C1 s + g K0 + v^2 K2) [1, steer] = 0` for every eigenvalue of
+/// the benchmark bicycle from 0 to 10 m/s.
+#[test]
+fn issue_10_9_mode_shapes_solve_the_eigenproblem() {
+    use bikedyn::runtime::output::mode_shape;
+    let c = Bicycle::resolve("benchmark").unwrap().canonical().unwrap();
+    let speeds: Vec<f64> = (0..=100).map(|k| k as f64 * 0.1).collect();
+    for p in eigen_sweep(&c, &speeds).unwrap().points {
+        for k in 0..4 {
+            let s = p.eigenvalues[k];
+            let shape = mode_shape(&p.eigenvectors[k]);
+            assert_eq!((shape.roll_amplitude, shape.roll_phase), (1.0, 0.0));
+            let u = [
+                Complex::new(1.0, 0.0),
+                Complex::from_polar(shape.steer_amplitude, shape.steer_phase),
+            ];
+            let (kk, cc) = (c.stiffness(p.v), c.damping(p.v));
+            for i in 0..2 {
+                let r: Complex<f64> = (0..2)
+                    .map(|j| (s * s * c.m0[(i, j)] + s * cc[(i, j)] + kk[(i, j)]) * u[j])
+                    .sum();
+                let scale = (0..2)
+                    .map(|j| (s * s * c.m0[(i, j)]).norm() + (s * cc[(i, j)]).norm() + kk[(i, j)].abs())
+                    .sum::<f64>()
+                    * (1.0 + shape.steer_amplitude);
+                assert!(r.norm() <= 1e-9 * scale, "v = {}, s = {s}: residual {}", p.v, r.norm());
+            }
+        }
+    }
+}
