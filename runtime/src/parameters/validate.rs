@@ -144,8 +144,8 @@ fn validate_common(
     bodies: &[Body],
 ) -> Result<Vec<ParameterWarning>, ParameterError> {
     // The canonical matrices multiply up to four parameters per entry and the
-    // characteristic quartic up to four entries: 1e15^12 stays finite.
-    const LIMIT: f64 = 1e15;
+    // characteristic quartic up to four entries: 1e20^12 stays finite.
+    const LIMIT: f64 = 1e20;
     for (field, value) in values {
         if !value.is_finite() {
             return Err(ParameterError::NotFinite {
