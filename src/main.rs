@@ -578,6 +578,16 @@ fn run(cli: Cli) -> Result<bool> {
             ParamsCommand::Show { bike } => {
                 let b = load(&bike)?;
                 print!("{}", b.parameters.to_toml_string());
+                // Derived geometry, whatever the form of the file (issue 10,
+                // point 9), as TOML comments so the output still loads.
+                let g = bikedyn::runtime::geometry::DerivedGeometry::of(&b.parameters.to_benchmark()?);
+                println!("\n# Derived geometry (Meijaard et al. 2007, appendix A; benchmark axes):");
+                for (sym, value, unit, what) in g.rows() {
+                    println!(
+                        "# {sym:<8} = {:>14} {unit:<7} {what}",
+                        output::format_significant(value, 8)
+                    );
+                }
                 Ok(true)
             }
         },

@@ -286,3 +286,22 @@ fn issue_10_5_9_streamed_eig_output_with_mode_shapes() {
     assert_eq!(s.lines().count(), 10_002);
     assert!(s.starts_with("v,re_1,im_1,mode_1,roll_amp_1,roll_phase_1,steer_amp_1,steer_phase_1,re_2"));
 }
+
+/// Issue 10, point 9: `params show` prints the derived geometry of a bicycle
+/// in either form, as comments (the output still loads).
+#[test]
+fn issue_10_9_params_show_prints_derived_geometry() {
+    for bike in ["thesis", "benchmark"] {
+        let out = bikedyn(&["params", "show", "--bike", bike]);
+        let s = text(&out.stdout);
+        for key in ["# w ", "# c ", "# lam ", "# mT ", "# xT ", "# hT ", "# IAll "] {
+            assert!(s.contains(key), "{bike}: {key} missing in\n{s}");
+        }
+        let p = tmp(&format!("{bike}_shown.toml"));
+        std::fs::write(&p, &s).unwrap();
+        let again = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+        assert!(again.status.success(), "{}", text(&again.stderr));
+    }
+    let s = text(&bikedyn(&["params", "show", "--bike", "benchmark"]).stdout);
+    assert!(s.contains("# mT       =      94.000000 kg"), "{s}");
+}

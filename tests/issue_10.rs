@@ -473,3 +473,30 @@ fn issue_10_9_mode_shapes_solve_the_eigenproblem() {
         }
     }
 }
+
+/// Issue 10, point 9: the derived geometry agrees with the canonical matrices
+/// of the generated model (an independent route): `M0[1][1] = IAll + 2 mu
+/// IAlz + mu^2 ITzz` and `K0[0][0] = -mT hT`, for the built-ins, the
+/// fixtures and every real file.
+#[test]
+fn issue_10_9_derived_geometry_matches_the_model() {
+    use bikedyn::runtime::geometry::DerivedGeometry;
+    for (name, b) in bases() {
+        let g = DerivedGeometry::of(&b);
+        let c = canonical_of(&b.to_thesis().unwrap()).unwrap();
+        let m11 = g.front_steer_inertia
+            + 2.0 * g.trail_ratio * g.front_steer_z_product
+            + g.trail_ratio * g.trail_ratio * g.total_izz;
+        assert!(
+            (m11 - c.m0[(1, 1)]).abs() <= 1e-10 * c.m0.amax(),
+            "{name}: {m11} vs {}",
+            c.m0[(1, 1)]
+        );
+        let k00 = -g.total_mass * g.total_com_height;
+        assert!((k00 - c.k0[(0, 0)]).abs() <= 1e-10 * c.k0.amax(), "{name}");
+    }
+    let g = DerivedGeometry::of(&BenchmarkParameters::benchmark_bicycle());
+    assert_eq!(g.total_mass, 94.0);
+    assert!((g.total_com_height - 80.95 / 94.0).abs() < 1e-15);
+    assert!((g.steer_axis_tilt_deg - 18.0).abs() < 1e-12);
+}

@@ -8,6 +8,7 @@ pub mod benchmark_oracle;
 pub mod canonical;
 pub mod constraints;
 pub mod eigen;
+pub mod geometry;
 pub mod linalg;
 pub mod linearize;
 pub mod model;
