@@ -30,6 +30,19 @@ enum Format {
     Json,
 }
 
+/// Quantity of a stability map.
+#[derive(Clone, Copy, ValueEnum)]
+enum MapArg {
+    /// Width of the self-stable speed range (m/s).
+    Width,
+    /// Weave speed (m/s).
+    Weave,
+    /// Capsize speed (m/s).
+    Capsize,
+    /// Real part of the least stable eigenvalue at --at-speed (1/s).
+    LeastStable,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum FormName {
     Benchmark,
@@ -133,6 +146,16 @@ enum Command {
         /// Stability map plot (.svg or .png), two-parameter sweeps only.
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// Quantity mapped by --plot: the self-stable range width, the weave
+        /// or capsize speed, or the real part of the least stable eigenvalue
+        /// at --at-speed. Cells whose stable range reaches --speed-max are
+        /// marked (the range is cut there).
+        #[arg(long, value_enum, default_value_t = MapArg::Width)]
+        map: MapArg,
+        /// Speed (m/s) of --map least-stable; its value is also written to the
+        /// JSON of every cell.
+        #[arg(long)]
+        at_speed: Option<f64>,
     },
     /// Parameter sets: show or convert between thesis and benchmark forms.
     Params {
@@ -503,10 +526,37 @@ fn run(cli: Cli) -> Result<bool> {
             speed_max,
             out: OutputArgs { format, output: out },
             plot,
+            map,
+            at_speed,
         } => {
             let b = load(&bike)?;
+            // Every output is checked before any work (issue 10, point 4).
+            if let Some(p) = &out {
+                output::output_target(p)?;
+            }
+            if let Some(p) = &plot {
+                ImageFormat::from_path(p)?;
+                output::output_target(p)?;
+            }
+            let quantity = match map {
+                MapArg::Width => MapQuantity::StableWidth,
+                MapArg::Weave => MapQuantity::WeaveSpeed,
+                MapArg::Capsize => MapQuantity::CapsizeSpeed,
+                MapArg::LeastStable => MapQuantity::LeastStableRealPart,
+            };
+            if matches!(map, MapArg::LeastStable) && at_speed.is_none() {
+                bail!("--map least-stable needs --at-speed V (m/s)");
+            }
+            if let Some(v) = at_speed {
+                if !v.is_finite() {
+                    bail!("--at-speed must be a finite speed, found {v:?}");
+                }
+            }
             let xs = parse_range(&values, "--values")?;
-            let opts = SweepOptions::with_speed_range(0.0, speed_max);
+            let opts = SweepOptions {
+                probe_speed: at_speed,
+                ..SweepOptions::with_speed_range(0.0, speed_max)
+            };
             let text = match (param2, values2) {
                 (Some(p2), Some(v2)) => {
                     let ys = parse_range(&v2, "--values2")?;
@@ -527,7 +577,7 @@ fn run(cli: Cli) -> Result<bool> {
                             y_label: Some(axis_label(&p2)),
                             ..PlotOptions::default()
                         };
-                        plot_stability_map(p, &map, MapQuantity::StableWidth, &opts)?;
+                        plot_stability_map(p, &map, quantity, &opts)?;
                         eprintln!("wrote {}", p.display());
                     }
                     match format {

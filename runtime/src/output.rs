@@ -730,6 +730,9 @@ fn cell_json(c: &CellResult) -> serde_json::Map<String, Value> {
             m.insert("stable_intervals".into(), json!(s.stable_intervals));
             m.insert("stable_width".into(), json!(s.stable_width));
             m.insert("open_ended".into(), json!(s.open_ended));
+            if s.least_stable_real_part.is_some() {
+                m.insert("least_stable_real_part".into(), json!(s.least_stable_real_part));
+            }
             m.insert("error".into(), Value::Null);
         }
         Err(e) => {
