@@ -500,3 +500,38 @@ fn issue_10_9_derived_geometry_matches_the_model() {
     assert!((g.total_com_height - 80.95 / 94.0).abs() < 1e-15);
     assert!((g.steer_axis_tilt_deg - 18.0).abs() < 1e-12);
 }
+
+/// Issue 10, point 10: the faster linearization (one full dual evaluation at
+/// V = 1 plus the gravity-only stiffness at rest) gives the same canonical
+/// matrices as the previous two full linearizations, on 500 random designs.
+#[test]
+fn issue_10_10_fast_linearization_equals_two_speed_method() {
+    use bikedyn::generated::{ThesisWhipple, WhippleOffset};
+    use bikedyn::runtime::linearize::{canonical_matrices, canonical_matrices_two_speeds};
+    let bases = bases();
+    let mut rng = Rng(10);
+    let mut checked = 0;
+    for case in 0..500 {
+        let (name, base) = &bases[case % bases.len()];
+        let d = random_design(base, &mut rng);
+        if d.rear_wheel_radius == 0.0 || d.front_wheel_radius == 0.0 {
+            continue;
+        }
+        let t = d.to_thesis().unwrap();
+        let (fast, slow) = if t.fork_com_offset == 0.0 {
+            (
+                canonical_matrices::<ThesisWhipple>(|s| t.get(s)).unwrap(),
+                canonical_matrices_two_speeds::<ThesisWhipple>(|s| t.get(s)).unwrap(),
+            )
+        } else {
+            (
+                canonical_matrices::<WhippleOffset>(|s| t.get(s)).unwrap(),
+                canonical_matrices_two_speeds::<WhippleOffset>(|s| t.get(s)).unwrap(),
+            )
+        };
+        let diff = relative_difference(&fast, &slow);
+        assert!(diff < 1e-12, "case {case} around {name}: {diff:e}");
+        checked += 1;
+    }
+    assert!(checked > 400);
+}

@@ -374,12 +374,73 @@ pub fn parameter_vector<M: MultibodyModel>(
         .collect()
 }
 
-/// Canonical matrices of Meijaard et al. (2007) from a generated model:
-/// `M0 = M`, `C1 = C(v=1)`, `K0 = K(v=0)/g`, `K2 = K(v=1) - K(v=0)`, exact
-/// because the reduced equations are quadratic in the forward speed. The
-/// thesis's steer angle gamma is minus the benchmark's delta, so the
-/// off-diagonal entries change sign.
-pub fn canonical_matrices<M: MultibodyModel>(
+/// Stiffness `K` of the linearization at zero forward speed, where only
+/// gravity (and applied forces at rest) act: with `V = 0` and `q' = 0` every
+/// velocity vanishes (the driving constraint's `Ct` is `-V/Rt`), so `Qv`, the
+/// convective terms and `F` are zero and `Ec = -E^T (Qgrav + Qext)`. This
+/// needs only the configuration, `E` and the gravity forces with 2-direction
+/// dual numbers, a fraction of a full [`linearize`].
+pub fn static_stiffness<M: MultibodyModel>(param: &[f64]) -> Result<DMatrix<f64>, LinearizeError> {
+    const N: usize = 2;
+    let ni = M::INDEPENDENT.len();
+    if ni != 2 {
+        return Err(LinearizeError::NotRollSteer { model: M::NAME, n: ni });
+    }
+    let nq = M::nq();
+    let ind = M::INDEPENDENT;
+    let pd: Vec<Dual<N>> = param.iter().map(|&x| Dual::cst(x)).collect();
+    let guess = upright_guess::<M>(param)?;
+    let mut p: Vec<Dual<N>> = guess.iter().map(|&x| Dual::cst(x)).collect();
+    for (k, &j) in ind.iter().enumerate() {
+        p[j] = Dual::variable(0.0, k);
+    }
+    let t = Dual::<N>::zero();
+    solve_configuration::<M, Dual<N>>(&pd, t, &mut p, &NewtonOptions::default())?;
+    let solved: Vec<f64> = p.iter().map(|x| x.re).collect();
+    check_physical_branch::<M>(param, &solved)?;
+    let cm = constraint_matrices::<M, Dual<N>>(&pd, t, &p);
+    let depv = dependent_velocities::<M>();
+    let nd = depv.len();
+    let nc = cm.d_rhs.len();
+    let mut a = vec![Dual::<N>::zero(); nd * nd];
+    let mut rhs = vec![Dual::<N>::zero(); nd * ni];
+    for i in 0..nc {
+        for (k, &j) in depv.iter().enumerate() {
+            a[i * nd + k] = cm.d[i * nq + j];
+        }
+        for (k, &j) in ind.iter().enumerate() {
+            rhs[i * ni + k] = cm.d[i * nq + j];
+        }
+    }
+    solve_in_place(&mut a, nd, &mut rhs, ni).map_err(|s| ConstraintError::SingularJacobian {
+        what: "coordinate partitioning",
+        column: s.column,
+        pivot: s.pivot,
+        scale: s.scale,
+    })?;
+    // Q = Qgrav + Qext at rest; Qi_k = sum_r E[r][k] Q[r].
+    let mut qg = vec![Dual::<N>::zero(); nq];
+    M::gravity_forces(&pd, &p, &mut qg);
+    let mut qe = vec![Dual::<N>::zero(); nq];
+    let dp = vec![Dual::<N>::zero(); nq];
+    M::applied_forces(&pd, t, &p, &dp, &mut qe);
+    let mut k = DMatrix::zeros(2, 2);
+    for a_ in 0..ni {
+        let mut qi = qg[ind[a_]] + qe[ind[a_]];
+        for (r, &j) in depv.iter().enumerate() {
+            qi -= rhs[r * ni + a_] * (qg[j] + qe[j]);
+        }
+        for b in 0..ni {
+            k[(a_, b)] = -qi.eps[b];
+        }
+    }
+    Ok(k)
+}
+
+/// Canonical matrices by two full linearizations (at `V = 0` and `V = 1`),
+/// the method [`canonical_matrices`] used before issue 10, point 10; kept for
+/// the bench's comparison and as a cross-check.
+pub fn canonical_matrices_two_speeds<M: MultibodyModel>(
     lookup: impl Fn(&str) -> Option<f64>,
 ) -> Result<CanonicalMatrices, LinearizeError> {
     let g = lookup("g").ok_or_else(|| LinearizeError::MissingParameter {
@@ -394,6 +455,34 @@ pub fn canonical_matrices<M: MultibodyModel>(
         c1: flip(&l1.damping),
         k0: flip(&l0.stiffness) / g,
         k2: flip(&(&l1.stiffness - &l0.stiffness)),
+        g,
+    })
+}
+
+/// Canonical matrices of Meijaard et al. (2007) from a generated model:
+/// `M0 = M`, `C1 = C(v=1)`, `K0 = K(v=0)/g`, `K2 = K(v=1) - K(v=0)`, exact
+/// because the reduced equations are quadratic in the forward speed. The
+/// thesis's steer angle gamma is minus the benchmark's delta, so the
+/// off-diagonal entries change sign.
+///
+/// One full dual-number linearization at `V = 1` gives `M`, `C(1)` and
+/// `K(1)`; `K(0)` comes from [`static_stiffness`] (gravity only, 2-direction
+/// duals), which costs a fraction of a second full linearization.
+pub fn canonical_matrices<M: MultibodyModel>(
+    lookup: impl Fn(&str) -> Option<f64>,
+) -> Result<CanonicalMatrices, LinearizeError> {
+    let g = lookup("g").ok_or_else(|| LinearizeError::MissingParameter {
+        model: M::NAME,
+        name: "g".into(),
+    })?;
+    let k_rest = static_stiffness::<M>(&parameter_vector::<M>(&lookup, 0.0)?)?;
+    let l1 = linearize::<M>(&parameter_vector::<M>(&lookup, 1.0)?)?;
+    let flip = |m: &DMatrix<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);
+    Ok(CanonicalMatrices {
+        m0: flip(&l1.mass),
+        c1: flip(&l1.damping),
+        k0: flip(&k_rest) / g,
+        k2: flip(&(&l1.stiffness - &k_rest)),
         g,
     })
 }
