@@ -408,9 +408,15 @@ fn issue_10_7_random_designs_have_continuous_mode_labels() {
         let (name, base) = &bases[case % bases.len()];
         let d = random_design(base, &mut rng);
         let c = meijaard_canonical(&d);
-        let Ok(sweep) = eigen_sweep(&c, &speeds) else {
-            refused += 1;
-            continue;
+        let sweep = match eigen_sweep(&c, &speeds) {
+            Ok(s) => s,
+            Err(e) => {
+                if refused == 0 {
+                    eprintln!("first refusal (case {case} around {name}): {e}");
+                }
+                refused += 1;
+                continue;
+            }
         };
         checked += 1;
         if let Err(e) = check_mode_continuity(&sweep.points) {
@@ -418,7 +424,10 @@ fn issue_10_7_random_designs_have_continuous_mode_labels() {
         }
     }
     eprintln!("{checked} designs checked, {refused} refused by the eigen analysis");
-    assert!(checked >= 9_900, "{checked}");
+    // Before issue 10 the anchor search gave up on 57 of these designs (the
+    // quartic solver at an extreme ladder speed); one remains (mode
+    // continuation does not converge for a two-mass-skate variant).
+    assert!(checked >= 9_990, "{checked}");
 }
 
 /// Issue 10, point 6: a singular-Jacobian message states the pivot against
