@@ -75,7 +75,7 @@ pub fn reduced_equations<M: MultibodyModel, T: Scalar>(
 ) -> Result<(Vec<T>, Vec<T>), ConstraintError> {
     let paramf: Vec<f64> = param.iter().map(|x| x.re()).collect();
     let guess = upright_guess::<M>(&paramf)?;
-    reduced_equations_from::<M, T>(param, t, &guess, q, dq, ddq).map(|(ec, mi, _)| (ec, mi))
+    reduced_equations_from::<M, T>(param, t, &guess, q, dq, ddq).map(|r| (r.ec, r.mi))
 }
 
 /// Physical upright configuration of a bicycle model with the thesis's
@@ -174,9 +174,21 @@ fn check_physical_branch<M: MultibodyModel>(param: &[f64], p: &[f64]) -> Result<
     Ok(())
 }
 
+/// What [`reduced_equations_from`] returns.
+struct Reduced<T> {
+    /// `Ec = Mi q'' - Qi`.
+    ec: Vec<T>,
+    /// `Mi`, row-major.
+    mi: Vec<T>,
+    /// `-E^T (Qgrav + Qext(p, 0, t))`: the reduced equations at rest (zero
+    /// velocities), at the same configuration.
+    ec_rest: Vec<T>,
+    /// Solved coordinates (real parts).
+    solved: Vec<f64>,
+}
+
 /// [`reduced_equations`] from the configuration guess `guess` (all
-/// coordinates; the independent ones are replaced by `q`). Also returns the
-/// solved coordinates (real parts).
+/// coordinates; the independent ones are replaced by `q`).
 fn reduced_equations_from<M: MultibodyModel, T: Scalar>(
     param: &[T],
     t: T,
@@ -184,7 +196,7 @@ fn reduced_equations_from<M: MultibodyModel, T: Scalar>(
     q: &[T],
     dq: &[T],
     ddq: &[T],
-) -> Result<(Vec<T>, Vec<T>, Vec<f64>), ConstraintError> {
+) -> Result<Reduced<T>, ConstraintError> {
     let nq = M::nq();
     let ind = M::INDEPENDENT;
     let ni = ind.len();
@@ -257,6 +269,8 @@ fn reduced_equations_from<M: MultibodyModel, T: Scalar>(
     M::gravity_forces(param, &p, &mut qg);
     let mut qe = vec![T::zero(); nq];
     M::applied_forces(param, t, &p, &dp, &mut qe);
+    let mut qe_rest = vec![T::zero(); nq];
+    M::applied_forces(param, t, &p, &vec![T::zero(); nq], &mut qe_rest);
     // Q = Qv + Qgrav + Qext - M F; Mi = E^T M E; Qi = E^T Q (eq. 46-47).
     let mut qtot = vec![T::zero(); nq];
     for r in 0..nq {
@@ -278,11 +292,15 @@ fn reduced_equations_from<M: MultibodyModel, T: Scalar>(
     }
     let mut mi = vec![T::zero(); ni * ni];
     let mut ec = vec![T::zero(); ni];
+    let mut ec_rest = vec![T::zero(); ni];
     for a_ in 0..ni {
         let mut qi = T::zero();
+        let mut qi_rest = T::zero();
         for r in 0..nq {
             qi += e[r * ni + a_] * qtot[r];
+            qi_rest += e[r * ni + a_] * (qg[r] + qe_rest[r]);
         }
+        ec_rest[a_] = -qi_rest;
         let mut s = -qi;
         for b in 0..ni {
             let mut m = T::zero();
@@ -295,7 +313,12 @@ fn reduced_equations_from<M: MultibodyModel, T: Scalar>(
         ec[a_] = s;
     }
     let solved = p.iter().map(|x| x.re()).collect();
-    Ok((ec, mi, solved))
+    Ok(Reduced {
+        ec,
+        mi,
+        ec_rest,
+        solved,
+    })
 }
 
 /// `M`, `C`, `K` of `M q'' + C q' + K q = 0` (thesis eq. 48-50) about
@@ -309,6 +332,14 @@ pub struct Linearization {
 
 /// Exact linearization (dual numbers) at `param` (which fixes the speed).
 pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, LinearizeError> {
+    linearize_with_rest::<M>(param).map(|(l, _)| l)
+}
+
+/// [`linearize`] and, from the same dual evaluation, the stiffness at rest
+/// (`V = 0`): `K(0) = d/dq [-E^T (Qgrav + Qext(p, 0))]`, because the
+/// configuration and `E` do not depend on the speed and every velocity
+/// term vanishes at rest (see [`static_stiffness`]).
+fn linearize_with_rest<M: MultibodyModel>(param: &[f64]) -> Result<(Linearization, DMatrix<f64>), LinearizeError> {
     const N: usize = 4;
     let ni = M::INDEPENDENT.len();
     if ni != 2 {
@@ -319,16 +350,20 @@ pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, Line
     let dq = [Dual::<N>::variable(0.0, 2), Dual::variable(0.0, 3)];
     let ddq = [Dual::<N>::zero(); 2];
     let guess = upright_guess::<M>(param)?;
-    let (ec, mi, solved) = reduced_equations_from::<M, Dual<N>>(&pd, Dual::zero(), &guess, &q, &dq, &ddq)?;
-    check_physical_branch::<M>(param, &solved)?;
-    let mass = DMatrix::from_fn(2, 2, |i, j| mi[i * 2 + j].re);
-    let stiffness = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[j]);
-    let damping = DMatrix::from_fn(2, 2, |i, j| ec[i].eps[2 + j]);
-    Ok(Linearization {
-        mass,
-        damping,
-        stiffness,
-    })
+    let r = reduced_equations_from::<M, Dual<N>>(&pd, Dual::zero(), &guess, &q, &dq, &ddq)?;
+    check_physical_branch::<M>(param, &r.solved)?;
+    let mass = DMatrix::from_fn(2, 2, |i, j| r.mi[i * 2 + j].re);
+    let stiffness = DMatrix::from_fn(2, 2, |i, j| r.ec[i].eps[j]);
+    let damping = DMatrix::from_fn(2, 2, |i, j| r.ec[i].eps[2 + j]);
+    let rest = DMatrix::from_fn(2, 2, |i, j| r.ec_rest[i].eps[j]);
+    Ok((
+        Linearization {
+            mass,
+            damping,
+            stiffness,
+        },
+        rest,
+    ))
 }
 
 /// The thesis's finite-difference linearization (forward differences, step
@@ -465,9 +500,9 @@ pub fn canonical_matrices_two_speeds<M: MultibodyModel>(
 /// thesis's steer angle gamma is minus the benchmark's delta, so the
 /// off-diagonal entries change sign.
 ///
-/// One full dual-number linearization at `V = 1` gives `M`, `C(1)` and
-/// `K(1)`; `K(0)` comes from [`static_stiffness`] (gravity only, 2-direction
-/// duals), which costs a fraction of a second full linearization.
+/// One dual-number linearization at `V = 1` gives `M`, `C(1)`, `K(1)` and,
+/// from the same evaluation, `K(0)` (the gravity and rest terms alone; see
+/// [`static_stiffness`] for the standalone computation).
 pub fn canonical_matrices<M: MultibodyModel>(
     lookup: impl Fn(&str) -> Option<f64>,
 ) -> Result<CanonicalMatrices, LinearizeError> {
@@ -475,8 +510,7 @@ pub fn canonical_matrices<M: MultibodyModel>(
         model: M::NAME,
         name: "g".into(),
     })?;
-    let k_rest = static_stiffness::<M>(&parameter_vector::<M>(&lookup, 0.0)?)?;
-    let l1 = linearize::<M>(&parameter_vector::<M>(&lookup, 1.0)?)?;
+    let (l1, k_rest) = linearize_with_rest::<M>(&parameter_vector::<M>(&lookup, 1.0)?)?;
     let flip = |m: &DMatrix<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);
     Ok(CanonicalMatrices {
         m0: flip(&l1.mass),
