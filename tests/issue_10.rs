@@ -512,11 +512,14 @@ fn issue_10_9_derived_geometry_matches_the_model() {
 
 /// Issue 10, point 10: the faster linearization (one full dual evaluation at
 /// V = 1 plus the gravity-only stiffness at rest) gives the same canonical
-/// matrices as the previous two full linearizations, on 500 random designs.
+/// matrices as the previous two full linearizations, on 500 random designs;
+/// so does the standalone gravity-only stiffness at rest (`g K0`).
 #[test]
 fn issue_10_10_fast_linearization_equals_two_speed_method() {
     use bikedyn::generated::{ThesisWhipple, WhippleOffset};
-    use bikedyn::runtime::linearize::{canonical_matrices, canonical_matrices_two_speeds};
+    use bikedyn::runtime::linearize::{
+        canonical_matrices, canonical_matrices_two_speeds, parameter_vector, static_stiffness,
+    };
     let bases = bases();
     let mut rng = Rng(10);
     let mut checked = 0;
@@ -540,6 +543,17 @@ fn issue_10_10_fast_linearization_equals_two_speed_method() {
         };
         let diff = relative_difference(&fast, &slow);
         assert!(diff < 1e-12, "case {case} around {name}: {diff:e}");
+        // The standalone gravity-only stiffness at rest gives g K0.
+        let rest = if t.fork_com_offset == 0.0 {
+            static_stiffness::<ThesisWhipple>(&parameter_vector::<ThesisWhipple>(|s| t.get(s), 0.0).unwrap())
+        } else {
+            static_stiffness::<WhippleOffset>(&parameter_vector::<WhippleOffset>(|s| t.get(s), 0.0).unwrap())
+        }
+        .unwrap();
+        let g = t.g;
+        let k0 = Matrix2::new(rest[(0, 0)], -rest[(0, 1)], -rest[(1, 0)], rest[(1, 1)]) / g;
+        let scale = slow.k0.amax();
+        assert!((k0 - slow.k0).amax() <= 1e-12 * scale, "case {case} around {name}");
         checked += 1;
     }
     assert!(checked > 400);
