@@ -898,7 +898,11 @@ pub fn format_parameter_table(s: &ParameterSweep) -> String {
         .values
         .iter()
         .zip(&s.points)
-        .map(|(p, c)| std::iter::once(format!("{p:.6}")).chain(summary_row(c)).collect())
+        .map(|(p, c)| {
+            std::iter::once(format_fixed(*p, 6, false))
+                .chain(summary_row(c))
+                .collect()
+        })
         .collect();
     format_table(&header, &rows)
 }
@@ -914,7 +918,10 @@ pub fn format_stability_map_table(m: &StabilityMap) -> String {
     for i in 0..nx {
         for j in 0..ny {
             if let Some(c) = m.cell(i, j) {
-                let mut r = vec![format!("{:.6}", m.x.values[i]), format!("{:.6}", m.y.values[j])];
+                let mut r = vec![
+                    format_fixed(m.x.values[i], 6, false),
+                    format_fixed(m.y.values[j], 6, false),
+                ];
                 r.extend(summary_row(c));
                 rows.push(r);
             }
