@@ -2,7 +2,9 @@
 //!
 //! # Atomic writes
 //! Every `save_*` function (and the plots in [`crate::plot`]) writes through
-//! [`write_atomic`] / [`write_atomic_via_path`]: the content goes to a fresh
+//! [`write_atomic`] / [`write_atomic_via_path`]. A symbolic link is followed
+//! (and kept); a FIFO or a device is written through, never replaced
+//! ([`output_target`]). For a regular file or a new path the content goes to a fresh
 //! temporary file in the target's directory (`.<name>.tmp-<pid>-<n>.<ext>`),
 //! is flushed and fsynced, and is then renamed over the target (followed by a
 //! best-effort fsync of the directory). On any error the temporary file is
@@ -11,7 +13,8 @@
 //!
 //! # Eigenvalue order
 //! Within each speed the four eigenvalues are written in the order of
-//! [`ordered_eigenvalues`]: by mode (weave, capsize, castering, other), then by
+//! [`ordered_eigenvalues`]: by mode (weave, capsize, castering, the merged
+//! pairs weave-capsize, weave-castering, capsize-castering, other), then by
 //! descending imaginary part, then by descending real part. For a conventional
 //! bicycle slots 1-2 are the weave pair (`+i` first; two real roots below
 //! `v_d`), slot 3 capsize and slot 4 castering; the mode of each slot is

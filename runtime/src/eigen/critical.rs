@@ -78,9 +78,11 @@ fn direction(cp: &CharPoly, s: C64, v: f64) -> Option<CrossingDirection> {
 ///   contains them) where a real root passes through zero or a complex pair
 ///   crosses the imaginary axis, ascending, with the label of the crossing root
 ///   (tracked as in [`eigen_sweep`]) and the direction with increasing speed.
-/// * `weave_speed` (`v_w`): the lowest speed `>= 0` in the range where the weave
-///   becomes stable (stabilizing weave crossing); `capsize_speed` (`v_c`): the lowest
-///   speed `>= 0` in the range where the capsize mode becomes unstable;
+/// * `weave_speed` (`v_w`): the lowest speed `>= 0` in the range where an
+///   oscillation containing the weave becomes stable (a stabilizing complex-pair
+///   crossing of `weave`, `weave-capsize` or `weave-castering`); `capsize_speed`
+///   (`v_c`): the lowest speed `>= 0` in the range where the capsize mode (alone or
+///   merged with castering) becomes unstable;
 ///   `weave_real_pair_merge` (`v_d`): the lowest speed `>= 0` in the range where the
 ///   two real weave roots merge into the weave pair (with the double root in
 ///   `weave_merge_eigenvalue`). Each is `None` if it does not occur in the range.
