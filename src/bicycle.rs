@@ -183,7 +183,7 @@ fn canonical_zero_radius(p: &ThesisParameters) -> Result<CanonicalMatrices, Line
     // Step: a tenth of the wheelbase keeps every sample a plain bicycle.
     let h = 0.1 * bench.wheelbase;
     let at = |s: f64| -> Result<CanonicalMatrices, LinearizeError> {
-        let mut b = bench.clone();
+        let mut b = bench;
         if p.rear_wheel_radius == 0.0 {
             b.rear_wheel_radius = s;
         }
@@ -197,8 +197,8 @@ fn canonical_zero_radius(p: &ThesisParameters) -> Result<CanonicalMatrices, Line
     let combine = |w: [f64; 4], get: &dyn Fn(&CanonicalMatrices) -> f64| -> f64 {
         w.iter().zip(&f).map(|(wi, fi)| wi * get(fi)).sum()
     };
-    let entries: [&dyn Fn(&CanonicalMatrices) -> nalgebra::Matrix2<f64>; 4] =
-        [&|c| c.m0, &|c| c.c1, &|c| c.k0, &|c| c.k2];
+    type Entry = fn(&CanonicalMatrices) -> nalgebra::Matrix2<f64>;
+    let entries: [Entry; 4] = [|c| c.m0, |c| c.c1, |c| c.k0, |c| c.k2];
     let mut out = [nalgebra::Matrix2::zeros(); 4];
     for (m, get) in entries.iter().enumerate() {
         // Rounding is relative to the matrix, not to an entry that may be
@@ -209,7 +209,7 @@ fn canonical_zero_radius(p: &ThesisParameters) -> Result<CanonicalMatrices, Line
                 let e = |c: &CanonicalMatrices| get(c)[(i, j)];
                 // Third difference: zero for a quadratic, up to rounding.
                 let departure = combine([-1.0, 3.0, -3.0, 1.0], &e).abs();
-                if !(departure <= 1e-9 * scale) {
+                if departure.is_nan() || departure > 1e-9 * scale {
                     return Err(LinearizeError::ZeroRadiusLimit { departure, scale });
                 }
                 // Lagrange extrapolation of a quadratic to radius 0.

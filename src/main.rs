@@ -213,7 +213,7 @@ fn range_spec(s: &str, what: &str, limit: usize) -> Result<(f64, f64, usize)> {
             // Count in floating point: `as usize` would saturate (and `+ 1`
             // wrap) for a tiny step such as 1e-300.
             let intervals = ((b - a) / h + 1e-9).floor();
-            if !(intervals < limit as f64) {
+            if intervals.is_nan() || intervals >= limit as f64 {
                 bail!(
                     "{what}: `{s}` gives {} points, more than the limit of {limit} \
                      (use a larger STEP or a shorter range)",
