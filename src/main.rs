@@ -191,6 +191,12 @@ enum ParamsCommand {
 /// Most points a `START:STOP:STEP` range may have when all its results are
 /// held in memory (sweeps, tables, plots).
 const MAX_POINTS: usize = 10_000_000;
+/// Most rows of a terminal table (`eig --format table`): the table is
+/// aligned, so it is held in memory; CSV and JSON stream instead.
+const MAX_TABLE_ROWS: usize = 100_000;
+/// Most cells of a two-parameter stability map (each cell is one
+/// linearization and one critical-speed search, held in memory).
+const MAX_MAP_CELLS: usize = 10_000_000;
 /// Most speeds of `eig` with CSV or JSON output, which streams its rows (memory
 /// stays flat; the limit only bounds the run time, about 1 µs per speed).
 const MAX_STREAMED_POINTS: usize = 1_000_000_000;
@@ -458,10 +464,17 @@ fn run(cli: Cli) -> Result<bool> {
                 output::output_target(p)?;
             }
             let limit = match format {
-                Format::Table => MAX_POINTS,
+                Format::Table => MAX_TABLE_ROWS,
                 Format::Csv | Format::Json => MAX_STREAMED_POINTS,
             };
-            let (start, step, n) = range_spec(&speeds, "--speeds", limit)?;
+            let (start, step, n) = range_spec(&speeds, "--speeds", limit).map_err(|e| match format {
+                Format::Table => {
+                    anyhow::anyhow!(
+                        "{e}; a table holds every row, --format csv or json streams up to {MAX_STREAMED_POINTS} points"
+                    )
+                }
+                _ => e,
+            })?;
             let c = b.canonical()?;
             let speed = |k: usize| start + k as f64 * step;
             let stream = |fmt: output::StreamFormat| -> Result<()> {
@@ -560,6 +573,16 @@ fn run(cli: Cli) -> Result<bool> {
             let text = match (param2, values2) {
                 (Some(p2), Some(v2)) => {
                     let ys = parse_range(&v2, "--values2")?;
+                    let cells = xs.len() as f64 * ys.len() as f64;
+                    if cells > MAX_MAP_CELLS as f64 {
+                        bail!(
+                            "--values x --values2 gives {} x {} = {} cells, more than the limit of {MAX_MAP_CELLS} \
+                             (use larger steps)",
+                            xs.len(),
+                            ys.len(),
+                            output::format_significant(cells, 4)
+                        );
+                    }
                     b.with_parameter(&param, xs[0])?.with_parameter(&p2, ys[0])?;
                     let map = stability_map(
                         ParamAxis::new(param.clone(), xs),

@@ -378,3 +378,32 @@ fn issue_10_9_sweep_maps_a_chosen_quantity() {
     ]);
     assert!(!out.status.success() && text(&out.stderr).contains("--at-speed"));
 }
+
+/// Issue 10, point 5: the in-memory outputs state their limits: a table of
+/// more than 100,000 rows points to the streamed formats, and a stability
+/// map of more than 10^7 cells says how many it would have.
+#[test]
+fn issue_10_5_in_memory_limits_are_stated() {
+    let out = bikedyn(&["eig", "--speeds", "0:10:1e-5"]);
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("1000001 points") && err.contains("--format csv or json streams"),
+        "{err}"
+    );
+    let out = bikedyn(&[
+        "sweep",
+        "--param",
+        "c",
+        "--values",
+        "0:1:1e-4",
+        "--param2",
+        "lam",
+        "--values2",
+        "0:1:1e-4",
+    ]);
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("10001 x 10001") && err.contains("limit of 10000000"),
+        "{err}"
+    );
+}
