@@ -181,6 +181,10 @@ impl Bicycle {
                 effects: active.join(", "),
             });
         }
+        let t = self.thesis()?;
+        if t.rear_wheel_radius == 0.0 || t.front_wheel_radius == 0.0 {
+            return canonical_zero_radius(&t);
+        }
         let lookup = self.lookup()?;
         with_model(info.name, Canonical(&lookup))
             .expect("registered model")
@@ -272,6 +276,18 @@ impl<F: Fn(&str) -> Option<f64>> ModelVisitor for Canonical<'_, F> {
 /// Canonical matrices of thesis-form parameters, through the model that fits
 /// them (the thesis model when the fork mass centre is on the steer axis,
 /// the offset variant otherwise; chosen from the registry by parameters).
+///
+/// A wheel of zero radius (a skate, as in the two-mass-skate bicycle of
+/// Kooijman et al. 2011) has its contact point at the wheel centre. The
+/// generated model cannot represent it directly (its driving constraint
+/// divides by the rear radius and the rim angle of the front contact is then
+/// undetermined), so the zero-radius bicycle is reached as a limit: with the
+/// wheel's spin inertia zero, the canonical matrices are polynomials of
+/// degree 2 in the wheel radii at fixed benchmark geometry (Meijaard et al.
+/// 2007, eqs. A 1 - A 27: the radii enter through `mT zT`, `ITxx`, `ITxz`,
+/// `zA`, `IAxx`, `IAxz`, `uA`, none above the second power). They are
+/// evaluated at radius `h, 2h, 3h` and extrapolated exactly to 0; a fourth
+/// radius `4h` checks that the third difference vanishes.
 pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleError> {
     Bicycle {
         name: "parameters".into(),
@@ -280,4 +296,74 @@ pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleEr
         effects: BTreeMap::new(),
     }
     .canonical()
+}
+
+/// Canonical matrices of a bicycle with one or both wheel radii zero (see
+/// [`canonical_of`]).
+fn canonical_zero_radius(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleError> {
+    let lin = |source| BicycleError::Linearize {
+        bike: "zero-radius bicycle".into(),
+        source,
+    };
+    use bikedyn_runtime::parameters::body;
+    if p.rear_wheel_radius == 0.0 && p.rear_wheel_i_axial != 0.0 {
+        return Err(lin(LinearizeError::SkateWithSpinInertia {
+            wheel: body::REAR_WHEEL,
+            radius_symbol: "Rt (rR)",
+            inertia_symbol: "I2y (IRyy)",
+            inertia: p.rear_wheel_i_axial,
+        }));
+    }
+    if p.front_wheel_radius == 0.0 && p.front_wheel_i_axial != 0.0 {
+        return Err(lin(LinearizeError::SkateWithSpinInertia {
+            wheel: body::FRONT_WHEEL,
+            radius_symbol: "Rd (rF)",
+            inertia_symbol: "I5y (IFyy)",
+            inertia: p.front_wheel_i_axial,
+        }));
+    }
+    let bench = p.to_benchmark()?;
+    // Step: a tenth of the wheelbase keeps every sample a plain bicycle.
+    let h = 0.1 * bench.wheelbase;
+    let at = |s: f64| -> Result<CanonicalMatrices, BicycleError> {
+        let mut b = bench;
+        if p.rear_wheel_radius == 0.0 {
+            b.rear_wheel_radius = s;
+        }
+        if p.front_wheel_radius == 0.0 {
+            b.front_wheel_radius = s;
+        }
+        canonical_of(&b.to_thesis()?)
+    };
+    let f = [at(h)?, at(2.0 * h)?, at(3.0 * h)?, at(4.0 * h)?];
+    let combine = |w: [f64; 4], get: &dyn Fn(&CanonicalMatrices) -> f64| -> f64 {
+        w.iter().zip(&f).map(|(wi, fi)| wi * get(fi)).sum()
+    };
+    type Entry = fn(&CanonicalMatrices) -> nalgebra::Matrix2<f64>;
+    let entries: [Entry; 4] = [|c| c.m0, |c| c.c1, |c| c.k0, |c| c.k2];
+    let mut out = [nalgebra::Matrix2::zeros(); 4];
+    for (m, get) in entries.iter().enumerate() {
+        // Rounding is relative to the matrix, not to an entry that may be
+        // structurally zero.
+        let scale = f.iter().fold(0.0f64, |a, c| a.max(get(c).amax()));
+        for i in 0..2 {
+            for j in 0..2 {
+                let e = |c: &CanonicalMatrices| get(c)[(i, j)];
+                // Third difference: zero for a quadratic, up to rounding.
+                let departure = combine([-1.0, 3.0, -3.0, 1.0], &e).abs();
+                if departure.is_nan() || departure > 1e-9 * scale {
+                    return Err(lin(LinearizeError::ZeroRadiusLimit { departure, scale }));
+                }
+                // Lagrange extrapolation of a quadratic to radius 0.
+                out[m][(i, j)] = combine([3.0, -3.0, 1.0, 0.0], &e);
+            }
+        }
+    }
+    Ok(CanonicalMatrices {
+        m0: out[0],
+        c1: out[1],
+        k0: out[2],
+        k2: out[3],
+        g: bench.g,
+    })
 }

@@ -2,9 +2,9 @@
 
 use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::{Bicycle, BUILT_IN};
-use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds};
+use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds, CrossingDirection, CrossingKind};
 use bikedyn::runtime::output;
-use bikedyn::runtime::plot::{plot_continuation, plot_stability_map, PlotOptions};
+use bikedyn::runtime::plot::{plot_continuation, plot_stability_map, ImageFormat, PlotOptions};
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
 use bikedyn::runtime::verify::VerifyOptions;
 use bikedyn::runtime::CanonicalMatrices;
@@ -31,6 +31,19 @@ enum Format {
     Table,
     Csv,
     Json,
+}
+
+/// Quantity of a stability map.
+#[derive(Clone, Copy, ValueEnum)]
+enum MapArg {
+    /// Width of the self-stable speed range (m/s).
+    Width,
+    /// Weave speed (m/s).
+    Weave,
+    /// Capsize speed (m/s).
+    Capsize,
+    /// Real part of the least stable eigenvalue at --at-speed (1/s).
+    LeastStable,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -148,6 +161,16 @@ enum Command {
         /// Stability map plot (.svg or .png), two-parameter sweeps only.
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// Quantity mapped by --plot: the self-stable range width, the weave
+        /// or capsize speed, or the real part of the least stable eigenvalue
+        /// at --at-speed. Cells whose stable range reaches --speed-max are
+        /// marked (the range is cut there).
+        #[arg(long, value_enum, default_value_t = MapArg::Width)]
+        map: MapArg,
+        /// Speed (m/s) of --map least-stable; its value is also written to the
+        /// JSON of every cell.
+        #[arg(long)]
+        at_speed: Option<f64>,
     },
     /// Parameter sets: show or convert between thesis and benchmark forms.
     Params {
@@ -191,7 +214,22 @@ enum ParamsCommand {
     },
 }
 
-fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
+/// Most points a `START:STOP:STEP` range may have when all its results are
+/// held in memory (sweeps, tables, plots).
+const MAX_POINTS: usize = 10_000_000;
+/// Most rows of a terminal table (`eig --format table`): the table is
+/// aligned, so it is held in memory; CSV and JSON stream instead.
+const MAX_TABLE_ROWS: usize = 100_000;
+/// Most cells of a two-parameter stability map (each cell is one
+/// linearization and one critical-speed search, held in memory).
+const MAX_MAP_CELLS: usize = 10_000_000;
+/// Most speeds of `eig` with CSV or JSON output, which streams its rows (memory
+/// stays flat; the limit only bounds the run time, about 1 µs per speed).
+const MAX_STREAMED_POINTS: usize = 1_000_000_000;
+
+/// `START:STOP:STEP` (or one number) as `(start, step, count)`, with at most
+/// `limit` points.
+fn range_spec(s: &str, what: &str, limit: usize) -> Result<(f64, f64, usize)> {
     let parts: Vec<&str> = s.split(':').collect();
     let nums: Vec<f64> = parts
         .iter()
@@ -202,16 +240,27 @@ fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
         })
         .collect::<Result<_>>()?;
     match nums.as_slice() {
-        [x] if x.is_finite() => Ok(vec![*x]),
+        [x] if x.is_finite() => Ok((*x, 0.0, 1)),
         [a, b, h] if a.is_finite() && b.is_finite() && h.is_finite() && *h > 0.0 && b >= a => {
-            let n = ((b - a) / h + 1e-9).floor() as usize;
-            if n > 10_000_000 {
-                bail!("{what}: {} points is too many", n + 1);
+            // Count in floating point: `as usize` would saturate (and `+ 1`
+            // wrap) for a tiny step such as 1e-300.
+            let intervals = ((b - a) / h + 1e-9).floor();
+            if intervals.is_nan() || intervals >= limit as f64 {
+                bail!(
+                    "{what}: `{s}` gives {} points, more than the limit of {limit} \
+                     (use a larger STEP or a shorter range)",
+                    output::format_significant(intervals + 1.0, 4)
+                );
             }
-            Ok((0..=n).map(|k| a + k as f64 * h).collect())
+            Ok((*a, *h, intervals as usize + 1))
         }
         _ => bail!("{what}: `{s}` must be START:STOP:STEP with STEP > 0 and STOP >= START"),
     }
+}
+
+fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
+    let (a, h, n) = range_spec(s, what, MAX_POINTS)?;
+    Ok((0..n).map(|k| a + k as f64 * h).collect())
 }
 
 fn load(bike: &str) -> Result<Bicycle> {
@@ -242,7 +291,9 @@ fn stability_json(name: &str, c: &CriticalSpeeds) -> serde_json::Value {
         "weave_real_pair_merge_speed": c.weave_real_pair_merge,
         "stable_intervals": c.stable_intervals,
         "crossings": c.crossings.iter().map(|x| serde_json::json!({
-            "speed": x.speed, "mode": x.mode.name(), "direction": format!("{:?}", x.direction).to_lowercase(), "frequency": x.frequency
+            "speed": x.speed, "mode": x.mode.name(), "direction": format!("{:?}", x.direction).to_lowercase(),
+            "kind": match x.kind { CrossingKind::RealRoot => "real_root", CrossingKind::ComplexPair => "complex_pair" },
+            "frequency": x.frequency
         })).collect::<Vec<_>>(),
     })
 }
@@ -261,6 +312,20 @@ fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
     }
     for [lo, hi] in &c.stable_intervals {
         s += &format!("  self-stable from {lo:.4} to {hi:.4} m/s\n");
+    }
+    if !c.crossings.is_empty() {
+        s += "  stability crossings (speed, mode, direction):\n";
+    }
+    for x in &c.crossings {
+        let dir = match x.direction {
+            CrossingDirection::Destabilizing => "becomes unstable",
+            CrossingDirection::Stabilizing => "becomes stable",
+        };
+        let kind = match x.kind {
+            CrossingKind::RealRoot => "real root through zero".to_string(),
+            CrossingKind::ComplexPair => format!("oscillation, {:.4} rad/s", x.frequency),
+        };
+        s += &format!("    {:.10} m/s  {:<17}  {dir} ({kind})\n", x.speed, x.mode.name());
     }
     s
 }
@@ -325,14 +390,15 @@ fn params_show_text(b: &Bicycle, model: Option<&str>) -> Result<String> {
     Ok(s)
 }
 
+/// Canonical matrices for people: 12 significant digits relative to each
+/// matrix's largest entry, no negative zero (the JSON keeps full precision).
 fn canonical_text(c: &CanonicalMatrices) -> String {
     let m = |name: &str, x: &nalgebra::Matrix2<f64>| {
+        let e = output::format_matrix_entries(&[x[(0, 0)], x[(0, 1)], x[(1, 0)], x[(1, 1)]], 12);
+        let w = e.iter().map(String::len).max().unwrap_or(0);
         format!(
-            "{name} = [[{:.14}, {:.14}],\n      [{:.14}, {:.14}]]\n",
-            x[(0, 0)],
-            x[(0, 1)],
-            x[(1, 0)],
-            x[(1, 1)]
+            "{name} = [[{:>w$}, {:>w$}],\n      [{:>w$}, {:>w$}]]\n",
+            e[0], e[1], e[2], e[3]
         )
     };
     format!(
@@ -480,22 +546,62 @@ fn run(cli: Cli) -> Result<bool> {
             plot,
         } => {
             let b = load(&bike)?;
-            let c = b.canonical_with(model.as_deref())?;
-            let speeds = parse_range(&speeds, "--speeds")?;
-            let sweep = eigen_sweep(&c, &speeds)?;
-            let text = match format {
-                Format::Table => output::format_eigen_table(&sweep),
-                Format::Json => serde_json::to_string_pretty(&output::eigen_sweep_json(&sweep))? + "\n",
-                Format::Csv => {
-                    let mut buf = Vec::new();
-                    output::write_eigen_sweep_csv(&mut buf, &sweep)?;
-                    String::from_utf8(buf)?
-                }
+            // Every output is checked before any work (issue 10, point 4).
+            if let Some(p) = &out {
+                output::output_target(p)?;
+            }
+            if let Some(p) = &plot {
+                ImageFormat::from_path(p)?;
+                output::output_target(p)?;
+            }
+            let limit = match format {
+                Format::Table => MAX_TABLE_ROWS,
+                Format::Csv | Format::Json => MAX_STREAMED_POINTS,
             };
-            emit(&text, &out)?;
+            let (start, step, n) = range_spec(&speeds, "--speeds", limit).map_err(|e| match format {
+                Format::Table => {
+                    anyhow::anyhow!(
+                        "{e}; a table holds every row, --format csv or json streams up to {MAX_STREAMED_POINTS} points"
+                    )
+                }
+                _ => e,
+            })?;
+            let c = b.canonical_with(model.as_deref())?;
+            let speed = |k: usize| start + k as f64 * step;
+            let stream = |fmt: output::StreamFormat| -> Result<()> {
+                match &out {
+                    Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep(&c, n, speed, fmt, w))?,
+                    None => {
+                        let mut w = std::io::BufWriter::new(std::io::stdout().lock());
+                        output::stream_eigen_sweep(&c, n, speed, fmt, &mut w).map_err(|e| anyhow::anyhow!(e))?;
+                        std::io::Write::flush(&mut w)?;
+                    }
+                }
+                Ok(())
+            };
+            match format {
+                Format::Table => {
+                    let speeds: Vec<f64> = (0..n).map(speed).collect();
+                    emit(&output::format_eigen_table(&eigen_sweep(&c, &speeds)?), &out)?;
+                }
+                Format::Csv => stream(output::StreamFormat::Csv)?,
+                Format::Json => stream(output::StreamFormat::Json)?,
+            }
             if let Some(p) = plot {
-                let vmax = speeds.last().copied().unwrap_or(10.0).max(speeds[0] + 1e-9);
-                let crit = critical_speeds(&c, speeds[0], vmax).ok();
+                // A diagram needs no more than 20,001 points: longer ranges are
+                // plotted at evenly spaced speeds over the same interval.
+                const PLOT_POINTS: usize = 20_001;
+                let last = speed(n - 1);
+                let speeds: Vec<f64> = if n <= PLOT_POINTS {
+                    (0..n).map(speed).collect()
+                } else {
+                    (0..PLOT_POINTS)
+                        .map(|k| start + (last - start) * k as f64 / (PLOT_POINTS - 1) as f64)
+                        .collect()
+                };
+                let sweep = eigen_sweep(&c, &speeds)?;
+                let vmax = last.max(start + 1e-9);
+                let crit = critical_speeds(&c, start, vmax).ok();
                 plot_continuation(&p, &sweep, crit.as_ref(), &PlotOptions::default())?;
                 eprintln!("wrote {}", p.display());
             }
@@ -524,13 +630,50 @@ fn run(cli: Cli) -> Result<bool> {
             speed_max,
             out: OutputArgs { format, output: out },
             plot,
+            map,
+            at_speed,
         } => {
             let b = load(&bike)?;
+            // Every output is checked before any work (issue 10, point 4).
+            if let Some(p) = &out {
+                output::output_target(p)?;
+            }
+            if let Some(p) = &plot {
+                ImageFormat::from_path(p)?;
+                output::output_target(p)?;
+            }
+            let quantity = match map {
+                MapArg::Width => MapQuantity::StableWidth,
+                MapArg::Weave => MapQuantity::WeaveSpeed,
+                MapArg::Capsize => MapQuantity::CapsizeSpeed,
+                MapArg::LeastStable => MapQuantity::LeastStableRealPart,
+            };
+            if matches!(map, MapArg::LeastStable) && at_speed.is_none() {
+                bail!("--map least-stable needs --at-speed V (m/s)");
+            }
+            if let Some(v) = at_speed {
+                if !v.is_finite() {
+                    bail!("--at-speed must be a finite speed, found {v:?}");
+                }
+            }
             let xs = parse_range(&values, "--values")?;
-            let opts = SweepOptions::with_speed_range(0.0, speed_max);
+            let opts = SweepOptions {
+                probe_speed: at_speed,
+                ..SweepOptions::with_speed_range(0.0, speed_max)
+            };
             let text = match (param2, values2) {
                 (Some(p2), Some(v2)) => {
                     let ys = parse_range(&v2, "--values2")?;
+                    let cells = xs.len() as f64 * ys.len() as f64;
+                    if cells > MAX_MAP_CELLS as f64 {
+                        bail!(
+                            "--values x --values2 gives {} x {} = {} cells, more than the limit of {MAX_MAP_CELLS} \
+                             (use larger steps)",
+                            xs.len(),
+                            ys.len(),
+                            output::format_significant(cells, 4)
+                        );
+                    }
                     b.with_parameter(&param, xs[0])?.with_parameter(&p2, ys[0])?;
                     let map = stability_map(
                         ParamAxis::new(param.clone(), xs),
@@ -548,7 +691,7 @@ fn run(cli: Cli) -> Result<bool> {
                             y_label: Some(axis_label(&p2)),
                             ..PlotOptions::default()
                         };
-                        plot_stability_map(p, &map, MapQuantity::StableWidth, &opts)?;
+                        plot_stability_map(p, &map, quantity, &opts)?;
                         eprintln!("wrote {}", p.display());
                     }
                     match format {
@@ -602,6 +745,16 @@ fn run(cli: Cli) -> Result<bool> {
             ParamsCommand::Show { file, bike, model } => {
                 let b = load(file.as_deref().unwrap_or(&bike))?;
                 print!("{}", params_show_text(&b, model.as_deref())?);
+                // Derived geometry, whatever the form of the file (issue 10,
+                // point 9), as TOML comments so the output still loads.
+                let g = bikedyn::runtime::geometry::DerivedGeometry::of(&b.parameters.to_benchmark()?);
+                println!("\n# Derived geometry (Meijaard et al. 2007, appendix A; benchmark axes):");
+                for (sym, value, unit, what) in g.rows() {
+                    println!(
+                        "# {sym:<8} = {:>14} {unit:<7} {what}",
+                        output::format_significant(value, 8)
+                    );
+                }
                 Ok(true)
             }
         },
@@ -615,12 +768,36 @@ fn run(cli: Cli) -> Result<bool> {
     }
 }
 
+/// The error and its causes, each cause once: a cause whose text the
+/// message already contains (errors that print their source) is skipped.
+/// Every part is cut to `MAX_PART` characters, so a junk input line is not
+/// echoed whole.
+fn error_message(e: &anyhow::Error) -> String {
+    const MAX_PART: usize = 400;
+    let mut msg = String::new();
+    for cause in e.chain() {
+        let mut part = cause.to_string();
+        if msg.contains(&part) {
+            continue;
+        }
+        let n = part.chars().count();
+        if n > MAX_PART {
+            part = part.chars().take(MAX_PART).collect::<String>() + &format!("... ({} more characters)", n - MAX_PART);
+        }
+        if !msg.is_empty() {
+            msg += ": ";
+        }
+        msg += &part;
+    }
+    msg
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_message(&e));
             ExitCode::from(2)
         }
     }

@@ -66,17 +66,16 @@ fn a_front_wheel_that_cannot_reach_the_ground_is_a_typed_error_not_nan() {
     let mut t = ThesisParameters::thesis_bicycle();
     t.front_wheel_radius = 3.0; // far larger than the wheelbase allows
     let err = canonical_matrices::<W>(|s| t.get(s)).unwrap_err();
+    // Detected from the model's closed-form upright configuration before
+    // Newton runs (issue 10, point 1): the frame pitch has no real value.
     match err {
-        LinearizeError::Constraint(ConstraintError::NotSatisfiable {
-            constraint, residual, ..
-        }) => {
-            assert!(constraint.starts_with("front_contact"), "{constraint}");
-            assert!(residual.is_finite() && residual > 1e-3);
+        LinearizeError::Constraint(ConstraintError::NoUprightConfiguration { coordinate }) => {
+            assert_eq!(coordinate, "beta");
         }
-        other => panic!("expected NotSatisfiable, got {other:?}"),
+        other => panic!("expected NoUprightConfiguration, got {other:?}"),
     }
     let msg = canonical_matrices::<W>(|s| t.get(s)).unwrap_err().to_string();
-    assert!(msg.contains("no ground contact"), "{msg}");
+    assert!(msg.contains("cannot touch the ground"), "{msg}");
 }
 
 #[test]

@@ -68,8 +68,11 @@ pub fn meijaard_canonical(p: &BenchmarkParameters) -> CanonicalMatrices {
     let ialz = ma * ua * xa + iaxz * sl + iazz * cl;
     // (A 18-21)
     let mu = c / w * cl;
-    let sr = iryy / rr;
-    let sf = ifyy / rf;
+    // A skate wheel (zero radius) has zero spin inertia (the two-mass-skate
+    // bicycle, Kooijman et al. 2011): its gyrostatic coefficient is 0.
+    let gyrostatic = |i: f64, r: f64| if i == 0.0 { 0.0 } else { i / r };
+    let sr = gyrostatic(iryy, rr);
+    let sf = gyrostatic(ifyy, rf);
     let st = sr + sf;
     let sa = ma * ua + mu * mt * xt;
     // (A 22-27) canonical matrices

@@ -43,12 +43,23 @@ pub enum ConstraintError {
         iterations: usize,
     },
     /// The constraint Jacobian with respect to the dependent coordinates is singular.
-    #[error("the constraint Jacobian is singular at column {column} (pivot {pivot:.3e}) for the {what}: the dependent coordinates are not determined by the constraints here")]
+    #[error("the constraint Jacobian is singular at column {column} for the {what}: its largest available pivot {pivot:.3e} is below 1e-14 times its largest entry {scale:.3e}, so the dependent coordinates are not determined by the constraints here")]
     SingularJacobian {
         what: &'static str,
         column: usize,
         pivot: f64,
+        /// Largest entry magnitude of the Jacobian.
+        scale: f64,
     },
+    /// The front wheel cannot reach the ground ahead of the rear wheel: the
+    /// height difference of the wheel centres `Rd - Rt` is at least the
+    /// distance `reach` from the rear wheel centre to the front one.
+    #[error("the front wheel cannot touch the ground: |Rd - Rt| = {height_difference_abs:.6} m is not less than the distance between the wheel centres ({reach:.6} m)", height_difference_abs = height_difference.abs())]
+    NoGroundContact { height_difference: f64, reach: f64 },
+    /// The model's closed-form upright configuration has no real value
+    /// (e.g. the frame pitch when the front wheel cannot reach the ground).
+    #[error("the front wheel cannot touch the ground: the model's upright configuration has no real value for `{coordinate}` with these parameters")]
+    NoUprightConfiguration { coordinate: &'static str },
     /// A parameter, coordinate or result is NaN or infinite.
     #[error("non-finite value in {what}")]
     NotFinite { what: &'static str },
@@ -59,6 +70,7 @@ fn singular(what: &'static str) -> impl Fn(Singular) -> ConstraintError {
         what,
         column: s.column,
         pivot: s.pivot,
+        scale: s.scale,
     }
 }
 

@@ -68,10 +68,12 @@ use quartic::{quartic_roots, sort_desc, C64};
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EigenError {
     /// `M0` is singular (or numerically so): the quartic is not of degree 4.
-    #[error("singular mass matrix M0 (det = {det:e})")]
+    #[error("singular mass matrix M0: det M0 = {det:.3e} is at most 1e-12 times |m11 m22| + |m12 m21| = {scale:.3e}")]
     SingularMassMatrix {
         /// Determinant of `M0`.
         det: f64,
+        /// `|m11 m22| + |m12 m21|`, the size of the determinant's terms.
+        scale: f64,
     },
     /// A matrix entry, `g`, or a speed is NaN or infinite.
     #[error("non-finite input: {what}")]
@@ -115,19 +117,71 @@ pub enum Mode {
     Capsize,
     /// Castering (real).
     Castering,
+    /// A weave root and the capsize root merged into a complex pair.
+    WeaveCapsize,
+    /// A weave root and the castering root merged into a complex pair.
+    WeaveCastering,
+    /// The capsize and castering roots merged into a complex pair (the thesis
+    /// bicycle from 0.19 to 2.55 m/s).
+    CapsizeCastering,
     /// Unclassified.
     Other(u8),
 }
 
 impl Mode {
-    /// Lower-case name: "weave", "capsize", "castering", "other".
+    /// Lower-case name: "weave", "capsize", "castering", "weave-capsize",
+    /// "weave-castering", "capsize-castering", "other".
     pub fn name(&self) -> &'static str {
         match self {
             Mode::Weave => "weave",
             Mode::Capsize => "capsize",
             Mode::Castering => "castering",
+            Mode::WeaveCapsize => "weave-capsize",
+            Mode::WeaveCastering => "weave-castering",
+            Mode::CapsizeCastering => "capsize-castering",
             Mode::Other(_) => "other",
         }
+    }
+
+    /// Output order: weave, capsize, castering, the merged pairs, other.
+    pub fn rank(&self) -> u16 {
+        match self {
+            Mode::Weave => 0,
+            Mode::Capsize => 1,
+            Mode::Castering => 2,
+            Mode::WeaveCapsize => 3,
+            Mode::WeaveCastering => 4,
+            Mode::CapsizeCastering => 5,
+            Mode::Other(k) => 6 + *k as u16,
+        }
+    }
+
+    /// The merged mode of a pair formed by `a` and `b` (either order), if both
+    /// are distinct named real modes.
+    pub fn merge(a: Mode, b: Mode) -> Option<Mode> {
+        let (lo, hi) = if a.rank() <= b.rank() { (a, b) } else { (b, a) };
+        match (lo, hi) {
+            (Mode::Weave, Mode::Capsize) => Some(Mode::WeaveCapsize),
+            (Mode::Weave, Mode::Castering) => Some(Mode::WeaveCastering),
+            (Mode::Capsize, Mode::Castering) => Some(Mode::CapsizeCastering),
+            _ => None,
+        }
+    }
+
+    /// The two modes of a merged pair, lower rank first.
+    pub fn components(&self) -> Option<(Mode, Mode)> {
+        match self {
+            Mode::WeaveCapsize => Some((Mode::Weave, Mode::Capsize)),
+            Mode::WeaveCastering => Some((Mode::Weave, Mode::Castering)),
+            Mode::CapsizeCastering => Some((Mode::Capsize, Mode::Castering)),
+            _ => None,
+        }
+    }
+
+    /// Whether this mode is, or contains, `m` (e.g. `CapsizeCastering`
+    /// involves `Capsize`).
+    pub fn involves(&self, m: Mode) -> bool {
+        *self == m || self.components().is_some_and(|(a, b)| a == m || b == m)
     }
 }
 
@@ -277,8 +331,16 @@ impl CharPoly {
         }
         let k4 = det2(&c.m0);
         let scale = (c.m0[(0, 0)] * c.m0[(1, 1)]).abs() + (c.m0[(0, 1)] * c.m0[(1, 0)]).abs();
+        if !(k4.is_finite() && scale.is_finite()) {
+            return Err(EigenError::NonFinite {
+                what: format!(
+                    "det M0 overflows double precision (M0 entries up to {:.3e})",
+                    c.m0.amax()
+                ),
+            });
+        }
         if !(k4.abs() > 1e-12 * scale) {
-            return Err(EigenError::SingularMassMatrix { det: k4 });
+            return Err(EigenError::SingularMassMatrix { det: k4, scale });
         }
         let (m, c1, k0, k2) = (&c.m0, &c.c1, &c.k0, &c.k2);
         let cp = CharPoly {
@@ -389,12 +451,7 @@ pub(crate) struct Labelled {
 }
 
 fn rank(m: Mode) -> u16 {
-    match m {
-        Mode::Weave => 0,
-        Mode::Capsize => 1,
-        Mode::Castering => 2,
-        Mode::Other(k) => 3 + k as u16,
-    }
+    m.rank()
 }
 
 impl Labelled {
@@ -506,11 +563,13 @@ fn match_roots(prev: &Labelled, new: &[C64; 4]) -> ([C64; 4], bool) {
     (out, dmax <= 0.3 * sep)
 }
 
-/// A complex-conjugate pair is one mode: when two roots with different labels
-/// form a pair, the pair takes the lower-ranked label `L` (weave < capsize <
-/// castering < other) and the displaced label `D` passes to the other root labelled
-/// `L`, if any. Two *real* roots sharing a non-weave label (a capsize/castering pair
-/// that split again) become capsize (larger) and castering (smaller).
+/// A complex-conjugate pair is one mode: when two named real modes `A`, `B`
+/// form a pair, the pair becomes the merged mode `A-B` and no other label
+/// changes. Two *real* roots sharing a merged label (the pair split again) take
+/// its components, the lower rank on the larger root. For `Other` labels the
+/// old rule stays: the pair takes the lower-ranked label and the displaced one
+/// passes to the other root with the pair's label; two real roots sharing a
+/// non-weave label become capsize (larger) and castering (smaller).
 fn pair_rule(z: &[C64; 4], mut l: [Mode; 4]) -> [Mode; 4] {
     for i in 0..4 {
         if z[i].im <= 0.0 {
@@ -520,6 +579,11 @@ fn pair_rule(z: &[C64; 4], mut l: [Mode; 4]) -> [Mode; 4] {
             continue;
         };
         if l[i] == l[j] {
+            continue;
+        }
+        if let Some(m) = Mode::merge(l[i], l[j]) {
+            l[i] = m;
+            l[j] = m;
             continue;
         }
         let (lo, hi) = if rank(l[i]) <= rank(l[j]) {
@@ -537,8 +601,9 @@ fn pair_rule(z: &[C64; 4], mut l: [Mode; 4]) -> [Mode; 4] {
         for j in i + 1..4 {
             if l[i] == l[j] && l[i] != Mode::Weave && z[i].im == 0.0 && z[j].im == 0.0 {
                 let (big, small) = if z[i].re >= z[j].re { (i, j) } else { (j, i) };
-                l[big] = Mode::Capsize;
-                l[small] = Mode::Castering;
+                let (a, b) = l[i].components().unwrap_or((Mode::Capsize, Mode::Castering));
+                l[big] = a;
+                l[small] = b;
             }
         }
     }
@@ -612,7 +677,12 @@ fn anchor(cp: &CharPoly) -> Result<(f64, Labelled), EigenError> {
         .map(|k| base * 2f64.powi(k))
         .chain((1..=80).map(|k| base / 1.25f64.powi(k)));
     for v in ladder {
-        let z = cp.roots(v)?;
+        // A ladder speed where the quartic solver does not converge (extreme
+        // speeds of unusual designs, e.g. 4.6e5 m/s for a two-mass-skate
+        // variant) is skipped: the anchor is only a starting point.
+        let Ok(z) = cp.roots(v) else {
+            continue;
+        };
         if let Some(l) = classify_anchor(&z) {
             return Ok((v, Labelled { roots: z, labels: l }));
         }

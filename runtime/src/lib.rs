@@ -9,6 +9,7 @@ pub mod canonical;
 pub mod constraints;
 pub mod eigen;
 pub mod experiment;
+pub mod geometry;
 pub mod linalg;
 pub mod linearize;
 pub mod model;

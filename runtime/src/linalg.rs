@@ -10,6 +10,9 @@ pub struct Singular {
     pub column: usize,
     /// Largest available pivot magnitude.
     pub pivot: f64,
+    /// Largest entry magnitude of the matrix; a pivot is usable when it
+    /// exceeds `1e-14 * scale`.
+    pub scale: f64,
 }
 
 /// Solve `A X = B` in place by Gaussian elimination with partial pivoting
@@ -29,7 +32,11 @@ pub fn solve_in_place<T: Scalar>(a: &mut [T], n: usize, b: &mut [T], nrhs: usize
             }
         }
         if !(best > scale * 1e-14) {
-            return Err(Singular { column: k, pivot: best });
+            return Err(Singular {
+                column: k,
+                pivot: best,
+                scale,
+            });
         }
         if piv != k {
             for j in 0..n {

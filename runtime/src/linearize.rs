@@ -40,6 +40,22 @@ pub enum LinearizeError {
         expected: f64,
         what: &'static str,
     },
+    /// A wheel of zero radius (a skate) that has a spin inertia: its spin
+    /// rate, and so its gyroscopic moment, would be infinite.
+    #[error("the {wheel} has zero radius ({radius_symbol} = 0) but a non-zero spin inertia ({inertia_symbol} = {inertia}): a skate wheel must have zero spin inertia")]
+    SkateWithSpinInertia {
+        wheel: &'static str,
+        radius_symbol: &'static str,
+        inertia_symbol: &'static str,
+        inertia: f64,
+    },
+    /// The parameters could not be converted for a derived computation.
+    #[error("{0}")]
+    Parameters(String),
+    /// The zero-radius limit could not be taken reliably (the matrices are
+    /// not the quadratic polynomial in the radius that the closed form says).
+    #[error("the zero-radius limit is not reliable here (departure from a quadratic in the radius: {departure:.3e}, relative to {scale:.3e})")]
+    ZeroRadiusLimit { departure: f64, scale: f64 },
     #[error("model `{model}` declares no forward speed (no speed parameter and no speed coordinate)")]
     NoForwardSpeed { model: &'static str },
     #[error("model `{model}` has {n} independent coordinates or states, more than the linearization supports")]
@@ -73,6 +89,10 @@ pub struct ReducedSystem<T> {
     pub p: Vec<T>,
     /// All velocities (dependent ones solved).
     pub dp: Vec<T>,
+    /// `Ec` at rest (all velocities zero, no acceleration):
+    /// `-E^T (Qgrav + Qext(p, 0))`; its derivative in `q` is the stiffness
+    /// at zero forward speed, from the same evaluation.
+    pub ec_rest: Vec<T>,
 }
 
 /// [`reduced_equations`], also returning `p` and `p'`.
@@ -91,8 +111,10 @@ pub fn reduced_system<M: MultibodyModel, T: Scalar>(
     let paramf: Vec<f64> = param.iter().map(|x| x.re()).collect();
     let mut guess = vec![0.0; nq];
     M::upright_configuration(&paramf, M::INITIAL_GUESS, &mut guess);
-    if guess.iter().any(|x| !x.is_finite()) {
-        guess.copy_from_slice(M::INITIAL_GUESS);
+    if let Some(j) = guess.iter().position(|x| !x.is_finite()) {
+        return Err(ConstraintError::NoUprightConfiguration {
+            coordinate: M::COORDINATES[j],
+        });
     }
     let mut p: Vec<T> = guess.iter().map(|&x| T::cst(x)).collect();
     for (k, &j) in ind.iter().enumerate() {
@@ -110,6 +132,7 @@ pub fn reduced_system<M: MultibodyModel, T: Scalar>(
         what: "coordinate partitioning",
         column: s.column,
         pivot: s.pivot,
+        scale: s.scale,
     };
     let mut a = vec![T::zero(); nd * nd];
     // Right-hand sides: columns [Dind (ni columns) | d].
@@ -199,7 +222,24 @@ pub fn reduced_system<M: MultibodyModel, T: Scalar>(
         }
         ec[a_] = s;
     }
-    Ok(ReducedSystem { ec, mi, p, dp })
+    let mut qe_rest = vec![T::zero(); nq];
+    M::applied_forces(param, t, &p, &vec![T::zero(); nq], &mut qe_rest);
+    let ec_rest: Vec<T> = (0..ni)
+        .map(|a_| {
+            let mut qi = T::zero();
+            for r in 0..nq {
+                qi += e[r * ni + a_] * (qg[r] + qe_rest[r]);
+            }
+            -qi
+        })
+        .collect();
+    Ok(ReducedSystem {
+        ec,
+        mi,
+        p,
+        dp,
+        ec_rest,
+    })
 }
 
 /// `M`, `C`, `K` of `M q'' + C q' + K q = 0` (thesis eq. 48-50) about
@@ -230,6 +270,14 @@ fn linearize_about<M: MultibodyModel, const N: usize>(
     param: &[f64],
     dq0: &[f64],
 ) -> Result<Linearization, LinearizeError> {
+    linearize_with_rest::<M, N>(param, dq0).map(|(l, _)| l)
+}
+
+/// [`linearize_about`] and, from the same evaluation, the stiffness at rest.
+fn linearize_with_rest<M: MultibodyModel, const N: usize>(
+    param: &[f64],
+    dq0: &[f64],
+) -> Result<(Linearization, DMatrix<f64>), LinearizeError> {
     let ni = M::INDEPENDENT.len();
     assert_eq!(2 * ni, N, "dual width is twice the independent coordinates");
     let pd: Vec<Dual<N>> = param.iter().map(|&x| Dual::cst(x)).collect();
@@ -239,11 +287,14 @@ fn linearize_about<M: MultibodyModel, const N: usize>(
     let sys = reduced_system::<M, Dual<N>>(&pd, Dual::zero(), &q, &dq, &ddq)?;
     check_physical_branch::<M>(param, &sys.p.iter().map(|x| x.re).collect::<Vec<_>>())?;
     let (ec, mi) = (sys.ec, sys.mi);
-    Ok(Linearization {
-        mass: DMatrix::from_fn(ni, ni, |i, j| mi[i * ni + j].re),
-        stiffness: DMatrix::from_fn(ni, ni, |i, j| ec[i].eps[j]),
-        damping: DMatrix::from_fn(ni, ni, |i, j| ec[i].eps[ni + j]),
-    })
+    Ok((
+        Linearization {
+            mass: DMatrix::from_fn(ni, ni, |i, j| mi[i * ni + j].re),
+            stiffness: DMatrix::from_fn(ni, ni, |i, j| ec[i].eps[j]),
+            damping: DMatrix::from_fn(ni, ni, |i, j| ec[i].eps[ni + j]),
+        },
+        DMatrix::from_fn(ni, ni, |i, j| sys.ec_rest[i].eps[j]),
+    ))
 }
 
 /// Check that a solved upright configuration is the physical one: every
@@ -469,10 +520,57 @@ pub fn parameter_vector<M: MultibodyModel>(
 /// thesis's steer angle gamma is minus the benchmark's delta, so the
 /// off-diagonal entries change sign.
 ///
+/// One dual-number linearization at speed 1 gives `M`, `C(1)`, `K(1)` and,
+/// from the same evaluation, `K(0)` (gravity and forces at rest: every
+/// velocity vanishes at zero speed). Works for driven and free-speed models
+/// alike (the roll-steer block); the gravity parameter is the one the model
+/// declares.
+pub fn canonical_matrices<M: MultibodyModel>(
+    lookup: impl Fn(&str) -> Option<f64>,
+) -> Result<CanonicalMatrices, LinearizeError> {
+    let param = parameter_vector::<M>(&lookup, 0.0)?;
+    let g = M::GRAVITY_PARAMETER
+        .map(|k| param[k])
+        .ok_or(LinearizeError::MissingParameter {
+            model: M::NAME,
+            name: "gravity".into(),
+        })?;
+    if !M::STATES.is_empty() {
+        return Err(LinearizeError::HasStates { model: M::NAME });
+    }
+    let (p1, dq1) = speed_setup::<M>(&param, 1.0)?;
+    let (l1, rest) = match M::INDEPENDENT.len() {
+        2 => linearize_with_rest::<M, 4>(&p1, &dq1)?,
+        3 => linearize_with_rest::<M, 6>(&p1, &dq1)?,
+        n => return Err(LinearizeError::TooManyIndependent { model: M::NAME, n }),
+    };
+    let l1 = lateral_block::<M>(&l1);
+    let idx = lateral_indices::<M>();
+    let k0 = DMatrix::from_fn(2, 2, |i, j| rest[(idx[i], idx[j])]);
+    let flip = |m: &DMatrix<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);
+    Ok(CanonicalMatrices {
+        m0: flip(&l1.mass),
+        c1: flip(&l1.damping),
+        k0: flip(&k0) / g,
+        k2: flip(&(&l1.stiffness - &k0)),
+        g,
+    })
+}
+
+/// Canonical matrices by two full linearizations (at `V = 0` and `V = 1`),
+/// the method used before issue 10, point 10; kept for the bench's
+/// comparison and as a cross-check of [`canonical_matrices`].
+///
+/// Canonical matrices of Meijaard et al. (2007) from a generated model:
+/// `M0 = M`, `C1 = C(v=1)`, `K0 = K(v=0)/g`, `K2 = K(v=1) - K(v=0)`, exact
+/// because the reduced equations are quadratic in the forward speed. The
+/// thesis's steer angle gamma is minus the benchmark's delta, so the
+/// off-diagonal entries change sign.
+///
 /// Works for driven and free-speed models alike (the roll-steer block of
 /// [`linearize_at_speed`]); the gravity parameter is the one the model
 /// declares.
-pub fn canonical_matrices<M: MultibodyModel>(
+pub fn canonical_matrices_two_speeds<M: MultibodyModel>(
     lookup: impl Fn(&str) -> Option<f64>,
 ) -> Result<CanonicalMatrices, LinearizeError> {
     let param = parameter_vector::<M>(&lookup, 0.0)?;

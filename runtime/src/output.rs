@@ -2,7 +2,9 @@
 //!
 //! # Atomic writes
 //! Every `save_*` function (and the plots in [`crate::plot`]) writes through
-//! [`write_atomic`] / [`write_atomic_via_path`]: the content goes to a fresh
+//! [`write_atomic`] / [`write_atomic_via_path`]. A symbolic link is followed
+//! (and kept); a FIFO or a device is written through, never replaced
+//! ([`output_target`]). For a regular file or a new path the content goes to a fresh
 //! temporary file in the target's directory (`.<name>.tmp-<pid>-<n>.<ext>`),
 //! is flushed and fsynced, and is then renamed over the target (followed by a
 //! best-effort fsync of the directory). On any error the temporary file is
@@ -11,7 +13,8 @@
 //!
 //! # Eigenvalue order
 //! Within each speed the four eigenvalues are written in the order of
-//! [`ordered_eigenvalues`]: by mode (weave, capsize, castering, other), then by
+//! [`ordered_eigenvalues`]: by mode (weave, capsize, castering, the merged
+//! pairs weave-capsize, weave-castering, capsize-castering, other), then by
 //! descending imaginary part, then by descending real part. For a conventional
 //! bicycle slots 1-2 are the weave pair (`+i` first; two real roots below
 //! `v_d`), slot 3 capsize and slot 4 castering; the mode of each slot is
@@ -19,10 +22,15 @@
 //!
 //! # Eigen sweep formats
 //! * JSON ([`eigen_sweep_json`]): a list of
-//!   `{"v": speed, "eigenvalues": [[re, im], x4], "modes": ["weave", x4]}`.
-//! * CSV ([`write_eigen_sweep_csv`]): header
-//!   `v,re_1,im_1,mode_1,re_2,im_2,mode_2,re_3,im_3,mode_3,re_4,im_4,mode_4`,
-//!   one row per speed, in sweep order. Units: `v` m/s, eigenvalues 1/s.
+//!   `{"v": speed, "eigenvalues": [[re, im], x4], "modes": ["weave", x4],
+//!   "mode_shapes": [{"roll_amplitude", "roll_phase", "steer_amplitude",
+//!   "steer_phase"}, x4]}` ([`ModeShape`]: roll normalised to 1).
+//! * CSV ([`write_eigen_sweep_csv`]): header `v`, then for `k = 1..4`
+//!   `re_k,im_k,mode_k,roll_amp_k,roll_phase_k,steer_amp_k,steer_phase_k`,
+//!   one row per speed, in sweep order. Units: `v` m/s, eigenvalues 1/s,
+//!   phases rad.
+//! * [`stream_eigen_sweep`] writes either format block by block, so memory
+//!   stays flat in the number of speeds.
 //!
 //! # Parameter sweep / stability map formats
 //! CSV columns (after the parameter column(s), for a grid also `i,j`):
@@ -63,6 +71,20 @@ pub enum OutputError {
         /// Its (missing) directory.
         dir: PathBuf,
     },
+    /// The path is a directory.
+    #[error("cannot write {}: it is a directory", .path.display())]
+    IsDirectory {
+        /// Offending path.
+        path: PathBuf,
+    },
+    /// The path is a symbolic link that leads nowhere.
+    #[error("cannot write {}: it is a symbolic link to a missing file ({})", .path.display(), .target.display())]
+    DanglingSymlink {
+        /// Offending path.
+        path: PathBuf,
+        /// Where the link points.
+        target: PathBuf,
+    },
     /// The path has no file name (e.g. ends in `..` or is a root).
     #[error("cannot write {}: not a file path", .path.display())]
     InvalidPath {
@@ -94,6 +116,8 @@ impl OutputError {
     pub fn path(&self) -> &Path {
         match self {
             OutputError::NoSuchDirectory { path, .. }
+            | OutputError::IsDirectory { path }
+            | OutputError::DanglingSymlink { path, .. }
             | OutputError::InvalidPath { path }
             | OutputError::Io { path, .. }
             | OutputError::Content { path, .. } => path,
@@ -189,25 +213,121 @@ fn commit(tmp: &Path, path: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// Atomically replace `path` with what `write` writes (see the module docs).
+/// How an output path is written.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum OutputTarget {
+    /// A regular file or a new path: written to a temporary file in the same
+    /// directory and renamed over it.
+    Atomic(PathBuf),
+    /// Anything else that can be opened for writing (a FIFO, a character
+    /// device such as `/dev/null`, a terminal): written through, so the node
+    /// itself is never replaced.
+    WriteThrough(PathBuf),
+}
+
+/// Decide how `path` is written, following symbolic links (the link stays, its
+/// target is written). Errors: a directory, a dangling link, a path without a
+/// file name, or a missing parent directory. Call it before computing, so a
+/// bad output is reported before any work (issue 10, point 4).
+pub fn output_target(path: impl AsRef<Path>) -> Result<OutputTarget, OutputError> {
+    let path = path.as_ref();
+    match fs::symlink_metadata(path) {
+        Err(_) => {
+            // A new file: its directory must exist and it must have a name.
+            if path.file_name().is_none() {
+                return Err(OutputError::InvalidPath {
+                    path: path.to_path_buf(),
+                });
+            }
+            let dir = match path.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+                _ => PathBuf::from("."),
+            };
+            if !dir.is_dir() {
+                return Err(OutputError::NoSuchDirectory {
+                    path: path.to_path_buf(),
+                    dir,
+                });
+            }
+            Ok(OutputTarget::Atomic(path.to_path_buf()))
+        }
+        Ok(m) if m.file_type().is_symlink() => match fs::canonicalize(path) {
+            Ok(real) => output_target(real),
+            Err(_) => {
+                // A link to a file not yet written: write that file, if its
+                // directory exists (the link then points at it).
+                let target = fs::read_link(path).unwrap_or_default();
+                let resolved = match path.parent() {
+                    Some(d) if target.is_relative() => d.join(&target),
+                    _ => target.clone(),
+                };
+                match resolved.parent() {
+                    Some(d)
+                        if d.is_dir() && resolved.file_name().is_some() && fs::symlink_metadata(&resolved).is_err() =>
+                    {
+                        Ok(OutputTarget::Atomic(resolved))
+                    }
+                    _ => Err(OutputError::DanglingSymlink {
+                        path: path.to_path_buf(),
+                        target,
+                    }),
+                }
+            }
+        },
+        Ok(m) if m.is_dir() => Err(OutputError::IsDirectory {
+            path: path.to_path_buf(),
+        }),
+        Ok(m) if m.is_file() => Ok(OutputTarget::Atomic(path.to_path_buf())),
+        Ok(_) => Ok(OutputTarget::WriteThrough(path.to_path_buf())),
+    }
+}
+
+/// Open a non-regular file for writing through (no create, no truncate).
+fn open_through(path: &Path) -> Result<File, OutputError> {
+    OpenOptions::new().write(true).open(path).map_err(|e| OutputError::Io {
+        path: path.to_path_buf(),
+        op: "open for writing",
+        source: e,
+    })
+}
+
+/// Write `path` with what `write` writes: atomically for a regular file or a
+/// new path (see the module docs), through the node for a FIFO or a device
+/// (see [`output_target`]); a symbolic link is followed and kept.
 ///
 /// The writer is buffered; `write` need not flush. If `write` fails, nothing
-/// at `path` changes and the temporary file is removed.
+/// at a regular `path` changes and the temporary file is removed.
 pub fn write_atomic<F, E>(path: impl AsRef<Path>, write: F) -> Result<(), OutputError>
 where
     F: FnOnce(&mut dyn Write) -> Result<(), E>,
     E: Into<BoxError>,
 {
-    let path = path.as_ref();
+    let given = path.as_ref();
+    let path = match output_target(given)? {
+        OutputTarget::Atomic(p) => p,
+        OutputTarget::WriteThrough(p) => {
+            let mut w = BufWriter::new(open_through(&p)?);
+            write(&mut w).map_err(|e| OutputError::Content {
+                path: given.to_path_buf(),
+                source: e.into(),
+            })?;
+            return w.flush().map_err(|e| OutputError::Io {
+                path: given.to_path_buf(),
+                op: "write",
+                source: e,
+            });
+        }
+    };
+    let path = path.as_path();
     let (file, tmp) = create_temp(path)?;
     let result = (|| {
         let mut w = BufWriter::new(file);
         write(&mut w).map_err(|e| OutputError::Content {
-            path: path.to_path_buf(),
+            path: given.to_path_buf(),
             source: e.into(),
         })?;
         w.flush().map_err(|e| OutputError::Io {
-            path: path.to_path_buf(),
+            path: given.to_path_buf(),
             op: "write",
             source: e,
         })?;
@@ -220,26 +340,53 @@ where
     result
 }
 
-/// Atomically replace `path` with a file that `produce` writes at the given
-/// temporary path (same directory and extension as `path`; the file exists and
-/// is empty when `produce` is called and may be overwritten).
+/// Write `path` with a file that `produce` writes at the given temporary path
+/// (same directory and extension as `path`; the file exists and is empty
+/// when `produce` is called and may be overwritten). A regular file or new
+/// path is replaced atomically; for a FIFO or a device the finished file is
+/// copied through the node (see [`output_target`]).
 pub fn write_atomic_via_path<F, E>(path: impl AsRef<Path>, produce: F) -> Result<(), OutputError>
 where
     F: FnOnce(&Path) -> Result<(), E>,
     E: Into<BoxError>,
 {
-    let path = path.as_ref();
-    let (file, tmp) = create_temp(path)?;
+    let given = path.as_ref();
+    let target = output_target(given)?;
+    let path = match &target {
+        OutputTarget::Atomic(p) => p.clone(),
+        OutputTarget::WriteThrough(_) => {
+            // Render into a temporary file of the same extension elsewhere.
+            let ext = given
+                .extension()
+                .map(|e| e.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            std::env::temp_dir().join(format!("bikedyn-output.{ext}"))
+        }
+    };
+    let (file, tmp) = create_temp(&path)?;
     drop(file);
     let result = produce(&tmp)
         .map_err(|e| OutputError::Content {
-            path: path.to_path_buf(),
+            path: given.to_path_buf(),
             source: e.into(),
         })
-        .and_then(|()| commit(&tmp, path));
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
+        .and_then(|()| match &target {
+            OutputTarget::Atomic(p) => commit(&tmp, p),
+            OutputTarget::WriteThrough(p) => {
+                let mut out = open_through(p)?;
+                let mut src = File::open(&tmp).map_err(|e| OutputError::Io {
+                    path: given.to_path_buf(),
+                    op: "read rendered file",
+                    source: e,
+                })?;
+                io::copy(&mut src, &mut out).map(|_| ()).map_err(|e| OutputError::Io {
+                    path: given.to_path_buf(),
+                    op: "write",
+                    source: e,
+                })
+            }
+        });
+    let _ = fs::remove_file(&tmp);
     result
 }
 
@@ -252,56 +399,120 @@ pub fn write_string_atomic(path: impl AsRef<Path>, contents: &str) -> Result<(),
 // Eigen sweeps
 
 fn mode_rank(m: Mode) -> u32 {
-    match m {
-        Mode::Weave => 0,
-        Mode::Capsize => 1,
-        Mode::Castering => 2,
-        Mode::Other(k) => 3 + k as u32,
+    m.rank() as u32
+}
+
+/// Indices of a point's eigenvalues in the stable output order: by mode
+/// (weave, capsize, castering, merged pairs, other), then descending imaginary
+/// part, then descending real part.
+pub fn ordered_indices(p: &EigenPoint) -> [usize; 4] {
+    let mut idx = [0usize, 1, 2, 3];
+    idx.sort_by(|&a, &b| {
+        mode_rank(p.modes[a])
+            .cmp(&mode_rank(p.modes[b]))
+            .then(p.eigenvalues[b].im.total_cmp(&p.eigenvalues[a].im))
+            .then(p.eigenvalues[b].re.total_cmp(&p.eigenvalues[a].re))
+    });
+    idx
+}
+
+/// The eigenvalues of a point with their modes, in the stable output order
+/// ([`ordered_indices`]).
+pub fn ordered_eigenvalues(p: &EigenPoint) -> [(Complex<f64>, Mode); 4] {
+    ordered_indices(p).map(|k| (p.eigenvalues[k], p.modes[k]))
+}
+
+/// Roll and steer components of an eigenvector (a mode shape), normalised so
+/// that the roll component is 1 (amplitude 1, phase 0), as the eigenvector
+/// components of the benchmark are presented (Meijaard et al. 2007, Fig. 4:
+/// components relative to the roll angle); a mode without roll (roll
+/// amplitude below `1e-12` of steer) is normalised on the steer component
+/// instead. Phases in rad, in `(-pi, pi]`; for a real eigenvalue the phase is
+/// 0 or pi (steer in or against the roll direction). Benchmark sign
+/// convention (roll right, steer right positive).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct ModeShape {
+    /// Roll amplitude (1 unless the mode has no roll).
+    pub roll_amplitude: f64,
+    /// Roll phase (rad).
+    pub roll_phase: f64,
+    /// Steer amplitude relative to roll (rad per rad).
+    pub steer_amplitude: f64,
+    /// Steer phase relative to roll (rad).
+    pub steer_phase: f64,
+}
+
+/// The [`ModeShape`] of an eigenvector `x = [phi, delta, phi', delta']`.
+pub fn mode_shape(x: &[Complex<f64>; 4]) -> ModeShape {
+    let (roll, steer) = (x[0], x[1]);
+    let reference = if roll.norm() > 1e-12 * steer.norm() {
+        roll
+    } else {
+        steer
+    };
+    if !(reference.norm() > 0.0) {
+        return ModeShape {
+            roll_amplitude: 0.0,
+            roll_phase: 0.0,
+            steer_amplitude: 0.0,
+            steer_phase: 0.0,
+        };
+    }
+    let phase = |z: Complex<f64>| if z.norm() == 0.0 { 0.0 } else { z.im.atan2(z.re) + 0.0 };
+    let (r, d) = (roll / reference, steer / reference);
+    ModeShape {
+        roll_amplitude: r.norm(),
+        roll_phase: phase(r),
+        steer_amplitude: d.norm(),
+        steer_phase: phase(d),
     }
 }
 
-/// The eigenvalues of a point with their modes, in the stable output order:
-/// by mode (weave, capsize, castering, other), then descending imaginary part,
-/// then descending real part.
-pub fn ordered_eigenvalues(p: &EigenPoint) -> [(Complex<f64>, Mode); 4] {
-    let mut out: [(Complex<f64>, Mode); 4] = std::array::from_fn(|k| (p.eigenvalues[k], p.modes[k]));
-    out.sort_by(|a, b| {
-        mode_rank(a.1)
-            .cmp(&mode_rank(b.1))
-            .then(b.0.im.total_cmp(&a.0.im))
-            .then(b.0.re.total_cmp(&a.0.re))
-    });
-    out
+/// JSON object of one speed point: `{"v", "eigenvalues", "modes",
+/// "mode_shapes"}` (see [`eigen_sweep_json`]).
+pub fn eigen_point_json(p: &EigenPoint) -> Value {
+    let idx = ordered_indices(p);
+    json!({
+        "v": p.v,
+        "eigenvalues": idx.iter().map(|&k| [p.eigenvalues[k].re, p.eigenvalues[k].im]).collect::<Vec<_>>(),
+        "modes": idx.iter().map(|&k| p.modes[k].name()).collect::<Vec<_>>(),
+        "mode_shapes": idx.iter().map(|&k| mode_shape(&p.eigenvectors[k])).collect::<Vec<_>>(),
+    })
 }
 
-/// JSON value of an eigen sweep:
-/// `[{"v": .., "eigenvalues": [[re, im], ..], "modes": ["weave", ..]}, ..]`.
+/// JSON value of an eigen sweep: `[{"v": .., "eigenvalues": [[re, im], ..],
+/// "modes": ["weave", ..], "mode_shapes": [{"roll_amplitude", "roll_phase",
+/// "steer_amplitude", "steer_phase"}, ..]}, ..]` (see [`ModeShape`]).
 pub fn eigen_sweep_json(sweep: &EigenSweep) -> Value {
-    Value::Array(
-        sweep
-            .points
-            .iter()
-            .map(|p| {
-                let ev = ordered_eigenvalues(p);
-                json!({
-                    "v": p.v,
-                    "eigenvalues": ev.iter().map(|(s, _)| [s.re, s.im]).collect::<Vec<_>>(),
-                    "modes": ev.iter().map(|(_, m)| m.name()).collect::<Vec<_>>(),
-                })
-            })
-            .collect(),
-    )
+    Value::Array(sweep.points.iter().map(eigen_point_json).collect())
 }
 
-/// Header of the eigen-sweep CSV.
+/// Header of the eigen-sweep CSV: `v`, then per eigenvalue `k`: `re_k, im_k,
+/// mode_k, roll_amp_k, roll_phase_k, steer_amp_k, steer_phase_k`.
 pub fn eigen_sweep_csv_header() -> Vec<String> {
     let mut h = vec!["v".to_string()];
     for k in 1..=4 {
-        h.push(format!("re_{k}"));
-        h.push(format!("im_{k}"));
-        h.push(format!("mode_{k}"));
+        for c in ["re", "im", "mode", "roll_amp", "roll_phase", "steer_amp", "steer_phase"] {
+            h.push(format!("{c}_{k}"));
+        }
     }
     h
+}
+
+/// One CSV row of a speed point (columns of [`eigen_sweep_csv_header`]).
+pub fn eigen_point_csv_row(p: &EigenPoint) -> Vec<String> {
+    let mut row = vec![num(p.v)];
+    for k in ordered_indices(p) {
+        let (s, m, shape) = (p.eigenvalues[k], p.modes[k], mode_shape(&p.eigenvectors[k]));
+        row.push(num(s.re));
+        row.push(num(s.im));
+        row.push(m.name().to_string());
+        row.push(num(shape.roll_amplitude));
+        row.push(num(shape.roll_phase));
+        row.push(num(shape.steer_amplitude));
+        row.push(num(shape.steer_phase));
+    }
+    row
 }
 
 /// Write an eigen sweep as CSV (see the module docs for the columns).
@@ -309,15 +520,71 @@ pub fn write_eigen_sweep_csv<W: Write>(w: W, sweep: &EigenSweep) -> Result<(), c
     let mut wr = csv::Writer::from_writer(w);
     wr.write_record(eigen_sweep_csv_header())?;
     for p in &sweep.points {
-        let mut row = vec![num(p.v)];
-        for (s, m) in ordered_eigenvalues(p) {
-            row.push(num(s.re));
-            row.push(num(s.im));
-            row.push(m.name().to_string());
-        }
-        wr.write_record(&row)?;
+        wr.write_record(eigen_point_csv_row(p))?;
     }
     wr.flush()?;
+    Ok(())
+}
+
+/// Machine-readable formats of [`stream_eigen_sweep`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StreamFormat {
+    /// CSV, as [`write_eigen_sweep_csv`].
+    Csv,
+    /// JSON, as [`eigen_sweep_json`] (one point object per line).
+    Json,
+}
+
+/// Speeds per block of [`stream_eigen_sweep`].
+pub const STREAM_BLOCK: usize = 4096;
+
+/// Compute and write the eigen sweep of `c` at the `n` speeds `speed(0)`,
+/// ..., `speed(n - 1)` block by block ([`STREAM_BLOCK`] speeds at a time), so
+/// memory stays flat in `n` (issue 10, point 5). Labels are the same as those
+/// of one [`crate::eigen::eigen_sweep`] over all speeds, because every speed
+/// is labelled by continuation from the bicycle's anchor speed, independent
+/// of the other requested speeds.
+pub fn stream_eigen_sweep(
+    c: &crate::canonical::CanonicalMatrices,
+    n: usize,
+    speed: impl Fn(usize) -> f64,
+    format: StreamFormat,
+    w: &mut dyn Write,
+) -> Result<(), BoxError> {
+    // Fail before writing anything if the bicycle has no eigen analysis.
+    crate::eigen::CharPoly::new(c)?;
+    let for_each_point = |f: &mut dyn FnMut(usize, &EigenPoint) -> Result<(), BoxError>| -> Result<(), BoxError> {
+        let mut speeds = Vec::with_capacity(STREAM_BLOCK.min(n));
+        let mut start = 0;
+        while start < n {
+            let end = (start + STREAM_BLOCK).min(n);
+            speeds.clear();
+            speeds.extend((start..end).map(&speed));
+            let sweep = crate::eigen::eigen_sweep(c, &speeds)?;
+            for (i, p) in sweep.points.iter().enumerate() {
+                f(start + i, p)?;
+            }
+            start = end;
+        }
+        Ok(())
+    };
+    match format {
+        StreamFormat::Csv => {
+            let mut wr = csv::Writer::from_writer(w);
+            wr.write_record(eigen_sweep_csv_header())?;
+            for_each_point(&mut |_, p| Ok(wr.write_record(eigen_point_csv_row(p))?))?;
+            wr.flush()?;
+        }
+        StreamFormat::Json => {
+            w.write_all(b"[")?;
+            for_each_point(&mut |i, p| {
+                w.write_all(if i == 0 { b"\n  " } else { b",\n  " })?;
+                serde_json::to_writer(&mut *w, &eigen_point_json(p))?;
+                Ok(())
+            })?;
+            w.write_all(b"\n]\n")?;
+        }
+    }
     Ok(())
 }
 
@@ -360,7 +627,12 @@ pub fn format_eigen_table(sweep: &EigenSweep) -> String {
         .map(|(p, r)| {
             let mut row = vec![format!("{:.3}", p.v)];
             for (s, m) in r {
-                let z = format!("{:+.5} {} {:.5}i", s.re, if s.im < 0.0 { '-' } else { '+' }, s.im.abs());
+                let z = format!(
+                    "{} {} {}i",
+                    format_fixed(s.re, 5, true),
+                    if s.im < 0.0 { '-' } else { '+' },
+                    format_fixed(s.im.abs(), 5, false)
+                );
                 row.push(if uniform { z } else { format!("{z} {}", m.name()) });
             }
             row
@@ -461,6 +733,9 @@ fn cell_json(c: &CellResult) -> serde_json::Map<String, Value> {
             m.insert("stable_intervals".into(), json!(s.stable_intervals));
             m.insert("stable_width".into(), json!(s.stable_width));
             m.insert("open_ended".into(), json!(s.open_ended));
+            if s.least_stable_real_part.is_some() {
+                m.insert("least_stable_real_part".into(), json!(s.least_stable_real_part));
+            }
             m.insert("error".into(), Value::Null);
         }
         Err(e) => {
@@ -626,7 +901,11 @@ pub fn format_parameter_table(s: &ParameterSweep) -> String {
         .values
         .iter()
         .zip(&s.points)
-        .map(|(p, c)| std::iter::once(format!("{p:.6}")).chain(summary_row(c)).collect())
+        .map(|(p, c)| {
+            std::iter::once(format_fixed(*p, 6, false))
+                .chain(summary_row(c))
+                .collect()
+        })
         .collect();
     format_table(&header, &rows)
 }
@@ -642,11 +921,94 @@ pub fn format_stability_map_table(m: &StabilityMap) -> String {
     for i in 0..nx {
         for j in 0..ny {
             if let Some(c) = m.cell(i, j) {
-                let mut r = vec![format!("{:.6}", m.x.values[i]), format!("{:.6}", m.y.values[j])];
+                let mut r = vec![
+                    format_fixed(m.x.values[i], 6, false),
+                    format_fixed(m.y.values[j], 6, false),
+                ];
                 r.extend(summary_row(c));
                 rows.push(r);
             }
         }
     }
     format_table(&header, &rows)
+}
+
+// ---------------------------------------------------------------------------
+// Printed numbers (issue 10, point 8). JSON and CSV keep full precision
+// (shortest round-trip representation); text for people has a fixed number
+// of significant digits and never a negative zero.
+
+/// Remove the sign of a formatted number whose digits are all zero
+/// (`"-0.000"` -> `"0.000"`, `"+0.000"` stays unsigned-zero as `"+0.000"`
+/// only when `plus` formatting was asked for).
+fn drop_negative_zero(s: String) -> String {
+    let digits_zero = s
+        .chars()
+        .take_while(|c| *c != 'e' && *c != 'E')
+        .all(|c| matches!(c, '-' | '+' | '0' | '.'));
+    if digits_zero && s.starts_with('-') {
+        s[1..].to_string()
+    } else {
+        s
+    }
+}
+
+/// `x` with `digits` significant digits: plain decimals for `1e-4 <= |x| <
+/// 1e12`, scientific notation otherwise (so `1e-300` prints as
+/// `1.00000e-300`, not with 300 digits); `0` and `-0` print as `0`.
+///
+/// ```
+/// use bikedyn_runtime::output::format_significant;
+/// assert_eq!(format_significant(80.81721999999998, 6), "80.8172");
+/// assert_eq!(format_significant(-0.0, 6), "0");
+/// assert_eq!(format_significant(1e-300, 3), "1.00e-300");
+/// ```
+pub fn format_significant(x: f64, digits: usize) -> String {
+    let digits = digits.max(1);
+    if x == 0.0 {
+        return "0".to_string();
+    }
+    if !x.is_finite() {
+        return x.to_string();
+    }
+    let e = x.abs().log10().floor() as i32;
+    if !(-4..12).contains(&e) {
+        return drop_negative_zero(format!("{:.*e}", digits - 1, x));
+    }
+    let decimals = (digits as i32 - 1 - e).max(0) as usize;
+    drop_negative_zero(format!("{x:.decimals$}"))
+}
+
+/// `x` with a fixed number of decimals, and a `+` sign when `plus`; a value
+/// that rounds to zero prints without a minus sign.
+pub fn format_fixed(x: f64, decimals: usize, plus: bool) -> String {
+    let s = if plus {
+        format!("{x:+.decimals$}")
+    } else {
+        format!("{x:.decimals$}")
+    };
+    let s = drop_negative_zero(s);
+    if plus && !s.starts_with(['+', '-']) {
+        format!("+{s}")
+    } else {
+        s
+    }
+}
+
+/// The entries of a matrix with `digits` significant digits relative to its
+/// largest entry (all entries get the same number of decimals, so columns
+/// align and an entry that is zero to that precision prints as zero without
+/// a sign); scientific notation when the largest entry is below `1e-4` or at
+/// least `1e12`.
+pub fn format_matrix_entries(entries: &[f64], digits: usize) -> Vec<String> {
+    let max = entries.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if max == 0.0 || !max.is_finite() {
+        return entries.iter().map(|&x| format_significant(x, digits)).collect();
+    }
+    let e = max.log10().floor() as i32;
+    if !(-4..12).contains(&e) {
+        return entries.iter().map(|&x| format_significant(x, digits)).collect();
+    }
+    let decimals = (digits as i32 - 1 - e).max(0) as usize;
+    entries.iter().map(|&x| format_fixed(x, decimals, false)).collect()
 }

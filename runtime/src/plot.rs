@@ -466,12 +466,14 @@ fn mode_class(m: Mode) -> usize {
         Mode::Weave => 0,
         Mode::Capsize => 1,
         Mode::Castering => 2,
-        Mode::Other(_) => 3,
+        Mode::WeaveCapsize | Mode::WeaveCastering | Mode::CapsizeCastering => 3,
+        Mode::Other(_) => 4,
     }
 }
 
-const CLASS_NAMES: [&str; 4] = ["weave", "capsize", "castering", "other"];
-const CLASS_COLORS: [RGBColor; 4] = [WEAVE, CAPSIZE, CASTERING, OTHER];
+const MERGED: RGBColor = RGBColor(204, 121, 167);
+const CLASS_NAMES: [&str; 5] = ["weave", "capsize", "castering", "merged pair", "other"];
+const CLASS_COLORS: [RGBColor; 5] = [WEAVE, CAPSIZE, CASTERING, MERGED, OTHER];
 
 /// Tick label: shortest decimal of the value rounded to 6 significant places.
 pub(crate) fn tick(v: f64) -> String {
@@ -617,7 +619,7 @@ struct Curve {
 /// the positive imaginary part per mode, as continuous pieces.
 fn continuation_curves(sweep: &EigenSweep) -> Vec<Curve> {
     let mut curves = Vec::new();
-    for class in 0..4 {
+    for class in 0..CLASS_NAMES.len() {
         let per_point: Vec<Vec<f64>> = sweep
             .points
             .iter()
@@ -1169,6 +1171,7 @@ fn missing_label(q: MapQuantity) -> &'static str {
         MapQuantity::StableWidth => "not self-stable",
         MapQuantity::WeaveSpeed => "no weave speed",
         MapQuantity::CapsizeSpeed => "no capsize speed",
+        MapQuantity::LeastStableRealPart => "no probe speed",
     }
 }
 
@@ -1300,6 +1303,30 @@ impl Figure for MapFigure<'_> {
             }
         }
         chart.draw_series(rects).map_err(de)?;
+        // Cells whose self-stable range reaches the upper speed limit: the
+        // range is cut there (its width is a lower bound); marked with a
+        // small open circle.
+        let mut cut = Vec::new();
+        for i in 0..nx {
+            for j in 0..ny {
+                if let Some(Ok(s)) = m.cell(i, j) {
+                    let (xc, yc) = (m.x.values[i], m.y.values[j]);
+                    if s.open_ended && xc >= xr.0 && xc <= xr.1 && yc >= yr.0 && yc <= yr.1 {
+                        cut.push(Circle::new((xc, yc), o.pxu(3.0), WHITE.stroke_width(o.pxu(1.0))));
+                    }
+                }
+            }
+        }
+        let any_cut = !cut.is_empty();
+        chart.draw_series(cut).map_err(de)?;
+        if any_cut {
+            main.draw_text(
+                "o: stable up to the speed limit (range cut there)",
+                &o.font(0.8),
+                (o.pxi(12.0), o.pxi(2.0)),
+            )
+            .map_err(de)?;
+        }
         let xl = o.x_label.clone().unwrap_or_else(|| m.x.name.clone());
         let yl = o.y_label.clone().unwrap_or_else(|| m.y.name.clone());
         chart

@@ -44,6 +44,10 @@ pub struct SweepOptions {
     pub progress: bool,
     /// The bar appears only once the run has taken this long. Default 1 s.
     pub progress_delay: Duration,
+    /// Speed (m/s) at which every cell also records the real part of its
+    /// least stable eigenvalue ([`StabilitySummary::least_stable_real_part`],
+    /// [`MapQuantity::LeastStableRealPart`]). Default `None`.
+    pub probe_speed: Option<f64>,
 }
 
 impl Default for SweepOptions {
@@ -53,6 +57,7 @@ impl Default for SweepOptions {
             speed_max: 10.0,
             progress: true,
             progress_delay: Duration::from_secs(1),
+            probe_speed: None,
         }
     }
 }
@@ -132,6 +137,9 @@ pub struct StabilitySummary {
     pub stable_width: f64,
     /// The last stable interval reaches `speed_max` (stable at the end of the range).
     pub open_ended: bool,
+    /// Largest real part of the eigenvalues at [`SweepOptions::probe_speed`]
+    /// (1/s), when a probe speed was given.
+    pub least_stable_real_part: Option<f64>,
 }
 
 impl StabilitySummary {
@@ -154,6 +162,7 @@ impl StabilitySummary {
             stable_intervals: c.stable_intervals.clone(),
             stable_width,
             open_ended,
+            least_stable_real_part: None,
         }
     }
 
@@ -242,6 +251,9 @@ pub enum MapQuantity {
     WeaveSpeed,
     /// Capsize speed `v_c` (m/s).
     CapsizeSpeed,
+    /// Real part of the least stable eigenvalue at
+    /// [`SweepOptions::probe_speed`] (1/s; negative means stable there).
+    LeastStableRealPart,
 }
 
 impl MapQuantity {
@@ -252,6 +264,7 @@ impl MapQuantity {
             MapQuantity::StableWidth => (s.stable_width > 0.0).then_some(s.stable_width),
             MapQuantity::WeaveSpeed => s.weave_speed,
             MapQuantity::CapsizeSpeed => s.capsize_speed,
+            MapQuantity::LeastStableRealPart => s.least_stable_real_part,
         }
     }
 
@@ -261,6 +274,7 @@ impl MapQuantity {
             MapQuantity::StableWidth => "self-stable speed range width (m/s)",
             MapQuantity::WeaveSpeed => "weave speed (m/s)",
             MapQuantity::CapsizeSpeed => "capsize speed (m/s)",
+            MapQuantity::LeastStableRealPart => "real part of the least stable eigenvalue (1/s)",
         }
     }
 }
@@ -366,12 +380,18 @@ fn evaluate_cell<E: Display>(map: impl FnOnce() -> Result<CanonicalMatrices, E>,
             });
         }
     };
-    critical_speeds(&c, opts.speed_min, opts.speed_max)
+    let eigen_error = |e: EigenError| CellError {
+        stage: CellStage::Eigen,
+        message: e.to_string(),
+    };
+    let mut summary = critical_speeds(&c, opts.speed_min, opts.speed_max)
         .map(|cs| StabilitySummary::from_critical(&cs, opts.speed_max))
-        .map_err(|e| CellError {
-            stage: CellStage::Eigen,
-            message: e.to_string(),
-        })
+        .map_err(eigen_error)?;
+    if let Some(v) = opts.probe_speed {
+        let z = crate::eigen::eigenvalues(&c, v).map_err(eigen_error)?;
+        summary.least_stable_real_part = Some(z.iter().map(|s| s.re).fold(f64::NEG_INFINITY, f64::max));
+    }
+    Ok(summary)
 }
 
 /// Progress bar that starts hidden and is switched to stderr after the delay

@@ -542,7 +542,7 @@ IFyy=0.28
         println!("{err}");
         let mut b = BenchmarkParameters::benchmark_bicycle();
         b.steer_axis_tilt = 2.0;
-        assert!(matches!(b.to_thesis(), Err(ParameterError::SteerAxisNotUpright { .. })));
+        assert!(matches!(b.to_thesis(), Err(ParameterError::TiltOutOfRange { .. })));
     }
 
     fn benchmark_strategy() -> impl Strategy<Value = BenchmarkParameters> {

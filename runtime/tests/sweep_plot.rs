@@ -118,7 +118,7 @@ fn sweep_speed_json_schema() {
         let o = obj.as_object().expect("entries are objects");
         let mut keys: Vec<&str> = o.keys().map(String::as_str).collect();
         keys.sort();
-        assert_eq!(keys, ["eigenvalues", "modes", "v"]);
+        assert_eq!(keys, ["eigenvalues", "mode_shapes", "modes", "v"]);
         assert_eq!(o["v"].as_f64().unwrap(), *v);
         let ev = o["eigenvalues"].as_array().unwrap();
         let modes = o["modes"].as_array().unwrap();
@@ -173,27 +173,33 @@ fn sweep_speed_json_schema() {
 fn sweep_speed_csv_header_rows_and_table() {
     let speeds = linspace(0.0, 10.0, 41);
     let sweep = speed_sweep(&benchmark(), &speeds).unwrap();
-    let header = [
-        "v", "re_1", "im_1", "mode_1", "re_2", "im_2", "mode_2", "re_3", "im_3", "mode_3", "re_4", "im_4", "mode_4",
-    ];
+    let mut header = vec!["v".to_string()];
+    for k in 1..=4 {
+        for c in ["re", "im", "mode", "roll_amp", "roll_phase", "steer_amp", "steer_phase"] {
+            header.push(format!("{c}_{k}"));
+        }
+    }
     assert_eq!(eigen_sweep_csv_header(), header);
     let mut buf = Vec::new();
     write_eigen_sweep_csv(&mut buf, &sweep).unwrap();
     let mut rd = csv::Reader::from_reader(buf.as_slice());
-    assert_eq!(rd.headers().unwrap().iter().collect::<Vec<_>>(), header);
+    assert_eq!(
+        rd.headers().unwrap().iter().collect::<Vec<_>>(),
+        header.iter().map(String::as_str).collect::<Vec<_>>()
+    );
     let rows: Vec<csv::StringRecord> = rd.records().map(Result::unwrap).collect();
     assert_eq!(rows.len(), 41);
     for (r, v) in rows.iter().zip(&speeds) {
-        assert_eq!(r.len(), 13);
+        assert_eq!(r.len(), 29);
         assert_eq!(r[0].parse::<f64>().unwrap(), *v, "speeds round-trip exactly");
         for k in 0..4 {
-            assert!(r[1 + 3 * k].parse::<f64>().is_ok() && r[2 + 3 * k].parse::<f64>().is_ok());
+            assert!(r[1 + 7 * k].parse::<f64>().is_ok() && r[2 + 7 * k].parse::<f64>().is_ok());
         }
     }
     // v = 10 m/s: castering -24.62459635017404 in slot 4.
     let last = &rows[40];
-    assert_eq!(&last[12], "castering");
-    assert!((last[10].parse::<f64>().unwrap() + 24.62459635017404).abs() < 1e-9);
+    assert_eq!(&last[24], "castering");
+    assert!((last[22].parse::<f64>().unwrap() + 24.62459635017404).abs() < 1e-9);
 
     let dir = test_dir("csv");
     let path = dir.join("sweep.csv");

@@ -78,9 +78,11 @@ fn direction(cp: &CharPoly, s: C64, v: f64) -> Option<CrossingDirection> {
 ///   contains them) where a real root passes through zero or a complex pair
 ///   crosses the imaginary axis, ascending, with the label of the crossing root
 ///   (tracked as in [`eigen_sweep`]) and the direction with increasing speed.
-/// * `weave_speed` (`v_w`): the lowest speed `>= 0` in the range where the weave
-///   becomes stable (stabilizing weave crossing); `capsize_speed` (`v_c`): the lowest
-///   speed `>= 0` in the range where the capsize mode becomes unstable;
+/// * `weave_speed` (`v_w`): the lowest speed `>= 0` in the range where an
+///   oscillation containing the weave becomes stable (a stabilizing complex-pair
+///   crossing of `weave`, `weave-capsize` or `weave-castering`); `capsize_speed`
+///   (`v_c`): the lowest speed `>= 0` in the range where the capsize mode (alone or
+///   merged with castering) becomes unstable;
 ///   `weave_real_pair_merge` (`v_d`): the lowest speed `>= 0` in the range where the
 ///   two real weave roots merge into the weave pair (with the double root in
 ///   `weave_merge_eigenvalue`). Each is `None` if it does not occur in the range.
@@ -174,18 +176,27 @@ pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<
         });
     }
 
+    // The weave speed is where an oscillatory mode containing the weave
+    // stabilizes (the weave pair, or a weave root merged with capsize or
+    // castering); the capsize speed is where the capsize mode (alone or merged
+    // with castering) destabilizes.
     let weave_speed = crossings
         .iter()
         .find(|x| {
             x.speed >= 0.0
-                && x.mode == Mode::Weave
+                && x.mode.involves(Mode::Weave)
                 && x.kind == CrossingKind::ComplexPair
                 && x.direction == CrossingDirection::Stabilizing
         })
         .map(|x| x.speed);
     let capsize_speed = crossings
         .iter()
-        .find(|x| x.speed >= 0.0 && x.mode == Mode::Capsize && x.direction == CrossingDirection::Destabilizing)
+        .find(|x| {
+            x.speed >= 0.0
+                && x.mode.involves(Mode::Capsize)
+                && !x.mode.involves(Mode::Weave)
+                && x.direction == CrossingDirection::Destabilizing
+        })
         .map(|x| x.speed);
 
     // Stable intervals.
@@ -227,23 +238,24 @@ pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<
 /// Grid intervals used to bracket `v_d`.
 const MERGE_GRID: usize = 512;
 
-/// `Some(true)`: both weave roots real; `Some(false)`: both complex.
+/// `Some(false)`: a complex pair whose mode contains the weave (the weave
+/// pair, or a weave root merged with capsize or castering); `Some(true)`: no
+/// such pair and at least two real weave roots.
 fn weave_state(l: &Labelled) -> Option<bool> {
-    let mut w = (0..4).filter(|&k| l.labels[k] == Mode::Weave).map(|k| l.roots[k]);
-    let (a, b) = (w.next()?, w.next()?);
-    if w.next().is_some() {
-        return None;
+    if (0..4).any(|k| l.roots[k].im != 0.0 && l.labels[k].involves(Mode::Weave)) {
+        return Some(false);
     }
-    match (a.im == 0.0, b.im == 0.0) {
-        (true, true) => Some(true),
-        (false, false) => Some(false),
-        _ => None,
-    }
+    let real_weave = (0..4)
+        .filter(|&k| l.labels[k] == Mode::Weave && l.roots[k].im == 0.0)
+        .count();
+    (real_weave >= 2).then_some(true)
 }
 
+/// Real part of the oscillatory weave-containing pair (the double root just
+/// after it formed).
 fn weave_mean(l: &Labelled) -> f64 {
     let w: Vec<f64> = (0..4)
-        .filter(|&k| l.labels[k] == Mode::Weave)
+        .filter(|&k| l.roots[k].im != 0.0 && l.labels[k].involves(Mode::Weave))
         .map(|k| l.roots[k].re)
         .collect();
     w.iter().sum::<f64>() / w.len().max(1) as f64

@@ -182,7 +182,7 @@ impl BenchmarkParameters {
     ///
     /// Errors: [`ParameterError::NotFinite`] for NaN or infinite values,
     /// [`ParameterError::NonPositive`] for `w <= 0`,
-    /// [`ParameterError::SteerAxisNotUpright`] for `|lam| >= pi/2`.
+    /// [`ParameterError::TiltOutOfRange`] for `|lam| >= pi/2`.
     pub fn to_thesis(&self) -> Result<ThesisParameters, ParameterError> {
         check_finite(&Self::SYMBOLS, |k| self.get(k))?;
         if self.wheelbase <= 0.0 {
@@ -192,9 +192,11 @@ impl BenchmarkParameters {
                 origin: Default::default(),
             });
         }
-        if self.steer_axis_tilt.cos() <= 0.0 {
-            return Err(ParameterError::SteerAxisNotUpright {
-                tilt: self.steer_axis_tilt,
+        if !(self.steer_axis_tilt.abs() < std::f64::consts::FRAC_PI_2) {
+            return Err(ParameterError::TiltOutOfRange {
+                field: "lam".to_string(),
+                value: self.steer_axis_tilt,
+                origin: Default::default(),
             });
         }
         let beta = -self.steer_axis_tilt;

@@ -87,6 +87,15 @@ pub enum ParameterError {
         field: String,
     },
 
+    /// Several required parameters are absent (all are listed).
+    #[error("{}: missing {} parameters: {}", path.display(), fields.len(), fields.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", "))]
+    MissingFields {
+        /// The file.
+        path: PathBuf,
+        /// Every missing symbol, in the form's order.
+        fields: Vec<String>,
+    },
+
     /// A name that is not a parameter of the detected (or forced) form.
     #[error("{}:{line}: unknown parameter `{field}` ({why})", path.display())]
     UnknownField {
@@ -129,7 +138,7 @@ pub enum ParameterError {
     },
 
     /// A value is NaN or infinite.
-    #[error("parameter `{field}` is not finite: {value}{origin}")]
+    #[error("parameter `{field}` is not finite: {value:?}{origin}")]
     NotFinite {
         /// The symbol.
         field: String,
@@ -142,7 +151,7 @@ pub enum ParameterError {
     /// A wheelbase, `g`, rear-frame mass, radius, mass or diagonal inertia
     /// that is not > 0 (zeros are allowed only for degenerate bodies, see
     /// [`ParameterWarning::Degenerate`]).
-    #[error("parameter `{field}` must be positive, found {value}{origin}")]
+    #[error("parameter `{field}` must be positive, found {value:?}{origin}")]
     NonPositive {
         /// The symbol.
         field: String,
@@ -152,8 +161,22 @@ pub enum ParameterError {
         origin: Origin,
     },
 
+    /// A value so large in magnitude that the equations, which multiply up
+    /// to a dozen parameters, would overflow double precision.
+    #[error("parameter `{field}` = {value:?} is too large: at most {limit:e} in SI units, else the equations overflow double precision{origin}")]
+    TooLarge {
+        /// The symbol.
+        field: String,
+        /// The value.
+        value: f64,
+        /// The largest magnitude accepted.
+        limit: f64,
+        /// File and line, when read from a file.
+        origin: Origin,
+    },
+
     /// An uncertainty (`+/-std`) that is negative or not finite.
-    #[error("{}:{line}: uncertainty of `{field}` must be finite and >= 0, found {value}", path.display())]
+    #[error("{}:{line}: uncertainty of `{field}` must be finite and >= 0, found {value:?}", path.display())]
     InvalidUncertainty {
         /// The file.
         path: PathBuf,
@@ -168,7 +191,7 @@ pub enum ParameterError {
     /// A body's inertia tensor is not positive definite.
     #[error(
         "inertia tensor of the {body} is not positive definite \
-         (xx {ixx}, zz {izz}, xz {ixz}: xx*zz - xz^2 = {det}){origin}"
+         (xx {ixx:?}, zz {izz:?}, xz {ixz:?}: xx*zz - xz^2 = {det:?}){origin}"
     )]
     NonPhysicalInertia {
         /// The body (`"rear wheel"`, `"rear frame"`, `"handlebar"`, `"front wheel"`).
@@ -232,8 +255,8 @@ pub enum ParameterError {
     /// rear wheel centre to the front wheel centre in frame axes, or the only
     /// root puts the front wheel behind).
     #[error(
-        "no ground contact for the front wheel: Rd - Rt = {height_difference} but the \
-         front wheel centre is {reach} m from the rear wheel centre ({detail})"
+        "no ground contact for the front wheel: Rd - Rt = {height_difference:?} but the \
+         front wheel centre is {reach:?} m from the rear wheel centre ({detail})"
     )]
     NoGroundContact {
         /// `Rd - Rt` (m).
@@ -246,10 +269,24 @@ pub enum ParameterError {
 
     /// The steer axis is not tilted less than 90 degrees from vertical, so it
     /// does not meet the ground ahead of the wheels in the usual way.
-    #[error("steer-axis tilt {tilt} rad is not within (-pi/2, pi/2)")]
+    #[error("steer-axis tilt {tilt:?} rad is not within (-pi/2, pi/2)")]
     SteerAxisNotUpright {
         /// The steer-axis tilt `lam` from vertical (rad).
         tilt: f64,
+    },
+
+    /// The steer-axis tilt `lam` of a benchmark set is not within the stated
+    /// range `(-pi/2, pi/2)` rad (exclusive: `lam = pi/2` is a horizontal steer
+    /// axis, a degenerate bicycle). A value such as 18 was probably meant in
+    /// degrees; the message then gives it in radians.
+    #[error("parameter `{field}` = {value:?} rad is outside the steer-axis tilt range (-pi/2, pi/2) rad{hint}{origin}", hint = degrees_hint(*value))]
+    TiltOutOfRange {
+        /// The symbol (`lam`).
+        field: String,
+        /// The value (rad).
+        value: f64,
+        /// File and line, when read from a file.
+        origin: Origin,
     },
 
     /// A parameter set was of the other form than the one required.
@@ -262,6 +299,33 @@ pub enum ParameterError {
         /// The form found.
         found: &'static str,
     },
+}
+
+/// `text` cut to at most `max` characters, with the number left out.
+pub(crate) fn cut(text: &str, max: usize) -> String {
+    let n = text.chars().count();
+    if n <= max {
+        text.to_string()
+    } else {
+        format!(
+            "{}... ({} more characters)",
+            text.chars().take(max).collect::<String>(),
+            n - max
+        )
+    }
+}
+
+/// `"; if 18 is in degrees, that is 0.314159 rad"` for values that look like
+/// an angle in degrees (magnitude at most 360), else `""`.
+pub(crate) fn degrees_hint(value: f64) -> String {
+    if value.is_finite() && value.abs() >= 1.0 && value.abs() <= 360.0 {
+        format!(
+            "; it looks like degrees: {value} deg is {} rad",
+            crate::output::format_significant(value.to_radians(), 6)
+        )
+    } else {
+        String::new()
+    }
 }
 
 fn fmt_line(line: Option<usize>) -> String {
@@ -283,6 +347,24 @@ impl ParameterError {
             },
             ParameterError::NonPositive { field, value, origin } if origin.path.is_none() => {
                 ParameterError::NonPositive {
+                    origin: Origin::new(path, line_of(&field)),
+                    field,
+                    value,
+                }
+            }
+            ParameterError::TooLarge {
+                field,
+                value,
+                limit,
+                origin,
+            } if origin.path.is_none() => ParameterError::TooLarge {
+                origin: Origin::new(path, line_of(&field)),
+                field,
+                value,
+                limit,
+            },
+            ParameterError::TiltOutOfRange { field, value, origin } if origin.path.is_none() => {
+                ParameterError::TiltOutOfRange {
                     origin: Origin::new(path, line_of(&field)),
                     field,
                     value,
@@ -316,6 +398,8 @@ impl ParameterError {
             | ParameterError::WrongType { field, .. }
             | ParameterError::NotFinite { field, .. }
             | ParameterError::NonPositive { field, .. }
+            | ParameterError::TiltOutOfRange { field, .. }
+            | ParameterError::TooLarge { field, .. }
             | ParameterError::InvalidUncertainty { field, .. } => Some(field),
             _ => None,
         }
@@ -331,7 +415,10 @@ impl ParameterError {
             | ParameterError::WrongType { line, .. }
             | ParameterError::InvalidUncertainty { line, .. }
             | ParameterError::InvalidForm { line, .. } => Some(*line),
-            ParameterError::NotFinite { origin, .. } | ParameterError::NonPositive { origin, .. } => origin.line,
+            ParameterError::NotFinite { origin, .. }
+            | ParameterError::NonPositive { origin, .. }
+            | ParameterError::TiltOutOfRange { origin, .. }
+            | ParameterError::TooLarge { origin, .. } => origin.line,
             _ => None,
         }
     }
@@ -379,6 +466,22 @@ pub enum ParameterWarning {
         /// What the name means.
         meaning: &'static str,
     },
+    /// A length so large that it was probably given in millimetres (more
+    /// than 10 m; a wheelbase of 1020 is 1.02 m).
+    LooksLikeMillimetres {
+        /// The symbol.
+        field: &'static str,
+        /// The value as given (read as metres).
+        value: f64,
+    },
+    /// A body's mass centre is below the ground plane when the bicycle is
+    /// upright.
+    MassCentreBelowGround {
+        /// `"rear frame"` or `"handlebar"`.
+        body: &'static str,
+        /// Height of the mass centre above the ground (< 0, m).
+        height: f64,
+    },
 }
 
 impl fmt::Display for ParameterWarning {
@@ -390,8 +493,23 @@ impl fmt::Display for ParameterWarning {
                 excess,
             } => write!(
                 f,
-                "principal moments of the {body} {principal:?} violate the triangle \
-                 inequality by {excess} kg m^2"
+                "principal moments of the {body} [{}, {}, {}] kg m^2 violate the triangle \
+                 inequality by {} kg m^2",
+                crate::output::format_significant(principal[0], 6),
+                crate::output::format_significant(principal[1], 6),
+                crate::output::format_significant(principal[2], 6),
+                crate::output::format_significant(*excess, 6),
+            ),
+            ParameterWarning::LooksLikeMillimetres { field, value } => write!(
+                f,
+                "`{field}` = {value:?} m is implausibly long for a bicycle; if it is in millimetres, \
+                 write {} (metres)",
+                crate::output::format_significant(value / 1000.0, 6)
+            ),
+            ParameterWarning::MassCentreBelowGround { body, height } => write!(
+                f,
+                "the {body} mass centre is {} m below the ground when upright",
+                crate::output::format_significant(-height, 6)
             ),
             ParameterWarning::Degenerate { body, what } => {
                 write!(f, "the {body} is degenerate: {what}")
@@ -403,7 +521,7 @@ impl fmt::Display for ParameterWarning {
                 meaning,
             } => write!(
                 f,
-                "line {line}: `{field} = {value}` ({meaning}) is not a model parameter; kept aside"
+                "line {line}: `{field} = {value:?}` ({meaning}) is not a model parameter; kept aside"
             ),
         }
     }

@@ -121,6 +121,18 @@ impl ParameterSet {
             .filter_map(|&e| fields.values.remove(e).map(|(v, _)| (e.to_string(), v)))
             .collect();
         let line_of = |f: &str| fields.values.get(f).map(|&(_, line)| line);
+        let symbols: &[&str] = match fields.form {
+            Form::Thesis => &ThesisParameters::SYMBOLS,
+            Form::Benchmark => &BenchmarkParameters::SYMBOLS,
+        };
+        let absent: Vec<&str> = symbols
+            .iter()
+            .copied()
+            .filter(|s| *s != "d4" && !fields.values.contains_key(*s))
+            .collect();
+        if let Some(err) = missing_all(path, &absent) {
+            return Err(err);
+        }
         let set = match fields.form {
             Form::Thesis => ParameterSet::Thesis(ThesisParameters::from_lookup(|sym| match fields.values.get(sym) {
                 Some(&(v, _)) => Ok(v),
@@ -292,6 +304,18 @@ pub(crate) fn read(path: &Path) -> Result<String, ParameterError> {
         path: path.to_path_buf(),
         source,
     })
+}
+
+/// The error for absent required fields: all of them at once.
+pub(crate) fn missing_all(path: &Path, absent: &[&str]) -> Option<ParameterError> {
+    match absent {
+        [] => None,
+        [one] => Some(missing(path, one)),
+        many => Some(ParameterError::MissingFields {
+            path: path.to_path_buf(),
+            fields: many.iter().map(|s| s.to_string()).collect(),
+        }),
+    }
 }
 
 fn missing(path: &Path, field: &str) -> ParameterError {

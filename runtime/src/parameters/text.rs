@@ -115,8 +115,8 @@ impl MeasuredBenchmark {
             let syntax = |reason: String| ParameterError::Syntax {
                 path: pb(),
                 line,
-                text: raw.trim().to_string(),
-                reason,
+                text: super::error::cut(raw.trim(), 80),
+                reason: super::error::cut(&reason, 160),
             };
             let Some((name, rhs)) = content.split_once('=') else {
                 return Err(syntax("expected `name = value`".to_string()));
@@ -169,6 +169,14 @@ impl MeasuredBenchmark {
                 });
             }
             values.insert(name.to_string(), (value, line));
+        }
+        let absent: Vec<&str> = BenchmarkParameters::SYMBOLS
+            .iter()
+            .copied()
+            .filter(|s| !values.contains_key(*s))
+            .collect();
+        if let Some(err) = super::load::missing_all(&pb(), &absent) {
+            return Err(err);
         }
         let parameters = BenchmarkParameters::from_lookup(|sym| {
             values

@@ -143,11 +143,22 @@ fn validate_common(
     positive: &[Field],
     bodies: &[Body],
 ) -> Result<Vec<ParameterWarning>, ParameterError> {
+    // The canonical matrices multiply up to four parameters per entry and the
+    // characteristic quartic up to four entries: 1e20^12 stays finite.
+    const LIMIT: f64 = 1e20;
     for (field, value) in values {
         if !value.is_finite() {
             return Err(ParameterError::NotFinite {
                 field: field.to_string(),
                 value,
+                origin: Default::default(),
+            });
+        }
+        if value.abs() > LIMIT {
+            return Err(ParameterError::TooLarge {
+                field: field.to_string(),
+                value,
+                limit: LIMIT,
                 origin: Default::default(),
             });
         }
@@ -160,6 +171,27 @@ fn validate_common(
         b.check(&mut warnings)?;
     }
     Ok(warnings)
+}
+
+/// Plausibility warnings shared by both forms: lengths over 10 m (probably
+/// millimetres) and mass centres below the ground.
+fn plausibility(lengths: &[Field], bench: Option<&BenchmarkParameters>, warnings: &mut Vec<ParameterWarning>) {
+    for &(field, value) in lengths {
+        if value.abs() > 10.0 {
+            warnings.push(ParameterWarning::LooksLikeMillimetres { field, value });
+        }
+    }
+    if let Some(b) = bench {
+        // Benchmark z is down: a mass centre below the ground has z > 0.
+        for (body, z) in [
+            (body::REAR_FRAME, b.rear_frame_com_z),
+            (body::HANDLEBAR, b.front_frame_com_z),
+        ] {
+            if z > 0.0 {
+                warnings.push(ParameterWarning::MassCentreBelowGround { body, height: -z });
+            }
+        }
+    }
 }
 
 impl ThesisParameters {
@@ -178,7 +210,29 @@ impl ThesisParameters {
     /// [`ThesisParameters::thesis_bicycle`] has two, for the handlebar and the
     /// front wheel). The first problem found is the error; errors carry no
     /// file name here (loaders add it).
+    ///
+    /// Plausibility warnings: a length over 10 m
+    /// ([`ParameterWarning::LooksLikeMillimetres`]) and a frame or handlebar
+    /// mass centre below the ground ([`ParameterWarning::MassCentreBelowGround`]).
     pub fn validate(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
+        let mut warnings = self.validate_bodies()?;
+        let s = self;
+        let lengths = [
+            ("Rt", s.rear_wheel_radius),
+            ("Rd", s.front_wheel_radius),
+            ("x3", s.frame_com_x),
+            ("z3", s.frame_com_z),
+            ("x4", s.steer_point_x),
+            ("z4", s.steer_point_z),
+            ("x5", s.front_wheel_x),
+            ("z5", s.front_wheel_z),
+            ("d4", s.fork_com_offset),
+        ];
+        plausibility(&lengths, self.to_benchmark().ok().as_ref(), &mut warnings);
+        Ok(warnings)
+    }
+
+    fn validate_bodies(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
         let s = self;
         validate_common(
             Self::SYMBOLS.iter().map(|&k| (k, s.get(k).unwrap_or(f64::NAN))),
@@ -239,7 +293,38 @@ impl BenchmarkParameters {
     /// Returns the warnings (e.g. [`ParameterWarning::TriangleInequality`]).
     /// The first problem found is the error; errors carry no file name here
     /// (loaders add it).
+    ///
+    /// The steer-axis tilt must be within `(-pi/2, pi/2)` rad
+    /// ([`ParameterError::TiltOutOfRange`], whose message suggests the value in
+    /// radians when it looks like degrees). Plausibility warnings: a length
+    /// over 10 m ([`ParameterWarning::LooksLikeMillimetres`]) and a frame or
+    /// handlebar mass centre below the ground
+    /// ([`ParameterWarning::MassCentreBelowGround`]).
     pub fn validate(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
+        let mut warnings = self.validate_bodies()?;
+        let s = self;
+        if !(s.steer_axis_tilt.abs() < std::f64::consts::FRAC_PI_2) {
+            return Err(ParameterError::TiltOutOfRange {
+                field: "lam".to_string(),
+                value: s.steer_axis_tilt,
+                origin: Default::default(),
+            });
+        }
+        let lengths = [
+            ("w", s.wheelbase),
+            ("c", s.trail),
+            ("rR", s.rear_wheel_radius),
+            ("rF", s.front_wheel_radius),
+            ("xB", s.rear_frame_com_x),
+            ("zB", s.rear_frame_com_z),
+            ("xH", s.front_frame_com_x),
+            ("zH", s.front_frame_com_z),
+        ];
+        plausibility(&lengths, Some(self), &mut warnings);
+        Ok(warnings)
+    }
+
+    fn validate_bodies(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
         let s = self;
         validate_common(
             Self::SYMBOLS.iter().map(|&k| (k, s.get(k).unwrap_or(f64::NAN))),
