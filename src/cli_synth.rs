@@ -59,14 +59,30 @@ fn clock_offset(nominal: f64, seed: u64) -> f64 {
     nominal + 0.6 * ((z >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
 }
 
+/// Time the bicycle stands still, held upright, before the launch (s): the
+/// loggers start during it and the IMUs settle (FORMAT.md, "What a run
+/// contains", step 1).
+const REST_BEFORE_LAUNCH: f64 = 2.5;
+
+/// The sensor-side motion: the rest before the launch, then the simulated
+/// run shifted by it.
 fn sensor_trajectory(tr: &RunTrajectory) -> Trajectory {
+    let dt = tr.t.get(1).map_or(0.01, |t1| t1 - tr.t[0]).max(1e-4);
+    let n_rest = (REST_BEFORE_LAUNCH / dt).round() as usize;
+    let rest = |v: &[f64]| -> Vec<f64> {
+        let first = v.first().copied().unwrap_or(0.0);
+        std::iter::repeat_n(first, n_rest).chain(v.iter().copied()).collect()
+    };
     Trajectory {
-        t: tr.t.clone(),
-        yaw: tr.yaw.clone(),
-        roll: tr.roll.clone(),
-        pitch: tr.pitch.clone(),
-        steer: tr.steer.clone(),
-        rear_wheel_angle: tr.rear_wheel_angle.clone(),
+        t: (0..n_rest)
+            .map(|k| k as f64 * dt)
+            .chain(tr.t.iter().map(|t| t - tr.t[0] + n_rest as f64 * dt))
+            .collect(),
+        yaw: rest(&tr.yaw),
+        roll: rest(&tr.roll),
+        pitch: rest(&tr.pitch),
+        steer: rest(&tr.steer),
+        rear_wheel_angle: rest(&tr.rear_wheel_angle),
     }
 }
 
@@ -152,6 +168,7 @@ pub fn run(a: SynthArgs) -> Result<bool> {
                 "speed": plan.speed,
             },
             "kick_time": plan.launch_duration + plan.kick_delay,
+            "kick_time_on_imu_clock": REST_BEFORE_LAUNCH + plan.launch_duration + plan.kick_delay,
             "stop": sim.stop.to_string(),
             "max_constraint_residual": sim.max_constraint_residual(),
             "mean_speed_after_release": mean_speed,

@@ -233,13 +233,7 @@ pub fn reduced_system<M: MultibodyModel, T: Scalar>(
             -qi
         })
         .collect();
-    Ok(ReducedSystem {
-        ec,
-        mi,
-        p,
-        dp,
-        ec_rest,
-    })
+    Ok(ReducedSystem { ec, mi, p, dp, ec_rest })
 }
 
 /// `M`, `C`, `K` of `M q'' + C q' + K q = 0` (thesis eq. 48-50) about
@@ -555,6 +549,20 @@ pub fn canonical_matrices<M: MultibodyModel>(
         k2: flip(&(&l1.stiffness - &k0)),
         g,
     })
+}
+
+/// Stiffness of the roll-steer linearization at zero forward speed, where
+/// only gravity and forces at rest act (every velocity vanishes): the
+/// derivative of `-E^T (Qgrav + Qext(p, 0))` in roll and steer.
+pub fn static_stiffness<M: MultibodyModel>(param: &[f64]) -> Result<DMatrix<f64>, LinearizeError> {
+    let (p0, dq0) = speed_setup::<M>(param, 0.0)?;
+    let (_, rest) = match M::INDEPENDENT.len() {
+        2 => linearize_with_rest::<M, 4>(&p0, &dq0)?,
+        3 => linearize_with_rest::<M, 6>(&p0, &dq0)?,
+        n => return Err(LinearizeError::TooManyIndependent { model: M::NAME, n }),
+    };
+    let idx = lateral_indices::<M>();
+    Ok(DMatrix::from_fn(2, 2, |i, j| rest[(idx[i], idx[j])]))
 }
 
 /// Canonical matrices by two full linearizations (at `V = 0` and `V = 1`),

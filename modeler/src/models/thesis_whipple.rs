@@ -105,15 +105,20 @@ pub fn declare(name: &str, source: &str, speed: Speed) -> (ModelBuilder, Bicycle
     m.gravity("g", Axis::Z);
 
     // The physical upright configuration in closed form: the frame pitch
-    // that puts both wheels on the ground with the front wheel ahead
-    // (Rt - sin(beta) P + cos(beta) Q = Rd, P = x4 + x5 > 0, Q = z4 + z5),
-    // beta = atan(Q / P) - asin((Rd - Rt) / hypot(P, Q)), and the rim angle
-    // of the lowest point of the front rim, xi = pi/2 - beta - eps.
+    // that puts both wheels on the ground with the front wheel ahead,
+    // Rt - sin(beta) P + cos(beta) Q = Rd with P = x4 + x5, Q = z4 + z5,
+    // R = hypot(P, Q): beta = acos((Rd - Rt) / R) - atan2(P, Q), written
+    // with acos(x) = pi/2 - atan(x / sqrt(1 - x^2)) and the half-angle form
+    // atan2(P, Q) = 2 atan(P / (R + Q)); and the rim angle of the lowest
+    // point of the front rim, xi = pi/2 - beta - eps.
     {
         let (p, q) = (x4.clone() + x5.clone(), z4.clone() + z5.clone());
         let d = rd.clone() - rt.clone();
         let r2 = p.clone().powi(2) + q.clone().powi(2);
-        let beta_up = (q / p).atan() - (d.clone() / (r2 - d.powi(2)).sqrt()).atan();
+        let r = r2.clone().sqrt();
+        let beta_up = exact(PI / 2.0)
+            - (d.clone() / (r2 - d.powi(2)).sqrt()).atan()
+            - crate::expr::num(2) * (p / (r + q)).atan();
         m.upright_value("beta", beta_up.clone());
         m.upright_value("xi", exact(PI / 2.0) - beta_up - crate::expr::coord("eps"));
     }
