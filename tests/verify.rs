@@ -105,6 +105,18 @@ mod broken_impl {
         fn upright_configuration<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
             W::upright_configuration(a, p, o)
         }
+        fn linearize_with_rest_exact(
+            param: &[f64],
+            dq0: &[f64],
+        ) -> Result<bikedyn::runtime::linearize::WithRest, bikedyn::runtime::linearize::LinearizeError> {
+            W::linearize_with_rest_exact(param, dq0)
+        }
+        fn state_space_exact(
+            param: &[f64],
+            dq0: &[f64],
+        ) -> Result<bikedyn::runtime::linearize::StateMatrix, bikedyn::runtime::linearize::LinearizeError> {
+            W::state_space_exact(param, dq0)
+        }
         fn applied_force_terms<T: Scalar>(a: &[T], t: T, p: &[T], dp: &[T], o: &mut [T]) {
             W::applied_force_terms(a, t, p, dp, o)
         }
@@ -230,6 +242,18 @@ mod pumping_impl {
         }
         fn upright_configuration<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
             W::upright_configuration(a, p, o)
+        }
+        fn linearize_with_rest_exact(
+            param: &[f64],
+            dq0: &[f64],
+        ) -> Result<bikedyn::runtime::linearize::WithRest, bikedyn::runtime::linearize::LinearizeError> {
+            W::linearize_with_rest_exact(param, dq0)
+        }
+        fn state_space_exact(
+            param: &[f64],
+            dq0: &[f64],
+        ) -> Result<bikedyn::runtime::linearize::StateMatrix, bikedyn::runtime::linearize::LinearizeError> {
+            W::state_space_exact(param, dq0)
         }
         const COORDINATES: &'static [&'static str] = W::COORDINATES;
         const PARAMETERS: &'static [&'static str] = W::PARAMETERS;

@@ -8391,4 +8391,22 @@ impl MultibodyModel for ThesisExtendedFree {
     fn upright_configuration<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) {
         upright_configuration(param, p, out)
     }
+    fn linearize_with_rest_exact(
+        param: &[f64],
+        dq0: &[f64],
+    ) -> Result<
+        bikedyn_runtime::linearize::WithRest,
+        bikedyn_runtime::linearize::LinearizeError,
+    > {
+        bikedyn_runtime::linearize::linearize_with_rest::<Self, 6usize>(param, dq0)
+    }
+    fn state_space_exact(
+        param: &[f64],
+        dq0: &[f64],
+    ) -> Result<
+        bikedyn_runtime::linearize::StateMatrix,
+        bikedyn_runtime::linearize::LinearizeError,
+    > {
+        bikedyn_runtime::linearize::state_space_dual::<Self, 6usize>(param, dq0)
+    }
 }

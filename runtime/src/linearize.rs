@@ -253,22 +253,18 @@ pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, Line
     if ni != 2 {
         return Err(LinearizeError::NotRollSteer { model: M::NAME, n: ni });
     }
-    linearize_about::<M, 4>(param, &[0.0; 2])
+    M::linearize_with_rest_exact(param, &[0.0; 2]).map(|(l, _)| l)
 }
 
-/// Exact linearization about the steady motion with all independent
-/// coordinates zero and independent rates `dq0` (for a free-speed model,
-/// the rear wheel's spin rate), over all independent coordinates. `N` must
-/// be twice their number (dual directions: coordinates, then rates).
-fn linearize_about<M: MultibodyModel, const N: usize>(
-    param: &[f64],
-    dq0: &[f64],
-) -> Result<Linearization, LinearizeError> {
-    linearize_with_rest::<M, N>(param, dq0).map(|(l, _)| l)
-}
+/// A linearization and the stiffness at rest from the same evaluation.
+pub type WithRest = (Linearization, DMatrix<f64>);
 
-/// [`linearize_about`] and, from the same evaluation, the stiffness at rest.
-fn linearize_with_rest<M: MultibodyModel, const N: usize>(
+/// [`linearize_about`] and, from the same evaluation, the stiffness at rest,
+/// with dual numbers of width `N = 2 x` the independent coordinates. Each
+/// generated model calls it with its own `N`
+/// ([`MultibodyModel::linearize_with_rest_exact`]), so only that width is
+/// compiled per model.
+pub fn linearize_with_rest<M: MultibodyModel, const N: usize>(
     param: &[f64],
     dq0: &[f64],
 ) -> Result<(Linearization, DMatrix<f64>), LinearizeError> {
@@ -332,12 +328,11 @@ pub fn linearize_at_speed<M: MultibodyModel>(param: &[f64], speed: f64) -> Resul
         return Err(LinearizeError::HasStates { model: M::NAME });
     }
     let (param, dq0) = speed_setup::<M>(param, speed)?;
-    match M::INDEPENDENT.len() {
-        2 => linearize_about::<M, 4>(&param, &dq0),
-        3 => linearize_about::<M, 6>(&param, &dq0),
-        n => Err(LinearizeError::TooManyIndependent { model: M::NAME, n }),
-    }
+    M::linearize_with_rest_exact(&param, &dq0).map(|(l, _)| l)
 }
+
+/// A state matrix (re-exported so generated code needs no nalgebra).
+pub type StateMatrix = DMatrix<f64>;
 
 /// A linear state-space model `x' = A x` about upright straight running.
 #[derive(Clone, Debug)]
@@ -357,22 +352,18 @@ pub fn state_space_at_speed<M: MultibodyModel>(param: &[f64], speed: f64) -> Res
     let ni = M::INDEPENDENT.len();
     let nz = M::STATES.len();
     let (param, dq0) = speed_setup::<M>(param, speed)?;
-    let a = match 2 * ni + nz {
-        4 => state_space_dual::<M, 4>(&param, &dq0)?,
-        6 => state_space_dual::<M, 6>(&param, &dq0)?,
-        8 => state_space_dual::<M, 8>(&param, &dq0)?,
-        10 => state_space_dual::<M, 10>(&param, &dq0)?,
-        12 => state_space_dual::<M, 12>(&param, &dq0)?,
-        14 => state_space_dual::<M, 14>(&param, &dq0)?,
-        n => return Err(LinearizeError::TooManyIndependent { model: M::NAME, n }),
-    };
+    let _ = (ni, nz);
+    let a = M::state_space_exact(&param, &dq0)?;
     let mut names: Vec<String> = M::INDEPENDENT.iter().map(|&j| M::COORDINATES[j].to_string()).collect();
     names.extend(M::INDEPENDENT.iter().map(|&j| format!("d{}", M::COORDINATES[j])));
     names.extend(M::STATES.iter().map(|s| s.to_string()));
     Ok(StateSpace { names, a })
 }
 
-fn state_space_dual<M: MultibodyModel, const N: usize>(
+/// The state matrix of [`state_space_at_speed`] with dual numbers of width
+/// `N = 2 x` independent coordinates `+` extra states (called by each
+/// generated model with its own `N`).
+pub fn state_space_dual<M: MultibodyModel, const N: usize>(
     param: &[f64],
     dq0: &[f64],
 ) -> Result<DMatrix<f64>, LinearizeError> {
@@ -533,11 +524,7 @@ pub fn canonical_matrices<M: MultibodyModel>(
         return Err(LinearizeError::HasStates { model: M::NAME });
     }
     let (p1, dq1) = speed_setup::<M>(&param, 1.0)?;
-    let (l1, rest) = match M::INDEPENDENT.len() {
-        2 => linearize_with_rest::<M, 4>(&p1, &dq1)?,
-        3 => linearize_with_rest::<M, 6>(&p1, &dq1)?,
-        n => return Err(LinearizeError::TooManyIndependent { model: M::NAME, n }),
-    };
+    let (l1, rest) = M::linearize_with_rest_exact(&p1, &dq1)?;
     let l1 = lateral_block::<M>(&l1);
     let idx = lateral_indices::<M>();
     let k0 = DMatrix::from_fn(2, 2, |i, j| rest[(idx[i], idx[j])]);
@@ -556,11 +543,7 @@ pub fn canonical_matrices<M: MultibodyModel>(
 /// derivative of `-E^T (Qgrav + Qext(p, 0))` in roll and steer.
 pub fn static_stiffness<M: MultibodyModel>(param: &[f64]) -> Result<DMatrix<f64>, LinearizeError> {
     let (p0, dq0) = speed_setup::<M>(param, 0.0)?;
-    let (_, rest) = match M::INDEPENDENT.len() {
-        2 => linearize_with_rest::<M, 4>(&p0, &dq0)?,
-        3 => linearize_with_rest::<M, 6>(&p0, &dq0)?,
-        n => return Err(LinearizeError::TooManyIndependent { model: M::NAME, n }),
-    };
+    let (_, rest) = M::linearize_with_rest_exact(&p0, &dq0)?;
     let idx = lateral_indices::<M>();
     Ok(DMatrix::from_fn(2, 2, |i, j| rest[(idx[i], idx[j])]))
 }

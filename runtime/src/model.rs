@@ -145,6 +145,19 @@ pub trait MultibodyModel: Send + Sync + 'static {
     /// closed form (e.g. frame pitch and the front contact's rim angle from
     /// the geometry) take that value, the others keep their value in `p`.
     fn upright_configuration<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
+    /// Exact linearization about the steady motion with independent rates
+    /// `dq0`, and the stiffness at rest, with this model's dual width
+    /// (generated: `linearize::linearize_with_rest::<Self, {2 ni}>`).
+    fn linearize_with_rest_exact(
+        param: &[f64],
+        dq0: &[f64],
+    ) -> Result<crate::linearize::WithRest, crate::linearize::LinearizeError>;
+    /// State matrix over `[q, q', z]` with this model's dual width
+    /// (generated: `linearize::state_space_dual::<Self, {2 ni + nz}>`).
+    fn state_space_exact(
+        param: &[f64],
+        dq0: &[f64],
+    ) -> Result<crate::linearize::StateMatrix, crate::linearize::LinearizeError>;
     /// Rates of the extra states, `STATES.len()` values.
     fn state_rates<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
 }
