@@ -51,11 +51,6 @@ pub enum ConstraintError {
         /// Largest entry magnitude of the Jacobian.
         scale: f64,
     },
-    /// The front wheel cannot reach the ground ahead of the rear wheel: the
-    /// height difference of the wheel centres `Rd - Rt` is at least the
-    /// distance `reach` from the rear wheel centre to the front one.
-    #[error("the front wheel cannot touch the ground: |Rd - Rt| = {height_difference_abs:.6} m is not less than the distance between the wheel centres ({reach:.6} m)", height_difference_abs = height_difference.abs())]
-    NoGroundContact { height_difference: f64, reach: f64 },
     /// The model's closed-form upright configuration has no real value
     /// (e.g. the frame pitch when the front wheel cannot reach the ground).
     #[error("the front wheel cannot touch the ground: the model's upright configuration has no real value for `{coordinate}` with these parameters")]

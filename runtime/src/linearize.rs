@@ -49,9 +49,6 @@ pub enum LinearizeError {
         inertia_symbol: &'static str,
         inertia: f64,
     },
-    /// The parameters could not be converted for a derived computation.
-    #[error("{0}")]
-    Parameters(String),
     /// The zero-radius limit could not be taken reliably (the matrices are
     /// not the quadratic polynomial in the radius that the closed form says).
     #[error("the zero-radius limit is not reliable here (departure from a quadratic in the radius: {departure:.3e}, relative to {scale:.3e})")]

@@ -61,7 +61,7 @@ pub mod plot;
 pub mod trajectory;
 
 pub use inputs::{Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, StopReason, TorquePulse};
-pub use rhs::{forward_speed, forward_speed_parameter, BicycleCoordinates, Evaluator, StateLayout};
+pub use rhs::{forward_speed, BicycleCoordinates, Evaluator, StateLayout};
 
 use std::io::Write;
 use std::path::Path;
@@ -367,7 +367,7 @@ pub fn initial_state<M: MultibodyModel>(
     }
     let mut param = param.to_vec();
     let driven = M::INDEPENDENT.len() == 2;
-    if let Some(k) = forward_speed_parameter::<M>().filter(|_| driven) {
+    if let Some(k) = M::FORWARD_SPEED_PARAMETER.filter(|_| driven) {
         if k < param.len() {
             param[k] = ic.speed;
         }

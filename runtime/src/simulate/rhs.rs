@@ -120,12 +120,6 @@ pub fn forward_speed(c: &BicycleCoordinates, p: &[f64], dp: &[f64]) -> f64 {
     dp[c.xc] * co + dp[c.yc] * s
 }
 
-/// Index of the forward-speed parameter of a driven model (`None` for a
-/// free-speed model), as the model declares it.
-pub fn forward_speed_parameter<M: MultibodyModel>() -> Option<usize> {
-    M::FORWARD_SPEED_PARAMETER
-}
-
 /// The rear wheel's rolling radius from the model's kinematics: forward
 /// speed per unit rear-wheel spin rate in upright running (no parameter is
 /// looked up by name).
