@@ -34,10 +34,19 @@ pub struct SynthArgs {
     /// Built-in bicycle (thesis, benchmark) or parameter file.
     #[arg(long, default_value = "thesis")]
     bike: String,
-    /// Generated model (default: thesis_whipple, or whipple_offset when the
-    /// fork mass centre is off the steer axis).
+    /// Generated model (default: the free-speed variant of the smallest
+    /// model with every parameter the bicycle and `--effects` set, so that
+    /// speed evolves physically after the release).
     #[arg(long)]
     model: Option<String>,
+    /// Hidden effects: comma-separated `SYMBOL=VALUE` (e.g.
+    /// `c_steer=0.3` or `Crr_rear=0.008,Crr_front=0.008`), on top of the
+    /// bicycle's own effect parameters.
+    #[arg(long, value_delimiter = ',')]
+    effects: Vec<String>,
+    /// Release speeds are drawn uniformly from LO:HI (m/s).
+    #[arg(long, default_value = "3:7")]
+    speeds: String,
     /// Number of runs.
     #[arg(long, default_value_t = 3)]
     runs: usize,
@@ -130,10 +139,35 @@ pub fn run(a: SynthArgs) -> Result<bool> {
     if a.runs == 0 || a.runs > 1000 {
         bail!("--runs must be between 1 and 1000");
     }
-    let bike = Bicycle::resolve(&a.bike)?;
+    let mut bike = Bicycle::resolve(&a.bike)?;
+    for e in &a.effects {
+        let (sym, val) = e
+            .split_once('=')
+            .with_context(|| format!("--effects `{e}`: expected SYMBOL=VALUE"))?;
+        let val: f64 = val
+            .trim()
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .with_context(|| format!("--effects `{e}`: `{}` is not a finite number", val.trim()))?;
+        bike = bike.with_parameter(sym.trim(), val)?;
+    }
+    let (lo, hi) = a
+        .speeds
+        .split_once(':')
+        .and_then(|(l, h)| Some((l.trim().parse::<f64>().ok()?, h.trim().parse::<f64>().ok()?)))
+        .filter(|(l, h)| l.is_finite() && h.is_finite() && *l > 0.0 && h >= l)
+        .with_context(|| format!("--speeds `{}`: expected LO:HI with 0 < LO <= HI (m/s)", a.speeds))?;
     let p = bike.thesis()?;
     let canonical = canonical_of(&p)?;
-    let info = bike.model(a.model.as_deref())?;
+    let info = match a.model.as_deref() {
+        Some(name) => bike.model(Some(name))?,
+        None => {
+            let driven = bike.model(None)?;
+            bikedyn::models::free_speed_variant(driven)
+                .with_context(|| format!("model `{}` has no free-speed variant; name one with --model", driven.name))?
+        }
+    };
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let lookup = bike.lookup()?;
     // Sensors like the thesis's instrumentation (FORMAT.md), on this
@@ -143,7 +177,9 @@ pub fn run(a: SynthArgs) -> Result<bool> {
         ..SensorModel::default()
     };
     for k in 0..a.runs {
-        let plan = RunPlan::random(a.seed.wrapping_add(k as u64));
+        let mut plan = RunPlan::random(a.seed.wrapping_add(k as u64));
+        // RunPlan::random draws 3-7 m/s; map that draw onto LO:HI.
+        plan.speed = lo + (hi - lo) * (plan.speed - 3.0) / 4.0;
         let (tr, sim, param, names) = with_model(
             info.name,
             OneRun {

@@ -178,6 +178,11 @@ pub fn find_kicks(
     // difference of two averages of 2h+1 samples.
     let sigma = (noise * (2.0 / (2 * h + 1) as f64).sqrt()).max(1e-12);
     let mut thr = opt.threshold_sigmas * sigma;
+    // A change already under way where the record (or the search after the
+    // release) begins is the launch or the hand letting go, not a kick.
+    if let Some(quiet) = score.iter().position(|s| s.abs() <= thr) {
+        score[..quiet].iter_mut().for_each(|s| *s = 0.0);
+    }
     if opt.single {
         // One kick: the first change of at least half the largest one (the
         // response that follows changes the rate less than the kick did).

@@ -279,12 +279,29 @@ pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOpti
     // Before the settled time the orientation is not trustworthy, and the
     // kick comes after the release, which ends the launch at the highest
     // speed (FORMAT.md: launch, release, then the kick).
-    let release =
-        sp.v.iter()
-            .enumerate()
-            .filter(|(_, v)| v.is_finite())
-            .max_by(|a, b| a.1.total_cmp(b.1))
-            .map(|(i, _)| sp.t[i] + offset.value);
+    // The release ends the launch: the first time after the launch's peak
+    // acceleration that the acceleration falls below half of that peak. (The
+    // highest speed is no mark: with little rolling loss the speed after the
+    // release is a plateau whose maximum falls anywhere on it.) The
+    // acceleration is a central difference over RELEASE_SPAN, short against
+    // a hand launch (seconds) and long against the magnet-to-magnet noise.
+    const RELEASE_SPAN: f64 = 0.2;
+    let accel: Vec<f64> = sp
+        .t
+        .iter()
+        .map(|&x| match (sp.at(x - RELEASE_SPAN), sp.at(x + RELEASE_SPAN)) {
+            (Some(a), Some(b)) => (b.0 - a.0) / (2.0 * RELEASE_SPAN),
+            _ => f64::NAN,
+        })
+        .collect();
+    let release = accel
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| a.is_finite())
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .filter(|(_, &amax)| amax > 0.0)
+        .and_then(|(imax, &amax)| (imax..accel.len()).find(|&i| accel[i] < 0.5 * amax))
+        .map(|i| sp.t[i] + offset.value);
     let k0 = t.partition_point(|&x| x < cal.settled_from.max(release.unwrap_or(f64::NEG_INFINITY)));
     let found = kicks::find_kicks(
         &t[k0..],
