@@ -20,4 +20,5 @@ pub mod bench;
 pub mod bench_simulate;
 pub mod bicycle;
 pub mod fit;
+pub mod identify;
 pub mod models;

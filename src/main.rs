@@ -78,6 +78,8 @@ struct OutputArgs {
 enum Command {
     /// Measured weave eigenvalues from raw logs (thesis-style run sets, TU Delft kick logs).
     Fit(bikedyn::fit::FitArgs),
+    /// Close the loop: from the residual of measured runs to the missing effect, its fitted parameters, and the error before and after
+    Identify(bikedyn::identify::IdentifyArgs),
     /// The main job on embedded defaults: verify the generated models, print
     /// the canonical matrices and self-stable speeds of the built-in bicycles,
     /// and write eigenvalue tables and continuation diagrams to a folder.
@@ -759,6 +761,7 @@ fn run(cli: Cli) -> Result<bool> {
             }
         },
         Command::Fit(args) => bikedyn::fit::command(&args),
+        Command::Identify(args) => bikedyn::identify::command(&args),
         Command::Simulate(args) => cli_simulate::run(args),
         Command::Synth(args) => cli_synth::run(args),
         Command::Bench { quick } => {

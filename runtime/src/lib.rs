@@ -10,6 +10,7 @@ pub mod constraints;
 pub mod eigen;
 pub mod experiment;
 pub mod geometry;
+pub mod identify;
 pub mod linalg;
 pub mod linearize;
 pub mod model;

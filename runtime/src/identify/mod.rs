@@ -1,0 +1,954 @@
+//! Closing the loop (issue 9): from the residual between a model and measured
+//! free responses to the effect the model lacks, its fitted parameters, and
+//! the error before and after.
+//!
+//! # Method
+//!
+//! * **Data.** Each kick of a measured set gives a [`Segment`]: roll and steer
+//!   (rad) on the IMU clock and the reed-switch speed (m/s) over the kick's
+//!   free-response window (found by `experiment`, never by hand).
+//! * **Time-series residuals.** A candidate model is the free-speed model `M`
+//!   (every effect of the library, each absent unless fitted) with some effect
+//!   parameters free. Each segment is simulated with the full nonlinear
+//!   equations from its own initial state (roll, steer, their rates and the
+//!   speed at the window start). The residual is measured minus simulated
+//!   roll, steer and speed at the measurement times, each channel divided by
+//!   its noise scale ([`Weights`]).
+//! * **Fitting.** Effect parameters are shared by all segments; the initial
+//!   states are per-segment nuisance parameters. Both are fitted together by
+//!   Levenberg-Marquardt (`levenberg-marquardt` crate). Sensitivities are
+//!   forward differences of whole simulations at tight tolerance (rtol
+//!   1e-9), so the difference step (1e-4 of the parameter's scale) is far
+//!   above the integration error. The Jacobian is block-sparse: a segment
+//!   depends only on the shared parameters and its own initial state, so a
+//!   column costs one simulation of one segment. Segments run in parallel.
+//! * **Uncertainty.** Standard errors come from `(J^T J)^-1 s^2`, with `s^2`
+//!   the residual variance, inflated by `(1 + rho) / (1 - rho)` for the lag-1
+//!   autocorrelation `rho` of the residuals: 120 Hz samples of a smooth
+//!   model error are not independent.
+//! * **Selection.** Forward stepwise: starting from no effect, each remaining
+//!   candidate is added and fitted; the best is kept only if it lowers the
+//!   Bayesian information criterion computed with the effective sample size
+//!   (`n (1 - rho) / (1 + rho)` per channel, from the current model's
+//!   residuals) *and* lowers the cross-validated error over held-out runs
+//!   (k-fold by run, the effect fitted on the other runs and only the
+//!   held-out run's initial state fitted to it), *and* its dissipative
+//!   parameters are positive (a negative damper is not physics). Sensor
+//!   nuisances (mounting misalignment, clock offset) are estimated per set by
+//!   the measured-run pipeline before, and are never candidates.
+
+pub mod plot;
+
+use crate::model::MultibodyModel;
+use crate::simulate::{simulate, Events, InitialConditions, Inputs, SimOptions};
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::sync::Mutex;
+
+/// Number of per-segment nuisance parameters: initial roll, steer (rad),
+/// roll rate, steer rate (rad/s) and forward speed (m/s).
+pub const NUISANCE: usize = 5;
+/// Scales of the nuisance parameters (difference steps and LM scaling).
+const NUISANCE_SCALE: [f64; NUISANCE] = [0.01, 0.01, 0.1, 0.1, 0.1];
+
+/// One measured free response.
+#[derive(Clone, Debug, Serialize)]
+pub struct Segment {
+    /// Run (path) the kick belongs to.
+    pub run: String,
+    /// Time of the window start on the IMU clock (s).
+    pub t0: f64,
+    /// Sample times from the window start (s).
+    pub t: Vec<f64>,
+    /// Measured roll (rad, positive leaning right).
+    pub roll: Vec<f64>,
+    /// Measured steer (rad, positive turning left).
+    pub steer: Vec<f64>,
+    /// Speed sample times from the window start (s).
+    pub speed_t: Vec<f64>,
+    /// Measured forward speed (m/s).
+    pub speed: Vec<f64>,
+    /// Initial state estimated from the data: roll, steer (rad), their rates
+    /// (rad/s), speed (m/s).
+    pub initial: [f64; NUISANCE],
+    /// Mean speed over the window (m/s) and its range.
+    pub mean_speed: f64,
+    pub speed_interval: [f64; 2],
+    /// Measured weave eigenvalue and its standard error (1/s), when fitted.
+    pub weave: Option<([f64; 2], [f64; 2])>,
+}
+
+impl Segment {
+    /// Build a segment from measured series on one clock; `t0` is the window
+    /// start. The initial roll, steer and rates come from a least-squares
+    /// line through the first `SLOPE_SPAN` seconds (a slope over a tenth of a
+    /// weave period averages the 120 Hz noise without bending the response).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        run: String,
+        t0: f64,
+        t: Vec<f64>,
+        roll: Vec<f64>,
+        steer: Vec<f64>,
+        speed_t: Vec<f64>,
+        speed: Vec<f64>,
+        weave: Option<([f64; 2], [f64; 2])>,
+    ) -> Option<Segment> {
+        const SLOPE_SPAN: f64 = 0.06;
+        if t.len() < 12 || speed.is_empty() {
+            return None;
+        }
+        let line = |x: &[f64]| {
+            let k = t.iter().take_while(|&&s| s <= SLOPE_SPAN).count().max(4).min(t.len());
+            let (n, st, sx) = (k as f64, t[..k].iter().sum::<f64>(), x[..k].iter().sum::<f64>());
+            let stt: f64 = t[..k].iter().map(|a| a * a).sum();
+            let stx: f64 = t[..k].iter().zip(&x[..k]).map(|(a, b)| a * b).sum();
+            let slope = (n * stx - st * sx) / (n * stt - st * st);
+            ((sx - slope * st) / n, slope)
+        };
+        let (r0, dr0) = line(&roll);
+        let (s0, ds0) = line(&steer);
+        let v0 = speed[0];
+        let mean_speed = speed.iter().sum::<f64>() / speed.len() as f64;
+        let lo = speed.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = speed.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let initial = [r0, s0, dr0, ds0, v0];
+        if initial.iter().any(|x| !x.is_finite()) || !(v0 > 0.0) {
+            return None;
+        }
+        Some(Segment {
+            run,
+            t0,
+            t,
+            roll,
+            steer,
+            speed_t,
+            speed,
+            initial,
+            mean_speed,
+            speed_interval: [lo, hi],
+            weave,
+        })
+    }
+
+    /// Window length (s).
+    pub fn duration(&self) -> f64 {
+        self.t.last().copied().unwrap_or(0.0).max(self.speed_t.last().copied().unwrap_or(0.0))
+    }
+
+    fn len(&self) -> usize {
+        2 * self.t.len() + self.speed.len()
+    }
+}
+
+/// A fitted effect parameter.
+#[derive(Clone, Debug, Serialize)]
+pub struct EffectParameter {
+    /// Model parameter symbol.
+    pub symbol: String,
+    /// Other symbols set to the same value (e.g. front and rear rolling
+    /// resistance coefficients).
+    pub tied: Vec<String>,
+    /// Typical magnitude (difference step and LM scaling).
+    pub scale: f64,
+    /// Physical only when positive (dissipation).
+    pub dissipative: bool,
+    /// Unit, for reports.
+    pub unit: String,
+}
+
+/// A candidate effect (or a combination): the parameters fitted when it is
+/// added, and fixed parameters it needs (e.g. the air density).
+#[derive(Clone, Debug, Serialize)]
+pub struct Candidate {
+    pub name: String,
+    /// Effects of the library it switches on.
+    pub effects: Vec<String>,
+    pub parameters: Vec<EffectParameter>,
+    pub fixed: Vec<(String, f64)>,
+    /// A speed-decay effect (rolling resistance, drag).
+    pub speed_decay: bool,
+    /// Why this effect is suspected, from the residual pattern.
+    pub reason: String,
+}
+
+/// Noise scales of the three channels.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Weights {
+    /// Roll (rad).
+    pub roll: f64,
+    /// Steer (rad).
+    pub steer: f64,
+    /// Speed (m/s).
+    pub speed: f64,
+}
+
+/// Errors of identification.
+#[derive(Debug, thiserror::Error)]
+pub enum IdentifyError {
+    #[error("model `{model}` has no parameter `{symbol}`")]
+    UnknownParameter { model: &'static str, symbol: String },
+    #[error("no segment to fit (no kick with a usable free-response window)")]
+    NoData,
+    #[error("the simulation of {run} failed at the initial state: {message}")]
+    Simulation { run: String, message: String },
+}
+
+/// The fitting problem: a base parameter vector of `M`, the segments, and
+/// the active effect parameters.
+pub struct Setup<'a> {
+    pub base: Vec<f64>,
+    pub segments: &'a [Segment],
+    pub weights: Weights,
+    pub options: SimOptions,
+    /// Active effect parameters: index lists into `base` (primary + tied).
+    slots: Vec<Vec<usize>>,
+    pub parameters: Vec<EffectParameter>,
+    simulate: fn(&[f64], &Segment, &[f64; NUISANCE], &SimOptions) -> Result<Sim, String>,
+}
+
+/// Simulated channels at the segment's sample times.
+pub struct Sim {
+    pub roll: Vec<f64>,
+    pub steer: Vec<f64>,
+    pub speed: Vec<f64>,
+}
+
+fn interp(ts: &[f64], xs: &[f64], t: f64) -> f64 {
+    let n = ts.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if t <= ts[0] {
+        return xs[0];
+    }
+    if t >= ts[n - 1] {
+        // After a fall the simulation stops: hold its last value.
+        return xs[n - 1];
+    }
+    let k = ts.partition_point(|&x| x <= t);
+    let w = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+    xs[k - 1] + w * (xs[k] - xs[k - 1])
+}
+
+fn simulate_segment<M: MultibodyModel>(
+    param: &[f64],
+    seg: &Segment,
+    x0: &[f64; NUISANCE],
+    opts: &SimOptions,
+) -> Result<Sim, String> {
+    let ic = InitialConditions {
+        roll: x0[0],
+        steer: x0[1],
+        roll_rate: x0[2],
+        steer_rate: x0[3],
+        speed: x0[4],
+        yaw: 0.0,
+    };
+    let dt = (seg.t.get(1).copied().unwrap_or(0.01) - seg.t[0]).max(1e-3);
+    let opts = SimOptions {
+        output_interval: dt,
+        ..*opts
+    };
+    let sim = simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &opts).map_err(|e| e.to_string())?;
+    let roll = sim.coordinate("theta").ok_or("model has no roll coordinate theta")?;
+    let steer = sim.coordinate("gamma").ok_or("model has no steer coordinate gamma")?;
+    Ok(Sim {
+        roll: seg.t.iter().map(|&t| interp(&sim.t, &roll, t)).collect(),
+        steer: seg.t.iter().map(|&t| interp(&sim.t, &steer, t)).collect(),
+        speed: seg.speed_t.iter().map(|&t| interp(&sim.t, &sim.speed, t)).collect(),
+    })
+}
+
+impl<'a> Setup<'a> {
+    /// A setup for model `M` with the effect parameters of `candidates`
+    /// active (their fixed values written into `base`).
+    pub fn new<M: MultibodyModel>(
+        base: &[f64],
+        segments: &'a [Segment],
+        weights: Weights,
+        candidates: &[&Candidate],
+    ) -> Result<Self, IdentifyError> {
+        let index = |s: &str| {
+            M::PARAMETERS
+                .iter()
+                .position(|p| *p == s)
+                .ok_or_else(|| IdentifyError::UnknownParameter {
+                    model: M::NAME,
+                    symbol: s.to_string(),
+                })
+        };
+        let mut base = base.to_vec();
+        let mut slots = Vec::new();
+        let mut parameters = Vec::new();
+        for c in candidates {
+            for (s, v) in &c.fixed {
+                base[index(s)?] = *v;
+            }
+            for p in &c.parameters {
+                let mut idx = vec![index(&p.symbol)?];
+                for t in &p.tied {
+                    idx.push(index(t)?);
+                }
+                slots.push(idx);
+                parameters.push(p.clone());
+            }
+        }
+        Ok(Setup {
+            base,
+            segments,
+            weights,
+            options: SimOptions {
+                rtol: 1e-9,
+                atol: 1e-11,
+                output_interval: 0.01,
+                // The measured response decides; a fall in the simulation
+                // only stops it (its last value is held).
+                events: Events {
+                    roll_limit: Some(1.2),
+                    steer_limit: Some(1.45),
+                },
+            },
+            slots,
+            parameters,
+            simulate: simulate_segment::<M>,
+        })
+    }
+
+    /// Number of shared (effect) parameters.
+    pub fn k(&self) -> usize {
+        self.slots.len()
+    }
+
+    /// Parameter vector of `M` for effect values `g`.
+    pub fn param(&self, g: &[f64]) -> Vec<f64> {
+        let mut p = self.base.clone();
+        for (slot, &v) in self.slots.iter().zip(g) {
+            for &i in slot {
+                p[i] = v;
+            }
+        }
+        p
+    }
+
+    /// Weighted residuals of one segment (roll, steer, speed blocks).
+    pub fn residuals(&self, g: &[f64], seg: &Segment, x0: &[f64; NUISANCE]) -> Result<Vec<f64>, String> {
+        let s = (self.simulate)(&self.param(g), seg, x0, &self.options)?;
+        let w = self.weights;
+        let mut r = Vec::with_capacity(seg.len());
+        r.extend(seg.roll.iter().zip(&s.roll).map(|(m, p)| (m - p) / w.roll));
+        r.extend(seg.steer.iter().zip(&s.steer).map(|(m, p)| (m - p) / w.steer));
+        r.extend(seg.speed.iter().zip(&s.speed).map(|(m, p)| (m - p) / w.speed));
+        if r.iter().any(|x| !x.is_finite()) {
+            return Err("non-finite residual".into());
+        }
+        Ok(r)
+    }
+
+    /// Simulated channels of one segment (for plots).
+    pub fn simulated(&self, g: &[f64], seg: &Segment, x0: &[f64; NUISANCE]) -> Result<Sim, String> {
+        (self.simulate)(&self.param(g), seg, x0, &self.options)
+    }
+}
+
+/// Which parameters a fit frees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Free {
+    /// Effect parameters and every segment's initial state.
+    All,
+    /// Effect parameters only (initial states held).
+    Shared,
+    /// Initial states only (effect parameters held).
+    Nuisance,
+}
+
+struct Problem<'s, 'a> {
+    setup: &'s Setup<'a>,
+    /// Segments taking part.
+    segs: Vec<usize>,
+    free: Free,
+    g: Vec<f64>,
+    x0: Vec<[f64; NUISANCE]>,
+    /// Last residuals per segment, for the Jacobian at the same point.
+    cache: Mutex<Option<(Vec<f64>, Vec<Vec<f64>>)>>,
+}
+
+impl Problem<'_, '_> {
+    fn n_free(&self) -> usize {
+        match self.free {
+            Free::All => self.setup.k() + NUISANCE * self.segs.len(),
+            Free::Shared => self.setup.k(),
+            Free::Nuisance => NUISANCE * self.segs.len(),
+        }
+    }
+    fn pack(&self) -> Vec<f64> {
+        let mut x = Vec::with_capacity(self.n_free());
+        if self.free != Free::Nuisance {
+            x.extend(&self.g);
+        }
+        if self.free != Free::Shared {
+            for &s in &self.segs {
+                x.extend(&self.x0[s]);
+            }
+        }
+        x
+    }
+    fn unpack(&mut self, x: &[f64]) {
+        let mut i = 0;
+        if self.free != Free::Nuisance {
+            let k = self.setup.k();
+            self.g.copy_from_slice(&x[..k]);
+            i = k;
+        }
+        if self.free != Free::Shared {
+            for &s in &self.segs {
+                self.x0[s].copy_from_slice(&x[i..i + NUISANCE]);
+                i += NUISANCE;
+            }
+        }
+    }
+    fn all_residuals(&self) -> Option<Vec<Vec<f64>>> {
+        let x = self.pack();
+        if let Some((cx, r)) = self.cache.lock().ok()?.as_ref() {
+            if *cx == x {
+                return Some(r.clone());
+            }
+        }
+        let r: Option<Vec<Vec<f64>>> = self
+            .segs
+            .par_iter()
+            .map(|&s| self.setup.residuals(&self.g, &self.setup.segments[s], &self.x0[s]).ok())
+            .collect();
+        let r = r?;
+        *self.cache.lock().ok()? = Some((x, r.clone()));
+        Some(r)
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.unpack(x.as_slice());
+    }
+    fn params(&self) -> DVector<f64> {
+        DVector::from_vec(self.pack())
+    }
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let r = self.all_residuals()?;
+        Some(DVector::from_iterator(r.iter().map(Vec::len).sum(), r.into_iter().flatten()))
+    }
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let base = self.all_residuals()?;
+        let rows: Vec<usize> = base.iter().map(Vec::len).collect();
+        let offsets: Vec<usize> = rows
+            .iter()
+            .scan(0, |o, &n| {
+                let r = *o;
+                *o += n;
+                Some(r)
+            })
+            .collect();
+        let k = self.setup.k();
+        // Columns: (segment position, free-parameter column, which parameter).
+        let mut tasks = Vec::new();
+        for (p, _) in self.segs.iter().enumerate() {
+            if self.free != Free::Nuisance {
+                for j in 0..k {
+                    tasks.push((p, j, None));
+                }
+            }
+            if self.free != Free::Shared {
+                let c0 = if self.free == Free::All { k } else { 0 };
+                for j in 0..NUISANCE {
+                    tasks.push((p, c0 + NUISANCE * p + j, Some(j)));
+                }
+            }
+        }
+        let cols: Option<Vec<(usize, usize, Vec<f64>)>> = tasks
+            .par_iter()
+            .map(|&(p, col, nj)| {
+                let s = self.segs[p];
+                let mut g = self.g.clone();
+                let mut x0 = self.x0[s];
+                let h = match nj {
+                    None => {
+                        let h = 1e-4 * self.setup.parameters[col].scale.max(g[col].abs());
+                        g[col] += h;
+                        h
+                    }
+                    Some(j) => {
+                        let h = 1e-4 * NUISANCE_SCALE[j].max(x0[j].abs());
+                        x0[j] += h;
+                        h
+                    }
+                };
+                let r = self.setup.residuals(&g, &self.setup.segments[s], &x0).ok()?;
+                Some((p, col, r.iter().zip(&base[p]).map(|(a, b)| (a - b) / h).collect()))
+            })
+            .collect();
+        let mut jac = DMatrix::zeros(rows.iter().sum(), self.n_free());
+        for (p, col, d) in cols? {
+            for (i, v) in d.into_iter().enumerate() {
+                jac[(offsets[p] + i, col)] = v;
+            }
+        }
+        Some(jac)
+    }
+}
+
+/// Residual statistics of one segment, unweighted.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct SegmentError {
+    /// RMS roll residual (rad).
+    pub roll_rms: f64,
+    /// RMS steer residual (rad).
+    pub steer_rms: f64,
+    /// RMS speed residual (m/s).
+    pub speed_rms: f64,
+    /// Lag-1 autocorrelation of the roll and steer residuals.
+    pub rho: f64,
+    #[serde(skip)]
+    pub channel_ss: [f64; 3],
+    #[serde(skip)]
+    pub channel_n: [usize; 3],
+}
+
+impl SegmentError {
+    fn of(r: &[f64], seg: &Segment, w: Weights) -> SegmentError {
+        let n = seg.t.len();
+        let (roll, rest) = r.split_at(n);
+        let (steer, speed) = rest.split_at(n);
+        let ss = |x: &[f64], s: f64| x.iter().map(|a| (a * s) * (a * s)).sum::<f64>();
+        let channel_ss = [ss(roll, w.roll), ss(steer, w.steer), ss(speed, w.speed)];
+        let channel_n = [n, n, speed.len()];
+        let rms = |c: usize| (channel_ss[c] / channel_n[c].max(1) as f64).sqrt();
+        let lag1 = |x: &[f64]| {
+            let m = x.iter().sum::<f64>() / x.len().max(1) as f64;
+            let num: f64 = x.windows(2).map(|w| (w[0] - m) * (w[1] - m)).sum();
+            let den: f64 = x.iter().map(|a| (a - m) * (a - m)).sum();
+            if den > 0.0 {
+                (num / den).clamp(0.0, 0.999)
+            } else {
+                0.0
+            }
+        };
+        SegmentError {
+            roll_rms: rms(0),
+            steer_rms: rms(1),
+            speed_rms: rms(2),
+            rho: 0.5 * (lag1(roll) + lag1(steer)),
+            channel_ss,
+            channel_n,
+        }
+    }
+}
+
+/// Result of fitting one candidate model.
+#[derive(Clone, Debug, Serialize)]
+pub struct CandidateFit {
+    /// Effect names in the model (empty: the base model).
+    pub effects: Vec<String>,
+    pub parameters: Vec<EffectParameter>,
+    /// Fitted values and standard errors of the effect parameters.
+    pub values: Vec<f64>,
+    pub stderr: Vec<f64>,
+    /// Fitted initial state of each segment.
+    #[serde(skip)]
+    pub nuisance: Vec<[f64; NUISANCE]>,
+    /// Errors per segment at the fit.
+    pub errors: Vec<SegmentError>,
+    /// Errors per segment held out (cross-validation).
+    pub held_out: Vec<SegmentError>,
+    /// Effect values fitted without each fold (fold of each segment).
+    #[serde(skip)]
+    pub fold_values: Vec<Vec<f64>>,
+    /// Bayesian information criterion with effective sample sizes.
+    pub bic: f64,
+    /// Cross-validated weighted error (mean squared weighted residual).
+    pub cv: f64,
+    /// Weighted sum of squares at the fit.
+    pub chi2: f64,
+    /// Simulations run for this candidate.
+    pub simulations: usize,
+    /// Whether every dissipative parameter is positive.
+    pub physical: bool,
+}
+
+/// Options of identification.
+#[derive(Clone, Debug)]
+pub struct IdentifyOptions {
+    /// Folds of the cross-validation (by segment; at most one per segment).
+    pub folds: usize,
+    /// Largest number of effects added.
+    pub max_effects: usize,
+    /// LM evaluation budget (patience) per fit.
+    pub patience: usize,
+}
+
+impl Default for IdentifyOptions {
+    fn default() -> Self {
+        IdentifyOptions {
+            folds: 4,
+            max_effects: 3,
+            patience: 30,
+        }
+    }
+}
+
+fn lm_fit<'s, 'a>(p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
+    let (p, _report) = LevenbergMarquardt::new().with_patience(patience).minimize(p);
+    p
+}
+
+/// Fit a model with the setup's effect parameters free, starting from `g0`
+/// and the initial states `x0`, then cross-validate it. `fold_of[s]` is the
+/// fold of segment `s`.
+pub fn fit_candidate(
+    setup: &Setup<'_>,
+    effects: Vec<String>,
+    g0: &[f64],
+    x0: &[[f64; NUISANCE]],
+    fold_of: &[usize],
+    opts: &IdentifyOptions,
+) -> Result<CandidateFit, IdentifyError> {
+    let nseg = setup.segments.len();
+    if nseg == 0 {
+        return Err(IdentifyError::NoData);
+    }
+    let sims = std::sync::atomic::AtomicUsize::new(0);
+    let all: Vec<usize> = (0..nseg).collect();
+    let problem = |segs: Vec<usize>, free: Free, g: Vec<f64>, x0: Vec<[f64; NUISANCE]>| Problem {
+        setup,
+        segs,
+        free,
+        g,
+        x0,
+        cache: Mutex::new(None),
+    };
+    // A fit where every segment's initial state moves: effect parameters
+    // and states together (the base model: states alone).
+    let free = if setup.k() == 0 { Free::Nuisance } else { Free::All };
+    let full = lm_fit(problem(all.clone(), free, g0.to_vec(), x0.to_vec()), opts.patience);
+    let count = |p: &Problem<'_, '_>| {
+        // Each LM evaluation is one residual pass; a Jacobian is one
+        // simulation per free column per segment (approximate count).
+        sims.fetch_add(p.segs.len() * (1 + p.n_free().min(setup.k() + NUISANCE)), std::sync::atomic::Ordering::Relaxed);
+    };
+    count(&full);
+    let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
+        run: setup.segments[0].run.clone(),
+        message: "the fitted model does not simulate every segment".into(),
+    })?;
+    let errors: Vec<SegmentError> = res
+        .iter()
+        .zip(setup.segments)
+        .map(|(r, s)| SegmentError::of(r, s, setup.weights))
+        .collect();
+    let chi2: f64 = res.iter().flatten().map(|x| x * x).sum();
+    let g = full.g.clone();
+    let nuisance = full.x0.clone();
+
+    // Standard errors of the effect parameters from the Jacobian at the fit.
+    let mut stderr = vec![f64::NAN; setup.k()];
+    if setup.k() > 0 {
+        if let Some(j) = full.jacobian() {
+            let n = j.nrows() as f64;
+            let p = j.ncols() as f64;
+            let rho = errors.iter().map(|e| e.rho).sum::<f64>() / errors.len() as f64;
+            let s2 = chi2 / (n - p).max(1.0) * (1.0 + rho) / (1.0 - rho);
+            if let Some(inv) = (j.transpose() * &j).try_inverse() {
+                for (i, s) in stderr.iter_mut().enumerate() {
+                    *s = (inv[(i, i)] * s2).sqrt();
+                }
+            }
+        }
+    }
+    let physical = setup.parameters.iter().zip(&g).all(|(p, v)| !p.dissipative || *v > 0.0);
+
+    // Cross-validation: for each fold, the effect parameters from the other
+    // segments (their initial states held at the full fit), then only the
+    // held-out segments' initial states fitted with those effect values.
+    let nfold = fold_of.iter().copied().max().map_or(0, |m| m + 1);
+    let mut held_out = vec![SegmentError::default(); nseg];
+    let mut held_res: Vec<Vec<f64>> = vec![Vec::new(); nseg];
+    let mut fold_values = vec![g.clone(); nfold];
+    for (f, fold_g) in fold_values.iter_mut().enumerate() {
+        let test: Vec<usize> = all.iter().copied().filter(|&s| fold_of[s] == f).collect();
+        let train: Vec<usize> = all.iter().copied().filter(|&s| fold_of[s] != f).collect();
+        if test.is_empty() {
+            continue;
+        }
+        let gf = if setup.k() > 0 && !train.is_empty() {
+            let p = lm_fit(problem(train, Free::Shared, g.clone(), nuisance.clone()), opts.patience);
+            count(&p);
+            p.g.clone()
+        } else {
+            g.clone()
+        };
+        let p = lm_fit(problem(test.clone(), Free::Nuisance, gf.clone(), nuisance.clone()), opts.patience);
+        count(&p);
+        if let Some(r) = p.all_residuals() {
+            for (i, &s) in test.iter().enumerate() {
+                held_out[s] = SegmentError::of(&r[i], &setup.segments[s], setup.weights);
+                held_res[s] = r[i].clone();
+            }
+        }
+        *fold_g = gf;
+    }
+    let n_cv: usize = held_res.iter().map(Vec::len).sum();
+    let cv = held_res.iter().flatten().map(|x| x * x).sum::<f64>() / n_cv.max(1) as f64;
+    Ok(CandidateFit {
+        effects,
+        parameters: setup.parameters.clone(),
+        values: g,
+        stderr,
+        nuisance,
+        errors,
+        held_out,
+        fold_values,
+        bic: f64::NAN,
+        cv,
+        chi2,
+        simulations: sims.into_inner(),
+        physical,
+    })
+}
+
+/// Bayesian information criterion of `fit` with the effective sample size
+/// of each channel taken from `reference` (the model being extended): the
+/// profile likelihood of Gaussian residuals with one unknown variance per
+/// channel, `sum_c n_eff,c ln(SS_c / n_c) + k ln(n_eff)`.
+pub fn bic(fit: &CandidateFit, reference: &CandidateFit) -> f64 {
+    let mut total = 0.0;
+    let mut n_eff_all = 0.0;
+    for c in 0..3 {
+        let (mut ss, mut n, mut n_eff) = (0.0, 0usize, 0.0);
+        for (e, r) in fit.errors.iter().zip(&reference.errors) {
+            ss += e.channel_ss[c];
+            n += e.channel_n[c];
+            // Speed samples are sparse (one per magnet): about independent.
+            let rho = if c == 2 { 0.0 } else { r.rho };
+            n_eff += e.channel_n[c] as f64 * (1.0 - rho) / (1.0 + rho);
+        }
+        if n > 0 && ss > 0.0 {
+            total += n_eff * (ss / n as f64).ln();
+            n_eff_all += n_eff;
+        }
+    }
+    total + fit.values.len() as f64 * n_eff_all.max(1.0).ln()
+}
+
+/// One step of the stepwise selection: every candidate tried on top of the
+/// current model.
+#[derive(Clone, Debug, Serialize)]
+pub struct Step {
+    /// Effects of the model this step extends.
+    pub base: Vec<String>,
+    pub base_bic: f64,
+    pub base_cv: f64,
+    /// Candidates tried, with their fits.
+    pub tried: Vec<(String, CandidateFit)>,
+    /// The candidate added (if any) and why the others were not.
+    pub added: Option<String>,
+    pub verdicts: Vec<(String, String)>,
+}
+
+/// Outcome of identification.
+#[derive(Clone, Debug, Serialize)]
+pub struct Identification {
+    pub weights: Weights,
+    /// The base model's fit (no effect added).
+    pub before: CandidateFit,
+    /// The selected model's fit (equal to `before` when nothing is warranted).
+    pub after: CandidateFit,
+    /// Selected candidates in order.
+    pub selected: Vec<String>,
+    pub steps: Vec<Step>,
+    /// Folds of the cross-validation.
+    pub folds: usize,
+    /// Simulations run in all.
+    pub simulations: usize,
+}
+
+/// Identify which of `candidates` the data warrant, for the free-speed
+/// model `M` with base parameters `base` (no effect). `progress` is called
+/// after each candidate fit.
+pub fn identify<M: MultibodyModel>(
+    base: &[f64],
+    segments: &[Segment],
+    candidates: &[Candidate],
+    opts: &IdentifyOptions,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<Identification, IdentifyError> {
+    if segments.is_empty() {
+        return Err(IdentifyError::NoData);
+    }
+    let folds = opts.folds.clamp(2, segments.len().max(2));
+    let fold_of: Vec<usize> = (0..segments.len()).map(|s| s % folds).collect();
+    let x0: Vec<[f64; NUISANCE]> = segments.iter().map(|s| s.initial).collect();
+    // Channel scales: first the sensor-level guess, then the base model's
+    // own residual level per channel, so that each channel weighs by how
+    // well the base model can describe it (roll and steer in rad, speed in
+    // m/s are otherwise incommensurable).
+    let mut weights = Weights {
+        roll: 0.005,
+        steer: 0.01,
+        speed: 0.05,
+    };
+    let setup0 = Setup::new::<M>(base, segments, weights, &[])?;
+    let first = fit_candidate(&setup0, vec![], &[], &x0, &fold_of, opts)?;
+    let pooled = |c: usize| {
+        let (ss, n) = first
+            .errors
+            .iter()
+            .fold((0.0, 0usize), |(a, b), e| (a + e.channel_ss[c], b + e.channel_n[c]));
+        (ss / n.max(1) as f64).sqrt()
+    };
+    weights = Weights {
+        roll: pooled(0).max(1e-4),
+        steer: pooled(1).max(1e-4),
+        speed: pooled(2).max(1e-3),
+    };
+    let setup0 = Setup::new::<M>(base, segments, weights, &[])?;
+    let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts)?;
+    before.bic = bic(&before, &before);
+    progress("base model");
+    let mut simulations = first.simulations + before.simulations;
+
+    let mut current = before.clone();
+    let mut selected: Vec<&Candidate> = Vec::new();
+    let mut steps = Vec::new();
+    while selected.len() < opts.max_effects {
+        let remaining: Vec<&Candidate> = candidates
+            .iter()
+            .filter(|c| !selected.iter().any(|s| s.name == c.name))
+            .collect();
+        if remaining.is_empty() {
+            break;
+        }
+        let mut tried = Vec::new();
+        for c in &remaining {
+            let mut active = selected.clone();
+            active.push(c);
+            let setup = Setup::new::<M>(base, segments, weights, &active)?;
+            let mut g0 = current.values.clone();
+            g0.extend(c.parameters.iter().map(|p| 0.1 * p.scale));
+            let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
+            match fit_candidate(&setup, effects, &g0, &current.nuisance, &fold_of, opts) {
+                Ok(mut f) => {
+                    f.bic = bic(&f, &current);
+                    simulations += f.simulations;
+                    tried.push((c.name.clone(), f));
+                }
+                Err(e) => progress(&format!("{}: {e}", c.name)),
+            }
+            progress(&c.name);
+        }
+        let base_bic = bic(&current, &current);
+        let mut verdicts = Vec::new();
+        let mut best: Option<usize> = None;
+        for (i, (name, f)) in tried.iter().enumerate() {
+            let verdict = if !f.physical {
+                "rejected: a dissipative parameter fitted negative (not physics)".to_string()
+            } else if !(f.bic < base_bic) {
+                format!("rejected: BIC {:+.1} (no gain beyond its added parameters)", f.bic - base_bic)
+            } else if !(f.cv < current.cv) {
+                format!(
+                    "rejected: held-out error {:.4} not below {:.4} (does not generalise)",
+                    f.cv, current.cv
+                )
+            } else {
+                if best.is_none_or(|b| f.bic < tried[b].1.bic) {
+                    best = Some(i);
+                }
+                format!("warranted: BIC {:+.1}, held-out error {:.4} (was {:.4})", f.bic - base_bic, f.cv, current.cv)
+            };
+            verdicts.push((name.clone(), verdict));
+        }
+        let added = best.map(|b| tried[b].0.clone());
+        let step = Step {
+            base: current.effects.clone(),
+            base_bic,
+            base_cv: current.cv,
+            tried: tried.clone(),
+            added: added.clone(),
+            verdicts,
+        };
+        steps.push(step);
+        match best {
+            Some(b) => {
+                let name = &tried[b].0;
+                selected.push(candidates.iter().find(|c| &c.name == name).expect("tried candidate"));
+                current = tried[b].1.clone();
+            }
+            None => break,
+        }
+    }
+    Ok(Identification {
+        weights,
+        before,
+        after: current,
+        selected: selected.iter().map(|c| c.name.clone()).collect(),
+        steps,
+        folds,
+        simulations,
+    })
+}
+
+/// Overall RMS of a channel over segments (rad or m/s).
+pub fn pooled_rms(errors: &[SegmentError], channel: usize) -> f64 {
+    let (ss, n) = errors
+        .iter()
+        .fold((0.0, 0usize), |(a, b), e| (a + e.channel_ss[channel], b + e.channel_n[channel]));
+    (ss / n.max(1) as f64).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolation_holds_the_last_value_after_a_stop() {
+        let ts = [0.0, 1.0, 2.0];
+        let xs = [0.0, 2.0, 4.0];
+        assert_eq!(interp(&ts, &xs, 0.5), 1.0);
+        assert_eq!(interp(&ts, &xs, 5.0), 4.0);
+        assert_eq!(interp(&ts, &xs, -1.0), 0.0);
+    }
+
+    #[test]
+    fn segment_initial_state_from_a_line_through_the_first_samples() {
+        let t: Vec<f64> = (0..120).map(|k| k as f64 / 120.0).collect();
+        let roll: Vec<f64> = t.iter().map(|&x| 0.02 + 0.3 * x).collect();
+        let steer: Vec<f64> = t.iter().map(|&x| -0.01 - 0.5 * x).collect();
+        let s = Segment::new("r".into(), 0.0, t.clone(), roll, steer, vec![0.0, 0.5], vec![5.0, 4.9], None).unwrap();
+        assert!((s.initial[0] - 0.02).abs() < 1e-12 && (s.initial[2] - 0.3).abs() < 1e-9);
+        assert!((s.initial[1] + 0.01).abs() < 1e-12 && (s.initial[3] + 0.5).abs() < 1e-9);
+        assert_eq!(s.initial[4], 5.0);
+        assert_eq!(s.speed_interval, [4.9, 5.0]);
+    }
+
+    #[test]
+    fn residual_statistics_unweight_and_count_channels() {
+        let t: Vec<f64> = (0..20).map(|k| k as f64 * 0.01).collect();
+        let z = vec![0.0; 20];
+        let s = Segment::new("r".into(), 0.0, t, z.clone(), z, vec![0.0], vec![5.0], None).unwrap();
+        let w = Weights {
+            roll: 0.1,
+            steer: 0.2,
+            speed: 0.5,
+        };
+        let mut r = vec![1.0; 20];
+        r.extend(vec![2.0; 20]);
+        r.push(4.0);
+        let e = SegmentError::of(&r, &s, w);
+        assert!((e.roll_rms - 0.1).abs() < 1e-12);
+        assert!((e.steer_rms - 0.4).abs() < 1e-12);
+        assert!((e.speed_rms - 2.0).abs() < 1e-12);
+        assert_eq!(e.channel_n, [20, 20, 1]);
+    }
+}

@@ -1,0 +1,187 @@
+//! Plots of an identification report (SVG): the weave eigenvalue over speed
+//! before and after adding the selected effect, with each measured
+//! eigenvalue on its speed segment; and the residual time series of one run
+//! before and after.
+
+use crate::output::write_string_atomic;
+use crate::plot::{find_font, use_font, PlotError};
+use plotters::prelude::*;
+use std::path::Path;
+
+const BEFORE: RGBColor = RGBColor(0, 114, 178);
+const AFTER: RGBColor = RGBColor(213, 94, 0);
+const MEASURED: RGBColor = RGBColor(60, 60, 60);
+
+fn drawing(path: &Path, e: impl std::fmt::Display) -> PlotError {
+    PlotError::Drawing {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = x
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let pad = ((hi - lo) * 0.08).max(1e-6);
+    (lo - pad, hi + pad)
+}
+
+/// A measured weave eigenvalue on its speed segment (m/s; 1/s).
+pub struct MeasuredWeave {
+    pub speed_interval: [f64; 2],
+    pub mean_speed: f64,
+    pub eigenvalue: [f64; 2],
+    pub stderr: [f64; 2],
+}
+
+/// Weave eigenvalue curves `(speed, re, im)` of the model before and after,
+/// and the measured eigenvalues.
+pub fn plot_continuation(
+    path: &Path,
+    before: &[(f64, f64, f64)],
+    after: &[(f64, f64, f64)],
+    after_label: &str,
+    measured: &[MeasuredWeave],
+) -> Result<(), PlotError> {
+    use_font(find_font()?)?;
+    let vmax = before.iter().chain(after).map(|p| p.0).fold(1.0, f64::max);
+    let (y0, y1) = range(
+        before
+            .iter()
+            .chain(after)
+            .flat_map(|p| [p.1, p.2])
+            .chain(measured.iter().flat_map(|m| m.eigenvalue)),
+    );
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 620)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| drawing(path, e))?;
+        let mut ch = ChartBuilder::on(&root)
+            .caption("weave eigenvalue before and after identification", ("sans-serif", 18))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(60)
+            .build_cartesian_2d(0.0..vmax, y0.max(-15.0)..y1.min(15.0))
+            .map_err(|e| drawing(path, e))?;
+        ch.configure_mesh()
+            .x_desc("forward speed (m/s)")
+            .y_desc("weave eigenvalue, real and imaginary parts (1/s)")
+            .draw()
+            .map_err(|e| drawing(path, e))?;
+        for (curve, col, label, dashed) in [
+            (before, BEFORE, "model before".to_string(), true),
+            (after, AFTER, format!("model after ({after_label})"), false),
+        ] {
+            for part in 0..2 {
+                let pts: Vec<(f64, f64)> = curve.iter().map(|p| (p.0, if part == 0 { p.1 } else { p.2 })).collect();
+                let style = col.stroke_width(if dashed { 1 } else { 2 });
+                let s = ch
+                    .draw_series(LineSeries::new(pts, style))
+                    .map_err(|e| drawing(path, e))?;
+                if part == 0 {
+                    let l = format!("{label}: real (lower) and imaginary (upper) parts");
+                    s.label(l)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
+                }
+            }
+        }
+        for (i, m) in measured.iter().enumerate() {
+            for part in 0..2 {
+                let (val, se) = (m.eigenvalue[part], m.stderr[part]);
+                let [lo, hi] = m.speed_interval;
+                let s = ch
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![(lo, val), (hi, val)],
+                        MEASURED.stroke_width(3),
+                    )))
+                    .map_err(|e| drawing(path, e))?;
+                if i == 0 && part == 0 {
+                    s.label("measured (over its speed interval, bar: one standard error)")
+                        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], MEASURED.stroke_width(3)));
+                }
+                ch.draw_series(std::iter::once(PathElement::new(
+                    vec![(m.mean_speed, val - se), (m.mean_speed, val + se)],
+                    BLACK.stroke_width(1),
+                )))
+                .map_err(|e| drawing(path, e))?;
+            }
+        }
+        ch.configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .draw()
+            .map_err(|e| drawing(path, e))?;
+        root.present().map_err(|e| drawing(path, e))?;
+    }
+    write_string_atomic(path, &svg)?;
+    Ok(())
+}
+
+/// One channel of a run: measured and simulated before and after.
+pub struct Channel<'a> {
+    pub name: &'a str,
+    pub unit: &'a str,
+    pub t: &'a [f64],
+    pub measured: &'a [f64],
+    pub before: &'a [f64],
+    pub after: &'a [f64],
+}
+
+/// Measured and simulated roll, steer and speed of one run, before and after.
+pub fn plot_run(path: &Path, title: &str, channels: &[Channel<'_>]) -> Result<(), PlotError> {
+    use_font(find_font()?)?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (900, 260 * channels.len() as u32 + 40)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| drawing(path, e))?;
+        let root = root
+            .titled(title, ("sans-serif", 18))
+            .map_err(|e| drawing(path, e))?;
+        let areas = root.split_evenly((channels.len(), 1));
+        for (area, c) in areas.iter().zip(channels) {
+            if c.t.is_empty() {
+                continue;
+            }
+            let x1 = c.t.last().copied().unwrap_or(1.0).max(1e-3);
+            let (y0, y1) = range(c.measured.iter().chain(c.before).chain(c.after).copied());
+            let mut ch = ChartBuilder::on(area)
+                .margin(8)
+                .x_label_area_size(35)
+                .y_label_area_size(60)
+                .build_cartesian_2d(0.0..x1, y0..y1)
+                .map_err(|e| drawing(path, e))?;
+            ch.configure_mesh()
+                .x_desc("time after the window start (s)")
+                .y_desc(format!("{} ({})", c.name, c.unit))
+                .draw()
+                .map_err(|e| drawing(path, e))?;
+            let series = [
+                (c.measured, MEASURED, "measured", 1),
+                (c.before, BEFORE, "model before", 2),
+                (c.after, AFTER, "model after", 2),
+            ];
+            for (y, col, label, w) in series {
+                let pts: Vec<(f64, f64)> = c.t.iter().copied().zip(y.iter().copied()).collect();
+                ch.draw_series(LineSeries::new(pts, col.stroke_width(w)))
+                    .map_err(|e| drawing(path, e))?
+                    .label(label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(w)));
+            }
+            ch.configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 12))
+                .draw()
+                .map_err(|e| drawing(path, e))?;
+        }
+        root.present().map_err(|e| drawing(path, e))?;
+    }
+    write_string_atomic(path, &svg)?;
+    Ok(())
+}
