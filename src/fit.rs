@@ -58,7 +58,12 @@ pub struct FitOutcome {
 /// Run the pipeline on the inputs.
 pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
     let bike = args.bike.as_deref().map(Bicycle::resolve).transpose()?;
-    let canonical = bike.as_ref().map(|b| b.canonical()).transpose()?;
+    // A bicycle with effect parameters has no canonical form (identify
+    // passes such bicycles for the frame pitch): no prediction then.
+    let canonical = match bike.as_ref().map(|b| b.canonical()) {
+        Some(Err(crate::bicycle::BicycleError::NotCanonical { .. })) | None => None,
+        Some(r) => Some(r?),
+    };
     let pitch_bike = match &bike {
         Some(b) => b.clone(),
         None => Bicycle::resolve("thesis")?,

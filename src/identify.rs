@@ -292,11 +292,40 @@ fn effect_values(fit: &bikedyn_runtime::identify::CandidateFit, values: &[f64], 
     m
 }
 
-/// Simulated channels of the typical run before and after, for the plot.
+/// Mean absolute rate of a sampled angle (rad/s).
+fn mean_abs_rate(t: &[f64], x: &[f64]) -> f64 {
+    let d: Vec<f64> = t
+        .windows(2)
+        .zip(x.windows(2))
+        .filter(|(a, _)| a[1] > a[0])
+        .map(|(a, b)| ((b[1] - b[0]) / (a[1] - a[0])).abs())
+        .collect();
+    d.iter().sum::<f64>() / d.len().max(1) as f64
+}
+
+/// Effect values for a linear (eigenvalue) prediction. Coulomb steer
+/// friction has no useful linearization about upright (the smoothed law
+/// linearizes to a stiff damper `T / w`), so it is replaced by its
+/// describing-function equivalent viscous damping at the response's steer
+/// rate: for a sinusoid of amplitude `A`, `c_eq = 4 T / (pi A)`, with
+/// `A = (pi / 2) mean|rate|`.
+fn linear_equivalent(values: &BTreeMap<String, f64>, mean_abs_steer_rate: f64) -> BTreeMap<String, f64> {
+    let mut v = values.clone();
+    if let Some(t) = v.get("T_steer").copied().filter(|t| *t != 0.0) {
+        let amp = std::f64::consts::FRAC_PI_2 * mean_abs_steer_rate;
+        let c_eq = if amp > 0.0 { 4.0 * t / (std::f64::consts::PI * amp) } else { 0.0 };
+        *v.entry("c_steer".into()).or_insert(0.0) += c_eq;
+        v.insert("T_steer".into(), 0.0);
+    }
+    v
+}
+
+/// Simulated channels of every segment before and after (plots, bias,
+/// amplitude of the steer rate), and the typical segment.
 struct RunPlot {
     segment: usize,
-    before: bikedyn_runtime::identify::Sim,
-    after: bikedyn_runtime::identify::Sim,
+    before: Vec<Option<bikedyn_runtime::identify::Sim>>,
+    after: Vec<Option<bikedyn_runtime::identify::Sim>>,
 }
 
 struct Identify<'a> {
@@ -316,21 +345,21 @@ impl ModelVisitor for Identify<'_> {
         // The typical run: median roll error before.
         let mut order: Vec<usize> = (0..self.segments.len()).collect();
         order.sort_by(|&a, &b| id.before.errors[a].roll_rms.total_cmp(&id.before.errors[b].roll_rms));
-        let plot = order.get(order.len() / 2).and_then(|&s| {
-            let sel: Vec<&Candidate> = id
-                .selected
-                .iter()
-                .filter_map(|n| self.candidates.iter().find(|c| &c.name == n))
-                .collect();
-            let before = Setup::new::<M>(&base, self.segments, id.weights, &[]).ok()?;
-            let after = Setup::new::<M>(&base, self.segments, id.weights, &sel).ok()?;
-            Some(RunPlot {
-                segment: s,
-                before: before.simulated(&[], &self.segments[s], &id.before.nuisance[s]).ok()?,
-                after: after
-                    .simulated(&id.after.values, &self.segments[s], &id.after.nuisance[s])
-                    .ok()?,
-            })
+        let sel: Vec<&Candidate> = id
+            .selected
+            .iter()
+            .filter_map(|n| self.candidates.iter().find(|c| &c.name == n))
+            .collect();
+        let before = Setup::new::<M>(&base, self.segments, id.weights, &[])?;
+        let after = Setup::new::<M>(&base, self.segments, id.weights, &sel)?;
+        let plot = order.get(order.len() / 2).map(|&s| RunPlot {
+            segment: s,
+            before: (0..self.segments.len())
+                .map(|i| before.simulated(&[], &self.segments[i], &id.before.nuisance[i]).ok())
+                .collect(),
+            after: (0..self.segments.len())
+                .map(|i| after.simulated(&id.after.values, &self.segments[i], &id.after.nuisance[i]).ok())
+                .collect(),
         });
         Ok((id, plot))
     }
@@ -460,6 +489,8 @@ pub struct Outcome {
     pub model: &'static str,
     pub driven_model: &'static str,
     pub seconds: f64,
+    /// Mean |steer rate| of each segment in the fitted simulation (rad/s).
+    pub steer_rate: Vec<f64>,
     run_plot: Option<RunPlot>,
 }
 
@@ -531,23 +562,46 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
     let speeds: Vec<f64> = segs.iter().map(|s| s.mean_speed).collect();
     let predicted_before = predict(driven, &bike, &BTreeMap::new(), &speeds)?;
     let values_after = effect_values(&id.after, &id.after.values, &cands);
-    let predicted_after = predict(driven, &bike, &values_after, &speeds)?;
+    // Steer-rate amplitude of each segment, from the fitted simulation.
+    let steer_rate: Vec<f64> = (0..segs.len())
+        .map(|i| {
+            run_plot
+                .as_ref()
+                .and_then(|rp| rp.after[i].as_ref())
+                .map_or(f64::NAN, |sim| mean_abs_rate(&segs[i].t, &sim.steer))
+        })
+        .collect();
+    let mut predicted_after = Vec::with_capacity(segs.len());
+    for (i, &v) in speeds.iter().enumerate() {
+        let vals = linear_equivalent(&values_after, steer_rate[i]);
+        predicted_after.push(predict(driven, &bike, &vals, &[v])?[0]);
+    }
     // Held out: each segment predicted with the values fitted without its fold.
     let mut predicted_held_out = vec![None; segs.len()];
     for (f, vals) in id.after.fold_values.iter().enumerate() {
         let idx: Vec<usize> = (0..segs.len()).filter(|&s| s % id.folds == f).collect();
         let sp: Vec<f64> = idx.iter().map(|&s| speeds[s]).collect();
-        let p = predict(driven, &bike, &effect_values(&id.after, vals, &cands), &sp)?;
+        let fold_vals = effect_values(&id.after, vals, &cands);
         for (k, &s) in idx.iter().enumerate() {
-            predicted_held_out[s] = p[k];
+            predicted_held_out[s] = predict(driven, &bike, &linear_equivalent(&fold_vals, steer_rate[s]), &sp[k..=k])?[0];
         }
     }
     // Steady bias: the base model's roll residual over the second half of
     // each window.
-    let bias: Vec<f64> = {
-        let setup_free = with_model(free.name, BiasProbe { bike: &bike, segs: &segs, id: &id }).expect("registered model")?;
-        setup_free
-    };
+    let bias: Vec<f64> = run_plot
+        .as_ref()
+        .map(|rp| {
+            segs.iter()
+                .zip(&rp.before)
+                .filter_map(|(s, sim)| {
+                    let sim = sim.as_ref()?;
+                    let h = s.t.len() / 2;
+                    let n = (s.t.len() - h).max(1) as f64;
+                    Some((h..s.t.len()).map(|k| s.roll[k] - sim.roll[k]).sum::<f64>() / n)
+                })
+                .collect()
+        })
+        .unwrap_or_default();
     let findings = diagnose(&segs, &predicted_before, &id.before.errors, &bias);
     Ok(Outcome {
         identification: id,
@@ -562,35 +616,9 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
         model: free.name,
         driven_model: driven.name,
         seconds: start.elapsed().as_secs_f64(),
+        steer_rate,
         run_plot,
     })
-}
-
-/// Mean roll residual of the base model over the second half of each window.
-struct BiasProbe<'a> {
-    bike: &'a Bicycle,
-    segs: &'a [Segment],
-    id: &'a Identification,
-}
-
-impl ModelVisitor for BiasProbe<'_> {
-    type Output = Result<Vec<f64>>;
-    fn visit<M: MultibodyModel>(self) -> Self::Output {
-        let lookup = self.bike.lookup()?;
-        let base = parameter_vector::<M>(&lookup, 5.0)?;
-        let setup = Setup::new::<M>(&base, self.segs, self.id.weights, &[])?;
-        Ok(self
-            .segs
-            .iter()
-            .enumerate()
-            .filter_map(|(i, s)| {
-                let sim = setup.simulated(&[], s, &self.id.before.nuisance[i]).ok()?;
-                let h = s.t.len() / 2;
-                let n = (s.t.len() - h).max(1) as f64;
-                Some((h..s.t.len()).map(|k| s.roll[k] - sim.roll[k]).sum::<f64>() / n)
-            })
-            .collect())
-    }
 }
 
 fn display_name(c: &Candidate) -> String {
@@ -803,7 +831,8 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
                 .zip(f.values.iter().zip(&f.stderr))
                 .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4}", p.symbol, v, se))
                 .collect();
-            let _ = writeln!(s, "| `{name}` | {} | {:+.1} | {:.4} | {} |", vals.join(", "), f.bic - step.base_bic, f.cv, step.verdicts[r].1);
+            let cv = if f.cv.is_finite() { format!("{:.4}", f.cv) } else { "-".into() };
+            let _ = writeln!(s, "| `{name}` | {} | {:+.1} | {cv} | {} |", vals.join(", "), f.bic - step.base_bic, step.verdicts[r].1);
         }
         let _ = writeln!(s);
     }
@@ -849,7 +878,7 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
         let _ = writeln!(s);
     }
     let fitted = dir.join("fitted.toml");
-    let _ = writeln!(s, "## Reproduce\n\nThe identified bicycle is `{}`: the bicycle's parameters plus the fitted effect values, for the model `{}` (driven speed) or `{}` (free speed). To see its predictions against the runs, and to refit from it:\n\n```sh\nbikedyn fit {} --bike {} --model {}\nbikedyn identify {} --bike {}\n```", fitted.display(), o.driven_model, o.model, inputs.join(" "), fitted.display(), o.driven_model, inputs.join(" "), fitted.display());
+    let _ = writeln!(s, "## Reproduce\n\nThe identified bicycle is `{}`: the bicycle's parameters plus the fitted effect values, for the model `{}` (driven speed) or `{}` (free speed). To refit from it, and to simulate it:\n\n```sh\nbikedyn identify {} --bike {}\nbikedyn simulate --bike {} --model {} --speed 5 --kick 0.5:3 --duration 6 --plot kick.svg\n```\n\nThe refit starts from the identified bicycle: the effects found here are part of its model, so the refit should warrant nothing more.", fitted.display(), o.driven_model, o.model, inputs.join(" "), fitted.display(), fitted.display(), o.model);
     s
 }
 
@@ -888,25 +917,31 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
     } else {
         o.identification.selected.join(" + ")
     };
+    let mut rates: Vec<f64> = o.steer_rate.iter().copied().filter(|x| x.is_finite()).collect();
+    rates.sort_by(f64::total_cmp);
+    let median_rate = rates.get(rates.len() / 2).copied().unwrap_or(f64::NAN);
     plot_continuation(
         &dir.join("continuation.svg"),
         &curve(&BTreeMap::new())?,
-        &curve(&o.values_after)?,
+        &curve(&linear_equivalent(&o.values_after, median_rate))?,
         &label,
         &measured,
     )?;
     if let Some(rp) = &o.run_plot {
         let s = &o.segments[rp.segment];
         let deg = |x: &[f64]| x.iter().map(|v| v.to_degrees()).collect::<Vec<f64>>();
-        let (mr, br, ar) = (deg(&s.roll), deg(&rp.before.roll), deg(&rp.after.roll));
-        let (ms, bs, as_) = (deg(&s.steer), deg(&rp.before.steer), deg(&rp.after.steer));
+        let (Some(b), Some(a)) = (&rp.before[rp.segment], &rp.after[rp.segment]) else {
+            bail!("the typical run could not be simulated for the plot");
+        };
+        let (mr, br, ar) = (deg(&s.roll), deg(&b.roll), deg(&a.roll));
+        let (ms, bs, as_) = (deg(&s.steer), deg(&b.steer), deg(&a.steer));
         plot_run(
             &dir.join("run_residuals.svg"),
             &format!("{} (window from {:.2} s): measured and simulated, before and after", s.run, s.t0),
             &[
                 Channel { name: "roll", unit: "deg", t: &s.t, measured: &mr, before: &br, after: &ar },
                 Channel { name: "steer", unit: "deg", t: &s.t, measured: &ms, before: &bs, after: &as_ },
-                Channel { name: "speed", unit: "m/s", t: &s.speed_t, measured: &s.speed, before: &rp.before.speed, after: &rp.after.speed },
+                Channel { name: "speed", unit: "m/s", t: &s.speed_t, measured: &s.speed, before: &b.speed, after: &a.speed },
             ],
         )?;
     }

@@ -614,6 +614,7 @@ pub fn fit_candidate(
     x0: &[[f64; NUISANCE]],
     fold_of: &[usize],
     opts: &IdentifyOptions,
+    reference: Option<&CandidateFit>,
 ) -> Result<CandidateFit, IdentifyError> {
     let nseg = setup.segments.len();
     if nseg == 0 {
@@ -668,7 +669,30 @@ pub fn fit_candidate(
         }
     }
     let physical = setup.parameters.iter().zip(&g).all(|(p, v)| !p.dissipative || *v > 0.0);
-
+    let mut fit = CandidateFit {
+        effects,
+        parameters: setup.parameters.clone(),
+        values: g.clone(),
+        stderr,
+        nuisance: nuisance.clone(),
+        errors,
+        held_out: vec![SegmentError::default(); nseg],
+        fold_values: Vec::new(),
+        bic: f64::NAN,
+        cv: f64::NAN,
+        chi2,
+        simulations: 0,
+        physical,
+    };
+    // Cross-validation is the costly half: a candidate already rejected by
+    // the information criterion or by physics is not cross-validated.
+    if let Some(r) = reference {
+        fit.bic = bic(&fit, r);
+        if !(physical && fit.bic < bic(r, r)) {
+            fit.simulations = sims.into_inner();
+            return Ok(fit);
+        }
+    }
     // Cross-validation: for each fold, the effect parameters from the other
     // segments (their initial states held at the full fit), then only the
     // held-out segments' initial states fitted with those effect values.
@@ -700,22 +724,11 @@ pub fn fit_candidate(
         *fold_g = gf;
     }
     let n_cv: usize = held_res.iter().map(Vec::len).sum();
-    let cv = held_res.iter().flatten().map(|x| x * x).sum::<f64>() / n_cv.max(1) as f64;
-    Ok(CandidateFit {
-        effects,
-        parameters: setup.parameters.clone(),
-        values: g,
-        stderr,
-        nuisance,
-        errors,
-        held_out,
-        fold_values,
-        bic: f64::NAN,
-        cv,
-        chi2,
-        simulations: sims.into_inner(),
-        physical,
-    })
+    fit.cv = held_res.iter().flatten().map(|x| x * x).sum::<f64>() / n_cv.max(1) as f64;
+    fit.held_out = held_out;
+    fit.fold_values = fold_values;
+    fit.simulations = sims.into_inner();
+    Ok(fit)
 }
 
 /// Bayesian information criterion of `fit` with the effective sample size
@@ -800,7 +813,8 @@ pub fn identify<M: MultibodyModel>(
         speed: 0.05,
     };
     let setup0 = Setup::new::<M>(base, segments, weights, &[])?;
-    let first = fit_candidate(&setup0, vec![], &[], &x0, &fold_of, opts)?;
+    // (No folds: this fit only sets the channel scales.)
+    let first = fit_candidate(&setup0, vec![], &[], &x0, &[], opts, None)?;
     let pooled = |c: usize| {
         let (ss, n) = first
             .errors
@@ -814,7 +828,7 @@ pub fn identify<M: MultibodyModel>(
         speed: pooled(2).max(1e-3),
     };
     let setup0 = Setup::new::<M>(base, segments, weights, &[])?;
-    let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts)?;
+    let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts, None)?;
     before.bic = bic(&before, &before);
     progress("base model");
     let mut simulations = first.simulations + before.simulations;
@@ -823,9 +837,17 @@ pub fn identify<M: MultibodyModel>(
     let mut selected: Vec<&Candidate> = Vec::new();
     let mut steps = Vec::new();
     while selected.len() < opts.max_effects {
+        // After the first step, only candidates that improved the criterion
+        // on their own are combined: one that explained nothing alone is not
+        // revived by a partner (and each try costs a full fit).
         let remaining: Vec<&Candidate> = candidates
             .iter()
             .filter(|c| !selected.iter().any(|s| s.name == c.name))
+            .filter(|c| {
+                steps.first().is_none_or(|s: &Step| {
+                    s.tried.iter().any(|(n, f)| n == &c.name && f.bic < s.base_bic)
+                })
+            })
             .collect();
         if remaining.is_empty() {
             break;
@@ -838,9 +860,8 @@ pub fn identify<M: MultibodyModel>(
             let mut g0 = current.values.clone();
             g0.extend(c.parameters.iter().map(|p| 0.1 * p.scale));
             let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
-            match fit_candidate(&setup, effects, &g0, &current.nuisance, &fold_of, opts) {
-                Ok(mut f) => {
-                    f.bic = bic(&f, &current);
+            match fit_candidate(&setup, effects, &g0, &current.nuisance, &fold_of, opts, Some(&current)) {
+                Ok(f) => {
                     simulations += f.simulations;
                     tried.push((c.name.clone(), f));
                 }
@@ -853,13 +874,17 @@ pub fn identify<M: MultibodyModel>(
         let mut best: Option<usize> = None;
         for (i, (name, f)) in tried.iter().enumerate() {
             let verdict = if !f.physical {
-                "rejected: a dissipative parameter fitted negative (not physics)".to_string()
+                "rejected: a dissipative parameter fitted negative (not physics; not cross-validated)".to_string()
             } else if !(f.bic < base_bic) {
-                format!("rejected: BIC {:+.1} (no gain beyond its added parameters)", f.bic - base_bic)
+                format!("rejected: BIC {:+.1} (no gain beyond its added parameters; not cross-validated)", f.bic - base_bic)
             } else if !(f.cv < current.cv) {
                 format!(
                     "rejected: held-out error {:.4} not below {:.4} (does not generalise)",
                     f.cv, current.cv
+                )
+            } else if let Some((d, se)) = paired_gain(&current, f, weights).filter(|(d, se)| !(*d > 2.0 * se)) {
+                format!(
+                    "rejected: held-out gain per run {d:.4} within two standard errors ({se:.4}) of zero (not a consistent improvement)"
                 )
             } else {
                 if best.is_none_or(|b| f.bic < tried[b].1.bic) {
@@ -897,6 +922,26 @@ pub fn identify<M: MultibodyModel>(
         folds,
         simulations,
     })
+}
+
+/// Paired comparison of the held-out errors of two models, run by run:
+/// mean gain (weighted mean square, `base - candidate`) and its standard
+/// error. Selection asks the gain to exceed two standard errors, so an
+/// effect that improves the held-out error only on average over a few runs
+/// (an artefact of one run, noise) is not added.
+pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: Weights) -> Option<(f64, f64)> {
+    let mse = |e: &SegmentError| {
+        let ss = e.channel_ss[0] / (w.roll * w.roll) + e.channel_ss[1] / (w.steer * w.steer) + e.channel_ss[2] / (w.speed * w.speed);
+        ss / (e.channel_n.iter().sum::<usize>().max(1) as f64)
+    };
+    let d: Vec<f64> = base.held_out.iter().zip(&cand.held_out).map(|(a, b)| mse(a) - mse(b)).collect();
+    let n = d.len() as f64;
+    if n < 2.0 {
+        return None;
+    }
+    let m = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
+    Some((m, (var / n).sqrt()))
 }
 
 /// Overall RMS of a channel over segments (rad or m/s).
