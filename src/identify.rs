@@ -9,6 +9,7 @@ use crate::bicycle::Bicycle;
 use crate::fit::{run_fit, FitArgs, FitOutcome};
 use crate::generated::{with_model, MODELS};
 use anyhow::{bail, Context, Result};
+use bikedyn_runtime::experiment::{kicks::WindowEnd, PipelineOptions};
 use bikedyn_runtime::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_runtime::identify::{
     identify, pooled_rms, Candidate, EffectParameter, Identification, IdentifyOptions, Segment, SegmentError, Setup,
@@ -23,6 +24,10 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+
+/// The committed example set: six runs of the thesis bicycle made by
+/// `bikedyn synth` with steer damping hidden (`examples/data/README.md`).
+pub const EXAMPLE_SET: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/data/hidden_steer_damping");
 
 /// Arguments of `bikedyn identify`.
 #[derive(Args, Debug, Clone)]
@@ -188,7 +193,26 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
         };
         let offset = r.clock_offset.map_or(0.0, |c| c.value);
         for k in &r.kicks {
-            let [w0, w1] = k.window;
+            let [w0, mut w1] = k.window;
+            // The eigenvalue fit stops where the oscillation has decayed (or
+            // drifts, or the speed has changed much); the nonlinear model
+            // describes what follows too, and slow effects (speed decay, a
+            // steady lean) show mostly there. So the identification window
+            // goes on to the end of the free motion: the record's end, a
+            // gap, or a fall, at most IDENTIFY_WINDOW after the start.
+            if matches!(k.window_end, WindowEnd::Decayed | WindowEnd::Drift | WindowEnd::SpeedChange) {
+                let fall = PipelineOptions::default().kicks.fall_angle;
+                let dt = (ang.t[ang.t.len() - 1] - ang.t[0]) / (ang.t.len().max(2) - 1) as f64;
+                let i0 = ang.t.partition_point(|&x| x < w0);
+                let mut end = w1;
+                for i in i0..ang.t.len() {
+                    if ang.t[i] > w0 + IDENTIFY_WINDOW || ang.roll[i].abs() > fall || (i > i0 && ang.t[i] - ang.t[i - 1] > 3.0 * dt) {
+                        break;
+                    }
+                    end = ang.t[i];
+                }
+                w1 = end.max(w1);
+            }
             let idx: Vec<usize> = (0..ang.t.len()).filter(|&i| ang.t[i] >= w0 && ang.t[i] <= w1).collect();
             let speed_idx: Vec<usize> = (0..sp.t.len())
                 .filter(|&i| sp.t[i] + offset >= w0 && sp.t[i] + offset <= w1 && sp.v[i].is_finite())
@@ -221,6 +245,11 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
     }
     (segs, skipped)
 }
+
+/// Longest identification window after a kick (s): a few weave periods and
+/// long enough for the speed to fall measurably; longer costs simulation
+/// time for little more information.
+const IDENTIFY_WINDOW: f64 = 4.0;
 
 /// Weave eigenvalue `[re, im]` of a linearization (the complex pair with
 /// the highest frequency), if any.

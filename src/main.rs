@@ -455,6 +455,25 @@ fn run(cli: Cli) -> Result<bool> {
                 output::save_json(out.join(format!("{name}_stability.json")), &stability_json(name, &crit))?;
             }
             println!("wrote tables and plots to {}", out.display());
+            // Close the loop on the committed example set (made by `bikedyn
+            // synth` with steer damping hidden): measured eigenvalues on the
+            // continuation diagram, the identified effect, before and after.
+            let set = PathBuf::from(bikedyn::identify::EXAMPLE_SET);
+            let args = bikedyn::identify::IdentifyArgs {
+                inputs: vec![set.clone()],
+                calibration: None,
+                bike: "thesis".into(),
+                effects: vec![],
+                report: Some(out.join("identify")),
+                json: false,
+                folds: 4,
+            };
+            println!("\nidentify {} (runs made by `bikedyn synth` with an effect hidden):", set.display());
+            let o = bikedyn::identify::run_identify(&args)?;
+            let dir = out.join("identify");
+            bikedyn::identify::write_report(&o, &args, &dir)?;
+            println!("{}", bikedyn::identify::summary(&o));
+            println!("report: {}", dir.join("report.md").display());
             Ok(ok)
         }
         Command::Verify {

@@ -18,7 +18,7 @@
 //!   states are per-segment nuisance parameters. Both are fitted together by
 //!   Levenberg-Marquardt (`levenberg-marquardt` crate). Sensitivities are
 //!   forward differences of whole simulations at tight tolerance (rtol
-//!   1e-9), so the difference step (1e-4 of the parameter's scale) is far
+//!   1e-8), with a difference step (1e-3 of the parameter's scale) far
 //!   above the integration error. The Jacobian is block-sparse: a segment
 //!   depends only on the shared parameters and its own initial state, so a
 //!   column costs one simulation of one segment. Segments run in parallel.
@@ -301,8 +301,8 @@ impl<'a> Setup<'a> {
             segments,
             weights,
             options: SimOptions {
-                rtol: 1e-9,
-                atol: 1e-11,
+                rtol: 1e-8,
+                atol: 1e-10,
                 output_interval: 0.01,
                 // The measured response decides; a fall in the simulation
                 // only stops it (its last value is held).
@@ -476,12 +476,12 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
                 let mut x0 = self.x0[s];
                 let h = match nj {
                     None => {
-                        let h = 1e-4 * self.setup.parameters[col].scale.max(g[col].abs());
+                        let h = 1e-3 * self.setup.parameters[col].scale.max(g[col].abs());
                         g[col] += h;
                         h
                     }
                     Some(j) => {
-                        let h = 1e-4 * NUISANCE_SCALE[j].max(x0[j].abs());
+                        let h = 1e-3 * NUISANCE_SCALE[j].max(x0[j].abs());
                         x0[j] += h;
                         h
                     }
