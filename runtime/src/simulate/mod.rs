@@ -6,9 +6,11 @@
 //! coordinates `q` of the model (`M::INDEPENDENT`: roll theta and steer gamma
 //! for a driven-speed model; theta, rear wheel rotation psi and gamma for a
 //! free-speed one) and their rates, the ignorable coordinates `g` (those that
-//! are neither independent nor dependent: `xc yc phi eps`), and extra
-//! first-order states `z` (none yet; appended last). At every evaluation of
-//! the right-hand side:
+//! are neither independent nor dependent: `xc yc phi eps` with rolling
+//! constraints, `xc eps` with tyre slip, where `yc` and `phi` are
+//! independent), and the extra first-order states `z` of `M::STATES` (e.g.
+//! the lagged lateral tyre forces of `tyre_relaxation`). At every evaluation
+//! of the right-hand side:
 //!
 //! 1. the dependent positions (`M::DEPENDENT`: pitch beta, the front contact
 //!    angle xi and, in driven models, psi) are solved from the holonomic
@@ -23,7 +25,18 @@
 //!    give `q''`; `Qin` are the torque pulses of [`Inputs`];
 //! 4. the ignorable coordinates are integrated from their rates (the
 //!    dependent velocities of step 2); time is a state too (`t' = 1`), which
-//!    makes the system autonomous for the integrator (see [`StateLayout`]).
+//!    makes the system autonomous for the integrator (see [`StateLayout`]);
+//! 5. the generated code reads `z` from the tail of the parameter vector
+//!    (`M::STATES`), so `z` is written there before step 1, and
+//!    `z' = M::state_rates(param + z, t, p, p')` with the full `p, p'`.
+//!
+//! Initial conditions: the independent rates other than roll and steer (the
+//! rear wheel's with free speed; with tyre slip also `yc` and `phi`) solve
+//! `speed = V` and `z' = 0` for the given `z(0)` (zero unless the parameter
+//! vector carries a tail): the extra states start at rest, which upright
+//! is rolling without lateral slip. A kick is a finite impulse, so with
+//! tyre slip it makes the wheels slide sideways until the tyre forces build
+//! up; `z` does not jump.
 //!
 //! # Drift control
 //!
@@ -171,6 +184,11 @@ pub struct Simulation {
     pub constraint_residual: Vec<f64>,
     /// Max-norm of the velocity constraints `D p' - d` (m/s, rad/s).
     pub velocity_residual: Vec<f64>,
+    /// Names of the model's extra first-order states (`M::STATES`; empty
+    /// for most models).
+    pub states: Vec<&'static str>,
+    /// Extra states at each sample (e.g. tyre lateral forces, N).
+    pub z: Vec<Vec<f64>>,
     pub stop: StopReason,
     pub stats: SimStats,
     pub options: SimOptions,
@@ -216,8 +234,15 @@ impl Simulation {
         e[start..].iter().fold(0.0f64, |m, x| m.max((x - e0).abs())) / e0.abs().max(f64::MIN_POSITIVE)
     }
 
+    /// Column of an extra state by name.
+    pub fn state(&self, name: &str) -> Option<Vec<f64>> {
+        let j = self.states.iter().position(|c| *c == name)?;
+        Some(self.z.iter().map(|z| z[j]).collect())
+    }
+
     /// CSV header: `t`, every coordinate, `d` + every coordinate, `speed`,
-    /// `kinetic_energy`, `potential_energy`, `constraint_residual`.
+    /// `kinetic_energy`, `potential_energy`, `constraint_residual`, then the
+    /// extra states by name (models with states only).
     pub fn csv_header(&self) -> Vec<String> {
         let mut h = vec!["t".to_string()];
         h.extend(self.coordinates.iter().map(|c| c.to_string()));
@@ -225,6 +250,7 @@ impl Simulation {
         for s in ["speed", "kinetic_energy", "potential_energy", "constraint_residual"] {
             h.push(s.into());
         }
+        h.extend(self.states.iter().map(|s| s.to_string()));
         h
     }
 
@@ -244,6 +270,7 @@ impl Simulation {
             ] {
                 row.push(format!("{x:.12e}"));
             }
+            row.extend(self.z[i].iter().map(|x| format!("{x:.12e}")));
             c.write_record(&row)?;
         }
         c.flush()?;
@@ -365,7 +392,7 @@ pub fn initial_state<M: MultibodyModel>(
             });
         }
     }
-    let mut param = param.to_vec();
+    let mut param = rhs::with_state_tail::<M>(param)?;
     let driven = M::INDEPENDENT.len() == 2;
     if let Some(k) = M::FORWARD_SPEED_PARAMETER.filter(|_| driven) {
         if k < param.len() {
@@ -388,44 +415,96 @@ pub fn initial_state<M: MultibodyModel>(
     y[c.steer_ind] = ic.steer;
     y[l.rates() + c.roll_ind] = ic.roll_rate;
     y[l.rates() + c.steer_ind] = ic.steer_rate;
+    // Yaw is ignorable with rolling constraints, independent with tyre slip.
     if let Some(k) = l.ignorable.iter().position(|&j| j == c.yaw) {
         y[l.ignorables() + k] = ic.yaw;
+    } else if let Some(k) = l.independent.iter().position(|&j| j == c.yaw) {
+        y[k] = ic.yaw;
     }
-    // Free-speed model: the remaining independent rates (the rear wheel
-    // rotation) set the forward speed; speed is affine in them, solve for it.
+    let np = M::PARAMETERS.len();
+    y[l.extras()..].copy_from_slice(&param[np..]);
+    // The independent rates besides roll and steer: the rate that carries
+    // the forward speed (the rear wheel's, in a free-speed model) and, with
+    // tyre slip, the lateral ones (yc, phi). They solve `speed = ic.speed`
+    // and `z' = 0` (the extra states start at rest; upright, that is rolling
+    // without lateral slip), one equation per extra state.
     let others: Vec<usize> = (0..l.ni()).filter(|&k| k != c.roll_ind && k != c.steer_ind).collect();
-    // A model whose only independent coordinates are roll and steer is
-    // driven (its speed parameter was set above); one more independent
-    // coordinate (the rear wheel angle) makes the speed free.
     if !others.is_empty() {
-        match others.as_slice() {
-            [k] => {
-                let k = l.rates() + *k;
-                y[k] = 0.0;
-                let (p0, dp0) = eval.full_state(0.0, &y)?;
-                let s0 = forward_speed(&c, &p0, &dp0);
-                y[k] = 1.0;
-                let (p1, dp1) = eval.full_state(0.0, &y)?;
-                let s1 = forward_speed(&c, &p1, &dp1) - s0;
-                if !(s1.abs() > 1e-12) {
-                    return Err(SimulateError::InvalidInput(
-                        "the free independent rate does not change the forward speed".into(),
-                    ));
-                }
-                y[k] = (ic.speed - s0) / s1;
-            }
-            _ => {
-                return Err(SimulateError::InvalidInput(format!(
-                "model `{}` has no speed parameter and {} independent coordinates besides roll and steer (expected 1)",
+        if others.len() != 1 + l.extra {
+            return Err(SimulateError::InvalidInput(format!(
+                "model `{}` has {} independent coordinates besides roll and steer and {} extra states (expected one more coordinate than states)",
                 M::NAME,
-                others.len()
-            )))
-            }
+                others.len(),
+                l.extra
+            )));
         }
+        solve_free_rates(&eval, &mut y, &others, ic.speed)?;
     }
     // Check that the configuration exists.
     eval.full_state(0.0, &y)?;
     Ok((y, param))
+}
+
+/// Set the rates `y[rates + k]`, `k` in `others`, so that the forward speed
+/// is `speed` and the extra states' rates vanish: Newton's method with a
+/// finite-difference Jacobian (the conditions are affine in the rates except
+/// through the regularised contact speeds of effects like tyre slip).
+fn solve_free_rates<M: MultibodyModel>(
+    eval: &Evaluator<'_, M>,
+    y: &mut [f64],
+    others: &[usize],
+    speed: f64,
+) -> Result<(), SimulateError> {
+    let l = eval.layout.clone();
+    let m = others.len();
+    let mut dy = vec![0.0; l.len()];
+    let mut residual = |y: &[f64]| -> Result<Vec<f64>, SimulateError> {
+        let (p, dp) = eval.full_state(0.0, y)?;
+        let mut r = vec![forward_speed(&eval.coords, &p, &dp) - speed];
+        if l.extra > 0 {
+            eval.derivative(0.0, y, &mut dy)?;
+            r.extend_from_slice(&dy[l.extras()..]);
+        }
+        Ok(r)
+    };
+    for _ in 0..20 {
+        let r0 = residual(y)?;
+        if r0.iter().all(|x| *x == 0.0) {
+            return Ok(());
+        }
+        let mut jac = nalgebra::DMatrix::<f64>::zeros(m, m);
+        for (col, &k) in others.iter().enumerate() {
+            let i = l.rates() + k;
+            let h = 1e-6 * y[i].abs().max(1.0);
+            let keep = y[i];
+            y[i] = keep + h;
+            let r1 = residual(y)?;
+            y[i] = keep;
+            for row in 0..m {
+                jac[(row, col)] = (r1[row] - r0[row]) / h;
+            }
+        }
+        let step = jac.lu().solve(&nalgebra::DVector::from_vec(r0)).ok_or_else(|| {
+            SimulateError::InvalidInput(
+                "the free independent rates do not set the forward speed and the extra states' rates".into(),
+            )
+        })?;
+        let mut small = true;
+        for (col, &k) in others.iter().enumerate() {
+            let i = l.rates() + k;
+            small &= step[col].abs() <= 1e-12 * y[i].abs().max(1.0);
+            y[i] -= step[col];
+        }
+        // Stop once the update is at rounding level (the conditions are
+        // affine or nearly so: two or three iterations).
+        if small {
+            return Ok(());
+        }
+    }
+    let r = residual(y)?;
+    Err(SimulateError::InvalidInput(format!(
+        "no initial rates give forward speed {speed} m/s with the extra states at rest (residual {r:?})"
+    )))
 }
 
 /// Simulate model `M` with parameters `param` from `ic` for `duration`
@@ -509,6 +588,8 @@ pub fn simulate<M: MultibodyModel>(
         potential_energy: vec![],
         constraint_residual: vec![],
         velocity_residual: vec![],
+        states: M::STATES.to_vec(),
+        z: vec![],
         stop: StopReason::Completed,
         stats: SimStats::default(),
         options: *opts,
@@ -522,6 +603,7 @@ pub fn simulate<M: MultibodyModel>(
         sim.potential_energy.push(M::potential_energy(&param, &p));
         sim.constraint_residual.push(r);
         sim.velocity_residual.push(v);
+        sim.z.push(y[eval.layout.extras()..].to_vec());
         sim.p.push(p);
         sim.dp.push(dp);
         Ok(())
