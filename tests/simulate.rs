@@ -5,7 +5,8 @@ use bikedyn::models::default_parameters;
 use bikedyn::ThesisWhipple;
 use bikedyn_runtime::linearize::linearize;
 use bikedyn_runtime::simulate::{
-    simulate, Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, StopReason, TorquePulse,
+    simulate, Events, InitialConditions, Inputs, Kick, Method, PulseShape, PulseTarget, SimOptions, StopReason,
+    TorquePulse,
 };
 use bikedyn_runtime::MultibodyModel;
 use nalgebra::{Matrix2, Matrix4, Vector4};
@@ -569,7 +570,10 @@ fn stiff_tyres_approach_the_no_slip_kick_response() {
     }
     // First order in 1/k (measured: 13.4%, 1.0%, 0.10% of the peak roll for
     // k = 1, 10, 100): 100x stiffer tyres must be within 0.3% of the peak.
-    assert!(last < 0.003, "deviation {last} of the peak roll with 100x stiffer tyres");
+    assert!(
+        last < 0.003,
+        "deviation {last} of the peak roll with 100x stiffer tyres"
+    );
 }
 
 /// Normal loads of the tyre model at a state, read from the model's own
@@ -687,7 +691,10 @@ fn cli_simulates_the_tyre_model() {
     assert!(stdout.contains("stop: completed"), "{stdout}");
     let text = std::fs::read_to_string(&csv).unwrap();
     let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
-    assert_eq!(&header[header.len() - 3..], ["constraint_residual", "Fy_rear", "Fy_front"]);
+    assert_eq!(
+        &header[header.len() - 3..],
+        ["constraint_residual", "Fy_rear", "Fy_front"]
+    );
     let last: Vec<f64> = text
         .lines()
         .last()
@@ -696,4 +703,134 @@ fn cli_simulates_the_tyre_model() {
         .map(|x| x.parse().unwrap())
         .collect();
     assert_eq!(last[0], 3.0);
+}
+
+/// Issue 7, point 2: stiff effects. With tyres 100 times stiffer
+/// (cornering stiffness x100, relaxation length 2 mm) the tyre dynamics are
+/// ~10^3-10^4 1/s fast and bound DOP853's step by stability: Radau5
+/// integrates the same kick in far fewer right-hand-side evaluations and
+/// both agree. With a 0.2 mm relaxation length DOP853 gives up (its
+/// stiffness detection) and says to use Radau5, which integrates it.
+#[test]
+fn stiff_tyres_need_far_fewer_evaluations_with_radau5() {
+    type T = bikedyn::generated::ThesisTyreFree;
+    let run = |param: &[f64], method| {
+        let inputs = Inputs {
+            kicks: vec![Kick::at_saddle(0.0, 3.0)],
+            pulses: vec![],
+        };
+        let ic = InitialConditions {
+            speed: 4.5,
+            ..Default::default()
+        };
+        let opts = SimOptions {
+            method,
+            ..Default::default()
+        };
+        simulate::<T>(param, &ic, &inputs, 3.0, &opts)
+    };
+    let param = stiff_tyres(100.0);
+    let explicit = run(&param, Method::Dop853).unwrap();
+    let implicit = run(&param, Method::Radau5).unwrap();
+    assert_eq!(implicit.stop, StopReason::Completed);
+    // Same output grid (DOP853 accumulates its sample times).
+    assert_eq!(implicit.t.len(), explicit.t.len());
+    assert!(implicit.t.iter().zip(&explicit.t).all(|(a, b)| (a - b).abs() < 1e-9));
+    assert!(implicit.max_constraint_residual() < 1e-9);
+    let peak = explicit
+        .coordinate("theta")
+        .unwrap()
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut dev = 0.0f64;
+    for name in ["theta", "gamma"] {
+        let (a, b) = (explicit.coordinate(name).unwrap(), implicit.coordinate(name).unwrap());
+        dev = a.iter().zip(&b).fold(dev, |m, (x, y)| m.max((x - y).abs()));
+    }
+    let (ne, ni) = (explicit.stats.rhs_evaluations, implicit.stats.rhs_evaluations);
+    println!(
+        "tyres 100x stiffer, rtol 1e-8: DOP853 {ne} evaluations ({} steps), Radau5 {ni} evaluations ({} steps), {:.1}x fewer; largest roll/steer difference {dev:.2e} rad ({:.1e} of the peak roll)",
+        explicit.stats.accepted_steps + explicit.stats.rejected_steps,
+        implicit.stats.accepted_steps + implicit.stats.rejected_steps,
+        ne as f64 / ni as f64,
+        dev / peak
+    );
+    assert!(ni * 5 < ne, "Radau5 {ni} vs DOP853 {ne} evaluations");
+    // Measured 5.0e-5 of the peak: Radau5's samples come from its
+    // collocation polynomial (order 4), DOP853's from a 7th-order one.
+    assert!(dev < 1e-4 * peak, "methods disagree by {dev} rad");
+
+    let mut param = default_parameters::<T>();
+    for w in ["rear", "front"] {
+        param[T::parameter_index(&format!("sigma_{w}")).unwrap()] = 2e-4;
+    }
+    match run(&param, Method::Dop853) {
+        Err(bikedyn_runtime::simulate::SimulateError::Integrator { message, .. }) => {
+            assert!(message.contains("radau5"), "{message}")
+        }
+        other => panic!("DOP853 on 0.2 mm relaxation: {:?}", other.map(|s| s.stats)),
+    }
+    let sim = run(&param, Method::Radau5).unwrap();
+    assert_eq!(sim.stop, StopReason::Completed);
+    println!(
+        "relaxation length 0.2 mm: Radau5 {} evaluations ({} steps)",
+        sim.stats.rhs_evaluations,
+        sim.stats.accepted_steps + sim.stats.rejected_steps
+    );
+
+    // The CLI selects the method.
+    let out = cli(&[
+        "simulate",
+        "--model",
+        "thesis_tyre_free",
+        "--speed",
+        "4.5",
+        "--kick",
+        "0:3",
+        "--duration",
+        "1",
+        "--method",
+        "radau5",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}");
+    assert!(stdout.contains("radau5: simulated 1.000 s"), "{stdout}");
+    let out = cli(&["simulate", "--speed", "4.5", "--duration", "1", "--method", "euler"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+/// Radau5 reproduces DOP853 on the non-stiff thesis model too, and locates
+/// a fall.
+#[test]
+fn radau5_matches_dop853_and_stops_at_a_fall() {
+    let ic = InitialConditions {
+        roll: 0.05,
+        speed: 1.0,
+        ..Default::default()
+    };
+    let run = |method| {
+        let opts = SimOptions {
+            method,
+            rtol: 1e-10,
+            atol: 1e-12,
+            events: Events {
+                roll_limit: Some(0.8),
+                steer_limit: None,
+            },
+            ..Default::default()
+        };
+        simulate::<M>(&thesis_at(1.0), &ic, &Inputs::default(), 20.0, &opts).unwrap()
+    };
+    let (a, b) = (run(Method::Dop853), run(Method::Radau5));
+    let (ta, tb) = match (a.stop, b.stop) {
+        (StopReason::Fell { time: ta, .. }, StopReason::Fell { time: tb, roll }) => {
+            assert!((roll.abs() - 0.8).abs() < 1e-8);
+            (ta, tb)
+        }
+        s => panic!("expected two falls, got {s:?}"),
+    };
+    println!("fall at {ta:.9} s (DOP853), {tb:.9} s (Radau5)");
+    // Measured 2.8e-6 s at rtol 1e-10 (the fall amplifies errors ~16x).
+    assert!((ta - tb).abs() < 1e-5, "{ta} vs {tb}");
 }

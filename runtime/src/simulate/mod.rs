@@ -55,13 +55,21 @@
 //!
 //! # Integrator
 //!
-//! `ode_solvers` 0.6.2 (`Dop853`, Hairer's DOP853: explicit Runge-Kutta of
-//! order 8(5,3), adaptive step with error control, 7th-order dense output),
-//! chosen because it uses the workspace's nalgebra 0.34 (no second nalgebra,
-//! a few seconds of build time) and is a faithful port of Hairer's code. The
-//! Whipple model with or without mild dissipation is not stiff. A stiff
-//! method (BDF/SDIRK of diffsol, nalgebra 0.35) is not wired in: see the
-//! README's "Simulation" section.
+//! [`Method::Dop853`] (default): `ode_solvers` 0.6.2 (`Dop853`, Hairer's
+//! DOP853: explicit Runge-Kutta of order 8(5,3), adaptive step with error
+//! control, 7th-order dense output), chosen because it uses the workspace's
+//! nalgebra 0.34 (no second nalgebra, a few seconds of build time) and is a
+//! faithful port of Hairer's code. The Whipple model with or without mild
+//! dissipation is not stiff.
+//!
+//! [`Method::Radau5`]: Radau IIA of order 5 (implicit, L-stable, adaptive,
+//! dense output; Hairer's RADAU5 scheme) from `differential-equations` 0.7
+//! (without features it depends on no nalgebra at all), for stiff effects:
+//! with a tyre relaxation length of a fraction of a millimetre the tyre
+//! forces relax at `|v| / sigma` ~ 10^4 1/s, which limits DOP853's step by
+//! stability, not accuracy. Its Jacobian is the crate's forward-difference
+//! one (one evaluation per state component); that crate scales the
+//! tolerances as RADAU5 does (`rtol -> 0.1 rtol^(2/3)`).
 //!
 //! Kicks and pulse edges are breakpoints: the integration restarts there, so
 //! the error control never steps over a discontinuity.
@@ -79,6 +87,9 @@ pub use rhs::{forward_speed, BicycleCoordinates, Evaluator, StateLayout};
 use std::io::Write;
 use std::path::Path;
 
+use differential_equations::prelude::{
+    ControlFlag, ImplicitRungeKutta, Interpolation, Matrix as DeMatrix, Solout, Solution, IVP, ODE,
+};
 use ode_solvers::{DVector, Dop853, OutputType, System};
 use serde::Serialize;
 use thiserror::Error;
@@ -136,6 +147,8 @@ pub struct SimOptions {
     pub output_interval: f64,
     /// Events that stop the run.
     pub events: Events,
+    /// Integration method (default DOP853).
+    pub method: Method,
 }
 
 impl Default for SimOptions {
@@ -145,7 +158,50 @@ impl Default for SimOptions {
             atol: 1e-10,
             output_interval: 0.01,
             events: Events::default(),
+            method: Method::default(),
         }
+    }
+}
+
+/// Integration method.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum Method {
+    /// DOP853 (explicit Runge-Kutta 8(5,3), `ode_solvers`): the default, for
+    /// models that are not stiff.
+    #[default]
+    Dop853,
+    /// Radau IIA of order 5 (implicit, L-stable, Hairer's RADAU5 scheme;
+    /// `differential-equations`), Jacobian by forward differences: for stiff
+    /// effects such as very short tyre relaxation lengths.
+    Radau5,
+}
+
+impl Method {
+    /// Every method, by its command-line name.
+    pub const ALL: [(&'static str, Method); 2] = [("dop853", Method::Dop853), ("radau5", Method::Radau5)];
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        Self::ALL
+            .iter()
+            .find(|(_, m)| *m == self)
+            .map(|(n, _)| *n)
+            .unwrap_or("?")
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = SimulateError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(s))
+            .map(|(_, m)| *m)
+            .ok_or_else(|| {
+                SimulateError::InvalidInput(format!(
+                    "unknown integration method `{s}` (expected {})",
+                    Self::ALL.map(|(n, _)| n).join(" or ")
+                ))
+            })
     }
 }
 
@@ -307,6 +363,201 @@ impl<M: MultibodyModel> System<f64, DVector<f64>> for Rhs<'_, '_, M> {
     }
 }
 
+/// The implicit integrator's view of the model. `differential-equations`
+/// 0.7.0's Radau5 starts its Newton iteration from `Y::zeros()`, which is
+/// empty for `Vec<f64>`, so the state is a fixed-size array: the model's `n`
+/// components, padded with components whose rate is zero.
+struct Padded<'f> {
+    n: usize,
+    f: &'f dyn Fn(&[f64], &mut [f64]),
+}
+
+impl<const N: usize> ODE<f64, [f64; N]> for Padded<'_> {
+    fn diff(&self, _t: f64, y: &[f64; N], dy: &mut [f64; N]) {
+        dy.fill(0.0);
+        (self.f)(&y[..self.n], &mut dy[..self.n]);
+    }
+    /// Forward differences over the model's components only (the padding is
+    /// constant).
+    fn jacobian(&self, t: f64, y: &[f64; N], j: &mut DeMatrix<f64>) {
+        let n = self.n;
+        for r in 0..j.nrows() {
+            for c in 0..j.ncols() {
+                j[(r, c)] = 0.0;
+            }
+        }
+        let (mut f0, mut f1) = ([0.0; N], [0.0; N]);
+        self.diff(t, y, &mut f0);
+        let mut yp = *y;
+        for c in 0..n {
+            let h = f64::EPSILON.sqrt() * y[c].abs().max(1.0);
+            yp[c] = y[c] + h;
+            self.diff(t, &yp, &mut f1);
+            yp[c] = y[c];
+            for r in 0..n {
+                j[(r, c)] = (f1[r] - f0[r]) / h;
+            }
+        }
+    }
+}
+
+/// Output of the implicit integrator: dense samples at `times`, and a stop
+/// at the end of the first step where `stop` holds (that end point is pushed
+/// too, so that an event is seen and located).
+struct Sampler<'f> {
+    stop: &'f dyn Fn(&[f64]) -> bool,
+    times: Vec<f64>,
+    next: usize,
+    /// Start `(t, y)` of the step at whose end `stop` held: a step point, as
+    /// accurate as the integration (the samples inside a step come from
+    /// Radau5's collocation polynomial, of order 4 only).
+    stopped_from: &'f std::cell::RefCell<Option<(f64, Vec<f64>)>>,
+}
+
+impl<const N: usize> Solout<f64, [f64; N]> for Sampler<'_> {
+    fn solout<I>(
+        &mut self,
+        t_curr: f64,
+        t_prev: f64,
+        y_curr: &[f64; N],
+        y_prev: &[f64; N],
+        interpolator: &mut I,
+        solution: &mut Solution<f64, [f64; N]>,
+    ) -> ControlFlag<f64, [f64; N]>
+    where
+        I: Interpolation<f64, [f64; N]> + ?Sized,
+    {
+        // The last step ends at the segment end up to rounding.
+        let tol = 1e-12 * t_curr.abs().max(1.0);
+        while let Some(&t) = self.times.get(self.next) {
+            if t > t_curr + tol {
+                break;
+            }
+            let y = if (t - t_curr).abs() <= tol {
+                *y_curr
+            } else {
+                match interpolator.interpolate(t) {
+                    Ok(y) => y,
+                    Err(_) => break,
+                }
+            };
+            solution.push(t, y);
+            self.next += 1;
+        }
+        if (self.stop)(y_curr) {
+            *self.stopped_from.borrow_mut() = Some((t_prev, y_prev.to_vec()));
+            if solution.t.last().is_none_or(|&t| t < t_curr) {
+                solution.push(t_curr, *y_curr);
+            }
+            return ControlFlag::Terminate;
+        }
+        ControlFlag::Continue
+    }
+}
+
+/// Samples `(t, y)` of a Radau5 run, its accepted and rejected steps, and
+/// the start of the step where it stopped early.
+type RadauRun = (Vec<f64>, Vec<Vec<f64>>, usize, usize, Option<(f64, Vec<f64>)>);
+
+fn radau_padded<const N: usize>(
+    f: &dyn Fn(&[f64], &mut [f64]),
+    stop: &dyn Fn(&[f64]) -> bool,
+    opts: &SimOptions,
+    t0: f64,
+    y0: &[f64],
+    times: Vec<f64>,
+) -> Result<RadauRun, (f64, String)> {
+    let n = y0.len();
+    let t1 = *times.last().expect("at least one sample time");
+    let mut y = [0.0; N];
+    y[..n].copy_from_slice(y0);
+    let sys = Padded { n, f };
+    // Hairer's RADAU5 Newton stopping tolerance for the scaled rtol; the
+    // crate's fixed default (3.2e-3) ignores rtol and stops the Newton
+    // iteration too early for tight tolerances.
+    let scaled_rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
+    let newton_tol = (10.0 * f64::EPSILON / scaled_rtol).max(0.03f64.min(scaled_rtol.sqrt()));
+    let method = ImplicitRungeKutta::radau5()
+        .rtol(opts.rtol)
+        .atol(opts.atol)
+        .newton_tol(newton_tol)
+        .max_steps(10_000_000);
+    let stopped_from = std::cell::RefCell::new(None);
+    let sampler = Sampler {
+        stop,
+        times,
+        next: 0,
+        stopped_from: &stopped_from,
+    };
+    let sol = IVP::ode(&sys, t0, t1, y)
+        .method(method)
+        .solout(sampler)
+        .solve()
+        .map_err(|e| {
+            use differential_equations::error::Error as E;
+            // The crate's error carries the state; say what happened.
+            match e {
+                E::MaxSteps { t, .. } => (t, "Radau5: maximum number of steps reached".to_string()),
+                E::StepSize { t, .. } => (t, "Radau5: step size too small".to_string()),
+                E::Stiffness { t, .. } => (t, "Radau5: stiffness detected".to_string()),
+                E::LinearAlgebra { t, msg, .. } => (t, format!("Radau5: {msg}")),
+                E::BadInput { msg } => (t0, format!("Radau5: {msg}")),
+                other => (t0, format!("Radau5: {other:?}")),
+            }
+        })?;
+    let ys = sol.y.iter().map(|y| y[..n].to_vec()).collect();
+    let from = stopped_from.into_inner().map(|(t, y)| (t, y[..n].to_vec()));
+    Ok((sol.t, ys, sol.steps.accepted, sol.steps.rejected, from))
+}
+
+/// Integrate with Radau5 from `(t0, y0)` and sample at `times` (increasing,
+/// after `t0`, the last one the end), stopping early when an event of
+/// `events` fires. Returns the samples and, after an early stop, the start
+/// of the last step.
+fn radau_samples<M: MultibodyModel>(
+    eval: &Evaluator<'_, M>,
+    opts: &SimOptions,
+    events: Events,
+    t0: f64,
+    y0: &[f64],
+    times: Vec<f64>,
+    stats: &mut SimStats,
+) -> Result<RadauSamples, SimulateError> {
+    let f = |y: &[f64], dy: &mut [f64]| {
+        if eval.error.borrow().is_some() {
+            dy.fill(f64::NAN);
+            return;
+        }
+        if let Err(e) = eval.derivative(y[eval.layout.time()], y, dy) {
+            *eval.error.borrow_mut() = Some(e);
+            dy.fill(f64::NAN);
+        }
+    };
+    let stop = |y: &[f64]| eval.error.borrow().is_some() || event_value(eval, &events, y).0 <= 0.0;
+    // A few padded sizes (each is a monomorphisation of the solver).
+    let r = match y0.len() {
+        0..=12 => radau_padded::<12>(&f, &stop, opts, t0, y0, times),
+        13..=16 => radau_padded::<16>(&f, &stop, opts, t0, y0, times),
+        17..=32 => radau_padded::<32>(&f, &stop, opts, t0, y0, times),
+        n => {
+            return Err(SimulateError::InvalidInput(format!(
+                "Radau5 supports states of up to 32 components, model `{}` has {n}",
+                M::NAME
+            )))
+        }
+    };
+    if let Some(e) = eval.error.borrow_mut().take() {
+        return Err(e);
+    }
+    let (ts, ys, accepted, rejected, from) = r.map_err(|(t, message)| SimulateError::Integrator { t, message })?;
+    stats.accepted_steps += accepted as u64;
+    stats.rejected_steps += rejected as u64;
+    Ok((ts, ys, from))
+}
+
+/// Samples of [`radau_samples`] and the start of the step where it stopped.
+type RadauSamples = (Vec<f64>, Vec<Vec<f64>>, Option<(f64, Vec<f64>)>);
+
 /// Smallest event margin (`limit - |angle|`, rad) and which event it is
 /// (0 roll, 1 steer).
 fn event_value<M: MultibodyModel>(eval: &Evaluator<'_, M>, ev: &Events, y: &[f64]) -> (f64, usize) {
@@ -337,6 +588,17 @@ fn integrate_to<M: MultibodyModel>(
     if t1 <= t0 {
         return Ok(y0.to_vec());
     }
+    if opts.method == Method::Radau5 {
+        let none = Events {
+            roll_limit: None,
+            steer_limit: None,
+        };
+        let (_, ys, _) = radau_samples(eval, opts, none, t0, y0, vec![t1], stats)?;
+        return ys.into_iter().last().ok_or_else(|| SimulateError::Integrator {
+            t: t0,
+            message: "Radau5 returned no end point".into(),
+        });
+    }
     let rhs = Rhs {
         eval,
         events: Events {
@@ -360,7 +622,7 @@ fn integrate_to<M: MultibodyModel>(
     }
     let st = r.map_err(|e| SimulateError::Integrator {
         t: t0,
-        message: e.to_string(),
+        message: format!("DOP853: {e} (for stiff effects use the Radau5 method, --method radau5)"),
     })?;
     stats.accepted_steps += st.accepted_steps as u64;
     stats.rejected_steps += st.rejected_steps as u64;
@@ -638,42 +900,56 @@ pub fn simulate<M: MultibodyModel>(
         let n = ((t1 - t0) / opts.output_interval - 1e-9).ceil().max(1.0);
         let dx = (t1 - t0) / n;
         eval.segment.set((t0, t1));
-        let rhs = Rhs {
-            eval: &eval,
-            events: opts.events,
-        };
-        // Integrate slightly past the segment end: ode_solvers 0.6.2 pushes
-        // an *extrapolated* dense sample at `x_end` whenever its next grid
-        // time is within 1e-9 of `x_end`, even from a step that ends before
-        // it. With the end off the grid the sample at `t1` is interpolated
-        // from the step that contains it.
-        let overshoot = (1e-6f64).min(0.01 * dx).max(1e-8);
-        let mut s = Dop853::new(
-            rhs,
-            t0,
-            t1 + overshoot,
-            dx,
-            DVector::from_column_slice(&y),
-            opts.rtol,
-            opts.atol,
-        );
-        s.set_output(OutputType::Dense);
-        let r = s.integrate();
-        if let Some(e) = eval.error.borrow_mut().take() {
-            return Err(e);
-        }
-        let st = r.map_err(|e| SimulateError::Integrator {
-            t: t0,
-            message: e.to_string(),
-        })?;
-        sim.stats.accepted_steps += st.accepted_steps as u64;
-        sim.stats.rejected_steps += st.rejected_steps as u64;
-        let (mut ts, ys) = (s.x_out().clone(), s.y_out().clone());
-        if let Some(last) = ts.last_mut() {
-            if (*last - t1).abs() <= 1e-9 * t1.abs().max(1.0) {
-                *last = t1;
+        let mut stopped_from = None;
+        let (ts, ys) = if opts.method == Method::Radau5 {
+            let times: Vec<f64> = (1..=n as usize)
+                .map(|k| if k == n as usize { t1 } else { t0 + k as f64 * dx })
+                .collect();
+            let (mut ts, mut ys, from) = radau_samples(&eval, opts, opts.events, t0, &y, times, &mut sim.stats)?;
+            stopped_from = from;
+            ts.insert(0, t0);
+            ys.insert(0, y.clone());
+            (ts, ys)
+        } else {
+            let rhs = Rhs {
+                eval: &eval,
+                events: opts.events,
+            };
+            // Integrate slightly past the segment end: ode_solvers 0.6.2 pushes
+            // an *extrapolated* dense sample at `x_end` whenever its next grid
+            // time is within 1e-9 of `x_end`, even from a step that ends before
+            // it. With the end off the grid the sample at `t1` is interpolated
+            // from the step that contains it.
+            let overshoot = (1e-6f64).min(0.01 * dx).max(1e-8);
+            let mut s = Dop853::new(
+                rhs,
+                t0,
+                t1 + overshoot,
+                dx,
+                DVector::from_column_slice(&y),
+                opts.rtol,
+                opts.atol,
+            );
+            s.set_output(OutputType::Dense);
+            let r = s.integrate();
+            if let Some(e) = eval.error.borrow_mut().take() {
+                return Err(e);
             }
-        }
+            let st = r.map_err(|e| SimulateError::Integrator {
+                t: t0,
+                message: format!("DOP853: {e} (for stiff effects use the Radau5 method, --method radau5)"),
+            })?;
+            sim.stats.accepted_steps += st.accepted_steps as u64;
+            sim.stats.rejected_steps += st.rejected_steps as u64;
+            let (mut ts, ys) = (s.x_out().clone(), s.y_out().clone());
+            if let Some(last) = ts.last_mut() {
+                if (*last - t1).abs() <= 1e-9 * t1.abs().max(1.0) {
+                    *last = t1;
+                }
+            }
+            let ys: Vec<Vec<f64>> = ys.iter().map(|v| v.as_slice().to_vec()).collect();
+            (ts, ys)
+        };
         // The first sample is the segment start: skip it unless this is the
         // first segment or a kick changed the state.
         let skip = if first || kicked { 0 } else { 1 };
@@ -683,7 +959,12 @@ pub fn simulate<M: MultibodyModel>(
             let (g, which) = event_value(&eval, &opts.events, yv);
             if g <= 0.0 {
                 // Locate the crossing between the previous sample and this one.
-                let (ta, ya) = prev.clone().unwrap_or((t0, y.clone()));
+                // From the previous sample, or from the start of Radau5's
+                // last step, which is more accurate than its samples.
+                let (ta, ya) = match stopped_from.take() {
+                    Some((t_step, y_step)) if t_step < *t => (t_step, y_step),
+                    _ => prev.clone().unwrap_or((t0, y.clone())),
+                };
                 let (te, ye) = locate_event(&eval, opts, ta, &ya, *t, &mut sim.stats)?;
                 if te > ta {
                     push(&mut sim, te, &ye)?;
@@ -709,10 +990,10 @@ pub fn simulate<M: MultibodyModel>(
         if (last_t - t1).abs() > 1e-9 * t1.abs().max(1.0) {
             // The dense output stopped short of the segment end (the step
             // cap or an early stop); finish without output.
-            let ya = ys.last().expect("non-empty").as_slice().to_vec();
+            let ya = ys.last().expect("non-empty").clone();
             y = integrate_to(&eval, last_t, &ya, t1, opts, &mut sim.stats)?;
         } else {
-            y = ys.last().expect("non-empty").as_slice().to_vec();
+            y = ys.last().expect("non-empty").clone();
         }
         t0 = t1;
         first = false;
