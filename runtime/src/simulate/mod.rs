@@ -67,9 +67,13 @@
 //! (without features it depends on no nalgebra at all), for stiff effects:
 //! with a tyre relaxation length of a fraction of a millimetre the tyre
 //! forces relax at `|v| / sigma` ~ 10^4 1/s, which limits DOP853's step by
-//! stability, not accuracy. Its Jacobian is the crate's forward-difference
-//! one (one evaluation per state component); that crate scales the
-//! tolerances as RADAU5 does (`rtol -> 0.1 rtol^(2/3)`).
+//! stability, not accuracy. The Jacobian is by forward differences over the
+//! model's state (one evaluation per component); the crate scales the
+//! tolerances as RADAU5 does (`rtol -> 0.1 rtol^(2/3)`), and the Newton
+//! tolerance is set as in Hairer's code. Its samples come from the
+//! collocation polynomial (order 4, DOP853's is 7), so at equal rtol the two
+//! methods' samples agree to about 1e-4 of the amplitude; events are located
+//! from a step point, not from a sample.
 //!
 //! Kicks and pulse edges are breakpoints: the integration restarts there, so
 //! the error control never steps over a discontinuity.
@@ -181,11 +185,10 @@ impl Method {
     pub const ALL: [(&'static str, Method); 2] = [("dop853", Method::Dop853), ("radau5", Method::Radau5)];
     /// The command-line name.
     pub fn name(self) -> &'static str {
-        Self::ALL
-            .iter()
-            .find(|(_, m)| *m == self)
-            .map(|(n, _)| *n)
-            .unwrap_or("?")
+        match self {
+            Method::Dop853 => "dop853",
+            Method::Radau5 => "radau5",
+        }
     }
 }
 
