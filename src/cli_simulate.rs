@@ -66,6 +66,10 @@ pub struct SimulateArgs {
     /// Absolute tolerance of the integrator.
     #[arg(long, default_value_t = 1e-10)]
     atol: f64,
+    /// Integration method: dop853 (explicit, default) or radau5 (implicit,
+    /// for stiff effects such as very short tyre relaxation lengths).
+    #[arg(long, default_value = "dop853")]
+    method: String,
     /// Output sample interval (s).
     #[arg(long, default_value_t = 0.01)]
     dt: f64,
@@ -199,6 +203,7 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
     let opts = SimOptions {
         rtol: a.rtol,
         atol: a.atol,
+        method: a.method.parse()?,
         output_interval: a.dt,
         events: Events {
             roll_limit: limit(a.roll_limit),
@@ -228,7 +233,8 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
     );
     println!("  stop: {}", sim.stop);
     println!(
-        "  simulated {simulated:.3} s in {:.3} ms ({:.0}x real time), {} right-hand-side evaluations, {} steps ({} rejected)",
+        "  {}: simulated {simulated:.3} s in {:.3} ms ({:.0}x real time), {} right-hand-side evaluations, {} steps ({} rejected)",
+        opts.method.name(),
         wall * 1e3,
         simulated / wall.max(1e-12),
         sim.stats.rhs_evaluations,

@@ -5,7 +5,8 @@ use bikedyn::models::default_parameters;
 use bikedyn::ThesisWhipple;
 use bikedyn_runtime::linearize::linearize;
 use bikedyn_runtime::simulate::{
-    simulate, Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, StopReason, TorquePulse,
+    simulate, Events, InitialConditions, Inputs, Kick, Method, PulseShape, PulseTarget, SimOptions, StopReason,
+    TorquePulse,
 };
 use bikedyn_runtime::MultibodyModel;
 use nalgebra::{Matrix2, Matrix4, Vector4};
@@ -501,4 +502,455 @@ fn free_speed_energy_drift_below_1e8_over_10_s() {
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(l, h), s| (l.min(*s), h.max(*s)));
     assert!(hi - lo > 1e-4, "speed constant: {lo} {hi}");
+}
+
+/// Kick response (3 N s at the saddle, 4.5 m/s, 3 s) of a free-speed model.
+fn free_kick<N: MultibodyModel>(param: &[f64], opts: &SimOptions) -> bikedyn_runtime::simulate::Simulation {
+    let inputs = Inputs {
+        kicks: vec![Kick::at_saddle(0.0, 3.0)],
+        pulses: vec![],
+    };
+    let ic = InitialConditions {
+        speed: 4.5,
+        ..Default::default()
+    };
+    simulate::<N>(param, &ic, &inputs, 3.0, opts).unwrap()
+}
+
+/// Tyre parameters scaled `k` times stiffer: cornering stiffness times `k`,
+/// relaxation length divided by `k`.
+fn stiff_tyres(k: f64) -> Vec<f64> {
+    type T = bikedyn::generated::ThesisTyreFree;
+    let mut p = default_parameters::<T>();
+    for w in ["rear", "front"] {
+        p[T::parameter_index(&format!("Ca_{w}")).unwrap()] *= k;
+        p[T::parameter_index(&format!("sigma_{w}")).unwrap()] /= k;
+    }
+    p
+}
+
+/// Issue 7, point 1: a model with extra first-order states (lagged tyre
+/// forces) integrates, and as the tyres stiffen its kick response approaches
+/// the no-slip model's.
+#[test]
+fn stiff_tyres_approach_the_no_slip_kick_response() {
+    type T = bikedyn::generated::ThesisTyreFree;
+    type W = bikedyn::generated::ThesisWhippleFree;
+    let opts = SimOptions::default();
+    let reference = free_kick::<W>(&default_parameters::<W>(), &opts);
+    let r_roll = reference.coordinate("theta").unwrap();
+    let r_steer = reference.coordinate("gamma").unwrap();
+    let peak = r_roll.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut previous = f64::INFINITY;
+    let mut last = 0.0;
+    for k in [1.0, 10.0, 100.0] {
+        let sim = free_kick::<T>(&stiff_tyres(k), &opts);
+        assert_eq!(sim.stop, StopReason::Completed, "k = {k}");
+        assert_eq!(sim.t, reference.t);
+        assert_eq!(sim.states, T::STATES);
+        assert!(sim.max_constraint_residual() < 1e-9);
+        let roll = sim.coordinate("theta").unwrap();
+        let steer = sim.coordinate("gamma").unwrap();
+        let dev = (0..roll.len())
+            .map(|i| (roll[i] - r_roll[i]).abs().max((steer[i] - r_steer[i]).abs()))
+            .fold(0.0f64, f64::max);
+        let fy = sim.state("Fy_front").unwrap();
+        println!(
+            "tyres {k:>5}x stiffer: max roll/steer deviation from no slip {:.3e} rad = {:.2}% of the peak roll {:.4} rad; max front tyre force {:.1} N; {} rhs evaluations",
+            dev,
+            100.0 * dev / peak,
+            peak,
+            fy.iter().fold(0.0f64, |m, x| m.max(x.abs())),
+            sim.stats.rhs_evaluations
+        );
+        assert!(fy.iter().any(|f| f.abs() > 1.0), "tyre forces never built up");
+        assert!(dev < previous, "no convergence: {dev} after {previous}");
+        previous = dev;
+        last = dev / peak;
+    }
+    // First order in 1/k (measured: 13.4%, 1.0%, 0.10% of the peak roll for
+    // k = 1, 10, 100): 100x stiffer tyres must be within 0.3% of the peak.
+    assert!(
+        last < 0.003,
+        "deviation {last} of the peak roll with 100x stiffer tyres"
+    );
+}
+
+/// Normal loads of the tyre model at a state, read from the model's own
+/// expressions: rolling resistance (switched on in a copy of the
+/// parameters) has power `-Crr N |v_c|^2 / S` with the regularised contact
+/// speed `S = sqrt(|v_c|^2 + 0.05^2)`, and the tyre force rate has slope
+/// `-S / sigma` in the force.
+fn tyre_loads(param: &[f64], p: &[f64], dp: &[f64]) -> [f64; 2] {
+    type T = bikedyn::generated::ThesisTyreFree;
+    let nq = T::nq();
+    let np = T::PARAMETERS.len();
+    let mut q = param.to_vec();
+    let mut loads = [0.0; 2];
+    for (i, w) in ["rear", "front"].iter().enumerate() {
+        q[T::parameter_index(&format!("Crr_{w}")).unwrap()] = 1.0;
+        let f = T::FORCES
+            .iter()
+            .position(|f| f.name == format!("rolling_resistance_{w}"))
+            .unwrap();
+        let mut terms = vec![0.0; T::FORCES.len() * nq];
+        T::applied_force_terms(&q, 0.0, p, dp, &mut terms);
+        let power: f64 = (0..nq).map(|j| terms[f * nq + j] * dp[j]).sum();
+        let mut rates = [[0.0; 2]; 2];
+        for (s, force) in [0.0, 1.0].iter().enumerate() {
+            q[np + i] = *force;
+            T::state_rates(&q, 0.0, p, dp, &mut rates[s]);
+        }
+        let sigma = param[T::parameter_index(&format!("sigma_{w}")).unwrap()];
+        let speed = -(rates[1][i] - rates[0][i]) * sigma;
+        loads[i] = -power * speed / (speed * speed - 0.05 * 0.05);
+    }
+    loads
+}
+
+/// Issue 7, point 1: with relaxation (and no camber thrust, which is not a
+/// dissipative force) the tyres dissipate: the total energy, kinetic plus
+/// potential plus the elastic energy of the tyres' lateral compliance
+/// `sigma F^2 / (2 C_alpha N)` per tyre (the relaxation law is a spring of
+/// stiffness `C_alpha N / sigma` in series with the slip damper), never
+/// increases.
+#[test]
+fn tyre_relaxation_never_increases_the_energy() {
+    type T = bikedyn::generated::ThesisTyreFree;
+    let mut param = default_parameters::<T>();
+    for w in ["rear", "front"] {
+        param[T::parameter_index(&format!("Cg_{w}")).unwrap()] = 0.0;
+    }
+    let opts = SimOptions {
+        rtol: 1e-10,
+        atol: 1e-12,
+        ..Default::default()
+    };
+    let sim = free_kick::<T>(&param, &opts);
+    assert_eq!(sim.stop, StopReason::Completed);
+    let idx = |n: &str| T::parameter_index(n).unwrap();
+    let weight = ["m2", "m3", "m4", "m5"].iter().map(|m| param[idx(m)]).sum::<f64>() * param[idx("g")];
+    let mut energy = Vec::new();
+    let mut mechanical_rises = 0;
+    for i in 0..sim.t.len() {
+        let n = tyre_loads(&sim.parameters, &sim.p[i], &sim.dp[i]);
+        // The quasi-static loads carry the weight (checks the probe).
+        assert!((n[0] + n[1] - weight).abs() < 1e-9 * weight, "{n:?} vs {weight}");
+        let elastic: f64 = ["rear", "front"]
+            .iter()
+            .enumerate()
+            .map(|(k, w)| {
+                param[idx(&format!("sigma_{w}"))] * sim.z[i][k].powi(2) / (2.0 * param[idx(&format!("Ca_{w}"))] * n[k])
+            })
+            .sum();
+        let mechanical = sim.kinetic_energy[i] + sim.potential_energy[i];
+        if i > 0 && sim.t[i] > sim.t[i - 1] {
+            let prev = sim.kinetic_energy[i - 1] + sim.potential_energy[i - 1];
+            mechanical_rises += (mechanical > prev) as usize;
+        }
+        energy.push((sim.t[i], mechanical + elastic));
+    }
+    // After the kick (the first sample is before it).
+    let e0 = energy[1].1;
+    let worst = energy[1..]
+        .windows(2)
+        .map(|w| w[1].1 - w[0].1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let lost = e0 - energy.last().unwrap().1;
+    println!(
+        "energy after the kick {e0:.6} J, dissipated by the tyres in 3 s {lost:.4} J, largest rise between samples {worst:.3e} J; kinetic + potential alone rose between {mechanical_rises} of {} samples",
+        energy.len() - 1
+    );
+    assert!(worst <= 1e-9 * e0, "energy rose by {worst} J");
+    assert!(lost > 1e-3 * e0, "no dissipation: {lost} J");
+}
+
+/// `bikedyn simulate --model thesis_tyre_free` runs a kick and writes the
+/// tyre forces as extra CSV columns.
+#[test]
+fn cli_simulates_the_tyre_model() {
+    let dir = std::env::temp_dir().join(format!("bikedyn-sim-tyre-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let csv = dir.join("tyre.csv");
+    let out = cli(&[
+        "simulate",
+        "--model",
+        "thesis_tyre_free",
+        "--speed",
+        "4.5",
+        "--kick",
+        "0.5:3",
+        "--duration",
+        "3",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}");
+    assert!(stdout.contains("stop: completed"), "{stdout}");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let header: Vec<&str> = text.lines().next().unwrap().split(',').collect();
+    assert_eq!(
+        &header[header.len() - 3..],
+        ["constraint_residual", "Fy_rear", "Fy_front"]
+    );
+    let last: Vec<f64> = text
+        .lines()
+        .last()
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    assert_eq!(last[0], 3.0);
+}
+
+/// Issue 7, point 2: stiff effects. With tyres 100 times stiffer
+/// (cornering stiffness x100, relaxation length 2 mm) the tyre dynamics are
+/// ~10^3-10^4 1/s fast and bound DOP853's step by stability: Radau5
+/// integrates the same kick in far fewer right-hand-side evaluations and
+/// both agree. With a 0.2 mm relaxation length DOP853 gives up (its
+/// stiffness detection) and says to use Radau5, which integrates it.
+#[test]
+fn stiff_tyres_need_far_fewer_evaluations_with_radau5() {
+    type T = bikedyn::generated::ThesisTyreFree;
+    let run = |param: &[f64], method| {
+        let inputs = Inputs {
+            kicks: vec![Kick::at_saddle(0.0, 3.0)],
+            pulses: vec![],
+        };
+        let ic = InitialConditions {
+            speed: 4.5,
+            ..Default::default()
+        };
+        let opts = SimOptions {
+            method,
+            ..Default::default()
+        };
+        simulate::<T>(param, &ic, &inputs, 3.0, &opts)
+    };
+    let param = stiff_tyres(100.0);
+    let explicit = run(&param, Method::Dop853).unwrap();
+    let implicit = run(&param, Method::Radau5).unwrap();
+    assert_eq!(implicit.stop, StopReason::Completed);
+    // Same output grid (DOP853 accumulates its sample times).
+    assert_eq!(implicit.t.len(), explicit.t.len());
+    assert!(implicit.t.iter().zip(&explicit.t).all(|(a, b)| (a - b).abs() < 1e-9));
+    assert!(implicit.max_constraint_residual() < 1e-9);
+    let peak = explicit
+        .coordinate("theta")
+        .unwrap()
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut dev = 0.0f64;
+    for name in ["theta", "gamma"] {
+        let (a, b) = (explicit.coordinate(name).unwrap(), implicit.coordinate(name).unwrap());
+        dev = a.iter().zip(&b).fold(dev, |m, (x, y)| m.max((x - y).abs()));
+    }
+    let (ne, ni) = (explicit.stats.rhs_evaluations, implicit.stats.rhs_evaluations);
+    println!(
+        "tyres 100x stiffer, rtol 1e-8: DOP853 {ne} evaluations ({} steps), Radau5 {ni} evaluations ({} steps), {:.1}x fewer; largest roll/steer difference {dev:.2e} rad ({:.1e} of the peak roll)",
+        explicit.stats.accepted_steps + explicit.stats.rejected_steps,
+        implicit.stats.accepted_steps + implicit.stats.rejected_steps,
+        ne as f64 / ni as f64,
+        dev / peak
+    );
+    assert!(ni * 5 < ne, "Radau5 {ni} vs DOP853 {ne} evaluations");
+    // Measured 5.0e-5 of the peak: Radau5's samples come from its
+    // collocation polynomial (order 4), DOP853's from a 7th-order one.
+    assert!(dev < 1e-4 * peak, "methods disagree by {dev} rad");
+
+    let mut param = default_parameters::<T>();
+    for w in ["rear", "front"] {
+        param[T::parameter_index(&format!("sigma_{w}")).unwrap()] = 2e-4;
+    }
+    match run(&param, Method::Dop853) {
+        Err(bikedyn_runtime::simulate::SimulateError::Integrator { message, .. }) => {
+            assert!(message.contains("radau5"), "{message}")
+        }
+        other => panic!("DOP853 on 0.2 mm relaxation: {:?}", other.map(|s| s.stats)),
+    }
+    let sim = run(&param, Method::Radau5).unwrap();
+    assert_eq!(sim.stop, StopReason::Completed);
+    println!(
+        "relaxation length 0.2 mm: Radau5 {} evaluations ({} steps)",
+        sim.stats.rhs_evaluations,
+        sim.stats.accepted_steps + sim.stats.rejected_steps
+    );
+
+    // The CLI selects the method.
+    let out = cli(&[
+        "simulate",
+        "--model",
+        "thesis_tyre_free",
+        "--speed",
+        "4.5",
+        "--kick",
+        "0:3",
+        "--duration",
+        "1",
+        "--method",
+        "radau5",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    println!("{stdout}");
+    assert!(stdout.contains("radau5: simulated 1.000 s"), "{stdout}");
+    let out = cli(&["simulate", "--speed", "4.5", "--duration", "1", "--method", "euler"]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+/// Radau5 reproduces DOP853 on the non-stiff thesis model too, and locates
+/// a fall.
+#[test]
+fn radau5_matches_dop853_and_stops_at_a_fall() {
+    let ic = InitialConditions {
+        roll: 0.05,
+        speed: 1.0,
+        ..Default::default()
+    };
+    let run = |method| {
+        let opts = SimOptions {
+            method,
+            rtol: 1e-10,
+            atol: 1e-12,
+            events: Events {
+                roll_limit: Some(0.8),
+                steer_limit: None,
+            },
+            ..Default::default()
+        };
+        simulate::<M>(&thesis_at(1.0), &ic, &Inputs::default(), 20.0, &opts).unwrap()
+    };
+    let (a, b) = (run(Method::Dop853), run(Method::Radau5));
+    let (ta, tb) = match (a.stop, b.stop) {
+        (StopReason::Fell { time: ta, .. }, StopReason::Fell { time: tb, roll }) => {
+            assert!((roll.abs() - 0.8).abs() < 1e-8);
+            (ta, tb)
+        }
+        s => panic!("expected two falls, got {s:?}"),
+    };
+    println!("fall at {ta:.9} s (DOP853), {tb:.9} s (Radau5)");
+    // Measured 2.8e-6 s at rtol 1e-10 (the fall amplifies errors ~16x).
+    assert!((ta - tb).abs() < 1e-5, "{ta} vs {tb}");
+}
+
+/// Extrema of a sampled signal after `t_start` (parabola-refined, as in
+/// `simulate::fit`): the fit window of the weave eigenvalue.
+fn extrema(t: &[f64], y: &[f64], t_start: f64) -> Vec<(f64, f64)> {
+    let mut ext = Vec::new();
+    for i in 1..t.len() - 1 {
+        if t[i] <= t_start || t[i - 1] >= t[i] || t[i] >= t[i + 1] {
+            continue;
+        }
+        let (y0, y1, y2) = (y[i - 1], y[i], y[i + 1]);
+        if (y1 > y0 && y1 >= y2) || (y1 < y0 && y1 <= y2) {
+            let den = y0 - 2.0 * y1 + y2;
+            let d = if den != 0.0 { 0.5 * (y0 - y2) / den } else { 0.0 };
+            ext.push((t[i] + d * (t[i + 1] - t[i]), y1 - 0.25 * (y0 - y2) * d));
+        }
+    }
+    ext
+}
+
+/// Saddle kick at t = 0 scaled so that the first roll peak is `peak` (rad),
+/// for any model (`thesis_at`-style parameters given).
+fn kick_to_peak_of<N: MultibodyModel>(param: &[f64], speed: f64, peak: f64) -> bikedyn_runtime::simulate::Simulation {
+    let run = |j: f64| {
+        let inputs = Inputs {
+            kicks: vec![Kick::at_saddle(0.0, j)],
+            pulses: vec![],
+        };
+        let o = SimOptions {
+            output_interval: 0.002,
+            ..Default::default()
+        };
+        let ic = InitialConditions {
+            speed,
+            ..Default::default()
+        };
+        simulate::<N>(param, &ic, &inputs, 4.0, &o).unwrap()
+    };
+    let mut j = 1.0;
+    for _ in 0..6 {
+        let s = run(j);
+        let r = s.coordinate("theta").unwrap();
+        let first = extrema(&s.t, &r, 0.0).into_iter().find(|e| e.1 > 0.0).unwrap().1;
+        j *= peak / first;
+    }
+    run(j)
+}
+
+/// Issue 7, point 5, speed-decay half: the weave eigenvalue fitted (as in
+/// `weave_fit_versus_amplitude`: first three half-swings after a saddle kick
+/// to 10 degrees of roll) to the free-speed thesis model with rolling
+/// resistance and aerodynamic drag, against the fit of the driven model at
+/// the mean speed of the fit window (same kick amplitude: the fitting
+/// window's own bias cancels) and the frozen-speed linear eigenvalue there.
+/// Prints the README's speed-decay table.
+#[test]
+fn weave_fit_with_speed_decay() {
+    type E = bikedyn::generated::ThesisExtendedFree;
+    let peak = 10f64.to_radians();
+    let idx = |n: &str| E::parameter_index(n).unwrap();
+    println!("| V0 (m/s) | Crr | CdA (m^2) | speed over the window (m/s) | mean V | a (1/s) | b (rad/s) | driven fit at mean V: a, b | linear at mean V: a, b | a - driven a | b vs driven b |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    for v0 in [4.5, 5.5] {
+        let mut previous_loss = -1.0;
+        for (crr, cda) in [(0.0, 0.0), (0.005, 0.3), (0.01, 0.5)] {
+            let mut param = default_parameters::<E>();
+            param[idx("Crr_rear")] = crr;
+            param[idx("Crr_front")] = crr;
+            param[idx("CdA")] = cda;
+            param[idx("rho_air")] = 1.2;
+            let sim = kick_to_peak_of::<E>(&param, v0, peak);
+            assert_eq!(sim.stop, StopReason::Completed);
+            let roll = sim.coordinate("theta").unwrap();
+            let (a, b) = bikedyn_runtime::simulate::fit::weave_from_extrema(&sim.t, &roll, 0.0, 3).unwrap();
+            // The fit uses the first five extrema: its window.
+            let ext = extrema(&sim.t, &roll, 0.0);
+            let (t0, t1) = (ext[0].0, ext[4].0);
+            let window: Vec<f64> = sim
+                .t
+                .iter()
+                .zip(&sim.speed)
+                .filter(|(t, _)| **t >= t0 && **t <= t1)
+                .map(|(_, v)| *v)
+                .collect();
+            let mean = window.iter().sum::<f64>() / window.len() as f64;
+            let (vs, ve) = (window[0], window[window.len() - 1]);
+            let driven = kick_to_peak_of::<M>(&thesis_at(mean), mean, peak);
+            let (da, db) = bikedyn_runtime::simulate::fit::weave_from_extrema(
+                &driven.t,
+                &driven.coordinate("theta").unwrap(),
+                0.0,
+                3,
+            )
+            .unwrap();
+            let (la, lb) = linear_weave(mean);
+            println!(
+                "| {v0} | {crr} | {cda} | {vs:.3} -> {ve:.3} | {mean:.3} | {a:.3} | {b:.3} | {da:.3}, {db:.3} | {la:.3}, {lb:.3} | {:+.3} | {:+.1}% |",
+                a - da,
+                (b - db) / db * 100.0
+            );
+            // Dissipation slows the bicycle over the window, more with more
+            // resistance.
+            let loss = vs - ve;
+            if crr > 0.0 {
+                assert!(
+                    loss > previous_loss && loss > 0.0,
+                    "speed loss {loss} after {previous_loss}"
+                );
+            }
+            previous_loss = loss;
+            // The free-speed model without dissipation fits like the driven
+            // one at its mean speed.
+            if crr == 0.0 && cda == 0.0 {
+                assert!(
+                    (a - da).abs() < 0.05 && (b - db).abs() < 0.01 * db,
+                    "{a} {b} vs {da} {db}"
+                );
+            }
+        }
+    }
 }

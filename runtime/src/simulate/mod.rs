@@ -6,9 +6,11 @@
 //! coordinates `q` of the model (`M::INDEPENDENT`: roll theta and steer gamma
 //! for a driven-speed model; theta, rear wheel rotation psi and gamma for a
 //! free-speed one) and their rates, the ignorable coordinates `g` (those that
-//! are neither independent nor dependent: `xc yc phi eps`), and extra
-//! first-order states `z` (none yet; appended last). At every evaluation of
-//! the right-hand side:
+//! are neither independent nor dependent: `xc yc phi eps` with rolling
+//! constraints, `xc eps` with tyre slip, where `yc` and `phi` are
+//! independent), and the extra first-order states `z` of `M::STATES` (e.g.
+//! the lagged lateral tyre forces of `tyre_relaxation`). At every evaluation
+//! of the right-hand side:
 //!
 //! 1. the dependent positions (`M::DEPENDENT`: pitch beta, the front contact
 //!    angle xi and, in driven models, psi) are solved from the holonomic
@@ -23,7 +25,18 @@
 //!    give `q''`; `Qin` are the torque pulses of [`Inputs`];
 //! 4. the ignorable coordinates are integrated from their rates (the
 //!    dependent velocities of step 2); time is a state too (`t' = 1`), which
-//!    makes the system autonomous for the integrator (see [`StateLayout`]).
+//!    makes the system autonomous for the integrator (see [`StateLayout`]);
+//! 5. the generated code reads `z` from the tail of the parameter vector
+//!    (`M::STATES`), so `z` is written there before step 1, and
+//!    `z' = M::state_rates(param + z, t, p, p')` with the full `p, p'`.
+//!
+//! Initial conditions: the independent rates other than roll and steer (the
+//! rear wheel's with free speed; with tyre slip also `yc` and `phi`) solve
+//! `speed = V` and `z' = 0` for the given `z(0)` (zero unless the parameter
+//! vector carries a tail): the extra states start at rest, which upright
+//! is rolling without lateral slip. A kick is a finite impulse, so with
+//! tyre slip it makes the wheels slide sideways until the tyre forces build
+//! up; `z` does not jump.
 //!
 //! # Drift control
 //!
@@ -42,13 +55,25 @@
 //!
 //! # Integrator
 //!
-//! `ode_solvers` 0.6.2 (`Dop853`, Hairer's DOP853: explicit Runge-Kutta of
-//! order 8(5,3), adaptive step with error control, 7th-order dense output),
-//! chosen because it uses the workspace's nalgebra 0.34 (no second nalgebra,
-//! a few seconds of build time) and is a faithful port of Hairer's code. The
-//! Whipple model with or without mild dissipation is not stiff. A stiff
-//! method (BDF/SDIRK of diffsol, nalgebra 0.35) is not wired in: see the
-//! README's "Simulation" section.
+//! [`Method::Dop853`] (default): `ode_solvers` 0.6.2 (`Dop853`, Hairer's
+//! DOP853: explicit Runge-Kutta of order 8(5,3), adaptive step with error
+//! control, 7th-order dense output), chosen because it uses the workspace's
+//! nalgebra 0.34 (no second nalgebra, a few seconds of build time) and is a
+//! faithful port of Hairer's code. The Whipple model with or without mild
+//! dissipation is not stiff.
+//!
+//! [`Method::Radau5`]: Radau IIA of order 5 (implicit, L-stable, adaptive,
+//! dense output; Hairer's RADAU5 scheme) from `differential-equations` 0.7
+//! (without features it depends on no nalgebra at all), for stiff effects:
+//! with a tyre relaxation length of a fraction of a millimetre the tyre
+//! forces relax at `|v| / sigma` ~ 10^4 1/s, which limits DOP853's step by
+//! stability, not accuracy. The Jacobian is by forward differences over the
+//! model's state (one evaluation per component); the crate scales the
+//! tolerances as RADAU5 does (`rtol -> 0.1 rtol^(2/3)`), and the Newton
+//! tolerance is set as in Hairer's code. Its samples come from the
+//! collocation polynomial (order 4, DOP853's is 7), so at equal rtol the two
+//! methods' samples agree to about 1e-4 of the amplitude; events are located
+//! from a step point, not from a sample.
 //!
 //! Kicks and pulse edges are breakpoints: the integration restarts there, so
 //! the error control never steps over a discontinuity.
@@ -66,6 +91,9 @@ pub use rhs::{forward_speed, BicycleCoordinates, Evaluator, StateLayout};
 use std::io::Write;
 use std::path::Path;
 
+use differential_equations::prelude::{
+    ControlFlag, ImplicitRungeKutta, Interpolation, Matrix as DeMatrix, Solout, Solution, IVP, ODE,
+};
 use ode_solvers::{DVector, Dop853, OutputType, System};
 use serde::Serialize;
 use thiserror::Error;
@@ -123,6 +151,8 @@ pub struct SimOptions {
     pub output_interval: f64,
     /// Events that stop the run.
     pub events: Events,
+    /// Integration method (default DOP853).
+    pub method: Method,
 }
 
 impl Default for SimOptions {
@@ -132,7 +162,49 @@ impl Default for SimOptions {
             atol: 1e-10,
             output_interval: 0.01,
             events: Events::default(),
+            method: Method::default(),
         }
+    }
+}
+
+/// Integration method.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub enum Method {
+    /// DOP853 (explicit Runge-Kutta 8(5,3), `ode_solvers`): the default, for
+    /// models that are not stiff.
+    #[default]
+    Dop853,
+    /// Radau IIA of order 5 (implicit, L-stable, Hairer's RADAU5 scheme;
+    /// `differential-equations`), Jacobian by forward differences: for stiff
+    /// effects such as very short tyre relaxation lengths.
+    Radau5,
+}
+
+impl Method {
+    /// Every method, by its command-line name.
+    pub const ALL: [(&'static str, Method); 2] = [("dop853", Method::Dop853), ("radau5", Method::Radau5)];
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Dop853 => "dop853",
+            Method::Radau5 => "radau5",
+        }
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = SimulateError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .iter()
+            .find(|(n, _)| n.eq_ignore_ascii_case(s))
+            .map(|(_, m)| *m)
+            .ok_or_else(|| {
+                SimulateError::InvalidInput(format!(
+                    "unknown integration method `{s}` (expected {})",
+                    Self::ALL.map(|(n, _)| n).join(" or ")
+                ))
+            })
     }
 }
 
@@ -171,6 +243,11 @@ pub struct Simulation {
     pub constraint_residual: Vec<f64>,
     /// Max-norm of the velocity constraints `D p' - d` (m/s, rad/s).
     pub velocity_residual: Vec<f64>,
+    /// Names of the model's extra first-order states (`M::STATES`; empty
+    /// for most models).
+    pub states: Vec<&'static str>,
+    /// Extra states at each sample (e.g. tyre lateral forces, N).
+    pub z: Vec<Vec<f64>>,
     pub stop: StopReason,
     pub stats: SimStats,
     pub options: SimOptions,
@@ -216,8 +293,15 @@ impl Simulation {
         e[start..].iter().fold(0.0f64, |m, x| m.max((x - e0).abs())) / e0.abs().max(f64::MIN_POSITIVE)
     }
 
+    /// Column of an extra state by name.
+    pub fn state(&self, name: &str) -> Option<Vec<f64>> {
+        let j = self.states.iter().position(|c| *c == name)?;
+        Some(self.z.iter().map(|z| z[j]).collect())
+    }
+
     /// CSV header: `t`, every coordinate, `d` + every coordinate, `speed`,
-    /// `kinetic_energy`, `potential_energy`, `constraint_residual`.
+    /// `kinetic_energy`, `potential_energy`, `constraint_residual`, then the
+    /// extra states by name (models with states only).
     pub fn csv_header(&self) -> Vec<String> {
         let mut h = vec!["t".to_string()];
         h.extend(self.coordinates.iter().map(|c| c.to_string()));
@@ -225,6 +309,7 @@ impl Simulation {
         for s in ["speed", "kinetic_energy", "potential_energy", "constraint_residual"] {
             h.push(s.into());
         }
+        h.extend(self.states.iter().map(|s| s.to_string()));
         h
     }
 
@@ -244,6 +329,7 @@ impl Simulation {
             ] {
                 row.push(format!("{x:.12e}"));
             }
+            row.extend(self.z[i].iter().map(|x| format!("{x:.12e}")));
             c.write_record(&row)?;
         }
         c.flush()?;
@@ -280,6 +366,201 @@ impl<M: MultibodyModel> System<f64, DVector<f64>> for Rhs<'_, '_, M> {
     }
 }
 
+/// The implicit integrator's view of the model. `differential-equations`
+/// 0.7.0's Radau5 starts its Newton iteration from `Y::zeros()`, which is
+/// empty for `Vec<f64>`, so the state is a fixed-size array: the model's `n`
+/// components, padded with components whose rate is zero.
+struct Padded<'f> {
+    n: usize,
+    f: &'f dyn Fn(&[f64], &mut [f64]),
+}
+
+impl<const N: usize> ODE<f64, [f64; N]> for Padded<'_> {
+    fn diff(&self, _t: f64, y: &[f64; N], dy: &mut [f64; N]) {
+        dy.fill(0.0);
+        (self.f)(&y[..self.n], &mut dy[..self.n]);
+    }
+    /// Forward differences over the model's components only (the padding is
+    /// constant).
+    fn jacobian(&self, t: f64, y: &[f64; N], j: &mut DeMatrix<f64>) {
+        let n = self.n;
+        for r in 0..j.nrows() {
+            for c in 0..j.ncols() {
+                j[(r, c)] = 0.0;
+            }
+        }
+        let (mut f0, mut f1) = ([0.0; N], [0.0; N]);
+        self.diff(t, y, &mut f0);
+        let mut yp = *y;
+        for c in 0..n {
+            let h = f64::EPSILON.sqrt() * y[c].abs().max(1.0);
+            yp[c] = y[c] + h;
+            self.diff(t, &yp, &mut f1);
+            yp[c] = y[c];
+            for r in 0..n {
+                j[(r, c)] = (f1[r] - f0[r]) / h;
+            }
+        }
+    }
+}
+
+/// Output of the implicit integrator: dense samples at `times`, and a stop
+/// at the end of the first step where `stop` holds (that end point is pushed
+/// too, so that an event is seen and located).
+struct Sampler<'f> {
+    stop: &'f dyn Fn(&[f64]) -> bool,
+    times: Vec<f64>,
+    next: usize,
+    /// Start `(t, y)` of the step at whose end `stop` held: a step point, as
+    /// accurate as the integration (the samples inside a step come from
+    /// Radau5's collocation polynomial, of order 4 only).
+    stopped_from: &'f std::cell::RefCell<Option<(f64, Vec<f64>)>>,
+}
+
+impl<const N: usize> Solout<f64, [f64; N]> for Sampler<'_> {
+    fn solout<I>(
+        &mut self,
+        t_curr: f64,
+        t_prev: f64,
+        y_curr: &[f64; N],
+        y_prev: &[f64; N],
+        interpolator: &mut I,
+        solution: &mut Solution<f64, [f64; N]>,
+    ) -> ControlFlag<f64, [f64; N]>
+    where
+        I: Interpolation<f64, [f64; N]> + ?Sized,
+    {
+        // The last step ends at the segment end up to rounding.
+        let tol = 1e-12 * t_curr.abs().max(1.0);
+        while let Some(&t) = self.times.get(self.next) {
+            if t > t_curr + tol {
+                break;
+            }
+            let y = if (t - t_curr).abs() <= tol {
+                *y_curr
+            } else {
+                match interpolator.interpolate(t) {
+                    Ok(y) => y,
+                    Err(_) => break,
+                }
+            };
+            solution.push(t, y);
+            self.next += 1;
+        }
+        if (self.stop)(y_curr) {
+            *self.stopped_from.borrow_mut() = Some((t_prev, y_prev.to_vec()));
+            if solution.t.last().is_none_or(|&t| t < t_curr) {
+                solution.push(t_curr, *y_curr);
+            }
+            return ControlFlag::Terminate;
+        }
+        ControlFlag::Continue
+    }
+}
+
+/// Samples `(t, y)` of a Radau5 run, its accepted and rejected steps, and
+/// the start of the step where it stopped early.
+type RadauRun = (Vec<f64>, Vec<Vec<f64>>, usize, usize, Option<(f64, Vec<f64>)>);
+
+fn radau_padded<const N: usize>(
+    f: &dyn Fn(&[f64], &mut [f64]),
+    stop: &dyn Fn(&[f64]) -> bool,
+    opts: &SimOptions,
+    t0: f64,
+    y0: &[f64],
+    times: Vec<f64>,
+) -> Result<RadauRun, (f64, String)> {
+    let n = y0.len();
+    let t1 = *times.last().expect("at least one sample time");
+    let mut y = [0.0; N];
+    y[..n].copy_from_slice(y0);
+    let sys = Padded { n, f };
+    // Hairer's RADAU5 Newton stopping tolerance for the scaled rtol; the
+    // crate's fixed default (3.2e-3) ignores rtol and stops the Newton
+    // iteration too early for tight tolerances.
+    let scaled_rtol = 0.1 * opts.rtol.powf(2.0 / 3.0);
+    let newton_tol = (10.0 * f64::EPSILON / scaled_rtol).max(0.03f64.min(scaled_rtol.sqrt()));
+    let method = ImplicitRungeKutta::radau5()
+        .rtol(opts.rtol)
+        .atol(opts.atol)
+        .newton_tol(newton_tol)
+        .max_steps(10_000_000);
+    let stopped_from = std::cell::RefCell::new(None);
+    let sampler = Sampler {
+        stop,
+        times,
+        next: 0,
+        stopped_from: &stopped_from,
+    };
+    let sol = IVP::ode(&sys, t0, t1, y)
+        .method(method)
+        .solout(sampler)
+        .solve()
+        .map_err(|e| {
+            use differential_equations::error::Error as E;
+            // The crate's error carries the state; say what happened.
+            match e {
+                E::MaxSteps { t, .. } => (t, "Radau5: maximum number of steps reached".to_string()),
+                E::StepSize { t, .. } => (t, "Radau5: step size too small".to_string()),
+                E::Stiffness { t, .. } => (t, "Radau5: stiffness detected".to_string()),
+                E::LinearAlgebra { t, msg, .. } => (t, format!("Radau5: {msg}")),
+                E::BadInput { msg } => (t0, format!("Radau5: {msg}")),
+                other => (t0, format!("Radau5: {other:?}")),
+            }
+        })?;
+    let ys = sol.y.iter().map(|y| y[..n].to_vec()).collect();
+    let from = stopped_from.into_inner().map(|(t, y)| (t, y[..n].to_vec()));
+    Ok((sol.t, ys, sol.steps.accepted, sol.steps.rejected, from))
+}
+
+/// Integrate with Radau5 from `(t0, y0)` and sample at `times` (increasing,
+/// after `t0`, the last one the end), stopping early when an event of
+/// `events` fires. Returns the samples and, after an early stop, the start
+/// of the last step.
+fn radau_samples<M: MultibodyModel>(
+    eval: &Evaluator<'_, M>,
+    opts: &SimOptions,
+    events: Events,
+    t0: f64,
+    y0: &[f64],
+    times: Vec<f64>,
+    stats: &mut SimStats,
+) -> Result<RadauSamples, SimulateError> {
+    let f = |y: &[f64], dy: &mut [f64]| {
+        if eval.error.borrow().is_some() {
+            dy.fill(f64::NAN);
+            return;
+        }
+        if let Err(e) = eval.derivative(y[eval.layout.time()], y, dy) {
+            *eval.error.borrow_mut() = Some(e);
+            dy.fill(f64::NAN);
+        }
+    };
+    let stop = |y: &[f64]| eval.error.borrow().is_some() || event_value(eval, &events, y).0 <= 0.0;
+    // A few padded sizes (each is a monomorphisation of the solver).
+    let r = match y0.len() {
+        0..=12 => radau_padded::<12>(&f, &stop, opts, t0, y0, times),
+        13..=16 => radau_padded::<16>(&f, &stop, opts, t0, y0, times),
+        17..=32 => radau_padded::<32>(&f, &stop, opts, t0, y0, times),
+        n => {
+            return Err(SimulateError::InvalidInput(format!(
+                "Radau5 supports states of up to 32 components, model `{}` has {n}",
+                M::NAME
+            )))
+        }
+    };
+    if let Some(e) = eval.error.borrow_mut().take() {
+        return Err(e);
+    }
+    let (ts, ys, accepted, rejected, from) = r.map_err(|(t, message)| SimulateError::Integrator { t, message })?;
+    stats.accepted_steps += accepted as u64;
+    stats.rejected_steps += rejected as u64;
+    Ok((ts, ys, from))
+}
+
+/// Samples of [`radau_samples`] and the start of the step where it stopped.
+type RadauSamples = (Vec<f64>, Vec<Vec<f64>>, Option<(f64, Vec<f64>)>);
+
 /// Smallest event margin (`limit - |angle|`, rad) and which event it is
 /// (0 roll, 1 steer).
 fn event_value<M: MultibodyModel>(eval: &Evaluator<'_, M>, ev: &Events, y: &[f64]) -> (f64, usize) {
@@ -310,6 +591,17 @@ fn integrate_to<M: MultibodyModel>(
     if t1 <= t0 {
         return Ok(y0.to_vec());
     }
+    if opts.method == Method::Radau5 {
+        let none = Events {
+            roll_limit: None,
+            steer_limit: None,
+        };
+        let (_, ys, _) = radau_samples(eval, opts, none, t0, y0, vec![t1], stats)?;
+        return ys.into_iter().last().ok_or_else(|| SimulateError::Integrator {
+            t: t0,
+            message: "Radau5 returned no end point".into(),
+        });
+    }
     let rhs = Rhs {
         eval,
         events: Events {
@@ -333,7 +625,7 @@ fn integrate_to<M: MultibodyModel>(
     }
     let st = r.map_err(|e| SimulateError::Integrator {
         t: t0,
-        message: e.to_string(),
+        message: format!("DOP853: {e} (for stiff effects use the Radau5 method, --method radau5)"),
     })?;
     stats.accepted_steps += st.accepted_steps as u64;
     stats.rejected_steps += st.rejected_steps as u64;
@@ -365,7 +657,7 @@ pub fn initial_state<M: MultibodyModel>(
             });
         }
     }
-    let mut param = param.to_vec();
+    let mut param = rhs::with_state_tail::<M>(param)?;
     let driven = M::INDEPENDENT.len() == 2;
     if let Some(k) = M::FORWARD_SPEED_PARAMETER.filter(|_| driven) {
         if k < param.len() {
@@ -388,44 +680,96 @@ pub fn initial_state<M: MultibodyModel>(
     y[c.steer_ind] = ic.steer;
     y[l.rates() + c.roll_ind] = ic.roll_rate;
     y[l.rates() + c.steer_ind] = ic.steer_rate;
+    // Yaw is ignorable with rolling constraints, independent with tyre slip.
     if let Some(k) = l.ignorable.iter().position(|&j| j == c.yaw) {
         y[l.ignorables() + k] = ic.yaw;
+    } else if let Some(k) = l.independent.iter().position(|&j| j == c.yaw) {
+        y[k] = ic.yaw;
     }
-    // Free-speed model: the remaining independent rates (the rear wheel
-    // rotation) set the forward speed; speed is affine in them, solve for it.
+    let np = M::PARAMETERS.len();
+    y[l.extras()..].copy_from_slice(&param[np..]);
+    // The independent rates besides roll and steer: the rate that carries
+    // the forward speed (the rear wheel's, in a free-speed model) and, with
+    // tyre slip, the lateral ones (yc, phi). They solve `speed = ic.speed`
+    // and `z' = 0` (the extra states start at rest; upright, that is rolling
+    // without lateral slip), one equation per extra state.
     let others: Vec<usize> = (0..l.ni()).filter(|&k| k != c.roll_ind && k != c.steer_ind).collect();
-    // A model whose only independent coordinates are roll and steer is
-    // driven (its speed parameter was set above); one more independent
-    // coordinate (the rear wheel angle) makes the speed free.
     if !others.is_empty() {
-        match others.as_slice() {
-            [k] => {
-                let k = l.rates() + *k;
-                y[k] = 0.0;
-                let (p0, dp0) = eval.full_state(0.0, &y)?;
-                let s0 = forward_speed(&c, &p0, &dp0);
-                y[k] = 1.0;
-                let (p1, dp1) = eval.full_state(0.0, &y)?;
-                let s1 = forward_speed(&c, &p1, &dp1) - s0;
-                if !(s1.abs() > 1e-12) {
-                    return Err(SimulateError::InvalidInput(
-                        "the free independent rate does not change the forward speed".into(),
-                    ));
-                }
-                y[k] = (ic.speed - s0) / s1;
-            }
-            _ => {
-                return Err(SimulateError::InvalidInput(format!(
-                "model `{}` has no speed parameter and {} independent coordinates besides roll and steer (expected 1)",
+        if others.len() != 1 + l.extra {
+            return Err(SimulateError::InvalidInput(format!(
+                "model `{}` has {} independent coordinates besides roll and steer and {} extra states (expected one more coordinate than states)",
                 M::NAME,
-                others.len()
-            )))
-            }
+                others.len(),
+                l.extra
+            )));
         }
+        solve_free_rates(&eval, &mut y, &others, ic.speed)?;
     }
     // Check that the configuration exists.
     eval.full_state(0.0, &y)?;
     Ok((y, param))
+}
+
+/// Set the rates `y[rates + k]`, `k` in `others`, so that the forward speed
+/// is `speed` and the extra states' rates vanish: Newton's method with a
+/// finite-difference Jacobian (the conditions are affine in the rates except
+/// through the regularised contact speeds of effects like tyre slip).
+fn solve_free_rates<M: MultibodyModel>(
+    eval: &Evaluator<'_, M>,
+    y: &mut [f64],
+    others: &[usize],
+    speed: f64,
+) -> Result<(), SimulateError> {
+    let l = eval.layout.clone();
+    let m = others.len();
+    let mut dy = vec![0.0; l.len()];
+    let mut residual = |y: &[f64]| -> Result<Vec<f64>, SimulateError> {
+        let (p, dp) = eval.full_state(0.0, y)?;
+        let mut r = vec![forward_speed(&eval.coords, &p, &dp) - speed];
+        if l.extra > 0 {
+            eval.derivative(0.0, y, &mut dy)?;
+            r.extend_from_slice(&dy[l.extras()..]);
+        }
+        Ok(r)
+    };
+    for _ in 0..20 {
+        let r0 = residual(y)?;
+        if r0.iter().all(|x| *x == 0.0) {
+            return Ok(());
+        }
+        let mut jac = nalgebra::DMatrix::<f64>::zeros(m, m);
+        for (col, &k) in others.iter().enumerate() {
+            let i = l.rates() + k;
+            let h = 1e-6 * y[i].abs().max(1.0);
+            let keep = y[i];
+            y[i] = keep + h;
+            let r1 = residual(y)?;
+            y[i] = keep;
+            for row in 0..m {
+                jac[(row, col)] = (r1[row] - r0[row]) / h;
+            }
+        }
+        let step = jac.lu().solve(&nalgebra::DVector::from_vec(r0)).ok_or_else(|| {
+            SimulateError::InvalidInput(
+                "the free independent rates do not set the forward speed and the extra states' rates".into(),
+            )
+        })?;
+        let mut small = true;
+        for (col, &k) in others.iter().enumerate() {
+            let i = l.rates() + k;
+            small &= step[col].abs() <= 1e-12 * y[i].abs().max(1.0);
+            y[i] -= step[col];
+        }
+        // Stop once the update is at rounding level (the conditions are
+        // affine or nearly so: two or three iterations).
+        if small {
+            return Ok(());
+        }
+    }
+    let r = residual(y)?;
+    Err(SimulateError::InvalidInput(format!(
+        "no initial rates give forward speed {speed} m/s with the extra states at rest (residual {r:?})"
+    )))
 }
 
 /// Simulate model `M` with parameters `param` from `ic` for `duration`
@@ -509,6 +853,8 @@ pub fn simulate<M: MultibodyModel>(
         potential_energy: vec![],
         constraint_residual: vec![],
         velocity_residual: vec![],
+        states: M::STATES.to_vec(),
+        z: vec![],
         stop: StopReason::Completed,
         stats: SimStats::default(),
         options: *opts,
@@ -522,6 +868,7 @@ pub fn simulate<M: MultibodyModel>(
         sim.potential_energy.push(M::potential_energy(&param, &p));
         sim.constraint_residual.push(r);
         sim.velocity_residual.push(v);
+        sim.z.push(y[eval.layout.extras()..].to_vec());
         sim.p.push(p);
         sim.dp.push(dp);
         Ok(())
@@ -556,42 +903,56 @@ pub fn simulate<M: MultibodyModel>(
         let n = ((t1 - t0) / opts.output_interval - 1e-9).ceil().max(1.0);
         let dx = (t1 - t0) / n;
         eval.segment.set((t0, t1));
-        let rhs = Rhs {
-            eval: &eval,
-            events: opts.events,
-        };
-        // Integrate slightly past the segment end: ode_solvers 0.6.2 pushes
-        // an *extrapolated* dense sample at `x_end` whenever its next grid
-        // time is within 1e-9 of `x_end`, even from a step that ends before
-        // it. With the end off the grid the sample at `t1` is interpolated
-        // from the step that contains it.
-        let overshoot = (1e-6f64).min(0.01 * dx).max(1e-8);
-        let mut s = Dop853::new(
-            rhs,
-            t0,
-            t1 + overshoot,
-            dx,
-            DVector::from_column_slice(&y),
-            opts.rtol,
-            opts.atol,
-        );
-        s.set_output(OutputType::Dense);
-        let r = s.integrate();
-        if let Some(e) = eval.error.borrow_mut().take() {
-            return Err(e);
-        }
-        let st = r.map_err(|e| SimulateError::Integrator {
-            t: t0,
-            message: e.to_string(),
-        })?;
-        sim.stats.accepted_steps += st.accepted_steps as u64;
-        sim.stats.rejected_steps += st.rejected_steps as u64;
-        let (mut ts, ys) = (s.x_out().clone(), s.y_out().clone());
-        if let Some(last) = ts.last_mut() {
-            if (*last - t1).abs() <= 1e-9 * t1.abs().max(1.0) {
-                *last = t1;
+        let mut stopped_from = None;
+        let (ts, ys) = if opts.method == Method::Radau5 {
+            let times: Vec<f64> = (1..=n as usize)
+                .map(|k| if k == n as usize { t1 } else { t0 + k as f64 * dx })
+                .collect();
+            let (mut ts, mut ys, from) = radau_samples(&eval, opts, opts.events, t0, &y, times, &mut sim.stats)?;
+            stopped_from = from;
+            ts.insert(0, t0);
+            ys.insert(0, y.clone());
+            (ts, ys)
+        } else {
+            let rhs = Rhs {
+                eval: &eval,
+                events: opts.events,
+            };
+            // Integrate slightly past the segment end: ode_solvers 0.6.2 pushes
+            // an *extrapolated* dense sample at `x_end` whenever its next grid
+            // time is within 1e-9 of `x_end`, even from a step that ends before
+            // it. With the end off the grid the sample at `t1` is interpolated
+            // from the step that contains it.
+            let overshoot = (1e-6f64).min(0.01 * dx).max(1e-8);
+            let mut s = Dop853::new(
+                rhs,
+                t0,
+                t1 + overshoot,
+                dx,
+                DVector::from_column_slice(&y),
+                opts.rtol,
+                opts.atol,
+            );
+            s.set_output(OutputType::Dense);
+            let r = s.integrate();
+            if let Some(e) = eval.error.borrow_mut().take() {
+                return Err(e);
             }
-        }
+            let st = r.map_err(|e| SimulateError::Integrator {
+                t: t0,
+                message: format!("DOP853: {e} (for stiff effects use the Radau5 method, --method radau5)"),
+            })?;
+            sim.stats.accepted_steps += st.accepted_steps as u64;
+            sim.stats.rejected_steps += st.rejected_steps as u64;
+            let (mut ts, ys) = (s.x_out().clone(), s.y_out().clone());
+            if let Some(last) = ts.last_mut() {
+                if (*last - t1).abs() <= 1e-9 * t1.abs().max(1.0) {
+                    *last = t1;
+                }
+            }
+            let ys: Vec<Vec<f64>> = ys.iter().map(|v| v.as_slice().to_vec()).collect();
+            (ts, ys)
+        };
         // The first sample is the segment start: skip it unless this is the
         // first segment or a kick changed the state.
         let skip = if first || kicked { 0 } else { 1 };
@@ -601,7 +962,12 @@ pub fn simulate<M: MultibodyModel>(
             let (g, which) = event_value(&eval, &opts.events, yv);
             if g <= 0.0 {
                 // Locate the crossing between the previous sample and this one.
-                let (ta, ya) = prev.clone().unwrap_or((t0, y.clone()));
+                // From the previous sample, or from the start of Radau5's
+                // last step, which is more accurate than its samples.
+                let (ta, ya) = match stopped_from.take() {
+                    Some((t_step, y_step)) if t_step < *t => (t_step, y_step),
+                    _ => prev.clone().unwrap_or((t0, y.clone())),
+                };
                 let (te, ye) = locate_event(&eval, opts, ta, &ya, *t, &mut sim.stats)?;
                 if te > ta {
                     push(&mut sim, te, &ye)?;
@@ -627,10 +993,10 @@ pub fn simulate<M: MultibodyModel>(
         if (last_t - t1).abs() > 1e-9 * t1.abs().max(1.0) {
             // The dense output stopped short of the segment end (the step
             // cap or an early stop); finish without output.
-            let ya = ys.last().expect("non-empty").as_slice().to_vec();
+            let ya = ys.last().expect("non-empty").clone();
             y = integrate_to(&eval, last_t, &ya, t1, opts, &mut sim.stats)?;
         } else {
-            y = ys.last().expect("non-empty").as_slice().to_vec();
+            y = ys.last().expect("non-empty").clone();
         }
         t0 = t1;
         first = false;

@@ -19,16 +19,17 @@ use super::SimulateError;
 /// models). Time is a state (`dt/dt = 1`): the system is autonomous for the
 /// integrator, because ode_solvers 0.6.2's DOP853 evaluates its 12th stage
 /// at `x` instead of `x + h` (its `c12` is 0, Hairer's is 1), which is
-/// harmless only for autonomous systems. Extra first-order states (e.g. tyre
-/// relaxation) are appended at the end; this is the only place that knows
-/// the layout.
+/// harmless only for autonomous systems. Extra first-order states `z`
+/// (`M::STATES`, e.g. lagged tyre forces) are appended at the end; the
+/// generated code reads them from the tail of the parameter vector, which
+/// [`Evaluator`] refreshes from `y` at every evaluation.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct StateLayout {
     /// Indices of the independent coordinates.
     pub independent: Vec<usize>,
     /// Indices of the ignorable coordinates (integrated from their rates).
     pub ignorable: Vec<usize>,
-    /// Number of extra first-order states (none in the current models).
+    /// Number of extra first-order states (`M::STATES.len()`).
     pub extra: usize,
 }
 
@@ -41,7 +42,7 @@ impl StateLayout {
         StateLayout {
             independent: M::INDEPENDENT.to_vec(),
             ignorable,
-            extra: 0,
+            extra: M::STATES.len(),
         }
     }
     /// Number of independent coordinates.
@@ -67,6 +68,10 @@ impl StateLayout {
     /// Offset of the ignorable coordinates.
     pub fn ignorables(&self) -> usize {
         2 * self.ni()
+    }
+    /// Offset of the extra first-order states.
+    pub fn extras(&self) -> usize {
+        self.time() + 1
     }
 }
 
@@ -418,10 +423,34 @@ fn newton<M: MultibodyModel>(param: &[f64], t: f64, w: &mut Workspace) -> Result
     Ok(())
 }
 
+/// The parameter vector with the extra states' tail: `param` as given when it
+/// already has it, else extended with zeros.
+pub(crate) fn with_state_tail<M: MultibodyModel>(param: &[f64]) -> Result<Vec<f64>, SimulateError> {
+    let (np, nz) = (M::PARAMETERS.len(), M::STATES.len());
+    if param.len() == np + nz {
+        Ok(param.to_vec())
+    } else if param.len() == np {
+        let mut v = param.to_vec();
+        v.resize(np + nz, 0.0);
+        Ok(v)
+    } else {
+        Err(SimulateError::ParameterCount {
+            model: M::NAME,
+            expected: np + nz,
+            got: param.len(),
+        })
+    }
+}
+
 /// Everything the model's equations need at one state: full `p`, `p'` and the
 /// independent accelerations. Generic over the model; `f64` only.
 pub struct Evaluator<'a, M: MultibodyModel> {
+    /// Parameters followed by the extra states (`M::PARAMETERS.len() +
+    /// M::STATES.len()` values; the tail holds the initial states).
     pub param: Vec<f64>,
+    /// `param` with its state tail overwritten by the `z` of the state being
+    /// evaluated (what the generated code reads).
+    pub(crate) pz: RefCell<Vec<f64>>,
     pub layout: StateLayout,
     pub coords: BicycleCoordinates,
     pub inputs: &'a Inputs,
@@ -438,21 +467,20 @@ pub struct Evaluator<'a, M: MultibodyModel> {
 }
 
 impl<'a, M: MultibodyModel> Evaluator<'a, M> {
+    /// `param` holds the parameters, optionally followed by initial values of
+    /// the extra states (zero when absent).
     pub fn new(param: &[f64], inputs: &'a Inputs) -> Result<Self, SimulateError> {
-        if param.len() != M::PARAMETERS.len() {
-            return Err(SimulateError::ParameterCount {
-                model: M::NAME,
-                expected: M::PARAMETERS.len(),
-                got: param.len(),
-            });
-        }
+        let param = with_state_tail::<M>(param)?;
         if let Some(k) = param.iter().position(|x| !x.is_finite()) {
-            return Err(SimulateError::NotFinite {
-                what: format!("parameter `{}`", M::PARAMETERS[k]),
-            });
+            let what = match M::PARAMETERS.get(k) {
+                Some(name) => format!("parameter `{name}`"),
+                None => format!("initial state `{}`", M::STATES[k - M::PARAMETERS.len()]),
+            };
+            return Err(SimulateError::NotFinite { what });
         }
         Ok(Evaluator {
-            param: param.to_vec(),
+            pz: RefCell::new(param.clone()),
+            param,
             layout: StateLayout::of::<M>(),
             coords: BicycleCoordinates::of::<M>()?,
             inputs,
@@ -479,6 +507,10 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
             });
         }
         let nh = M::HOLONOMIC.len();
+        let mut pz = self.pz.borrow_mut();
+        let np = M::PARAMETERS.len();
+        pz[np..].copy_from_slice(&y[l.extras()..l.extras() + l.extra]);
+        let param = &pz[..];
         w.p_prev.copy_from_slice(&w.p);
         for (k, &j) in l.independent.iter().enumerate() {
             w.p[j] = y[k];
@@ -513,14 +545,13 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
             }
         }
         w.have_prev = false;
-        if newton::<M>(&self.param, t, w).is_err() {
+        if newton::<M>(param, t, w).is_err() {
             // Retry from the model's initial guess (a poor warm start).
             for &j in M::DEPENDENT {
                 w.p[j] = M::INITIAL_GUESS[j];
             }
-            newton::<M>(&self.param, t, w)?;
+            newton::<M>(param, t, w)?;
         }
-        let param = &self.param[..];
         let nc = nh + M::NONHOLONOMIC.len();
         let nd = w.depv.len();
         M::holonomic_jacobian(param, t, &w.p, &mut w.d[..nh * nq]);
@@ -635,6 +666,11 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
             dy[l.ignorables() + k] = w.dp[j];
         }
         dy[l.time()] = 1.0;
+        if l.extra > 0 {
+            // `evaluate` left this state's `z` in the parameter tail.
+            let pz = self.pz.borrow();
+            M::state_rates(&pz, t, &w.p, &w.dp, &mut dy[l.extras()..l.extras() + l.extra]);
+        }
         Ok(())
     }
 
