@@ -124,7 +124,15 @@ impl Bicycle {
     /// model that has them all (the thesis model for a bicycle with its fork
     /// mass centre on the steer axis and no effects).
     pub fn model(&self, name: Option<&str>) -> Result<&'static ModelInfo, BicycleError> {
-        let nonzero = self.nonzero_parameters()?;
+        self.model_for(name, &self.nonzero_parameters()?)
+    }
+
+    /// [`Bicycle::model`] with the non-zero parameters already known.
+    fn model_for(
+        &self,
+        name: Option<&str>,
+        nonzero: &[(&'static str, f64)],
+    ) -> Result<&'static ModelInfo, BicycleError> {
         match name {
             Some(n) => {
                 let info = models()
@@ -149,10 +157,12 @@ impl Bicycle {
                     })
                 }
             }
-            None => models()
+            // Smallest first, so only the models smaller than the one chosen
+            // are tested (once per design in a sweep); ties keep registry order.
+            None => models_by_size()
                 .iter()
-                .filter(|m| !m.free_speed && fits(m, &nonzero))
-                .min_by_key(|m| m.parameters.len())
+                .find(|m| fits(m, nonzero))
+                .copied()
                 .ok_or_else(|| BicycleError::NoModelFits {
                     bike: self.name.clone(),
                     nonzero: nonzero.iter().map(|(s, _)| *s).collect::<Vec<_>>().join(", "),
@@ -169,9 +179,9 @@ impl Bicycle {
 
     /// Canonical matrices through a chosen model (`None`: the default model).
     pub fn canonical_with(&self, model: Option<&str>) -> Result<CanonicalMatrices, BicycleError> {
-        let info = self.model(model)?;
-        let active: Vec<String> = self
-            .nonzero_parameters()?
+        let nonzero = self.nonzero_parameters()?;
+        let info = self.model_for(model, &nonzero)?;
+        let active: Vec<String> = nonzero
             .into_iter()
             .filter(|(s, _)| info.parameter(s).is_some_and(|p| p.effect.is_some()))
             .map(|(s, v)| format!("{s} = {v}"))
@@ -262,6 +272,17 @@ fn set_field<P: serde::Serialize + serde::de::DeserializeOwned>(
         name: symbol.to_string(),
         thesis: ThesisParameters::SYMBOLS.join(", "),
         benchmark: BenchmarkParameters::SYMBOLS.join(", "),
+    })
+}
+
+/// The driven-speed models, by increasing number of parameters (stable, so
+/// ties keep registry order).
+fn models_by_size() -> &'static [&'static ModelInfo] {
+    static SORTED: std::sync::OnceLock<Vec<&'static ModelInfo>> = std::sync::OnceLock::new();
+    SORTED.get_or_init(|| {
+        let mut v: Vec<&'static ModelInfo> = models().iter().filter(|m| !m.free_speed).collect();
+        v.sort_by_key(|m| m.parameters.len());
+        v
     })
 }
 

@@ -8447,7 +8447,11 @@ impl MultibodyModel for ThesisExtended {
         bikedyn_runtime::linearize::WithRest,
         bikedyn_runtime::linearize::LinearizeError,
     > {
-        bikedyn_runtime::linearize::linearize_with_rest::<Self, 4usize>(param, dq0)
+        bikedyn_runtime::linearize::linearize_with_rest::<
+            Self,
+            2usize,
+            4usize,
+        >(param, dq0)
     }
     fn state_space_exact(
         param: &[f64],

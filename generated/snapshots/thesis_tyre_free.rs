@@ -9656,7 +9656,11 @@ impl MultibodyModel for ThesisTyreFree {
         bikedyn_runtime::linearize::WithRest,
         bikedyn_runtime::linearize::LinearizeError,
     > {
-        bikedyn_runtime::linearize::linearize_with_rest::<Self, 10usize>(param, dq0)
+        bikedyn_runtime::linearize::linearize_with_rest::<
+            Self,
+            5usize,
+            10usize,
+        >(param, dq0)
     }
     fn state_space_exact(
         param: &[f64],

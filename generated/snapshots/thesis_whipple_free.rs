@@ -6601,7 +6601,11 @@ impl MultibodyModel for ThesisWhippleFree {
         bikedyn_runtime::linearize::WithRest,
         bikedyn_runtime::linearize::LinearizeError,
     > {
-        bikedyn_runtime::linearize::linearize_with_rest::<Self, 6usize>(param, dq0)
+        bikedyn_runtime::linearize::linearize_with_rest::<
+            Self,
+            3usize,
+            6usize,
+        >(param, dq0)
     }
     fn state_space_exact(
         param: &[f64],

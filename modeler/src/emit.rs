@@ -699,6 +699,7 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
     // Dual widths of this model's linearizations, fixed here so that only
     // they are compiled.
     let lin_width = 2 * indep.len();
+    let lin_half = indep.len();
     let ss_width = 2 * indep.len() + m.states.len();
     let states: Vec<&str> = m.states.iter().map(|z| z.name.as_str()).collect();
     let state_docs: Vec<&str> = m.states.iter().map(|z| z.doc.as_str()).collect();
@@ -762,7 +763,7 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             fn state_rates<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) { state_rates(param, t, p, dp, out) }
             fn upright_configuration<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) { upright_configuration(param, p, out) }
             fn linearize_with_rest_exact(param: &[f64], dq0: &[f64]) -> Result<bikedyn_runtime::linearize::WithRest, bikedyn_runtime::linearize::LinearizeError> {
-                bikedyn_runtime::linearize::linearize_with_rest::<Self, #lin_width>(param, dq0)
+                bikedyn_runtime::linearize::linearize_with_rest::<Self, #lin_half, #lin_width>(param, dq0)
             }
             fn state_space_exact(param: &[f64], dq0: &[f64]) -> Result<bikedyn_runtime::linearize::StateMatrix, bikedyn_runtime::linearize::LinearizeError> {
                 bikedyn_runtime::linearize::state_space_dual::<Self, #ss_width>(param, dq0)

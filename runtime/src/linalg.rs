@@ -1,7 +1,7 @@
 //! Small dense linear algebra generic over [`Scalar`], so that dual numbers
 //! pass through constraint solves and the coordinate partitioning.
 
-use crate::scalar::Scalar;
+use crate::scalar::{Dual, Scalar};
 
 /// The matrix was singular to working precision (pivot below `tiny`).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -75,6 +75,159 @@ pub fn solve_in_place<T: Scalar>(a: &mut [T], n: usize, b: &mut [T], nrhs: usize
     Ok(())
 }
 
+/// LU factorization with partial pivoting of a real `n x n` matrix (row-major,
+/// in place), with the same pivot rule and singularity test as
+/// [`solve_in_place`]. `perm[k]` is the row swapped with row `k` at step `k`.
+/// Used to solve dual-number systems with one real factorization (see
+/// [`lu_solve_dual`]).
+pub fn lu_factor(a: &mut [f64], n: usize, perm: &mut [usize]) -> Result<(), Singular> {
+    assert_eq!(a.len(), n * n, "matrix size");
+    assert_eq!(perm.len(), n, "permutation size");
+    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(f64::MIN_POSITIVE);
+    for k in 0..n {
+        let (mut piv, mut best) = (k, a[k * n + k].abs());
+        for i in k + 1..n {
+            let v = a[i * n + k].abs();
+            if v > best {
+                piv = i;
+                best = v;
+            }
+        }
+        if !(best > scale * 1e-14) {
+            return Err(Singular {
+                column: k,
+                pivot: best,
+                scale,
+            });
+        }
+        perm[k] = piv;
+        if piv != k {
+            for j in 0..n {
+                a.swap(k * n + j, piv * n + j);
+            }
+        }
+        let inv = 1.0 / a[k * n + k];
+        for i in k + 1..n {
+            let f = a[i * n + k] * inv;
+            a[i * n + k] = f;
+            if f == 0.0 {
+                continue;
+            }
+            for j in k + 1..n {
+                a[i * n + j] -= f * a[k * n + j];
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Solve `A x = b` in place with the factors of [`lu_factor`].
+pub fn lu_solve(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64]) {
+    for k in 0..n {
+        b.swap(k, perm[k]);
+    }
+    for i in 0..n {
+        let mut s = b[i];
+        for j in 0..i {
+            s -= lu[i * n + j] * b[j];
+        }
+        b[i] = s;
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for j in i + 1..n {
+            s -= lu[i * n + j] * b[j];
+        }
+        b[i] = s / lu[i * n + i];
+    }
+}
+
+/// Solve `A X = B` in place with the factors of [`lu_factor`], for `m`
+/// right-hand sides at once (`b` is `n x m`, row-major): the inner loops run
+/// along the rows of `b`.
+pub fn lu_solve_many(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64], m: usize) {
+    assert_eq!(b.len(), n * m, "right-hand side size");
+    for k in 0..n {
+        if perm[k] != k {
+            for c in 0..m {
+                b.swap(k * m + c, perm[k] * m + c);
+            }
+        }
+    }
+    for i in 0..n {
+        let (done, rest) = b.split_at_mut(i * m);
+        let row = &mut rest[..m];
+        for j in 0..i {
+            let l = lu[i * n + j];
+            if l != 0.0 {
+                for (x, y) in row.iter_mut().zip(&done[j * m..(j + 1) * m]) {
+                    *x -= l * y;
+                }
+            }
+        }
+    }
+    for i in (0..n).rev() {
+        let (head, tail) = b.split_at_mut((i + 1) * m);
+        let row = &mut head[i * m..];
+        for j in i + 1..n {
+            let u = lu[i * n + j];
+            if u != 0.0 {
+                for (x, y) in row.iter_mut().zip(&tail[(j - i - 1) * m..(j - i) * m]) {
+                    *x -= u * y;
+                }
+            }
+        }
+        let inv = 1.0 / lu[i * n + i];
+        for x in row.iter_mut() {
+            *x *= inv;
+        }
+    }
+}
+
+/// Solve `A X = B` for dual-number `A` (`n x n`) and `B` (`n x nrhs`, both
+/// row-major) given the factors of `A`'s real part: `X = A0^-1 B0` and, along
+/// each direction, `X' = A0^-1 (B' - A' X)`. One real factorization replaces
+/// the elimination in dual arithmetic (the derivative of the inverse is
+/// exact, as with [`solve_in_place`] on duals). `B` receives `X`.
+pub fn lu_solve_dual<const N: usize>(
+    lu: &[f64],
+    n: usize,
+    perm: &[usize],
+    a: &[Dual<N>],
+    b: &mut [Dual<N>],
+    nrhs: usize,
+) {
+    let mut x: Vec<f64> = b.iter().map(|v| v.re).collect();
+    lu_solve_many(lu, n, perm, &mut x, nrhs);
+    // Columns (c, k): direction k of right-hand side c.
+    let m = nrhs * N;
+    let mut r = vec![0.0; n * m];
+    for i in 0..n {
+        for c in 0..nrhs {
+            for k in 0..N {
+                r[i * m + c * N + k] = b[i * nrhs + c].eps[k];
+            }
+        }
+        for j in 0..n {
+            let aij = &a[i * n + j].eps;
+            for c in 0..nrhs {
+                let xj = x[j * nrhs + c];
+                for k in 0..N {
+                    r[i * m + c * N + k] -= aij[k] * xj;
+                }
+            }
+        }
+    }
+    lu_solve_many(lu, n, perm, &mut r, m);
+    for i in 0..n {
+        for c in 0..nrhs {
+            let v = &mut b[i * nrhs + c];
+            v.re = x[i * nrhs + c];
+            v.eps.copy_from_slice(&r[i * m + c * N..i * m + (c + 1) * N]);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -87,6 +240,38 @@ mod tests {
         solve_in_place(&mut a, 3, &mut b, 1).unwrap();
         for i in 0..3 {
             assert!((b[i] - x[i]).abs() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn dual_solve_with_a_real_factorization_matches_dual_elimination() {
+        let re = [0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 3.0, 0.0, 1.0];
+        let a: Vec<Dual<2>> = re
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| Dual {
+                re: x,
+                eps: [0.1 * i as f64, (i as f64).sin()],
+            })
+            .collect();
+        let b: Vec<Dual<2>> = (0..6)
+            .map(|i| Dual {
+                re: 1.0 + i as f64,
+                eps: [(i as f64).cos(), -0.3 * i as f64],
+            })
+            .collect();
+        let (mut a1, mut b1) = (a.clone(), b.clone());
+        solve_in_place(&mut a1, 3, &mut b1, 2).unwrap();
+        let mut lu = re;
+        let mut perm = [0; 3];
+        lu_factor(&mut lu, 3, &mut perm).unwrap();
+        let mut b2 = b.clone();
+        lu_solve_dual(&lu, 3, &perm, &a, &mut b2, 2);
+        for (x, y) in b1.iter().zip(&b2) {
+            assert!((x.re - y.re).abs() < 1e-14);
+            for k in 0..2 {
+                assert!((x.eps[k] - y.eps[k]).abs() < 1e-13);
+            }
         }
     }
 

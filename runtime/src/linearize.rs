@@ -13,7 +13,7 @@ use crate::canonical::CanonicalMatrices;
 use crate::constraints::{
     constraint_matrices, dependent_velocities, solve_configuration, ConstraintError, NewtonOptions,
 };
-use crate::linalg::solve_in_place;
+use crate::linalg::{lu_factor, lu_solve, lu_solve_dual, solve_in_place};
 use crate::model::MultibodyModel;
 use crate::scalar::{Dual, Scalar};
 use nalgebra::{DMatrix, Matrix2};
@@ -256,12 +256,209 @@ pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, Line
 /// A linearization and the stiffness at rest from the same evaluation.
 pub type WithRest = (Linearization, DMatrix<f64>);
 
-/// [`linearize_about`] and, from the same evaluation, the stiffness at rest,
-/// with dual numbers of width `N = 2 x` the independent coordinates. Each
-/// generated model calls it with its own `N`
-/// ([`MultibodyModel::linearize_with_rest_exact`]), so only that width is
+/// The exact linearization about upright straight running (independent
+/// rates `dq0`) and, from the same evaluation, the stiffness at rest, with
+/// dual numbers of width `N = 2 H`, `H` the number of independent
+/// coordinates. Each generated model calls it with its own widths
+/// ([`MultibodyModel::linearize_with_rest_exact`]), so only they are
 /// compiled per model.
-pub fn linearize_with_rest<M: MultibodyModel, const N: usize>(
+///
+/// It computes what [`linearize_with_rest_general`] computes (equal to
+/// rounding) but evaluates only what the upright linearization needs, in the
+/// narrowest duals that carry it:
+/// * the configuration by Newton in `f64`, and the dependent coordinates'
+///   derivatives in `q` from one real solve (implicit function theorem);
+/// * everything that depends on the configuration only (`D`, `d`, `M`,
+///   `Qgrav`, the partitioning `E`) in `H`-wide duals along `q`: their
+///   derivatives along `q'` vanish;
+/// * one real LU factorization of `D_dep` for both eliminations, with dual
+///   right-hand sides ([`lu_solve_dual`]);
+/// * `N`-wide duals only for the velocity terms (`Qv`, `Qext`, `gamma`);
+/// * the reduced mass matrix `E^T M E` in `f64` (only its value is used).
+pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
+    param: &[f64],
+    dq0: &[f64],
+) -> Result<(Linearization, DMatrix<f64>), LinearizeError> {
+    let ni = M::INDEPENDENT.len();
+    assert!(
+        ni == H && 2 * H == N,
+        "dual widths are the independent coordinates and twice that"
+    );
+    let nq = M::nq();
+    let ind = M::INDEPENDENT;
+    let dep = M::DEPENDENT;
+    let nh = M::HOLONOMIC.len();
+    let nc = nh + M::NONHOLONOMIC.len();
+    // Configuration in f64, from the closed-form upright guess.
+    let mut pf = vec![0.0; nq];
+    M::upright_configuration(param, M::INITIAL_GUESS, &mut pf);
+    if let Some(j) = pf.iter().position(|x| !x.is_finite()) {
+        return Err(ConstraintError::NoUprightConfiguration {
+            coordinate: M::COORDINATES[j],
+        }
+        .into());
+    }
+    for &j in ind {
+        pf[j] = 0.0;
+    }
+    solve_configuration::<M, f64>(param, 0.0, &mut pf, &NewtonOptions::default())?;
+    let singular = |what: &'static str| {
+        move |s: crate::linalg::Singular| ConstraintError::SingularJacobian {
+            what,
+            column: s.column,
+            pivot: s.pivot,
+            scale: s.scale,
+        }
+    };
+    // Dependent coordinates' derivatives in q: -Cq_dep^-1 Cq_ind.
+    let mut cq = vec![0.0; nh * nq];
+    M::holonomic_jacobian(param, 0.0, &pf, &mut cq);
+    let mut jd: Vec<f64> = (0..nh * nh).map(|r| cq[(r / nh) * nq + dep[r % nh]]).collect();
+    let nd = nq - ni;
+    let mut perm = vec![0; nd.max(nh)];
+    lu_factor(&mut jd, nh, &mut perm[..nh]).map_err(singular("holonomic constraints"))?;
+    let mut p: Vec<Dual<H>> = pf.iter().map(|&x| Dual::cst(x)).collect();
+    let mut col = vec![0.0; nh];
+    for (k, &j) in ind.iter().enumerate() {
+        p[j] = Dual::variable(0.0, k);
+        for (i, c) in col.iter_mut().enumerate() {
+            *c = -cq[i * nq + j];
+        }
+        lu_solve(&jd, nh, &perm[..nh], &mut col);
+        for (r, &jj) in dep.iter().enumerate() {
+            p[jj].eps[k] = col[r];
+        }
+    }
+    let ph: Vec<Dual<H>> = param.iter().map(|&x| Dual::cst(x)).collect();
+    let th = Dual::<H>::zero();
+    // Coordinate partitioning (eq. 40-45) with one real factorization.
+    let cm = constraint_matrices::<M, Dual<H>>(&ph, th, &p);
+    let depv = dependent_velocities::<M>();
+    let mut a = vec![Dual::<H>::zero(); nd * nd];
+    let mut rhs = vec![Dual::<H>::zero(); nd * (ni + 1)];
+    for i in 0..nc {
+        for (k, &j) in depv.iter().enumerate() {
+            a[i * nd + k] = cm.d[i * nq + j];
+        }
+        for (k, &j) in ind.iter().enumerate() {
+            rhs[i * (ni + 1) + k] = cm.d[i * nq + j];
+        }
+        rhs[i * (ni + 1) + ni] = cm.d_rhs[i];
+    }
+    let mut lu: Vec<f64> = a.iter().map(|x| x.re).collect();
+    lu_factor(&mut lu, nd, &mut perm[..nd]).map_err(singular("coordinate partitioning"))?;
+    // Checked where the general path checks it: after the partitioning.
+    check_physical_branch::<M>(param, &pf)?;
+    lu_solve_dual(&lu, nd, &perm[..nd], &a, &mut rhs, ni + 1);
+    // E = [I; -Ddep^-1 Dind] (configuration only).
+    let mut e = vec![Dual::<H>::zero(); nq * ni];
+    for (k, &j) in ind.iter().enumerate() {
+        e[j * ni + k] = Dual::one();
+    }
+    for (r, &j) in depv.iter().enumerate() {
+        for k in 0..ni {
+            e[j * ni + k] = -rhs[r * (ni + 1) + k];
+        }
+    }
+    // Velocities, now along q and q'.
+    let pn: Vec<Dual<N>> = p.iter().map(|&x| widen(x)).collect();
+    let pdn: Vec<Dual<N>> = param.iter().map(|&x| Dual::cst(x)).collect();
+    let tn = Dual::<N>::zero();
+    let mut dp = vec![Dual::<N>::zero(); nq];
+    for (k, &j) in ind.iter().enumerate() {
+        dp[j] = Dual::variable(dq0[k], ni + k);
+    }
+    for (r, &j) in depv.iter().enumerate() {
+        let mut v = widen(rhs[r * (ni + 1) + ni]);
+        for k in 0..ni {
+            v -= widen(rhs[r * (ni + 1) + k]) * dp[ind[k]];
+        }
+        dp[j] = v;
+    }
+    // F = [0; -Ddep^-1 gamma].
+    let mut gamma = vec![Dual::<N>::zero(); nc];
+    M::holonomic_convective(&pdn, tn, &pn, &dp, &mut gamma[..nh]);
+    M::nonholonomic_convective(&pdn, tn, &pn, &dp, &mut gamma[nh..]);
+    let an: Vec<Dual<N>> = a.iter().map(|&x| widen(x)).collect();
+    lu_solve_dual(&lu, nd, &perm[..nd], &an, &mut gamma, 1);
+    let mut f = vec![Dual::<N>::zero(); nq];
+    for (r, &j) in depv.iter().enumerate() {
+        f[j] = -gamma[r];
+    }
+    let mut mass = vec![Dual::<H>::zero(); nq * nq];
+    M::mass_matrix(&ph, &p, &mut mass);
+    let mut qg = vec![Dual::<H>::zero(); nq];
+    M::gravity_forces(&ph, &p, &mut qg);
+    let mut qv = vec![Dual::<N>::zero(); nq];
+    M::quadratic_velocity_forces(&pdn, &pn, &dp, &mut qv);
+    let mut qe = vec![Dual::<N>::zero(); nq];
+    M::applied_forces(&pdn, tn, &pn, &dp, &mut qe);
+    // Forces at rest (every velocity zero), for the stiffness at rest.
+    let mut qe_rest = vec![Dual::<N>::zero(); nq];
+    M::applied_forces(&pdn, tn, &pn, &vec![Dual::zero(); nq], &mut qe_rest);
+    // Qi = E^T (Qv + Qgrav + Qext - M F) (eq. 46-47); Ec = Mi q'' - Qi at
+    // q'' = 0, so its derivatives are -Qi's.
+    let mut stiffness = DMatrix::zeros(ni, ni);
+    let mut damping = DMatrix::zeros(ni, ni);
+    let mut rest = DMatrix::zeros(ni, ni);
+    let mut qi = [Dual::<N>::zero(); H];
+    let mut qi_rest = [Dual::<N>::zero(); H];
+    for r in 0..nq {
+        let mut s = qv[r] + widen(qg[r]) + qe[r];
+        // F vanishes on the independent rows.
+        for &c in &depv {
+            s -= widen(mass[r * nq + c]) * f[c];
+        }
+        let s_rest = widen(qg[r]) + qe_rest[r];
+        for k in 0..ni {
+            let ek = widen(e[r * ni + k]);
+            qi[k] += ek * s;
+            qi_rest[k] += ek * s_rest;
+        }
+    }
+    // Mi = E^T M E, its value only.
+    let mut mi = DMatrix::zeros(ni, ni);
+    for k in 0..ni {
+        for b in 0..ni {
+            let mut m = 0.0;
+            for r in 0..nq {
+                let mut me = 0.0;
+                for c in 0..nq {
+                    me += mass[r * nq + c].re * e[c * ni + b].re;
+                }
+                m += e[r * ni + k].re * me;
+            }
+            mi[(k, b)] = m;
+        }
+        for b in 0..ni {
+            stiffness[(k, b)] = -qi[k].eps[b];
+            damping[(k, b)] = -qi[k].eps[ni + b];
+            rest[(k, b)] = -qi_rest[k].eps[b];
+        }
+    }
+    Ok((
+        Linearization {
+            mass: mi,
+            damping,
+            stiffness,
+        },
+        rest,
+    ))
+}
+
+/// A dual along `H` directions as one along `N >= H` (the first `H`).
+#[inline(always)]
+fn widen<const H: usize, const N: usize>(x: Dual<H>) -> Dual<N> {
+    let mut eps = [0.0; N];
+    eps[..H].copy_from_slice(&x.eps);
+    Dual { re: x.re, eps }
+}
+
+/// The general path of [`linearize_with_rest`]: the whole of
+/// [`reduced_system`] in dual numbers (Newton's last step, both eliminations
+/// and every generated function). Kept as the reference the fast path is
+/// tested against.
+pub fn linearize_with_rest_general<M: MultibodyModel, const N: usize>(
     param: &[f64],
     dq0: &[f64],
 ) -> Result<(Linearization, DMatrix<f64>), LinearizeError> {
@@ -510,6 +707,22 @@ pub fn parameter_vector<M: MultibodyModel>(
 pub fn canonical_matrices<M: MultibodyModel>(
     lookup: impl Fn(&str) -> Option<f64>,
 ) -> Result<CanonicalMatrices, LinearizeError> {
+    canonical_matrices_by::<M>(lookup, M::linearize_with_rest_exact)
+}
+
+/// [`canonical_matrices`] through the general path
+/// ([`linearize_with_rest_general`] with dual width `N`), the method before
+/// the fast upright path; kept for the bench's comparison.
+pub fn canonical_matrices_general<M: MultibodyModel, const N: usize>(
+    lookup: impl Fn(&str) -> Option<f64>,
+) -> Result<CanonicalMatrices, LinearizeError> {
+    canonical_matrices_by::<M>(lookup, linearize_with_rest_general::<M, N>)
+}
+
+fn canonical_matrices_by<M: MultibodyModel>(
+    lookup: impl Fn(&str) -> Option<f64>,
+    linearize: impl Fn(&[f64], &[f64]) -> Result<WithRest, LinearizeError>,
+) -> Result<CanonicalMatrices, LinearizeError> {
     let param = parameter_vector::<M>(&lookup, 0.0)?;
     let g = M::GRAVITY_PARAMETER
         .map(|k| param[k])
@@ -521,7 +734,7 @@ pub fn canonical_matrices<M: MultibodyModel>(
         return Err(LinearizeError::HasStates { model: M::NAME });
     }
     let (p1, dq1) = speed_setup::<M>(&param, 1.0)?;
-    let (l1, rest) = M::linearize_with_rest_exact(&p1, &dq1)?;
+    let (l1, rest) = linearize(&p1, &dq1)?;
     let l1 = lateral_block::<M>(&l1);
     let idx = lateral_indices::<M>();
     let k0 = DMatrix::from_fn(2, 2, |i, j| rest[(idx[i], idx[j])]);

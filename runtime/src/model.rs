@@ -147,7 +147,7 @@ pub trait MultibodyModel: Send + Sync + 'static {
     fn upright_configuration<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
     /// Exact linearization about the steady motion with independent rates
     /// `dq0`, and the stiffness at rest, with this model's dual width
-    /// (generated: `linearize::linearize_with_rest::<Self, {2 ni}>`).
+    /// (generated: `linearize::linearize_with_rest::<Self, {ni}, {2 ni}>`).
     fn linearize_with_rest_exact(
         param: &[f64],
         dq0: &[f64],
