@@ -310,6 +310,7 @@ impl<'a> Setup<'a> {
                     roll_limit: Some(1.2),
                     steer_limit: Some(1.45),
                 },
+                ..SimOptions::default()
             },
             slots,
             parameters,
