@@ -379,8 +379,8 @@ impl ModelVisitor for Identify<'_> {
             .iter()
             .filter_map(|n| self.candidates.iter().find(|c| &c.name == n))
             .collect();
-        let before = Setup::new::<M>(&base, self.segments, id.weights, &[])?;
-        let after = Setup::new::<M>(&base, self.segments, id.weights, &sel)?;
+        let before = Setup::new::<M>(&base, self.segments, &id.weights, &[])?;
+        let after = Setup::new::<M>(&base, self.segments, &id.weights, &sel)?;
         let plot = order.get(order.len() / 2).map(|&s| RunPlot {
             segment: s,
             before: (0..self.segments.len())
@@ -665,6 +665,8 @@ fn errors_json(o: &Outcome, after: bool) -> Value {
     let held_pred = if after { &o.predicted_held_out } else { &o.predicted_before };
     json!({
         "eigen_rms": eigen_rms(&o.segments, pred),
+        "median_run_roll_rms": median(fit.errors.iter().map(|e| e.roll_rms)),
+        "median_run_steer_rms": median(fit.errors.iter().map(|e| e.steer_rms)),
         "roll_rms": pooled_rms(&fit.errors, 0),
         "steer_rms": pooled_rms(&fit.errors, 1),
         "speed_rms": pooled_rms(&fit.errors, 2),
@@ -737,6 +739,12 @@ pub fn outcome_json(o: &Outcome) -> Value {
     })
 }
 
+fn median(x: impl Iterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = x.filter(|a| a.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
 fn fmt_c(z: Option<[f64; 2]>) -> String {
     z.map_or("-".into(), |z| format!("{:.3}{:+.3}i", z[0], z[1]))
 }
@@ -771,11 +779,13 @@ pub fn summary(o: &Outcome) -> String {
     let _ = writeln!(s, "parameters (95 %): {}", if vals.is_empty() { "-".into() } else { vals.join(", ") });
     let _ = writeln!(
         s,
-        "error before -> after: weave eigenvalue RMS {:.3} -> {:.3} 1/s, roll RMS {:.3} -> {:.3} deg, steer RMS {:.3} -> {:.3} deg",
+        "error before -> after: weave eigenvalue RMS {:.3} -> {:.3} 1/s, roll RMS {:.3} -> {:.3} deg (median run {:.3} -> {:.3}), steer RMS {:.3} -> {:.3} deg",
         b["eigen_rms"].as_f64().unwrap_or(f64::NAN),
         a["eigen_rms"].as_f64().unwrap_or(f64::NAN),
         b["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
         a["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        b["median_run_roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        a["median_run_roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
         b["steer_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
         a["steer_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
     );
@@ -831,7 +841,12 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
     let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed; fitted per run as nuisance parameters), and compared with the measured roll, steer and speed.");
     let _ = writeln!(s, "3. The residual pattern of the model without any added effect was related to the effects of the library (below).");
     let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all runs (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run), and its dissipative parameters are positive. The search stops when no candidate passes.\n", id.folds);
-    let _ = writeln!(s, "Channel weights (the base model's RMS residual per channel): roll {:.3} deg, steer {:.3} deg, speed {:.3} m/s.\n", id.weights.roll.to_degrees(), id.weights.steer.to_degrees(), id.weights.speed);
+    let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| {
+        let mut v: Vec<f64> = id.weights.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+    };
+    let _ = writeln!(s, "Channel scales (each run's RMS residual under the base model, at least the best run's; median over runs): roll {:.3} deg, steer {:.3} deg, speed {:.3} m/s. Each run and channel is weighed by its own scale, so a run that diverges toward a fall cannot outweigh the others.\n", med(&|w| w.roll).to_degrees(), med(&|w| w.steer).to_degrees(), med(&|w| w.speed));
     let _ = writeln!(s, "## Residual diagnosis (base model)\n");
     let _ = writeln!(s, "| pattern | evidence | points to | significant (2 sigma) |\n|---|---|---|---|");
     for f in &o.findings {
@@ -862,6 +877,9 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
                 .collect();
             let cv = if f.cv.is_finite() { format!("{:.4}", f.cv) } else { "-".into() };
             let _ = writeln!(s, "| `{name}` | {} | {:+.1} | {cv} | {} |", vals.join(", "), f.bic - step.base_bic, step.verdicts[r].1);
+        }
+        for (name, why) in &step.failed {
+            let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
         }
         let _ = writeln!(s);
     }

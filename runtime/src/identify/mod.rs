@@ -40,7 +40,7 @@
 pub mod plot;
 
 use crate::model::MultibodyModel;
-use crate::simulate::{simulate, Events, InitialConditions, Inputs, SimOptions};
+use crate::simulate::{simulate, Events, InitialConditions, Inputs, Method, SimOptions};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::{DMatrix, DVector, Dyn, Owned};
 use rayon::prelude::*;
@@ -201,7 +201,8 @@ pub enum IdentifyError {
 pub struct Setup<'a> {
     pub base: Vec<f64>,
     pub segments: &'a [Segment],
-    pub weights: Weights,
+    /// Channel scales of each segment.
+    pub weights: Vec<Weights>,
     pub options: SimOptions,
     /// Active effect parameters: index lists into `base` (primary + tied).
     slots: Vec<Vec<usize>>,
@@ -252,7 +253,17 @@ fn simulate_segment<M: MultibodyModel>(
         output_interval: dt,
         ..*opts
     };
-    let sim = simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &opts).map_err(|e| e.to_string())?;
+    // A stiff candidate (a steep friction law) stops the explicit method:
+    // retry with the implicit one.
+    let sim = simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &opts)
+        .or_else(|_| {
+            let stiff = SimOptions {
+                method: Method::Radau5,
+                ..opts
+            };
+            simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &stiff)
+        })
+        .map_err(|e| e.to_string())?;
     let roll = sim.coordinate("theta").ok_or("model has no roll coordinate theta")?;
     let steer = sim.coordinate("gamma").ok_or("model has no steer coordinate gamma")?;
     Ok(Sim {
@@ -268,7 +279,7 @@ impl<'a> Setup<'a> {
     pub fn new<M: MultibodyModel>(
         base: &[f64],
         segments: &'a [Segment],
-        weights: Weights,
+        weights: &[Weights],
         candidates: &[&Candidate],
     ) -> Result<Self, IdentifyError> {
         let index = |s: &str| {
@@ -299,7 +310,7 @@ impl<'a> Setup<'a> {
         Ok(Setup {
             base,
             segments,
-            weights,
+            weights: weights.to_vec(),
             options: SimOptions {
                 rtol: 1e-8,
                 atol: 1e-10,
@@ -335,9 +346,10 @@ impl<'a> Setup<'a> {
     }
 
     /// Weighted residuals of one segment (roll, steer, speed blocks).
-    pub fn residuals(&self, g: &[f64], seg: &Segment, x0: &[f64; NUISANCE]) -> Result<Vec<f64>, String> {
+    pub fn residuals(&self, g: &[f64], i: usize, x0: &[f64; NUISANCE]) -> Result<Vec<f64>, String> {
+        let seg = &self.segments[i];
         let s = (self.simulate)(&self.param(g), seg, x0, &self.options)?;
-        let w = self.weights;
+        let w = self.weights[i];
         let mut r = Vec::with_capacity(seg.len());
         r.extend(seg.roll.iter().zip(&s.roll).map(|(m, p)| (m - p) / w.roll));
         r.extend(seg.steer.iter().zip(&s.steer).map(|(m, p)| (m - p) / w.steer));
@@ -420,7 +432,7 @@ impl Problem<'_, '_> {
         let r: Option<Vec<Vec<f64>>> = self
             .segs
             .par_iter()
-            .map(|&s| self.setup.residuals(&self.g, &self.setup.segments[s], &self.x0[s]).ok())
+            .map(|&s| self.setup.residuals(&self.g, s, &self.x0[s]).ok())
             .collect();
         let r = r?;
         *self.cache.lock().ok()? = Some((x, r.clone()));
@@ -487,7 +499,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
                         h
                     }
                 };
-                let r = self.setup.residuals(&g, &self.setup.segments[s], &x0).ok()?;
+                let r = self.setup.residuals(&g, s, &x0).ok()?;
                 Some((p, col, r.iter().zip(&base[p]).map(|(a, b)| (a - b) / h).collect()))
             })
             .collect();
@@ -595,13 +607,20 @@ impl Default for IdentifyOptions {
         IdentifyOptions {
             folds: 4,
             max_effects: 3,
-            patience: 30,
+            patience: 4,
         }
     }
 }
 
 fn lm_fit<'s, 'a>(p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
-    let (p, _report) = LevenbergMarquardt::new().with_patience(patience).minimize(p);
+    // Relative tolerances of 1e-6 on the cost and the step: the simulations
+    // are accurate to about 1e-8, and the parameters' uncertainty is far
+    // larger than what further iterations would change.
+    let (p, _report) = LevenbergMarquardt::new()
+        .with_patience(patience)
+        .with_ftol(1e-6)
+        .with_xtol(1e-6)
+        .minimize(p);
     p
 }
 
@@ -648,7 +667,8 @@ pub fn fit_candidate(
     let errors: Vec<SegmentError> = res
         .iter()
         .zip(setup.segments)
-        .map(|(r, s)| SegmentError::of(r, s, setup.weights))
+        .zip(&setup.weights)
+        .map(|((r, s), w)| SegmentError::of(r, s, *w))
         .collect();
     let chi2: f64 = res.iter().flatten().map(|x| x * x).sum();
     let g = full.g.clone();
@@ -718,7 +738,7 @@ pub fn fit_candidate(
         count(&p);
         if let Some(r) = p.all_residuals() {
             for (i, &s) in test.iter().enumerate() {
-                held_out[s] = SegmentError::of(&r[i], &setup.segments[s], setup.weights);
+                held_out[s] = SegmentError::of(&r[i], &setup.segments[s], setup.weights[s]);
                 held_res[s] = r[i].clone();
             }
         }
@@ -735,21 +755,22 @@ pub fn fit_candidate(
 /// Bayesian information criterion of `fit` with the effective sample size
 /// of each channel taken from `reference` (the model being extended): the
 /// profile likelihood of Gaussian residuals with one unknown variance per
-/// channel, `sum_c n_eff,c ln(SS_c / n_c) + k ln(n_eff)`.
+/// channel of each segment (a run that the model follows badly, e.g. one
+/// that diverges toward a fall, then counts by the log of its misfit and
+/// cannot outweigh the others): `sum n_eff ln(SS / n) + k ln(n_eff)`.
 pub fn bic(fit: &CandidateFit, reference: &CandidateFit) -> f64 {
     let mut total = 0.0;
     let mut n_eff_all = 0.0;
-    for c in 0..3 {
-        let (mut ss, mut n, mut n_eff) = (0.0, 0usize, 0.0);
-        for (e, r) in fit.errors.iter().zip(&reference.errors) {
-            ss += e.channel_ss[c];
-            n += e.channel_n[c];
+    for (e, r) in fit.errors.iter().zip(&reference.errors) {
+        for c in 0..3 {
+            let n = e.channel_n[c];
+            if n == 0 || !(e.channel_ss[c] > 0.0) {
+                continue;
+            }
             // Speed samples are sparse (one per magnet): about independent.
             let rho = if c == 2 { 0.0 } else { r.rho };
-            n_eff += e.channel_n[c] as f64 * (1.0 - rho) / (1.0 + rho);
-        }
-        if n > 0 && ss > 0.0 {
-            total += n_eff * (ss / n as f64).ln();
+            let n_eff = n as f64 * (1.0 - rho) / (1.0 + rho);
+            total += n_eff * (e.channel_ss[c] / n as f64).ln();
             n_eff_all += n_eff;
         }
     }
@@ -769,12 +790,15 @@ pub struct Step {
     /// The candidate added (if any) and why the others were not.
     pub added: Option<String>,
     pub verdicts: Vec<(String, String)>,
+    /// Candidates whose fit failed, with the reason.
+    pub failed: Vec<(String, String)>,
 }
 
 /// Outcome of identification.
 #[derive(Clone, Debug, Serialize)]
 pub struct Identification {
-    pub weights: Weights,
+    /// Channel scales of each segment.
+    pub weights: Vec<Weights>,
     /// The base model's fit (no effect added).
     pub before: CandidateFit,
     /// The selected model's fit (equal to `before` when nothing is warranted).
@@ -804,31 +828,41 @@ pub fn identify<M: MultibodyModel>(
     let folds = opts.folds.clamp(2, segments.len().max(2));
     let fold_of: Vec<usize> = (0..segments.len()).map(|s| s % folds).collect();
     let x0: Vec<[f64; NUISANCE]> = segments.iter().map(|s| s.initial).collect();
-    // Channel scales: first the sensor-level guess, then the base model's
-    // own residual level per channel, so that each channel weighs by how
-    // well the base model can describe it (roll and steer in rad, speed in
-    // m/s are otherwise incommensurable).
-    let mut weights = Weights {
+    // Channel scales: first a sensor-level guess, then each segment's own
+    // residual level per channel under the base model (at least the best
+    // segment's, which is about the noise), so that each segment and
+    // channel weighs by how well the base model describes it: roll and
+    // steer (rad) and speed (m/s) are otherwise incommensurable, and a run
+    // that diverges toward a fall would otherwise dominate the fit.
+    let guess = Weights {
         roll: 0.005,
         steer: 0.01,
         speed: 0.05,
     };
-    let setup0 = Setup::new::<M>(base, segments, weights, &[])?;
+    let setup0 = Setup::new::<M>(base, segments, &vec![guess; segments.len()], &[])?;
     // (No folds: this fit only sets the channel scales.)
     let first = fit_candidate(&setup0, vec![], &[], &x0, &[], opts, None)?;
-    let pooled = |c: usize| {
-        let (ss, n) = first
+    let rms = |e: &SegmentError, c: usize| (e.channel_ss[c] / e.channel_n[c].max(1) as f64).sqrt();
+    let floor = |c: usize, min: f64| {
+        first
             .errors
             .iter()
-            .fold((0.0, 0usize), |(a, b), e| (a + e.channel_ss[c], b + e.channel_n[c]));
-        (ss / n.max(1) as f64).sqrt()
+            .map(|e| rms(e, c))
+            .filter(|x| x.is_finite() && *x > 0.0)
+            .fold(f64::INFINITY, f64::min)
+            .max(min)
     };
-    weights = Weights {
-        roll: pooled(0).max(1e-4),
-        steer: pooled(1).max(1e-4),
-        speed: pooled(2).max(1e-3),
-    };
-    let setup0 = Setup::new::<M>(base, segments, weights, &[])?;
+    let floors = [floor(0, 1e-4), floor(1, 1e-4), floor(2, 1e-3)];
+    let weights: Vec<Weights> = first
+        .errors
+        .iter()
+        .map(|e| Weights {
+            roll: rms(e, 0).max(floors[0]),
+            steer: rms(e, 1).max(floors[1]),
+            speed: rms(e, 2).max(floors[2]),
+        })
+        .collect();
+    let setup0 = Setup::new::<M>(base, segments, &weights, &[])?;
     let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts, None)?;
     before.bic = bic(&before, &before);
     progress("base model");
@@ -854,10 +888,11 @@ pub fn identify<M: MultibodyModel>(
             break;
         }
         let mut tried = Vec::new();
+        let mut failed: Vec<(String, String)> = Vec::new();
         for c in &remaining {
             let mut active = selected.clone();
             active.push(c);
-            let setup = Setup::new::<M>(base, segments, weights, &active)?;
+            let setup = Setup::new::<M>(base, segments, &weights, &active)?;
             let mut g0 = current.values.clone();
             g0.extend(c.parameters.iter().map(|p| 0.1 * p.scale));
             let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
@@ -866,7 +901,7 @@ pub fn identify<M: MultibodyModel>(
                     simulations += f.simulations;
                     tried.push((c.name.clone(), f));
                 }
-                Err(e) => progress(&format!("{}: {e}", c.name)),
+                Err(e) => failed.push((c.name.clone(), format!("fit failed: {e}"))),
             }
             progress(&c.name);
         }
@@ -883,7 +918,7 @@ pub fn identify<M: MultibodyModel>(
                     "rejected: held-out error {:.4} not below {:.4} (does not generalise)",
                     f.cv, current.cv
                 )
-            } else if let Some((d, se)) = paired_gain(&current, f, weights).filter(|(d, se)| !(*d > 2.0 * se)) {
+            } else if let Some((d, se)) = paired_gain(&current, f, &weights).filter(|(d, se)| !(*d > 2.0 * se)) {
                 format!(
                     "rejected: held-out gain per run {d:.4} within two standard errors ({se:.4}) of zero (not a consistent improvement)"
                 )
@@ -896,6 +931,7 @@ pub fn identify<M: MultibodyModel>(
             verdicts.push((name.clone(), verdict));
         }
         let added = best.map(|b| tried[b].0.clone());
+        let failed_names = failed.clone();
         let step = Step {
             base: current.effects.clone(),
             base_bic,
@@ -903,6 +939,7 @@ pub fn identify<M: MultibodyModel>(
             tried: tried.clone(),
             added: added.clone(),
             verdicts,
+            failed: failed_names,
         };
         steps.push(step);
         match best {
@@ -930,12 +967,18 @@ pub fn identify<M: MultibodyModel>(
 /// error. Selection asks the gain to exceed two standard errors, so an
 /// effect that improves the held-out error only on average over a few runs
 /// (an artefact of one run, noise) is not added.
-pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: Weights) -> Option<(f64, f64)> {
-    let mse = |e: &SegmentError| {
+pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> Option<(f64, f64)> {
+    let mse = |e: &SegmentError, w: &Weights| {
         let ss = e.channel_ss[0] / (w.roll * w.roll) + e.channel_ss[1] / (w.steer * w.steer) + e.channel_ss[2] / (w.speed * w.speed);
         ss / (e.channel_n.iter().sum::<usize>().max(1) as f64)
     };
-    let d: Vec<f64> = base.held_out.iter().zip(&cand.held_out).map(|(a, b)| mse(a) - mse(b)).collect();
+    let d: Vec<f64> = base
+        .held_out
+        .iter()
+        .zip(&cand.held_out)
+        .zip(w)
+        .map(|((a, b), w)| mse(a, w) - mse(b, w))
+        .collect();
     let n = d.len() as f64;
     if n < 2.0 {
         return None;
