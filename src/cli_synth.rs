@@ -251,3 +251,17 @@ pub fn run(a: SynthArgs) -> Result<bool> {
     println!("wrote {} runs to {}", a.runs, a.out.display());
     Ok(true)
 }
+
+/// A synthetic set of the thesis bicycle at 4-6.5 m/s with `effects` hidden
+/// (for the identification bench).
+pub fn thesis_set(out: &Path, runs: usize, seed: u64, effects: &[&str]) -> Result<bool> {
+    run(SynthArgs {
+        bike: "thesis".into(),
+        model: None,
+        effects: effects.iter().map(|s| s.to_string()).collect(),
+        speeds: "4:6.5".into(),
+        runs,
+        seed,
+        out: out.to_path_buf(),
+    })
+}

@@ -188,6 +188,10 @@ enum Command {
         /// Fewer repetitions (for a quick look).
         #[arg(long)]
         quick: bool,
+        /// Instead: time a full `identify` on a 12-run synthetic set (steer
+        /// damping hidden), made in a temporary folder.
+        #[arg(long)]
+        identify: bool,
     },
 }
 
@@ -783,7 +787,33 @@ fn run(cli: Cli) -> Result<bool> {
         Command::Identify(args) => bikedyn::identify::command(&args),
         Command::Simulate(args) => cli_simulate::run(args),
         Command::Synth(args) => cli_synth::run(args),
-        Command::Bench { quick } => {
+        Command::Bench { identify: true, .. } => {
+            let dir = std::env::temp_dir().join(format!("bikedyn-bench-identify-{}", std::process::id()));
+            let _ = std::fs::remove_dir_all(&dir);
+            cli_synth::thesis_set(&dir, 12, 22, &["c_steer=0.25"])?;
+            let args = bikedyn::identify::IdentifyArgs {
+                inputs: vec![dir.clone()],
+                calibration: None,
+                bike: "thesis".into(),
+                effects: vec![],
+                report: None,
+                json: false,
+                folds: 4,
+            };
+            let t = std::time::Instant::now();
+            let o = bikedyn::identify::run_identify(&args)?;
+            let secs = t.elapsed().as_secs_f64();
+            let _ = std::fs::remove_dir_all(&dir);
+            println!("{}", bikedyn::identify::summary(&o));
+            println!(
+                "identify, 12-run set ({} kicks): {secs:.1} s wall clock on {} threads, {} simulations (target < 60 s on 2 cores)",
+                o.segments.len(),
+                rayon::current_num_threads(),
+                o.identification.simulations
+            );
+            Ok(true)
+        }
+        Command::Bench { quick, .. } => {
             bikedyn::bench::run(quick)?;
             Ok(true)
         }
