@@ -12,9 +12,10 @@ use anyhow::{bail, Context, Result};
 use bikedyn_runtime::experiment::{kicks::WindowEnd, PipelineOptions};
 use bikedyn_runtime::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_runtime::identify::{
-    identify, pooled_rms, Candidate, EffectParameter, Identification, IdentifyOptions, Segment, SegmentError, Setup,
+    identify, pooled_rms, Candidate, EffectParameter, Factory, Identification, IdentifyOptions, ModelFactory, Segment,
+    SegmentError, Setup,
 };
-use bikedyn_runtime::linearize::{lateral_block, linearize_at_speed, parameter_vector};
+use bikedyn_runtime::linearize::{lateral_block, linearize_at_speed, parameter_vector, state_space_at_speed};
 use bikedyn_runtime::output::{save_json, write_string_atomic};
 use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
 use bikedyn_runtime::MultibodyModel;
@@ -62,6 +63,9 @@ pub struct IdentifyArgs {
 /// fixed companions, and the residual pattern that points to the effect.
 struct Spec {
     effect: &'static str,
+    /// Fitted with the free-speed model that has this effect instead of the
+    /// base identification model (the tyre model replaces no-slip).
+    alternative_model: bool,
     parameters: &'static [(&'static str, &'static [&'static str], f64, bool)],
     fixed: &'static [(&'static str, f64)],
     speed_decay: bool,
@@ -70,6 +74,7 @@ struct Spec {
 
 const SPECS: &[Spec] = &[
     Spec {
+        alternative_model: false,
         effect: "steer_damping",
         parameters: &[("c_steer", &[], 0.1, true)],
         fixed: &[],
@@ -77,6 +82,7 @@ const SPECS: &[Spec] = &[
         reason: "excess weave damping with a lower weave frequency: viscous damping in the headset slows the steer",
     },
     Spec {
+        alternative_model: false,
         effect: "steer_friction",
         parameters: &[("T_steer", &[], 0.05, true)],
         fixed: &[],
@@ -84,6 +90,7 @@ const SPECS: &[Spec] = &[
         reason: "decay that depends on amplitude (faster at small amplitude): Coulomb friction in the headset",
     },
     Spec {
+        alternative_model: false,
         effect: "lateral_mass_offset",
         parameters: &[("y3", &[], 0.01, false)],
         fixed: &[],
@@ -91,6 +98,7 @@ const SPECS: &[Spec] = &[
         reason: "a steady lean and steer bias after the kick: a mass centre off the plane of symmetry (electronics, battery)",
     },
     Spec {
+        alternative_model: false,
         effect: "steer_controller",
         parameters: &[("Kc_roll_rate", &[], 1.0, false)],
         fixed: &[],
@@ -98,6 +106,7 @@ const SPECS: &[Spec] = &[
         reason: "a steer torque in phase with the roll rate: a controller or rider acting on the handlebar",
     },
     Spec {
+        alternative_model: false,
         effect: "rolling_resistance",
         parameters: &[("Crr_rear", &["Crr_front"], 0.005, true)],
         fixed: &[],
@@ -105,23 +114,45 @@ const SPECS: &[Spec] = &[
         reason: "the speed falls during the response about evenly at all speeds: rolling resistance of the tyres",
     },
     Spec {
+        alternative_model: false,
         effect: "aero_drag",
         parameters: &[("CdA", &[], 0.3, true)],
         fixed: &[("rho_air", 1.2)],
         speed_decay: true,
         reason: "the speed falls faster at higher speed: aerodynamic drag",
     },
+    Spec {
+        alternative_model: true,
+        effect: "tyre_relaxation",
+        parameters: &[("sigma_rear", &["sigma_front"], 0.2, true)],
+        fixed: &[],
+        speed_decay: false,
+        reason: "a weave frequency shift growing with speed: lateral tyre slip with relaxation (fitted: the relaxation length; cornering and camber stiffness at the model's defaults)",
+    },
 ];
 
 /// Effects of the library identification does not yet consider, and why.
-pub const NOT_CANDIDATES: &[(&str, &str)] = &[(
-    "tyre_relaxation",
-    "a frequency shift growing with speed points to tyre slip or inertia errors; the tyre model has two extra states that the identification's simulator does not integrate yet",
-)];
+pub const NOT_CANDIDATES: &[(&str, &str)] = &[];
 
 /// The free-speed model with every candidate effect (the registry's
 /// free-speed model with the most effects of the bicycle's base).
 fn identification_model(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo)> {
+    identification_models(bike).map(|(f, d, _)| (f, d))
+}
+
+/// The identification model, its driven twin, and the alternative model
+/// (free speed, with states: the tyre model) if the registry has one.
+fn identification_models(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo, Option<&'static ModelInfo>)> {
+    let (free, driven) = identification_model_pair(bike)?;
+    let base = free.base;
+    let alt = MODELS
+        .iter()
+        .filter(|m| m.free_speed && m.base == base && !m.states.is_empty() && free.effects.iter().all(|e| m.effects.contains(e)))
+        .max_by_key(|m| m.effects.len());
+    Ok((free, driven, alt))
+}
+
+fn identification_model_pair(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo)> {
     let base = bike.model(None)?.base;
     let free = MODELS
         .iter()
@@ -137,7 +168,7 @@ fn identification_model(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static 
 
 /// The candidates for a model: every effect of it that has a spec (and is
 /// in `only` when given).
-pub fn candidates(info: &ModelInfo, bike: &Bicycle, only: &[String]) -> Result<Vec<Candidate>> {
+pub fn candidates(info: &ModelInfo, alt: Option<&ModelInfo>, bike: &Bicycle, only: &[String]) -> Result<Vec<Candidate>> {
     for o in only {
         if !SPECS.iter().any(|s| s.effect == o) {
             let known: Vec<&str> = SPECS.iter().map(|s| s.effect).collect();
@@ -146,9 +177,18 @@ pub fn candidates(info: &ModelInfo, bike: &Bicycle, only: &[String]) -> Result<V
     }
     let mut out = Vec::new();
     for s in SPECS {
-        if !info.effects.contains(&s.effect) || !(only.is_empty() || only.iter().any(|o| o == s.effect)) {
+        let model = if s.alternative_model {
+            match alt {
+                Some(a) if a.effects.contains(&s.effect) => a,
+                _ => continue,
+            }
+        } else {
+            info
+        };
+        if !model.effects.contains(&s.effect) || !(only.is_empty() || only.iter().any(|o| o == s.effect)) {
             continue;
         }
+        let info = model;
         let unit = |sym: &str| {
             info.parameter(sym)
                 .map(|p| p.doc.rsplit_once('(').map_or("", |(_, u)| u.trim_end_matches(')')).to_string())
@@ -166,6 +206,9 @@ pub fn candidates(info: &ModelInfo, bike: &Bicycle, only: &[String]) -> Result<V
                     scale: *scale,
                     dissipative: *diss,
                     unit: unit(sym),
+                    // The tyre model's relaxation starts from its default,
+                    // not from a tenth of it (a stiff start).
+                    initial: s.alternative_model.then(|| info.parameter(sym).and_then(|p| p.default)).flatten(),
                 })
                 .collect(),
             fixed: s
@@ -175,6 +218,7 @@ pub fn candidates(info: &ModelInfo, bike: &Bicycle, only: &[String]) -> Result<V
                 .collect(),
             speed_decay: s.speed_decay,
             reason: s.reason.to_string(),
+            alternative_model: s.alternative_model,
         });
     }
     Ok(out)
@@ -301,7 +345,18 @@ impl ModelVisitor for WeaveCurve<'_> {
 fn predict(driven: &ModelInfo, bike: &Bicycle, values: &BTreeMap<String, f64>, speeds: &[f64]) -> Result<Vec<Option<[f64; 2]>>> {
     let base = bike.lookup()?;
     let lookup = |s: &str| values.get(s).copied().or_else(|| base(s));
-    with_model(driven.name, WeaveCurve { lookup: &lookup, speeds }).expect("registered model")
+    let guide = with_model(driven.name, WeaveCurve { lookup: &lookup, speeds }).expect("registered model")?;
+    // Effects the driven model lacks (the tyre model's) are predicted with
+    // the alternative model's state-space linearization.
+    if let Some(alt) = values
+        .keys()
+        .any(|k| driven.parameter(k).is_none())
+        .then(|| identification_models(bike).ok().and_then(|m| m.2))
+        .flatten()
+    {
+        return with_model(alt.name, StateSpaceWeave { lookup: &lookup, speeds, guide: &guide }).expect("registered model");
+    }
+    Ok(guide)
 }
 
 /// Effect values of a fit, tied symbols and fixed companions included.
@@ -359,6 +414,7 @@ struct RunPlot {
 
 struct Identify<'a> {
     bike: &'a Bicycle,
+    alt: Option<&'static ModelInfo>,
     segments: &'a [Segment],
     candidates: &'a [Candidate],
     opts: &'a IdentifyOptions,
@@ -370,7 +426,11 @@ impl ModelVisitor for Identify<'_> {
     fn visit<M: MultibodyModel>(self) -> Self::Output {
         let lookup = self.bike.lookup()?;
         let base = parameter_vector::<M>(&lookup, 5.0)?;
-        let id = identify::<M>(&base, self.segments, self.candidates, self.opts, self.progress)?;
+        let alt: Option<Box<dyn ModelFactory>> = match self.alt {
+            Some(a) => Some(with_model(a.name, MakeFactory { lookup: &lookup }).expect("registered model")?),
+            None => None,
+        };
+        let id = identify::<M>(&base, self.segments, self.candidates, alt.as_deref(), self.opts, self.progress)?;
         // The typical run: median roll error before.
         let mut order: Vec<usize> = (0..self.segments.len()).collect();
         order.sort_by(|&a, &b| id.before.errors[a].roll_rms.total_cmp(&id.before.errors[b].roll_rms));
@@ -380,7 +440,10 @@ impl ModelVisitor for Identify<'_> {
             .filter_map(|n| self.candidates.iter().find(|c| &c.name == n))
             .collect();
         let before = Setup::new::<M>(&base, self.segments, &id.weights, &[])?;
-        let after = Setup::new::<M>(&base, self.segments, &id.weights, &sel)?;
+        let after = match alt.as_deref().filter(|_| sel.iter().any(|c| c.alternative_model)) {
+            Some(f) => f.setup(self.segments, &id.weights, &sel)?,
+            None => Setup::new::<M>(&base, self.segments, &id.weights, &sel)?,
+        };
         let plot = order.get(order.len() / 2).map(|&s| RunPlot {
             segment: s,
             before: (0..self.segments.len())
@@ -391,6 +454,50 @@ impl ModelVisitor for Identify<'_> {
                 .collect(),
         });
         Ok((id, plot))
+    }
+}
+
+struct MakeFactory<'a, F: Fn(&str) -> Option<f64>> {
+    lookup: &'a F,
+}
+
+impl<F: Fn(&str) -> Option<f64>> ModelVisitor for MakeFactory<'_, F> {
+    type Output = Result<Box<dyn ModelFactory>>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        Ok(Box::new(Factory::<M>::new(parameter_vector::<M>(self.lookup, 5.0)?)))
+    }
+}
+
+/// Weave eigenvalues of a model with extra states (state-space
+/// linearization): the complex eigenvalue nearest each `guide` (the no-slip
+/// model's weave).
+struct StateSpaceWeave<'a> {
+    lookup: &'a dyn Fn(&str) -> Option<f64>,
+    speeds: &'a [f64],
+    guide: &'a [Option<[f64; 2]>],
+}
+
+impl ModelVisitor for StateSpaceWeave<'_> {
+    type Output = Result<Vec<Option<[f64; 2]>>>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        let p = parameter_vector::<M>(self.lookup, 1.0)?;
+        Ok(self
+            .speeds
+            .iter()
+            .zip(self.guide)
+            .map(|(&v, g)| {
+                let g = (*g)?;
+                let ss = state_space_at_speed::<M>(&p, v).ok()?;
+                ss.a.complex_eigenvalues()
+                    .iter()
+                    .filter(|z| z.im > 1e-9)
+                    .min_by(|x, y| {
+                        let d = |z: &nalgebra::Complex<f64>| (z.re - g[0]).hypot(z.im - g[1]);
+                        d(x).total_cmp(&d(y))
+                    })
+                    .map(|z| [z.re, z.im])
+            })
+            .collect())
     }
 }
 
@@ -482,7 +589,7 @@ fn diagnose(segs: &[Segment], predicted: &[Option<[f64; 2]>], before: &[SegmentE
     f.push(Finding {
         pattern: "frequency shift growing with speed".into(),
         evidence: format!("slope of the imaginary-part residual against speed: {bs:+.3} +- {sbs:.3} rad/s per m/s"),
-        suspects: vec!["tyre_relaxation (not a candidate yet)".into(), "inertia errors".into()],
+        suspects: vec!["tyre_relaxation".into(), "inertia errors".into()],
         significant: bs.abs() > 2.0 * sbs,
     });
     let decel: Vec<f64> = segs
@@ -541,8 +648,8 @@ pub fn eigen_rms(segs: &[Segment], pred: &[Option<[f64; 2]>]) -> f64 {
 pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
     let start = std::time::Instant::now();
     let bike = Bicycle::resolve(&a.bike)?;
-    let (free, driven) = identification_model(&bike)?;
-    let cands = candidates(free, &bike, &a.effects)?;
+    let (free, driven, alt) = identification_models(&bike)?;
+    let cands = candidates(free, alt, &bike, &a.effects)?;
     let fit_args = FitArgs {
         inputs: a.inputs.clone(),
         calibration: a.calibration.clone(),
@@ -580,6 +687,7 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
         free.name,
         Identify {
             bike: &bike,
+            alt,
             segments: &segs,
             candidates: &cands,
             opts: &opts,

@@ -29,7 +29,7 @@ fn pair(v: &serde_json::Value) -> [f64; 2] {
 
 /// Every dev run is processed (one entry per run, the documented fields),
 /// and every reliable fit (r^2 > 0.95) is within 20 % of the model's
-/// frozen-speed weave eigenvalue at the window's mean speed. The dev runs
+/// frozen-speed weave eigenvalue over the window's speed interval. The dev runs
 /// contain physics the rigid model lacks, so they are not expected to match
 /// it exactly; 20 % is the bound.
 #[test]
@@ -63,8 +63,15 @@ fn dev_set_fits_every_run_near_the_model() {
         let m = pair(&e["weave"]);
         let se = pair(&e["weave_stderr"]);
         assert!(m[1] > 0.0 && se[0] > 0.0 && se[1] > 0.0);
+        // The model's eigenvalue over the window's speed interval (the
+        // speed falls during a response; below the weave speed the real
+        // part changes by ~1.6 1/s per m/s): distance from the measured
+        // eigenvalue to that range, relative to the eigenvalue at the mean
+        // speed.
         let p = pair(&e["predicted_weave"]["at_mean_speed"]);
-        let rel = (m[0] - p[0]).hypot(m[1] - p[1]) / p[0].hypot(p[1]);
+        let (re, im) = (pair(&e["predicted_weave"]["real_range"]), pair(&e["predicted_weave"]["imag_range"]));
+        let gap = |x: f64, r: [f64; 2]| (r[0] - x).max(x - r[1]).max(0.0);
+        let rel = gap(m[0], re).hypot(gap(m[1], im)) / p[0].hypot(p[1]);
         let r2 = e["r2"].as_f64().unwrap();
         eprintln!("{}: measured {m:?} predicted {p:?} rel {rel:.3} r2 {r2:.3}", e["run"]);
         if r2 > 0.95 {

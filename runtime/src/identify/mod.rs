@@ -157,6 +157,8 @@ pub struct EffectParameter {
     pub dissipative: bool,
     /// Unit, for reports.
     pub unit: String,
+    /// Starting value of the fit (default a tenth of the scale).
+    pub initial: Option<f64>,
 }
 
 /// A candidate effect (or a combination): the parameters fitted when it is
@@ -172,6 +174,36 @@ pub struct Candidate {
     pub speed_decay: bool,
     /// Why this effect is suspected, from the residual pattern.
     pub reason: String,
+    /// Simulated with the alternative model (e.g. the tyre model, which
+    /// replaces the no-slip constraints) instead of the base model.
+    pub alternative_model: bool,
+}
+
+/// Makes the fitting setup of one model (type-erased, so identification
+/// can switch models for a candidate without compiling every pair).
+pub trait ModelFactory: Sync {
+    fn setup<'a>(&self, segments: &'a [Segment], weights: &[Weights], active: &[&Candidate]) -> Result<Setup<'a>, IdentifyError>;
+}
+
+/// The [`ModelFactory`] of model `M` with base parameters `base`.
+pub struct Factory<M> {
+    pub base: Vec<f64>,
+    pub model: std::marker::PhantomData<fn() -> M>,
+}
+
+impl<M: MultibodyModel> Factory<M> {
+    pub fn new(base: Vec<f64>) -> Self {
+        Factory {
+            base,
+            model: std::marker::PhantomData,
+        }
+    }
+}
+
+impl<M: MultibodyModel> ModelFactory for Factory<M> {
+    fn setup<'a>(&self, segments: &'a [Segment], weights: &[Weights], active: &[&Candidate]) -> Result<Setup<'a>, IdentifyError> {
+        Setup::new::<M>(&self.base, segments, weights, active)
+    }
 }
 
 /// Noise scales of the three channels.
@@ -819,6 +851,7 @@ pub fn identify<M: MultibodyModel>(
     base: &[f64],
     segments: &[Segment],
     candidates: &[Candidate],
+    alternative: Option<&dyn ModelFactory>,
     opts: &IdentifyOptions,
     progress: &(dyn Fn(&str) + Sync),
 ) -> Result<Identification, IdentifyError> {
@@ -878,6 +911,7 @@ pub fn identify<M: MultibodyModel>(
         let remaining: Vec<&Candidate> = candidates
             .iter()
             .filter(|c| !selected.iter().any(|s| s.name == c.name))
+            .filter(|c| !c.alternative_model || alternative.is_some())
             .filter(|c| {
                 steps.first().is_none_or(|s: &Step| {
                     s.tried.iter().any(|(n, f)| n == &c.name && f.bic < s.base_bic)
@@ -892,9 +926,12 @@ pub fn identify<M: MultibodyModel>(
         for c in &remaining {
             let mut active = selected.clone();
             active.push(c);
-            let setup = Setup::new::<M>(base, segments, &weights, &active)?;
+            let setup = match alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
+                Some(f) => f.setup(segments, &weights, &active)?,
+                None => Setup::new::<M>(base, segments, &weights, &active)?,
+            };
             let mut g0 = current.values.clone();
-            g0.extend(c.parameters.iter().map(|p| 0.1 * p.scale));
+            g0.extend(c.parameters.iter().map(|p| p.initial.unwrap_or(0.1 * p.scale)));
             let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
             match fit_candidate(&setup, effects, &g0, &current.nuisance, &fold_of, opts, Some(&current)) {
                 Ok(f) => {
