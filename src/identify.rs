@@ -209,6 +209,10 @@ pub fn candidates(info: &ModelInfo, alt: Option<&ModelInfo>, bike: &Bicycle, onl
                     // The tyre model's relaxation starts from its default,
                     // not from a tenth of it (a stiff start).
                     initial: s.alternative_model.then(|| info.parameter(sym).and_then(|p| p.default)).flatten(),
+                    // A relaxation length toward zero is a rigid, stiff
+                    // tyre: below 1 cm the model is held there (tyres
+                    // measure 0.1-0.3 m).
+                    lower: s.alternative_model.then_some(0.01),
                 })
                 .collect(),
             fixed: s
@@ -826,6 +830,17 @@ pub fn outcome_json(o: &Outcome) -> Value {
                 "values": f.values,
                 "selected": step.added.as_deref() == Some(name.as_str()),
                 "verdict": verdict,
+            }));
+        }
+        for (name, why) in &step.failed {
+            cands.push(json!({
+                "step": k + 1,
+                "name": name,
+                "extends": step.base,
+                "score": Value::Null,
+                "cv": Value::Null,
+                "selected": false,
+                "verdict": why,
             }));
         }
     }

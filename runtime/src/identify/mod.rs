@@ -159,6 +159,10 @@ pub struct EffectParameter {
     pub unit: String,
     /// Starting value of the fit (default a tenth of the scale).
     pub initial: Option<f64>,
+    /// Smallest value the model is simulated with (values below are held
+    /// there): for parameters the model is undefined or singular without,
+    /// such as a relaxation length.
+    pub lower: Option<f64>,
 }
 
 /// A candidate effect (or a combination): the parameters fitted when it is
@@ -369,7 +373,8 @@ impl<'a> Setup<'a> {
     /// Parameter vector of `M` for effect values `g`.
     pub fn param(&self, g: &[f64]) -> Vec<f64> {
         let mut p = self.base.clone();
-        for (slot, &v) in self.slots.iter().zip(g) {
+        for ((slot, &v), info) in self.slots.iter().zip(g).zip(&self.parameters) {
+            let v = info.lower.map_or(v, |lo| v.max(lo));
             for &i in slot {
                 p[i] = v;
             }
@@ -703,7 +708,13 @@ pub fn fit_candidate(
         .map(|((r, s), w)| SegmentError::of(r, s, *w))
         .collect();
     let chi2: f64 = res.iter().flatten().map(|x| x * x).sum();
-    let g = full.g.clone();
+    // Values below a parameter's floor were simulated at the floor.
+    let g: Vec<f64> = full
+        .g
+        .iter()
+        .zip(&setup.parameters)
+        .map(|(&v, p)| p.lower.map_or(v, |lo| v.max(lo)))
+        .collect();
     let nuisance = full.x0.clone();
 
     // Standard errors of the effect parameters from the Jacobian at the fit.
@@ -721,7 +732,11 @@ pub fn fit_candidate(
             }
         }
     }
-    let physical = setup.parameters.iter().zip(&g).all(|(p, v)| !p.dissipative || *v > 0.0);
+    let physical = setup
+        .parameters
+        .iter()
+        .zip(&full.g)
+        .all(|(p, v)| !p.dissipative || *v > p.lower.unwrap_or(0.0));
     let mut fit = CandidateFit {
         effects,
         parameters: setup.parameters.clone(),
