@@ -277,7 +277,15 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
                 weave,
             );
             match seg {
-                Some(s) if s.duration() >= 0.5 => segs.push(s),
+                Some(mut s) if s.duration() >= 0.5 => {
+                    // The eigenvalue belongs to the fit window: compare and
+                    // draw it at that window's speeds.
+                    if k.mean_speed.is_finite() && k.speed_interval.iter().all(|v| v.is_finite()) {
+                        s.mean_speed = k.mean_speed;
+                        s.speed_interval = k.speed_interval;
+                    }
+                    segs.push(s)
+                }
                 _ => skipped.push(format!(
                     "{}: kick at {:.2} s has no usable window ({:.2}-{:.2} s)",
                     r.run.display(),
@@ -1022,7 +1030,7 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
     for (label, v) in [("fitted runs, before", &b), ("fitted runs, after", &af), ("held-out runs, before", &b["held_out"]), ("held-out runs, after", &af["held_out"])] {
         let _ = writeln!(s, "| {label} | {:.4} | {:.4} | {:.4} | {:.4} |", g(v, "eigen_rms"), g(v, "roll_rms").to_degrees(), g(v, "steer_rms").to_degrees(), g(v, "speed_rms"));
     }
-    let _ = writeln!(s, "\nPer run (roll RMS in deg; weave eigenvalues in 1/s):\n\n| run | window start (s) | speed (m/s) | measured weave | predicted before | predicted after | roll before | roll after | roll after, held out |\n|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "\nPer run (roll RMS in deg; weave eigenvalues in 1/s):\n\n| run | window start (s) | speed over the eigenvalue fit (m/s) | measured weave | predicted before | predicted after | roll before | roll after | roll after, held out |\n|---|---|---|---|---|---|---|---|---|");
     for (i, seg) in o.segments.iter().enumerate() {
         let _ = writeln!(
             s,
@@ -1063,11 +1071,24 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
     let speeds: Vec<f64> = (1..=200).map(|i| vmax * i as f64 / 200.0).collect();
     let (_, driven) = identification_model(&bike)?;
     let curve = |vals: &BTreeMap<String, f64>| -> Result<Vec<(f64, f64, f64)>> {
-        Ok(predict(driven, &bike, vals, &speeds)?
+        let pts: Vec<(f64, f64, f64)> = predict(driven, &bike, vals, &speeds)?
             .into_iter()
             .zip(&speeds)
             .filter_map(|(z, &v)| z.map(|z| (v, z[0], z[1])))
-            .collect())
+            .collect();
+        // The weave, followed down from high speed until it stops being
+        // one complex pair (a jump far beyond the typical step means
+        // another pair took over, e.g. capsize-castering at low speed).
+        let steps: Vec<f64> = pts.windows(2).map(|w| (w[1].1 - w[0].1).hypot(w[1].2 - w[0].2)).collect();
+        let typical = median(steps.iter().copied());
+        let mut start = 0;
+        for k in (0..steps.len()).rev() {
+            if steps[k] > 10.0 * typical.max(1e-9) {
+                start = k + 1;
+                break;
+            }
+        }
+        Ok(pts[start..].to_vec())
     };
     let measured: Vec<MeasuredWeave> = o
         .segments
@@ -1090,13 +1111,15 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
     let mut rates: Vec<f64> = o.steer_rate.iter().copied().filter(|x| x.is_finite()).collect();
     rates.sort_by(f64::total_cmp);
     let median_rate = rates.get(rates.len() / 2).copied().unwrap_or(f64::NAN);
+    for ext in ["svg", "png"] {
     plot_continuation(
-        &dir.join("continuation.svg"),
+        &dir.join(format!("continuation.{ext}")),
         &curve(&BTreeMap::new())?,
         &curve(&linear_equivalent(&o.values_after, median_rate))?,
         &label,
         &measured,
     )?;
+    }
     if let Some(rp) = &o.run_plot {
         let s = &o.segments[rp.segment];
         let deg = |x: &[f64]| x.iter().map(|v| v.to_degrees()).collect::<Vec<f64>>();
@@ -1105,15 +1128,21 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
         };
         let (mr, br, ar) = (deg(&s.roll), deg(&b.roll), deg(&a.roll));
         let (ms, bs, as_) = (deg(&s.steer), deg(&b.steer), deg(&a.steer));
+        for ext in ["svg", "png"] {
         plot_run(
-            &dir.join("run_residuals.svg"),
-            &format!("{} (window from {:.2} s): measured and simulated, before and after", s.run, s.t0),
+            &dir.join(format!("run_residuals.{ext}")),
+            &format!(
+                "{} (window from {:.2} s): measured and simulated, before and after",
+                Path::new(&s.run).file_name().map_or(s.run.clone(), |n| n.to_string_lossy().into_owned()),
+                s.t0
+            ),
             &[
                 Channel { name: "roll", unit: "deg", t: &s.t, measured: &mr, before: &br, after: &ar },
                 Channel { name: "steer", unit: "deg", t: &s.t, measured: &ms, before: &bs, after: &as_ },
                 Channel { name: "speed", unit: "m/s", t: &s.speed_t, measured: &s.speed, before: &b.speed, after: &a.speed },
             ],
         )?;
+        }
     }
     write_string_atomic(dir.join("report.md"), &report_markdown(o, a, dir))?;
     Ok(())

@@ -962,7 +962,7 @@ pub fn identify<M: MultibodyModel>(
         let mut best: Option<usize> = None;
         for (i, (name, f)) in tried.iter().enumerate() {
             let verdict = if !f.physical {
-                "rejected: a dissipative parameter fitted negative (not physics; not cross-validated)".to_string()
+                "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".to_string()
             } else if !(f.bic < base_bic) {
                 format!("rejected: BIC {:+.1} (no gain beyond its added parameters; not cross-validated)", f.bic - base_bic)
             } else if !(f.cv < current.cv) {

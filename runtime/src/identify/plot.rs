@@ -3,21 +3,14 @@
 //! eigenvalue on its speed segment; and the residual time series of one run
 //! before and after.
 
-use crate::output::write_string_atomic;
-use crate::plot::{find_font, use_font, PlotError};
+use crate::plot::{de, render, DrawErr, Figure, PlotError, PlotOptions};
+use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
 const BEFORE: RGBColor = RGBColor(0, 114, 178);
 const AFTER: RGBColor = RGBColor(213, 94, 0);
 const MEASURED: RGBColor = RGBColor(60, 60, 60);
-
-fn drawing(path: &Path, e: impl std::fmt::Display) -> PlotError {
-    PlotError::Drawing {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    }
-}
 
 fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = x
@@ -47,7 +40,33 @@ pub fn plot_continuation(
     after_label: &str,
     measured: &[MeasuredWeave],
 ) -> Result<(), PlotError> {
-    use_font(find_font()?)?;
+    let opts = PlotOptions {
+        width: 900,
+        height: 620,
+        ..PlotOptions::default()
+    };
+    render(
+        path,
+        &opts,
+        &Continuation {
+            before,
+            after,
+            after_label,
+            measured,
+        },
+    )
+}
+
+struct Continuation<'a> {
+    before: &'a [(f64, f64, f64)],
+    after: &'a [(f64, f64, f64)],
+    after_label: &'a str,
+    measured: &'a [MeasuredWeave],
+}
+
+impl Figure for Continuation<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
+    let (before, after, after_label, measured) = (self.before, self.after, self.after_label, self.measured);
     let vmax = before.iter().chain(after).map(|p| p.0).fold(1.0, f64::max);
     let (y0, y1) = range(
         before
@@ -56,22 +75,20 @@ pub fn plot_continuation(
             .flat_map(|p| [p.1, p.2])
             .chain(measured.iter().flat_map(|m| m.eigenvalue)),
     );
-    let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (900, 620)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| drawing(path, e))?;
-        let mut ch = ChartBuilder::on(&root)
+        root.fill(&WHITE).map_err(de)?;
+        let mut ch = ChartBuilder::on(root)
             .caption("weave eigenvalue before and after identification", ("sans-serif", 18))
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(60)
             .build_cartesian_2d(0.0..vmax, y0.max(-15.0)..y1.min(15.0))
-            .map_err(|e| drawing(path, e))?;
+            .map_err(de)?;
         ch.configure_mesh()
             .x_desc("forward speed (m/s)")
             .y_desc("weave eigenvalue, real and imaginary parts (1/s)")
             .draw()
-            .map_err(|e| drawing(path, e))?;
+            .map_err(de)?;
         for (curve, col, label, dashed) in [
             (before, BEFORE, "model before".to_string(), true),
             (after, AFTER, format!("model after ({after_label})"), false),
@@ -81,7 +98,7 @@ pub fn plot_continuation(
                 let style = col.stroke_width(if dashed { 1 } else { 2 });
                 let s = ch
                     .draw_series(LineSeries::new(pts, style))
-                    .map_err(|e| drawing(path, e))?;
+                    .map_err(de)?;
                 if part == 0 {
                     let l = format!("{label}: real (lower) and imaginary (upper) parts");
                     s.label(l)
@@ -98,7 +115,7 @@ pub fn plot_continuation(
                         vec![(lo, val), (hi, val)],
                         MEASURED.stroke_width(3),
                     )))
-                    .map_err(|e| drawing(path, e))?;
+                    .map_err(de)?;
                 if i == 0 && part == 0 {
                     s.label("measured (over its speed interval, bar: one standard error)")
                         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], MEASURED.stroke_width(3)));
@@ -107,20 +124,19 @@ pub fn plot_continuation(
                     vec![(m.mean_speed, val - se), (m.mean_speed, val + se)],
                     BLACK.stroke_width(1),
                 )))
-                .map_err(|e| drawing(path, e))?;
+                .map_err(de)?;
             }
         }
         ch.configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
+            .position(SeriesLabelPosition::UpperLeft)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
             .label_font(("sans-serif", 13))
             .draw()
-            .map_err(|e| drawing(path, e))?;
-        root.present().map_err(|e| drawing(path, e))?;
+            .map_err(de)?;
     }
-    write_string_atomic(path, &svg)?;
     Ok(())
+    }
 }
 
 /// One channel of a run: measured and simulated before and after.
@@ -135,14 +151,27 @@ pub struct Channel<'a> {
 
 /// Measured and simulated roll, steer and speed of one run, before and after.
 pub fn plot_run(path: &Path, title: &str, channels: &[Channel<'_>]) -> Result<(), PlotError> {
-    use_font(find_font()?)?;
-    let mut svg = String::new();
+    let opts = PlotOptions {
+        width: 900,
+        height: 260 * channels.len() as u32 + 40,
+        ..PlotOptions::default()
+    };
+    render(path, &opts, &RunFigure { title, channels })
+}
+
+struct RunFigure<'a, 'b> {
+    title: &'a str,
+    channels: &'a [Channel<'b>],
+}
+
+impl Figure for RunFigure<'_, '_> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
+    let (title, channels) = (self.title, self.channels);
     {
-        let root = SVGBackend::with_string(&mut svg, (900, 260 * channels.len() as u32 + 40)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| drawing(path, e))?;
+        root.fill(&WHITE).map_err(de)?;
         let root = root
             .titled(title, ("sans-serif", 18))
-            .map_err(|e| drawing(path, e))?;
+            .map_err(de)?;
         let areas = root.split_evenly((channels.len(), 1));
         for (area, c) in areas.iter().zip(channels) {
             if c.t.is_empty() {
@@ -155,12 +184,12 @@ pub fn plot_run(path: &Path, title: &str, channels: &[Channel<'_>]) -> Result<()
                 .x_label_area_size(35)
                 .y_label_area_size(60)
                 .build_cartesian_2d(0.0..x1, y0..y1)
-                .map_err(|e| drawing(path, e))?;
+                .map_err(de)?;
             ch.configure_mesh()
                 .x_desc("time after the window start (s)")
                 .y_desc(format!("{} ({})", c.name, c.unit))
                 .draw()
-                .map_err(|e| drawing(path, e))?;
+                .map_err(de)?;
             let series = [
                 (c.measured, MEASURED, "measured", 1),
                 (c.before, BEFORE, "model before", 2),
@@ -169,7 +198,7 @@ pub fn plot_run(path: &Path, title: &str, channels: &[Channel<'_>]) -> Result<()
             for (y, col, label, w) in series {
                 let pts: Vec<(f64, f64)> = c.t.iter().copied().zip(y.iter().copied()).collect();
                 ch.draw_series(LineSeries::new(pts, col.stroke_width(w)))
-                    .map_err(|e| drawing(path, e))?
+                    .map_err(de)?
                     .label(label)
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(w)));
             }
@@ -178,10 +207,9 @@ pub fn plot_run(path: &Path, title: &str, channels: &[Channel<'_>]) -> Result<()
                 .border_style(BLACK)
                 .label_font(("sans-serif", 12))
                 .draw()
-                .map_err(|e| drawing(path, e))?;
+                .map_err(de)?;
         }
-        root.present().map_err(|e| drawing(path, e))?;
     }
-    write_string_atomic(path, &svg)?;
     Ok(())
+    }
 }
