@@ -164,8 +164,12 @@ pub fn run(a: SynthArgs) -> Result<bool> {
         Some(name) => bike.model(Some(name))?,
         None => {
             let driven = bike.model(None)?;
-            bikedyn::models::free_speed_variant(driven)
-                .with_context(|| format!("model `{}` has no free-speed variant; name one with --model", driven.name))?
+            bikedyn::models::free_speed_variant(driven).with_context(|| {
+                format!(
+                    "model `{}` has no free-speed variant; name one with --model",
+                    driven.name
+                )
+            })?
         }
     };
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;

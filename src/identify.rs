@@ -134,24 +134,25 @@ const SPECS: &[Spec] = &[
 /// Effects of the library identification does not yet consider, and why.
 pub const NOT_CANDIDATES: &[(&str, &str)] = &[];
 
-/// The free-speed model with every candidate effect (the registry's
-/// free-speed model with the most effects of the bicycle's base).
-fn identification_model(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo)> {
-    identification_models(bike).map(|(f, d, _)| (f, d))
-}
-
 /// The identification model, its driven twin, and the alternative model
 /// (free speed, with states: the tyre model) if the registry has one.
-fn identification_models(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo, Option<&'static ModelInfo>)> {
+fn identification_models(
+    bike: &Bicycle,
+) -> Result<(&'static ModelInfo, &'static ModelInfo, Option<&'static ModelInfo>)> {
     let (free, driven) = identification_model_pair(bike)?;
     let base = free.base;
     let alt = MODELS
         .iter()
-        .filter(|m| m.free_speed && m.base == base && !m.states.is_empty() && free.effects.iter().all(|e| m.effects.contains(e)))
+        .filter(|m| {
+            m.free_speed && m.base == base && !m.states.is_empty() && free.effects.iter().all(|e| m.effects.contains(e))
+        })
         .max_by_key(|m| m.effects.len());
     Ok((free, driven, alt))
 }
 
+/// The free-speed model with every candidate effect (the registry's
+/// free-speed model with the most effects of the bicycle's base) and its
+/// driven-speed twin.
 fn identification_model_pair(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo)> {
     let base = bike.model(None)?.base;
     let free = MODELS
@@ -168,11 +169,19 @@ fn identification_model_pair(bike: &Bicycle) -> Result<(&'static ModelInfo, &'st
 
 /// The candidates for a model: every effect of it that has a spec (and is
 /// in `only` when given).
-pub fn candidates(info: &ModelInfo, alt: Option<&ModelInfo>, bike: &Bicycle, only: &[String]) -> Result<Vec<Candidate>> {
+pub fn candidates(
+    info: &ModelInfo,
+    alt: Option<&ModelInfo>,
+    bike: &Bicycle,
+    only: &[String],
+) -> Result<Vec<Candidate>> {
     for o in only {
         if !SPECS.iter().any(|s| s.effect == o) {
             let known: Vec<&str> = SPECS.iter().map(|s| s.effect).collect();
-            bail!("--effects: `{o}` is not an effect identification supports ({})", known.join(", "));
+            bail!(
+                "--effects: `{o}` is not an effect identification supports ({})",
+                known.join(", ")
+            );
         }
     }
     let mut out = Vec::new();
@@ -191,7 +200,12 @@ pub fn candidates(info: &ModelInfo, alt: Option<&ModelInfo>, bike: &Bicycle, onl
         let info = model;
         let unit = |sym: &str| {
             info.parameter(sym)
-                .map(|p| p.doc.rsplit_once('(').map_or("", |(_, u)| u.trim_end_matches(')')).to_string())
+                .map(|p| {
+                    p.doc
+                        .rsplit_once('(')
+                        .map_or("", |(_, u)| u.trim_end_matches(')'))
+                        .to_string()
+                })
                 .unwrap_or_default()
         };
         out.push(Candidate {
@@ -208,7 +222,10 @@ pub fn candidates(info: &ModelInfo, alt: Option<&ModelInfo>, bike: &Bicycle, onl
                     unit: unit(sym),
                     // The tyre model's relaxation starts from its default,
                     // not from a tenth of it (a stiff start).
-                    initial: s.alternative_model.then(|| info.parameter(sym).and_then(|p| p.default)).flatten(),
+                    initial: s
+                        .alternative_model
+                        .then(|| info.parameter(sym).and_then(|p| p.default))
+                        .flatten(),
                     // A relaxation length toward zero is a rigid, stiff
                     // tyre: below 1 cm the model is held there (tyres
                     // measure 0.1-0.3 m).
@@ -236,7 +253,10 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
     let mut skipped = Vec::new();
     for r in &out.reports {
         let (Some(ang), Some(sp)) = (&r.angles, &r.speed) else {
-            skipped.push(format!("{}: no angles or speed record (TU Delft logs are not identified yet)", r.run.display()));
+            skipped.push(format!(
+                "{}: no angles or speed record (TU Delft logs are not identified yet)",
+                r.run.display()
+            ));
             continue;
         };
         let offset = r.clock_offset.map_or(0.0, |c| c.value);
@@ -248,13 +268,19 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
             // steady lean) show mostly there. So the identification window
             // goes on to the end of the free motion: the record's end, a
             // gap, or a fall, at most IDENTIFY_WINDOW after the start.
-            if matches!(k.window_end, WindowEnd::Decayed | WindowEnd::Drift | WindowEnd::SpeedChange) {
+            if matches!(
+                k.window_end,
+                WindowEnd::Decayed | WindowEnd::Drift | WindowEnd::SpeedChange
+            ) {
                 let fall = PipelineOptions::default().kicks.fall_angle;
                 let dt = (ang.t[ang.t.len() - 1] - ang.t[0]) / (ang.t.len().max(2) - 1) as f64;
                 let i0 = ang.t.partition_point(|&x| x < w0);
                 let mut end = w1;
                 for i in i0..ang.t.len() {
-                    if ang.t[i] > w0 + IDENTIFY_WINDOW || ang.roll[i].abs() > fall || (i > i0 && ang.t[i] - ang.t[i - 1] > 3.0 * dt) {
+                    if ang.t[i] > w0 + IDENTIFY_WINDOW
+                        || ang.roll[i].abs() > fall
+                        || (i > i0 && ang.t[i] - ang.t[i - 1] > 3.0 * dt)
+                    {
                         break;
                     }
                     end = ang.t[i];
@@ -354,10 +380,22 @@ impl ModelVisitor for WeaveCurve<'_> {
 
 /// Predicted weave eigenvalues of the driven model with effect values
 /// `values` set on top of the bicycle.
-fn predict(driven: &ModelInfo, bike: &Bicycle, values: &BTreeMap<String, f64>, speeds: &[f64]) -> Result<Vec<Option<[f64; 2]>>> {
+fn predict(
+    driven: &ModelInfo,
+    bike: &Bicycle,
+    values: &BTreeMap<String, f64>,
+    speeds: &[f64],
+) -> Result<Vec<Option<[f64; 2]>>> {
     let base = bike.lookup()?;
     let lookup = |s: &str| values.get(s).copied().or_else(|| base(s));
-    let guide = with_model(driven.name, WeaveCurve { lookup: &lookup, speeds }).expect("registered model")?;
+    let guide = with_model(
+        driven.name,
+        WeaveCurve {
+            lookup: &lookup,
+            speeds,
+        },
+    )
+    .expect("registered model")?;
     // Effects the driven model lacks (the tyre model's) are predicted with
     // the alternative model's state-space linearization.
     if let Some(alt) = values
@@ -366,13 +404,25 @@ fn predict(driven: &ModelInfo, bike: &Bicycle, values: &BTreeMap<String, f64>, s
         .then(|| identification_models(bike).ok().and_then(|m| m.2))
         .flatten()
     {
-        return with_model(alt.name, StateSpaceWeave { lookup: &lookup, speeds, guide: &guide }).expect("registered model");
+        return with_model(
+            alt.name,
+            StateSpaceWeave {
+                lookup: &lookup,
+                speeds,
+                guide: &guide,
+            },
+        )
+        .expect("registered model");
     }
     Ok(guide)
 }
 
 /// Effect values of a fit, tied symbols and fixed companions included.
-fn effect_values(fit: &bikedyn_runtime::identify::CandidateFit, values: &[f64], cands: &[Candidate]) -> BTreeMap<String, f64> {
+fn effect_values(
+    fit: &bikedyn_runtime::identify::CandidateFit,
+    values: &[f64],
+    cands: &[Candidate],
+) -> BTreeMap<String, f64> {
     let mut m = BTreeMap::new();
     for (p, v) in fit.parameters.iter().zip(values) {
         m.insert(p.symbol.clone(), *v);
@@ -409,7 +459,11 @@ fn linear_equivalent(values: &BTreeMap<String, f64>, mean_abs_steer_rate: f64) -
     let mut v = values.clone();
     if let Some(t) = v.get("T_steer").copied().filter(|t| *t != 0.0) {
         let amp = std::f64::consts::FRAC_PI_2 * mean_abs_steer_rate;
-        let c_eq = if amp > 0.0 { 4.0 * t / (std::f64::consts::PI * amp) } else { 0.0 };
+        let c_eq = if amp > 0.0 {
+            4.0 * t / (std::f64::consts::PI * amp)
+        } else {
+            0.0
+        };
         *v.entry("c_steer".into()).or_insert(0.0) += c_eq;
         v.insert("T_steer".into(), 0.0);
     }
@@ -442,7 +496,14 @@ impl ModelVisitor for Identify<'_> {
             Some(a) => Some(with_model(a.name, MakeFactory { lookup: &lookup }).expect("registered model")?),
             None => None,
         };
-        let id = identify::<M>(&base, self.segments, self.candidates, alt.as_deref(), self.opts, self.progress)?;
+        let id = identify::<M>(
+            &base,
+            self.segments,
+            self.candidates,
+            alt.as_deref(),
+            self.opts,
+            self.progress,
+        )?;
         // The typical run: median roll error before.
         let mut order: Vec<usize> = (0..self.segments.len()).collect();
         order.sort_by(|&a, &b| id.before.errors[a].roll_rms.total_cmp(&id.before.errors[b].roll_rms));
@@ -462,7 +523,11 @@ impl ModelVisitor for Identify<'_> {
                 .map(|i| before.simulated(&[], &self.segments[i], &id.before.nuisance[i]).ok())
                 .collect(),
             after: (0..self.segments.len())
-                .map(|i| after.simulated(&id.after.values, &self.segments[i], &id.after.nuisance[i]).ok())
+                .map(|i| {
+                    after
+                        .simulated(&id.after.values, &self.segments[i], &id.after.nuisance[i])
+                        .ok()
+                })
                 .collect(),
         });
         Ok((id, plot))
@@ -548,7 +613,12 @@ fn slope(x: &[f64], y: &[f64]) -> (f64, f64) {
 
 /// Relate the base model's residuals to candidate effects (issue 9,
 /// point 2). Significance: two standard errors.
-fn diagnose(segs: &[Segment], predicted: &[Option<[f64; 2]>], before: &[SegmentError], sims_mean_roll: &[f64]) -> Vec<Finding> {
+fn diagnose(
+    segs: &[Segment],
+    predicted: &[Option<[f64; 2]>],
+    before: &[SegmentError],
+    sims_mean_roll: &[f64],
+) -> Vec<Finding> {
     let mut f = Vec::new();
     let pairs: Vec<(usize, [f64; 2], [f64; 2])> = segs
         .iter()
@@ -732,7 +802,8 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
         let sp: Vec<f64> = idx.iter().map(|&s| speeds[s]).collect();
         let fold_vals = effect_values(&id.after, vals, &cands);
         for (k, &s) in idx.iter().enumerate() {
-            predicted_held_out[s] = predict(driven, &bike, &linear_equivalent(&fold_vals, steer_rate[s]), &sp[k..=k])?[0];
+            predicted_held_out[s] =
+                predict(driven, &bike, &linear_equivalent(&fold_vals, steer_rate[s]), &sp[k..=k])?[0];
         }
     }
     // Steady bias: the base model's roll residual over the second half of
@@ -782,7 +853,11 @@ fn errors_json(o: &Outcome, after: bool) -> Value {
     let id = &o.identification;
     let fit = if after { &id.after } else { &id.before };
     let pred = if after { &o.predicted_after } else { &o.predicted_before };
-    let held_pred = if after { &o.predicted_held_out } else { &o.predicted_before };
+    let held_pred = if after {
+        &o.predicted_held_out
+    } else {
+        &o.predicted_before
+    };
     json!({
         "eigen_rms": eigen_rms(&o.segments, pred),
         "median_run_roll_rms": median(fit.errors.iter().map(|e| e.roll_rms)),
@@ -819,7 +894,12 @@ pub fn outcome_json(o: &Outcome) -> Value {
         .map(display_name)
         .collect();
     let mut params = serde_json::Map::new();
-    for (p, (v, se)) in id.after.parameters.iter().zip(id.after.values.iter().zip(&id.after.stderr)) {
+    for (p, (v, se)) in id
+        .after
+        .parameters
+        .iter()
+        .zip(id.after.values.iter().zip(&id.after.stderr))
+    {
         params.insert(
             p.symbol.clone(),
             json!({"value": v, "low": v - 1.96 * se, "high": v + 1.96 * se, "stderr": se, "unit": p.unit, "tied": p.tied}),
@@ -890,7 +970,11 @@ pub fn summary(o: &Outcome) -> String {
         s,
         "kicks: {} from {} runs ({} skipped); model {}",
         o.segments.len(),
-        o.segments.iter().map(|s| &s.run).collect::<std::collections::BTreeSet<_>>().len(),
+        o.segments
+            .iter()
+            .map(|s| &s.run)
+            .collect::<std::collections::BTreeSet<_>>()
+            .len(),
         o.skipped.len(),
         o.model
     );
@@ -907,7 +991,11 @@ pub fn summary(o: &Outcome) -> String {
         .zip(id.after.values.iter().zip(&id.after.stderr))
         .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4} {}", p.symbol, v, 1.96 * se, p.unit))
         .collect();
-    let _ = writeln!(s, "parameters (95 %): {}", if vals.is_empty() { "-".into() } else { vals.join(", ") });
+    let _ = writeln!(
+        s,
+        "parameters (95 %): {}",
+        if vals.is_empty() { "-".into() } else { vals.join(", ") }
+    );
     let _ = writeln!(
         s,
         "error before -> after: weave eigenvalue RMS {:.3} -> {:.3} 1/s, roll RMS {:.3} -> {:.3} deg (median run {:.3} -> {:.3}), steer RMS {:.3} -> {:.3} deg",
@@ -972,30 +1060,60 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
     let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed; fitted per run as nuisance parameters), and compared with the measured roll, steer and speed.");
     let _ = writeln!(s, "3. The residual pattern of the model without any added effect was related to the effects of the library (below).");
     let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all runs (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run), and its dissipative parameters are positive. The search stops when no candidate passes.\n", id.folds);
-    let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| {
-        let mut v: Vec<f64> = id.weights.iter().map(f).collect();
-        v.sort_by(f64::total_cmp);
-        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-    };
+    let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| median(id.weights.iter().map(f));
     let _ = writeln!(s, "Channel scales (each run's RMS residual under the base model, at least the best run's; median over runs): roll {:.3} deg, steer {:.3} deg, speed {:.3} m/s. Each run and channel is weighed by its own scale, so a run that diverges toward a fall cannot outweigh the others.\n", med(&|w| w.roll).to_degrees(), med(&|w| w.steer).to_degrees(), med(&|w| w.speed));
     let _ = writeln!(s, "## Residual diagnosis (base model)\n");
-    let _ = writeln!(s, "| pattern | evidence | points to | significant (2 sigma) |\n|---|---|---|---|");
+    let _ = writeln!(
+        s,
+        "| pattern | evidence | points to | significant (2 sigma) |\n|---|---|---|---|"
+    );
     for f in &o.findings {
-        let _ = writeln!(s, "| {} | {} | {} | {} |", f.pattern, f.evidence, f.suspects.join(", "), if f.significant { "yes" } else { "no" });
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} |",
+            f.pattern,
+            f.evidence,
+            f.suspects.join(", "),
+            if f.significant { "yes" } else { "no" }
+        );
     }
     let _ = writeln!(s, "\nCandidates and why each is suspected:\n");
     for c in &o.candidates {
-        let p: Vec<String> = c.parameters.iter().map(|p| format!("`{}` ({})", p.symbol, p.unit)).collect();
-        let _ = writeln!(s, "* `{}`{}: {} Fitted: {}.", c.name, if c.speed_decay { " (speed decay)" } else { "" }, c.reason, p.join(", "));
+        let p: Vec<String> = c
+            .parameters
+            .iter()
+            .map(|p| format!("`{}` ({})", p.symbol, p.unit))
+            .collect();
+        let _ = writeln!(
+            s,
+            "* `{}`{}: {} Fitted: {}.",
+            c.name,
+            if c.speed_decay { " (speed decay)" } else { "" },
+            c.reason,
+            p.join(", ")
+        );
     }
     for (e, why) in NOT_CANDIDATES {
         let _ = writeln!(s, "* `{e}` is not a candidate: {why}.");
     }
     let _ = writeln!(s, "\n## Ranking of the candidates\n");
     for (k, step) in id.steps.iter().enumerate() {
-        let base = if step.base.is_empty() { "the base model".to_string() } else { step.base.join(" + ") };
-        let _ = writeln!(s, "Step {}: added to {base} (BIC {:.1}, held-out error {:.4}).\n", k + 1, step.base_bic, step.base_cv);
-        let _ = writeln!(s, "| candidate | fitted values | BIC change | held-out error | verdict |\n|---|---|---|---|---|");
+        let base = if step.base.is_empty() {
+            "the base model".to_string()
+        } else {
+            step.base.join(" + ")
+        };
+        let _ = writeln!(
+            s,
+            "Step {}: added to {base} (BIC {:.1}, held-out error {:.4}).\n",
+            k + 1,
+            step.base_bic,
+            step.base_cv
+        );
+        let _ = writeln!(
+            s,
+            "| candidate | fitted values | BIC change | held-out error | verdict |\n|---|---|---|---|---|"
+        );
         let mut rows: Vec<usize> = (0..step.tried.len()).collect();
         rows.sort_by(|&x, &y| step.tried[x].1.bic.total_cmp(&step.tried[y].1.bic));
         for r in rows {
@@ -1006,8 +1124,18 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
                 .zip(f.values.iter().zip(&f.stderr))
                 .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4}", p.symbol, v, se))
                 .collect();
-            let cv = if f.cv.is_finite() { format!("{:.4}", f.cv) } else { "-".into() };
-            let _ = writeln!(s, "| `{name}` | {} | {:+.1} | {cv} | {} |", vals.join(", "), f.bic - step.base_bic, step.verdicts[r].1);
+            let cv = if f.cv.is_finite() {
+                format!("{:.4}", f.cv)
+            } else {
+                "-".into()
+            };
+            let _ = writeln!(
+                s,
+                "| `{name}` | {} | {:+.1} | {cv} | {} |",
+                vals.join(", "),
+                f.bic - step.base_bic,
+                step.verdicts[r].1
+            );
         }
         for (name, why) in &step.failed {
             let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
@@ -1017,9 +1145,30 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
     if id.selected.is_empty() {
         let _ = writeln!(s, "**No effect warranted.** No candidate lowered both the information criterion and the held-out error with physical parameter values: the residual of the base model is not explained better by any effect of the library than by noise. The model is left as it is.\n");
     } else {
-        let _ = writeln!(s, "## Identified effects\n\n| parameter | value | 95 % interval | unit |\n|---|---|---|---|");
-        for (p, (v, se)) in id.after.parameters.iter().zip(id.after.values.iter().zip(&id.after.stderr)) {
-            let _ = writeln!(s, "| `{}`{} | {:.5} | [{:.5}, {:.5}] | {} |", p.symbol, if p.tied.is_empty() { String::new() } else { format!(" (= `{}`)", p.tied.join("`, `")) }, v, v - 1.96 * se, v + 1.96 * se, p.unit);
+        let _ = writeln!(
+            s,
+            "## Identified effects\n\n| parameter | value | 95 % interval | unit |\n|---|---|---|---|"
+        );
+        for (p, (v, se)) in id
+            .after
+            .parameters
+            .iter()
+            .zip(id.after.values.iter().zip(&id.after.stderr))
+        {
+            let _ = writeln!(
+                s,
+                "| `{}`{} | {:.5} | [{:.5}, {:.5}] | {} |",
+                p.symbol,
+                if p.tied.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (= `{}`)", p.tied.join("`, `"))
+                },
+                v,
+                v - 1.96 * se,
+                v + 1.96 * se,
+                p.unit
+            );
         }
         let _ = writeln!(s);
     }
@@ -1027,8 +1176,20 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
     let af = errors_json(o, true);
     let g = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
     let _ = writeln!(s, "## Error before and after\n\n| | weave eigenvalue RMS (1/s) | roll RMS (deg) | steer RMS (deg) | speed RMS (m/s) |\n|---|---|---|---|---|");
-    for (label, v) in [("fitted runs, before", &b), ("fitted runs, after", &af), ("held-out runs, before", &b["held_out"]), ("held-out runs, after", &af["held_out"])] {
-        let _ = writeln!(s, "| {label} | {:.4} | {:.4} | {:.4} | {:.4} |", g(v, "eigen_rms"), g(v, "roll_rms").to_degrees(), g(v, "steer_rms").to_degrees(), g(v, "speed_rms"));
+    for (label, v) in [
+        ("fitted runs, before", &b),
+        ("fitted runs, after", &af),
+        ("held-out runs, before", &b["held_out"]),
+        ("held-out runs, after", &af["held_out"]),
+    ] {
+        let _ = writeln!(
+            s,
+            "| {label} | {:.4} | {:.4} | {:.4} | {:.4} |",
+            g(v, "eigen_rms"),
+            g(v, "roll_rms").to_degrees(),
+            g(v, "steer_rms").to_degrees(),
+            g(v, "speed_rms")
+        );
     }
     let _ = writeln!(s, "\nPer run (roll RMS in deg; weave eigenvalues in 1/s):\n\n| run | window start (s) | speed over the eigenvalue fit (m/s) | measured weave | predicted before | predicted after | roll before | roll after | roll after, held out |\n|---|---|---|---|---|---|---|---|---|");
     for (i, seg) in o.segments.iter().enumerate() {
@@ -1069,7 +1230,7 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
     // Continuation diagram before and after.
     let vmax = o.segments.iter().map(|s| s.speed_interval[1]).fold(7.0, f64::max) + 1.0;
     let speeds: Vec<f64> = (1..=200).map(|i| vmax * i as f64 / 200.0).collect();
-    let (_, driven) = identification_model(&bike)?;
+    let (_, driven, _) = identification_models(&bike)?;
     let curve = |vals: &BTreeMap<String, f64>| -> Result<Vec<(f64, f64, f64)>> {
         let pts: Vec<(f64, f64, f64)> = predict(driven, &bike, vals, &speeds)?
             .into_iter()
@@ -1079,7 +1240,10 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
         // The weave, followed down from high speed until it stops being
         // one complex pair (a jump far beyond the typical step means
         // another pair took over, e.g. capsize-castering at low speed).
-        let steps: Vec<f64> = pts.windows(2).map(|w| (w[1].1 - w[0].1).hypot(w[1].2 - w[0].2)).collect();
+        let steps: Vec<f64> = pts
+            .windows(2)
+            .map(|w| (w[1].1 - w[0].1).hypot(w[1].2 - w[0].2))
+            .collect();
         let typical = median(steps.iter().copied());
         let mut start = 0;
         for k in (0..steps.len()).rev() {
@@ -1112,13 +1276,13 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
     rates.sort_by(f64::total_cmp);
     let median_rate = rates.get(rates.len() / 2).copied().unwrap_or(f64::NAN);
     for ext in ["svg", "png"] {
-    plot_continuation(
-        &dir.join(format!("continuation.{ext}")),
-        &curve(&BTreeMap::new())?,
-        &curve(&linear_equivalent(&o.values_after, median_rate))?,
-        &label,
-        &measured,
-    )?;
+        plot_continuation(
+            &dir.join(format!("continuation.{ext}")),
+            &curve(&BTreeMap::new())?,
+            &curve(&linear_equivalent(&o.values_after, median_rate))?,
+            &label,
+            &measured,
+        )?;
     }
     if let Some(rp) = &o.run_plot {
         let s = &o.segments[rp.segment];
@@ -1129,19 +1293,42 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
         let (mr, br, ar) = (deg(&s.roll), deg(&b.roll), deg(&a.roll));
         let (ms, bs, as_) = (deg(&s.steer), deg(&b.steer), deg(&a.steer));
         for ext in ["svg", "png"] {
-        plot_run(
-            &dir.join(format!("run_residuals.{ext}")),
-            &format!(
-                "{} (window from {:.2} s): measured and simulated, before and after",
-                Path::new(&s.run).file_name().map_or(s.run.clone(), |n| n.to_string_lossy().into_owned()),
-                s.t0
-            ),
-            &[
-                Channel { name: "roll", unit: "deg", t: &s.t, measured: &mr, before: &br, after: &ar },
-                Channel { name: "steer", unit: "deg", t: &s.t, measured: &ms, before: &bs, after: &as_ },
-                Channel { name: "speed", unit: "m/s", t: &s.speed_t, measured: &s.speed, before: &b.speed, after: &a.speed },
-            ],
-        )?;
+            plot_run(
+                &dir.join(format!("run_residuals.{ext}")),
+                &format!(
+                    "{} (window from {:.2} s): measured and simulated, before and after",
+                    Path::new(&s.run)
+                        .file_name()
+                        .map_or(s.run.clone(), |n| n.to_string_lossy().into_owned()),
+                    s.t0
+                ),
+                &[
+                    Channel {
+                        name: "roll",
+                        unit: "deg",
+                        t: &s.t,
+                        measured: &mr,
+                        before: &br,
+                        after: &ar,
+                    },
+                    Channel {
+                        name: "steer",
+                        unit: "deg",
+                        t: &s.t,
+                        measured: &ms,
+                        before: &bs,
+                        after: &as_,
+                    },
+                    Channel {
+                        name: "speed",
+                        unit: "m/s",
+                        t: &s.speed_t,
+                        measured: &s.speed,
+                        before: &b.speed,
+                        after: &a.speed,
+                    },
+                ],
+            )?;
         }
     }
     write_string_atomic(dir.join("report.md"), &report_markdown(o, a, dir))?;

@@ -472,7 +472,10 @@ fn run(cli: Cli) -> Result<bool> {
                 json: false,
                 folds: 4,
             };
-            println!("\nidentify {} (runs made by `bikedyn synth` with an effect hidden):", set.display());
+            println!(
+                "\nidentify {} (runs made by `bikedyn synth` with an effect hidden):",
+                set.display()
+            );
             let o = bikedyn::identify::run_identify(&args)?;
             let dir = out.join("identify");
             bikedyn::identify::write_report(&o, &args, &dir)?;

@@ -69,7 +69,10 @@ fn dev_set_fits_every_run_near_the_model() {
         // eigenvalue to that range, relative to the eigenvalue at the mean
         // speed.
         let p = pair(&e["predicted_weave"]["at_mean_speed"]);
-        let (re, im) = (pair(&e["predicted_weave"]["real_range"]), pair(&e["predicted_weave"]["imag_range"]));
+        let (re, im) = (
+            pair(&e["predicted_weave"]["real_range"]),
+            pair(&e["predicted_weave"]["imag_range"]),
+        );
         let gap = |x: f64, r: [f64; 2]| (r[0] - x).max(x - r[1]).max(0.0);
         let rel = gap(m[0], re).hypot(gap(m[1], im)) / p[0].hypot(p[1]);
         let r2 = e["r2"].as_f64().unwrap();

@@ -23,7 +23,9 @@ fn synth_with(name: &str, model: Option<&str>, effects: &str, seed: u64) -> Path
     let dir = std::env::temp_dir().join(format!("bikedyn-identify-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let seed = seed.to_string();
-    let mut args = vec!["synth", "--bike", "thesis", "--speeds", "4:6.5", "--runs", "6", "--seed", &seed];
+    let mut args = vec![
+        "synth", "--bike", "thesis", "--speeds", "4:6.5", "--runs", "6", "--seed", &seed,
+    ];
     if !effects.is_empty() {
         args.extend(["--effects", effects]);
     }
@@ -42,7 +44,11 @@ fn identify(dir: &Path, report: Option<&Path>) -> Value {
         args.extend(["--report", r.to_str().unwrap()]);
     }
     let out = bikedyn(&args);
-    assert!(out.status.success(), "identify: {}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "identify: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).expect("JSON output")
 }
 
@@ -69,7 +75,12 @@ fn recovers_with(
 ) {
     let dir = synth_with(name, model, effects, seed);
     let j = identify(&dir, None);
-    let sel: Vec<&str> = j["selected_effects"].as_array().unwrap().iter().map(|v| v.as_str().unwrap()).collect();
+    let sel: Vec<&str> = j["selected_effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
     assert_eq!(sel, vec![selected], "{name}: selected {sel:?}\n{j:#}");
     let v = f(&j["parameters"][symbol]["value"]);
     assert!(
@@ -81,19 +92,38 @@ fn recovers_with(
     let (before, after) = (f(&j["error_before"][error_key]), f(&j["error_after"][error_key]));
     assert!(after <= 0.5 * before, "{name}: {error_key} {before} -> {after}");
     // Held out too: the effect generalises to runs it was not fitted on.
-    let (hb, ha) = (f(&j["error_before"]["held_out"][error_key]), f(&j["error_after"]["held_out"][error_key]));
+    let (hb, ha) = (
+        f(&j["error_before"]["held_out"][error_key]),
+        f(&j["error_after"]["held_out"][error_key]),
+    );
     assert!(ha <= 0.5 * hb, "{name}: held-out {error_key} {hb} -> {ha}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn hidden_steer_damping_is_found() {
-    recovers("damping", "c_steer=0.25", 22, "steer_damping", "c_steer", 0.25, "eigen_rms");
+    recovers(
+        "damping",
+        "c_steer=0.25",
+        22,
+        "steer_damping",
+        "c_steer",
+        0.25,
+        "eigen_rms",
+    );
 }
 
 #[test]
 fn hidden_steer_friction_is_found() {
-    recovers("friction", "T_steer=0.1", 23, "steer_friction", "T_steer", 0.1, "roll_rms");
+    recovers(
+        "friction",
+        "T_steer=0.1",
+        23,
+        "steer_friction",
+        "T_steer",
+        0.1,
+        "roll_rms",
+    );
 }
 
 #[test]
@@ -103,7 +133,15 @@ fn hidden_lateral_mass_offset_is_found() {
 
 #[test]
 fn hidden_steer_controller_is_found() {
-    recovers("controller", "Kc_roll_rate=0.6", 25, "steer_controller", "Kc_roll_rate", 0.6, "eigen_rms");
+    recovers(
+        "controller",
+        "Kc_roll_rate=0.6",
+        25,
+        "steer_controller",
+        "Kc_roll_rate",
+        0.6,
+        "eigen_rms",
+    );
 }
 
 #[test]
@@ -121,7 +159,15 @@ fn hidden_rolling_resistance_is_found() {
 
 #[test]
 fn hidden_aero_drag_is_found() {
-    recovers("drag", "CdA=0.5,rho_air=1.2", 27, "aero_drag (speed decay)", "CdA", 0.5, "speed_rms");
+    recovers(
+        "drag",
+        "CdA=0.5,rho_air=1.2",
+        27,
+        "aero_drag (speed decay)",
+        "CdA",
+        0.5,
+        "speed_rms",
+    );
 }
 
 #[test]
@@ -163,7 +209,13 @@ fn example_set_report_folder() {
     let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping");
     let j = identify(&set, Some(&dir));
     assert_eq!(j["selected_effects"][0], "steer_damping");
-    for f in ["report.md", "report.json", "fitted.toml", "continuation.svg", "run_residuals.svg"] {
+    for f in [
+        "report.md",
+        "report.json",
+        "fitted.toml",
+        "continuation.svg",
+        "run_residuals.svg",
+    ] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
     // The fitted parameter file loads, carries the effect, and refits to

@@ -286,14 +286,13 @@ pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOpti
     // acceleration is a central difference over RELEASE_SPAN, short against
     // a hand launch (seconds) and long against the magnet-to-magnet noise.
     const RELEASE_SPAN: f64 = 0.2;
-    let accel: Vec<f64> = sp
-        .t
-        .iter()
-        .map(|&x| match (sp.at(x - RELEASE_SPAN), sp.at(x + RELEASE_SPAN)) {
-            (Some(a), Some(b)) => (b.0 - a.0) / (2.0 * RELEASE_SPAN),
-            _ => f64::NAN,
-        })
-        .collect();
+    let accel: Vec<f64> =
+        sp.t.iter()
+            .map(|&x| match (sp.at(x - RELEASE_SPAN), sp.at(x + RELEASE_SPAN)) {
+                (Some(a), Some(b)) => (b.0 - a.0) / (2.0 * RELEASE_SPAN),
+                _ => f64::NAN,
+            })
+            .collect();
     let release = accel
         .iter()
         .enumerate()

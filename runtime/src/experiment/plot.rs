@@ -28,7 +28,8 @@ fn drawing(path: &Path, e: impl std::fmt::Display) -> PlotError {
     }
 }
 
-fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
+/// Data range with 8 % padding (`(0, 1)` without finite data).
+pub(crate) fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = x
         .filter(|v| v.is_finite())
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));

@@ -135,7 +135,11 @@ impl Segment {
 
     /// Window length (s).
     pub fn duration(&self) -> f64 {
-        self.t.last().copied().unwrap_or(0.0).max(self.speed_t.last().copied().unwrap_or(0.0))
+        self.t
+            .last()
+            .copied()
+            .unwrap_or(0.0)
+            .max(self.speed_t.last().copied().unwrap_or(0.0))
     }
 
     fn len(&self) -> usize {
@@ -186,7 +190,12 @@ pub struct Candidate {
 /// Makes the fitting setup of one model (type-erased, so identification
 /// can switch models for a candidate without compiling every pair).
 pub trait ModelFactory: Sync {
-    fn setup<'a>(&self, segments: &'a [Segment], weights: &[Weights], active: &[&Candidate]) -> Result<Setup<'a>, IdentifyError>;
+    fn setup<'a>(
+        &self,
+        segments: &'a [Segment],
+        weights: &[Weights],
+        active: &[&Candidate],
+    ) -> Result<Setup<'a>, IdentifyError>;
 }
 
 /// The [`ModelFactory`] of model `M` with base parameters `base`.
@@ -205,7 +214,12 @@ impl<M: MultibodyModel> Factory<M> {
 }
 
 impl<M: MultibodyModel> ModelFactory for Factory<M> {
-    fn setup<'a>(&self, segments: &'a [Segment], weights: &[Weights], active: &[&Candidate]) -> Result<Setup<'a>, IdentifyError> {
+    fn setup<'a>(
+        &self,
+        segments: &'a [Segment],
+        weights: &[Weights],
+        active: &[&Candidate],
+    ) -> Result<Setup<'a>, IdentifyError> {
         Setup::new::<M>(&self.base, segments, weights, active)
     }
 }
@@ -489,7 +503,10 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
     }
     fn residuals(&self) -> Option<DVector<f64>> {
         let r = self.all_residuals()?;
-        Some(DVector::from_iterator(r.iter().map(Vec::len).sum(), r.into_iter().flatten()))
+        Some(DVector::from_iterator(
+            r.iter().map(Vec::len).sum(),
+            r.into_iter().flatten(),
+        ))
     }
     fn jacobian(&self) -> Option<DMatrix<f64>> {
         let base = self.all_residuals()?;
@@ -694,7 +711,10 @@ pub fn fit_candidate(
     let count = |p: &Problem<'_, '_>| {
         // Each LM evaluation is one residual pass; a Jacobian is one
         // simulation per free column per segment (approximate count).
-        sims.fetch_add(p.segs.len() * (1 + p.n_free().min(setup.k() + NUISANCE)), std::sync::atomic::Ordering::Relaxed);
+        sims.fetch_add(
+            p.segs.len() * (1 + p.n_free().min(setup.k() + NUISANCE)),
+            std::sync::atomic::Ordering::Relaxed,
+        );
     };
     count(&full);
     let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
@@ -781,7 +801,10 @@ pub fn fit_candidate(
         } else {
             g.clone()
         };
-        let p = lm_fit(problem(test.clone(), Free::Nuisance, gf.clone(), nuisance.clone()), opts.patience);
+        let p = lm_fit(
+            problem(test.clone(), Free::Nuisance, gf.clone(), nuisance.clone()),
+            opts.patience,
+        );
         count(&p);
         if let Some(r) = p.all_residuals() {
             for (i, &s) in test.iter().enumerate() {
@@ -928,9 +951,9 @@ pub fn identify<M: MultibodyModel>(
             .filter(|c| !selected.iter().any(|s| s.name == c.name))
             .filter(|c| !c.alternative_model || alternative.is_some())
             .filter(|c| {
-                steps.first().is_none_or(|s: &Step| {
-                    s.tried.iter().any(|(n, f)| n == &c.name && f.bic < s.base_bic)
-                })
+                steps
+                    .first()
+                    .is_none_or(|s: &Step| s.tried.iter().any(|(n, f)| n == &c.name && f.bic < s.base_bic))
             })
             .collect();
         if remaining.is_empty() {
@@ -964,7 +987,10 @@ pub fn identify<M: MultibodyModel>(
             let verdict = if !f.physical {
                 "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".to_string()
             } else if !(f.bic < base_bic) {
-                format!("rejected: BIC {:+.1} (no gain beyond its added parameters; not cross-validated)", f.bic - base_bic)
+                format!(
+                    "rejected: BIC {:+.1} (no gain beyond its added parameters; not cross-validated)",
+                    f.bic - base_bic
+                )
             } else if !(f.cv < current.cv) {
                 format!(
                     "rejected: held-out error {:.4} not below {:.4} (does not generalise)",
@@ -978,7 +1004,12 @@ pub fn identify<M: MultibodyModel>(
                 if best.is_none_or(|b| f.bic < tried[b].1.bic) {
                     best = Some(i);
                 }
-                format!("warranted: BIC {:+.1}, held-out error {:.4} (was {:.4})", f.bic - base_bic, f.cv, current.cv)
+                format!(
+                    "warranted: BIC {:+.1}, held-out error {:.4} (was {:.4})",
+                    f.bic - base_bic,
+                    f.cv,
+                    current.cv
+                )
             };
             verdicts.push((name.clone(), verdict));
         }
@@ -1021,7 +1052,9 @@ pub fn identify<M: MultibodyModel>(
 /// (an artefact of one run, noise) is not added.
 pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> Option<(f64, f64)> {
     let mse = |e: &SegmentError, w: &Weights| {
-        let ss = e.channel_ss[0] / (w.roll * w.roll) + e.channel_ss[1] / (w.steer * w.steer) + e.channel_ss[2] / (w.speed * w.speed);
+        let ss = e.channel_ss[0] / (w.roll * w.roll)
+            + e.channel_ss[1] / (w.steer * w.steer)
+            + e.channel_ss[2] / (w.speed * w.speed);
         ss / (e.channel_n.iter().sum::<usize>().max(1) as f64)
     };
     let d: Vec<f64> = base
@@ -1042,9 +1075,9 @@ pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> O
 
 /// Overall RMS of a channel over segments (rad or m/s).
 pub fn pooled_rms(errors: &[SegmentError], channel: usize) -> f64 {
-    let (ss, n) = errors
-        .iter()
-        .fold((0.0, 0usize), |(a, b), e| (a + e.channel_ss[channel], b + e.channel_n[channel]));
+    let (ss, n) = errors.iter().fold((0.0, 0usize), |(a, b), e| {
+        (a + e.channel_ss[channel], b + e.channel_n[channel])
+    });
     (ss / n.max(1) as f64).sqrt()
 }
 
@@ -1066,7 +1099,17 @@ mod tests {
         let t: Vec<f64> = (0..120).map(|k| k as f64 / 120.0).collect();
         let roll: Vec<f64> = t.iter().map(|&x| 0.02 + 0.3 * x).collect();
         let steer: Vec<f64> = t.iter().map(|&x| -0.01 - 0.5 * x).collect();
-        let s = Segment::new("r".into(), 0.0, t.clone(), roll, steer, vec![0.0, 0.5], vec![5.0, 4.9], None).unwrap();
+        let s = Segment::new(
+            "r".into(),
+            0.0,
+            t.clone(),
+            roll,
+            steer,
+            vec![0.0, 0.5],
+            vec![5.0, 4.9],
+            None,
+        )
+        .unwrap();
         assert!((s.initial[0] - 0.02).abs() < 1e-12 && (s.initial[2] - 0.3).abs() < 1e-9);
         assert!((s.initial[1] + 0.01).abs() < 1e-12 && (s.initial[3] + 0.5).abs() < 1e-9);
         assert_eq!(s.initial[4], 5.0);
