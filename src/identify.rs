@@ -379,8 +379,8 @@ impl ModelVisitor for WeaveCurve<'_> {
 }
 
 /// Predicted weave eigenvalues of the driven model with effect values
-/// `values` set on top of the bicycle.
-fn predict(
+/// `values` set on top of the bicycle, at each of `speeds` (m/s).
+pub fn predict(
     driven: &ModelInfo,
     bike: &Bicycle,
     values: &BTreeMap<String, f64>,

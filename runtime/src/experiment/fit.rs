@@ -208,6 +208,155 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem {
     }
 }
 
+/// The variable-projection problem: nonlinear parameters `[s, w]` or
+/// `[s0, w0, s1, w1]`; residuals with the linear ones (`c, p, q`) solved
+/// exactly; Jacobian by Kaufman's approximation (the model's derivative at
+/// fixed linear parameters, projected off the span of the basis), which
+/// costs one pass over the samples.
+struct Projected<'a> {
+    tau: &'a [f64],
+    y: &'a [f64],
+    integral: Option<&'a [f64]>,
+    theta: DVector<f64>,
+}
+
+/// Basis `e^s cos w`, `e^s sin w` at every sample, the normal matrix of
+/// `[1, e^s cos w, e^s sin w]` and the linear parameters.
+struct Basis {
+    ec_es: Vec<(f64, f64)>,
+    normal: nalgebra::Cholesky<f64, nalgebra::U3>,
+    linear: nalgebra::Vector3<f64>,
+}
+
+impl Projected<'_> {
+    fn basis(&self) -> Option<Basis> {
+        let th = self.theta.as_slice();
+        let n = self.tau.len();
+        let mut ec_es = Vec::with_capacity(n);
+        match self.integral {
+            // Uniform samples and a phase linear in tau: e^((s + i w) tau) by
+            // recurrence (one complex product per sample).
+            None if uniform(self.tau) => {
+                let dt = self.tau[1] - self.tau[0];
+                let step = complex_exp(th[0] * dt, th[1] * dt);
+                let mut z = complex_exp(th[0] * self.tau[0], th[1] * self.tau[0]);
+                for _ in 0..n {
+                    ec_es.push(z);
+                    z = (z.0 * step.0 - z.1 * step.1, z.0 * step.1 + z.1 * step.0);
+                }
+            }
+            _ => {
+                let (s1, w1) = if th.len() > 2 { (th[2], th[3]) } else { (0.0, 0.0) };
+                for (k, &t) in self.tau.iter().enumerate() {
+                    let i = self.integral.map_or(0.0, |i| i[k]);
+                    ec_es.push(complex_exp(th[0] * t + s1 * i, th[1] * t + w1 * i));
+                }
+            }
+        }
+        let mut a = nalgebra::Matrix3::zeros();
+        let mut b = nalgebra::Vector3::zeros();
+        for (&(ec, es), &y) in ec_es.iter().zip(self.y) {
+            let x = nalgebra::Vector3::new(1.0, ec, es);
+            a += x * x.transpose();
+            b += x * y;
+        }
+        let normal = a.cholesky()?;
+        let linear = normal.solve(&b);
+        linear
+            .iter()
+            .all(|x| x.is_finite())
+            .then_some(Basis { ec_es, normal, linear })
+    }
+    /// The full parameter vector (form order) at the current `theta`.
+    fn full_parameters(&self, eq94: bool) -> Option<Vec<f64>> {
+        let th = self.theta.as_slice();
+        let l = self.basis()?.linear;
+        let (c, p, q) = (l[0], l[1], l[2]);
+        let mut full = if eq94 {
+            vec![p.hypot(q), th[0], th[1], (-q).atan2(p), c]
+        } else {
+            vec![c, th[0], th[1], p, q]
+        };
+        full.extend_from_slice(&th[2..]);
+        Some(full)
+    }
+}
+
+/// `e^(s + i w)` as `(re, im)`.
+fn complex_exp(s: f64, w: f64) -> (f64, f64) {
+    let e = s.exp();
+    let (sn, cs) = w.sin_cos();
+    (e * cs, e * sn)
+}
+
+/// Whether the samples are uniformly spaced (to rounding).
+fn uniform(tau: &[f64]) -> bool {
+    let n = tau.len();
+    n > 1 && {
+        let dt = tau[1] - tau[0];
+        (tau[n - 1] - tau[0] - dt * (n - 1) as f64).abs() < 1e-9 * (1.0 + tau[n - 1].abs())
+    }
+}
+
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Projected<'_> {
+    type ResidualStorage = Owned<f64, Dyn>;
+    type JacobianStorage = Owned<f64, Dyn, Dyn>;
+    type ParameterStorage = Owned<f64, Dyn>;
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.theta.copy_from(x);
+    }
+    fn params(&self) -> DVector<f64> {
+        self.theta.clone()
+    }
+    fn residuals(&self) -> Option<DVector<f64>> {
+        let b = self.basis()?;
+        let l = &b.linear;
+        let r = DVector::from_iterator(
+            self.y.len(),
+            b.ec_es
+                .iter()
+                .zip(self.y)
+                .map(|(&(ec, es), &y)| l[0] + l[1] * ec + l[2] * es - y),
+        );
+        r.iter().all(|x| x.is_finite()).then_some(r)
+    }
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let b = self.basis()?;
+        let (p, q) = (b.linear[1], b.linear[2]);
+        let k = self.theta.len();
+        let n = self.tau.len();
+        let mut j = DMatrix::zeros(n, k);
+        // Projections of each column onto the basis: accumulate Phi^T col.
+        let mut phit = vec![nalgebra::Vector3::zeros(); k];
+        for (i, &(ec, es)) in b.ec_es.iter().enumerate() {
+            let d_ds = p * ec + q * es;
+            let d_dw = -p * es + q * ec;
+            let t = self.tau[i];
+            let cols = [d_ds * t, d_dw * t];
+            for (c, v) in cols.iter().enumerate() {
+                j[(i, c)] = *v;
+            }
+            if k > 2 {
+                let int = self.integral.map_or(0.0, |x| x[i]);
+                j[(i, 2)] = d_ds * int;
+                j[(i, 3)] = d_dw * int;
+            }
+            let x = nalgebra::Vector3::new(1.0, ec, es);
+            for (c, acc) in phit.iter_mut().enumerate() {
+                *acc += x * j[(i, c)];
+            }
+        }
+        let coef: Vec<nalgebra::Vector3<f64>> = phit.iter().map(|v| b.normal.solve(v)).collect();
+        for (i, &(ec, es)) in b.ec_es.iter().enumerate() {
+            let x = nalgebra::Vector3::new(1.0, ec, es);
+            for (c, cf) in coef.iter().enumerate() {
+                j[(i, c)] -= x.dot(cf);
+            }
+        }
+        j.iter().all(|x| x.is_finite()).then_some(j)
+    }
+}
+
 /// Linear least squares of `y ~ c + e^(s tau) (p cos w tau + q sin w tau)`
 /// for fixed `s`, `w`: returns `(ssr, [c, p, q])`.
 fn linear_part(tau: &[f64], y: &[f64], s: f64, w: f64) -> Option<(f64, [f64; 3])> {
@@ -218,7 +367,7 @@ fn linear_part(tau: &[f64], y: &[f64], s: f64, w: f64) -> Option<(f64, [f64; 3])
     // search calls this hundreds of times per fit); exact otherwise.
     let n = tau.len();
     let dt = if n > 1 { tau[1] - tau[0] } else { 0.0 };
-    let uniform = n > 1 && (tau[n - 1] - tau[0] - dt * (n - 1) as f64).abs() < 1e-9 * (1.0 + tau[n - 1].abs());
+    let uniform = uniform(tau);
     let (step_re, step_im) = {
         let e = (s * dt).exp();
         let (sn, cs) = (w * dt).sin_cos();
@@ -250,15 +399,31 @@ fn linear_part(tau: &[f64], y: &[f64], s: f64, w: f64) -> Option<(f64, [f64; 3])
 }
 
 /// Dominant angular frequency from the mean spacing of zero crossings of the
-/// detrended signal (rad/s).
+/// detrended signal (rad/s). A crossing counts only once the signal has
+/// passed a band of a quarter of its standard deviation on the other side
+/// (hysteresis), so sample noise on a roll rate does not add crossings.
 fn crossing_frequency(tau: &[f64], y: &[f64]) -> Option<f64> {
-    let m = y.iter().sum::<f64>() / y.len() as f64;
+    let n = y.len() as f64;
+    let m = y.iter().sum::<f64>() / n;
+    let band = 0.25 * (y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / n).sqrt();
     let mut crossings = Vec::new();
-    for k in 1..y.len() {
-        let (a, b) = (y[k - 1] - m, y[k] - m);
-        if a == 0.0 || a.signum() != b.signum() {
-            let f = if a == b { 0.0 } else { a / (a - b) };
-            crossings.push(tau[k - 1] + f * (tau[k] - tau[k - 1]));
+    // Side of the band the signal was last on (+1 above, -1 below).
+    let mut side = 0.0;
+    let mut last_zero = None;
+    for k in 0..y.len() {
+        let a = y[k] - m;
+        if k > 0 {
+            let b = y[k - 1] - m;
+            if a == 0.0 || a.signum() != b.signum() {
+                let f = if a == b { 0.0 } else { b / (b - a) };
+                last_zero = Some(tau[k - 1] + f * (tau[k] - tau[k - 1]));
+            }
+        }
+        if a.abs() > band && a.signum() != side {
+            if side != 0.0 {
+                crossings.extend(last_zero);
+            }
+            side = a.signum();
         }
     }
     if crossings.len() < 2 {
@@ -291,20 +456,50 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
     let t0 = t[0];
     let tau: Vec<f64> = t.iter().map(|x| x - t0).collect();
     let w_hat = crossing_frequency(&tau, y).ok_or(FitError::NoOscillation)?;
-    // Coarse grid on (sigma, omega) with the linear parameters solved exactly.
-    let mut best: Option<(f64, f64, f64, [f64; 3])> = None;
-    for i in 0..=20 {
-        let w = w_hat * (0.6 + 0.05 * i as f64);
-        for j in 0..=24 {
-            let s = w_hat * (-1.2 + 0.075 * j as f64);
-            if let Some((ssr, lin)) = linear_part(&tau, y, s, w) {
-                if best.as_ref().is_none_or(|b| ssr < b.0) {
-                    best = Some((ssr, s, w, lin));
-                }
+    // Coarse grid on (sigma, omega) with the linear parameters solved
+    // exactly, for a start only: on at most GRID_SAMPLES samples (every
+    // `stride`-th; at least 4 per period of the top grid frequency, 1.6 w_hat).
+    const GRID_SAMPLES: usize = 100;
+    let dt = tau[n - 1] / (n - 1) as f64;
+    let max_stride = ((std::f64::consts::PI / (2.0 * 1.6 * w_hat * dt)).floor() as usize).max(1);
+    let stride = n.div_ceil(GRID_SAMPLES).clamp(1, max_stride);
+    let (tau_g, y_g): (Vec<f64>, Vec<f64>) = tau.iter().zip(y).step_by(stride).map(|(a, b)| (*a, *b)).unzip();
+    const NW: usize = 21;
+    const NS: usize = 25;
+    let mut grid = [[f64::INFINITY; NS]; NW];
+    let grid_w = |i: usize| w_hat * (0.6 + 0.05 * i as f64);
+    let grid_s = |j: usize| w_hat * (-1.2 + 0.075 * j as f64);
+    for (i, row) in grid.iter_mut().enumerate() {
+        for (j, cell) in row.iter_mut().enumerate() {
+            if let Some((ssr, _)) = linear_part(&tau_g, &y_g, grid_s(j), grid_w(i)) {
+                *cell = ssr;
             }
         }
     }
-    let (_, s0, w0, [c, p, q]) = best.ok_or(FitError::NoOscillation)?;
+    // Starts: the grid's local minima (no smaller neighbour), best first, at
+    // most MAX_STARTS. A growing or fast-decaying response has minima on
+    // both sides of a non-oscillating valley; one start can end in it.
+    const MAX_STARTS: usize = 4;
+    // MINPACK's limit on evaluations is patience x (parameters + 1); a
+    // projected fit that has not converged in 150-250 has left the valley.
+    const PATIENCE: usize = 50;
+    let mut minima: Vec<(f64, usize, usize)> = Vec::new();
+    for i in 0..NW {
+        for j in 0..NS {
+            let v = grid[i][j];
+            let is_min = v.is_finite()
+                && (i.saturating_sub(1)..=(i + 1).min(NW - 1))
+                    .all(|a| (j.saturating_sub(1)..=(j + 1).min(NS - 1)).all(|b| grid[a][b] >= v));
+            if is_min {
+                minima.push((v, i, j));
+            }
+        }
+    }
+    minima.sort_by(|a, b| a.0.total_cmp(&b.0));
+    minima.truncate(MAX_STARTS);
+    if minima.is_empty() {
+        return Err(FitError::NoOscillation);
+    }
     let eq94 = matches!(form, FitForm::RollAngle);
     let integral = if form.speed_varying() {
         let v = speed.expect("speed-varying fit needs the speed");
@@ -317,30 +512,79 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
     } else {
         None
     };
-    let mut p0 = if eq94 {
-        vec![p.hypot(q), s0, w0, (-q).atan2(p), c]
-    } else {
-        vec![c, s0, w0, p, q]
+    // Variable projection (Golub and Pereyra 1973): the linear parameters
+    // `c, p, q` are solved exactly for given phases, so Levenberg-Marquardt
+    // sees only the 2 (or 4) nonlinear ones. The full problem is badly
+    // conditioned where a slow drift sits under a fast decay (eq. 94's
+    // amplitude and phase trade against the constant); the projected one is
+    // not, and converges in a few steps, so several starts are affordable.
+    let span = tau[n - 1];
+    const MAX_FREQUENCY: f64 = 4.0;
+    // Converged, and at least half a cycle in the window.
+    let accept = |pr: &Projected, ok: bool| -> Option<f64> {
+        let th = pr.theta.as_slice();
+        // A frequency far above the signal's zero-crossing rate fits noise,
+        // not the window's oscillation.
+        let oscillates =
+            th[1].is_finite() && th[1].abs() * span >= std::f64::consts::PI && th[1].abs() <= MAX_FREQUENCY * w_hat;
+        (ok && oscillates)
+            .then(|| pr.residuals().map(|r| r.norm_squared()))
+            .flatten()
     };
-    if form.speed_varying() {
-        p0.extend([0.0, 0.0]);
+    // Starts in the order of the grid's residual; the first that converges
+    // to an oscillation is taken (not the smallest residual over all starts:
+    // a far start can end on the slow capsize drift, another mode).
+    let mut best: Option<Projected> = None;
+    let mut constant = None;
+    for &(_, i, j) in &minima {
+        let start = Projected {
+            tau: &tau,
+            y,
+            integral: None,
+            theta: DVector::from_vec(vec![grid_s(j), grid_w(i)]),
+        };
+        let (pr, report) = LevenbergMarquardt::new().with_patience(PATIENCE).minimize(start);
+        if accept(&pr, report.termination.was_successful()).is_some() {
+            constant = Some(pr);
+            break;
+        }
     }
+    if form.speed_varying() {
+        // The speed-varying form nests the constant one (zero slopes): start
+        // it from the constant optimum, so it fits at least as well and is
+        // not led off by the slopes' first steps. Where the constant form
+        // fits no oscillation (a growing response under a capsize drift),
+        // the speed-varying one may: start it from the grid's minima then.
+        let starts: Vec<[f64; 2]> = match &constant {
+            Some(c) => vec![[c.theta[0], c.theta[1]]],
+            None => minima.iter().map(|&(_, i, j)| [grid_s(j), grid_w(i)]).collect(),
+        };
+        for th in starts {
+            let start = Projected {
+                tau: &tau,
+                y,
+                integral: integral.as_deref(),
+                theta: DVector::from_vec(vec![th[0], th[1], 0.0, 0.0]),
+            };
+            let (pr, report) = LevenbergMarquardt::new().with_patience(PATIENCE).minimize(start);
+            if accept(&pr, report.termination.was_successful()).is_some() {
+                best = Some(pr);
+                break;
+            }
+        }
+    } else {
+        best = constant;
+    }
+    let p_full = best.and_then(|pr| pr.full_parameters(eq94));
     let problem = Problem {
         tau: tau.clone(),
         y: y.to_vec(),
         integral: integral.clone(),
         eq94,
-        p: DVector::from_vec(p0),
+        p: DVector::from_vec(p_full.ok_or(FitError::NotConverged {
+            reason: format!("no start of {} converged to an oscillation", minima.len()),
+        })?),
     };
-    // Patience: MINPACK's limit is patience x (parameters + 1) evaluations;
-    // ill-conditioned windows (a slow drift under a fast decay) need more
-    // than the default.
-    let (problem, report) = LevenbergMarquardt::new().with_patience(500).minimize(problem);
-    if !report.termination.was_successful() {
-        return Err(FitError::NotConverged {
-            reason: format!("{:?}", report.termination),
-        });
-    }
     let r = problem.residuals().ok_or(FitError::NotConverged {
         reason: "non-finite residuals".into(),
     })?;

@@ -16,6 +16,8 @@ use super::read::{RunMeta, SwitchRecord};
 pub struct SpeedProfile {
     /// Pulse centres (s, DAQ clock).
     pub pulses: Vec<f64>,
+    /// Segment of each pulse (a gap in the record starts a new one).
+    pub pulse_segment: Vec<usize>,
     /// Mid-times of the magnet-to-magnet intervals (s).
     pub t: Vec<f64>,
     /// Per-interval speed with the estimated magnet spacing (m/s).
@@ -242,6 +244,7 @@ pub fn speed_profile(sw: &SwitchRecord, meta: &RunMeta) -> SpeedProfile {
     let segment_start = (0..t.len()).map(|i| i > 0 && seg[i] != seg[i - 1]).collect();
     SpeedProfile {
         pulses: centres,
+        pulse_segment: seg_of_pulse,
         t,
         v_interval,
         v,

@@ -1,22 +1,29 @@
 //! Clock offset of the speed logger (DAQ) to the IMU logger,
 //! `t_imu = t_daq + offset`.
 //!
-//! The frame's yaw rate is tied to speed and steer by rolling without slip:
-//! for small angles `yaw' = (v steer + c steer') cos(lambda) / w`, with `c`
-//! the trail, `w` the wheelbase and `lambda` the steer-axis tilt (Meijaard et
-//! al. 2007, eq. for the rear-frame yaw). With `v` read on the DAQ clock, the
-//! relation holds only at the right offset. For each trial offset the
-//! coefficients of `v steer` and `steer'` (plus a constant for the slow
-//! heading drift of the units) are found by linear least squares, so no
-//! geometry is needed; the offset minimising the residual is refined by a
-//! parabola, and its standard error is `sqrt(s^2 / k)` with `k` the
-//! curvature of the residual sum of squares and `s^2` the residual variance
-//! (inflated for autocorrelation). Information comes from the speed changing
-//! while the bicycle steers: with a nearly constant speed the profile is flat
-//! and the nominal offset is kept with its stated uncertainty.
+//! Rolling without slip ties the frame's heading to the distance travelled:
+//! for small angles `yaw' = (v steer + c steer') cos(lambda) / w` (Meijaard
+//! et al. 2007, the rear frame's yaw rate; `c` trail, `w` wheelbase,
+//! `lambda` steer-axis tilt). Integrated over time it reads
+//!
+//! `yaw(t) = a int steer ds + b steer + c s + d + e t + f roll`
+//!
+//! with `s(t)` the distance travelled, read from the reed switch on the DAQ
+//! clock. The heading is integrated rather than the yaw rate differentiated,
+//! because differencing the orientation noise swamps the signal. The other
+//! terms: `c s` a residual steer offset (a steer misalignment makes a steady
+//! turn per metre), `d + e t` the units' slow heading drift, and `f roll`
+//! because the sensor's heading moves with roll (its x axis is pitched
+//! about 18 deg up from the horizon). No geometry is needed: the
+//! coefficients come from linear least squares at each trial offset, and
+//! the offset minimising the residual is refined by a parabola. Its standard
+//! error is `sqrt(s^2 / k)` with `k` the curvature of the residual sum of
+//! squares and `s^2` the residual variance (inflated for autocorrelation).
+//! Information comes from the speed changing while the bicycle steers (the
+//! launch, the decay after release); when it is too weak the nominal offset
+//! is kept with its stated uncertainty.
 
 use super::angles::Angles;
-use super::kicks::derivative;
 use super::speed::SpeedProfile;
 
 /// The nominal offset is good to +-0.3 s (FORMAT.md): as a uniform prior,
@@ -34,6 +41,10 @@ pub struct ClockOffset {
     pub from_data: bool,
 }
 
+/// A fall ends the usable record: the bicycle lies on the ground from the
+/// first roll beyond 45 deg (FORMAT.md's criterion; rad).
+const MAX_ROLL: f64 = std::f64::consts::FRAC_PI_4;
+
 /// Estimate the offset of one run. `start` is the IMU time from which the
 /// orientation output has settled.
 pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, start: f64) -> ClockOffset {
@@ -47,39 +58,67 @@ pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, star
     if n < 50 || speed.t.len() < 10 {
         return prior;
     }
+    // Distance travelled in magnet spacings (the regression's coefficients
+    // absorb the scale): the pulse count, linear between pulses, up to the
+    // first gap in the switch record (pulses cannot be counted across it).
+    // Before the first pulse the wheel is taken at rest (it has turned less
+    // than one spacing). Spacing errors (~0.1 %) are negligible here.
+    let pulses: Vec<f64> = speed
+        .pulses
+        .iter()
+        .zip(&speed.pulse_segment)
+        .take_while(|(_, &s)| s == 0)
+        .map(|(&p, _)| p)
+        .collect();
+    if pulses.len() < 10 {
+        return prior;
+    }
+    let distance = |x: f64| -> Option<f64> {
+        if x <= pulses[0] {
+            return Some(0.0);
+        }
+        if x.is_nan() || x > pulses[pulses.len() - 1] {
+            return None;
+        }
+        let k = pulses.partition_point(|&y| y <= x).clamp(1, pulses.len() - 1);
+        Some((k - 1) as f64 + (x - pulses[k - 1]) / (pulses[k] - pulses[k - 1]))
+    };
     let dt = (t[n - 1] - t[0]) / (n - 1) as f64;
-    let h = ((0.05 / dt) as usize).max(1);
-    let yaw_rate = derivative(t, &angles.yaw, h);
-    let steer_rate = derivative(t, &angles.steer, h);
-    let steer = &angles.steer;
     let search = 1.5 * NOMINAL_OFFSET_HALF_RANGE;
     let step = dt.max(0.002);
     let m = (2.0 * search / step).round() as usize;
     let offsets: Vec<f64> = (0..=m).map(|i| nominal - search + i as f64 * step).collect();
-    // Samples usable at every trial offset.
-    let usable: Vec<usize> = (0..n)
+    // Samples usable at every trial offset: settled, before a fall, with
+    // the distance known at both ends of the search.
+    let fall = (0..n)
+        .find(|&k| t[k] >= start && angles.roll[k].abs() > MAX_ROLL)
+        .unwrap_or(n);
+    let usable: Vec<usize> = (0..fall)
         .filter(|&k| {
-            t[k] >= start
-                && offsets
-                    .iter()
-                    .step_by(m.max(1))
-                    .all(|o| speed.at(t[k] - o).is_some_and(|(v, _)| v > 0.5))
+            t[k] >= start && distance(t[k] - nominal + search).is_some() && distance(t[k] - nominal - search).is_some()
         })
-        .filter(|&k| speed.at(t[k] - nominal).is_some())
         .collect();
     if usable.len() < 50 {
         return prior;
     }
+    let t_mean = usable.iter().map(|&k| t[k]).sum::<f64>() / usable.len() as f64;
     let ssr_at = |o: f64| -> Option<(f64, Vec<f64>)> {
-        let mut a = nalgebra::Matrix3::zeros();
-        let mut b = nalgebra::Vector3::zeros();
+        let mut a = nalgebra::SMatrix::<f64, 6, 6>::zeros();
+        let mut b = nalgebra::SVector::<f64, 6>::zeros();
         let mut rows = Vec::with_capacity(usable.len());
+        let mut int_steer = 0.0;
+        let mut s_prev: Option<f64> = None;
         for &k in &usable {
-            let (v, _) = speed.at(t[k] - o)?;
-            let x = nalgebra::Vector3::new(v * steer[k], steer_rate[k], 1.0);
+            let s = distance(t[k] - o)?;
+            if let Some(sp) = s_prev {
+                int_steer += angles.steer[k] * (s - sp);
+            }
+            s_prev = Some(s);
+            let x =
+                nalgebra::SVector::<f64, 6>::from([int_steer, angles.steer[k], s, 1.0, t[k] - t_mean, angles.roll[k]]);
             a += x * x.transpose();
-            b += x * yaw_rate[k];
-            rows.push((x, yaw_rate[k]));
+            b += x * angles.yaw[k];
+            rows.push((x, angles.yaw[k]));
         }
         let sol = a.cholesky()?.solve(&b);
         let r: Vec<f64> = rows.iter().map(|(x, y)| y - x.dot(&sol)).collect();
@@ -123,12 +162,20 @@ pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, star
     let best = x0 - c[1] / (2.0 * c[2]);
     let Some((ssr, r)) = ssr_at(best) else { return prior };
     let nn = r.len() as f64;
-    let rho = {
-        let c0: f64 = r.iter().map(|x| x * x).sum();
-        let c1: f64 = r.windows(2).map(|w| w[0] * w[1]).sum();
-        (c1 / c0).clamp(0.0, 0.99)
-    };
-    let s2 = ssr / (nn - 3.0) * (1.0 + rho) / (1.0 - rho);
+    // The heading drift is a random walk, not a line: residuals stay
+    // correlated over seconds, so the lag-one correlation understates it.
+    // Integrated autocorrelation time `1 + 2 sum rho_k`, summed while the
+    // correlations stay positive (Geyer's initial positive sequence).
+    let c0: f64 = r.iter().map(|x| x * x).sum();
+    let mut tau_int = 1.0;
+    for lag in 1..r.len() / 4 {
+        let rho = r.iter().zip(&r[lag..]).map(|(a, b)| a * b).sum::<f64>() / c0;
+        if rho <= 0.0 {
+            break;
+        }
+        tau_int += 2.0 * rho;
+    }
+    let s2 = ssr / (nn - 6.0) * tau_int;
     // SSR(o) ~ SSR_min + c2 (o - o*)^2; a change of s^2 is one standard error.
     let stderr = (s2 / c[2]).sqrt();
     if !(stderr.is_finite()) || stderr > prior.stderr || (best - nominal).abs() > search {
