@@ -401,36 +401,40 @@ fn linear_part(tau: &[f64], y: &[f64], s: f64, w: f64) -> Option<(f64, [f64; 3])
 /// Dominant angular frequency from the mean spacing of zero crossings of the
 /// detrended signal (rad/s). A crossing counts only once the signal has
 /// passed a band of a quarter of its standard deviation on the other side
-/// (hysteresis), so sample noise on a roll rate does not add crossings.
+/// (hysteresis), so sample noise on a roll rate does not add crossings; a
+/// heavily damped response may pass the band too few times, and then every
+/// crossing counts.
 fn crossing_frequency(tau: &[f64], y: &[f64]) -> Option<f64> {
     let n = y.len() as f64;
     let m = y.iter().sum::<f64>() / n;
-    let band = 0.25 * (y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / n).sqrt();
-    let mut crossings = Vec::new();
-    // Side of the band the signal was last on (+1 above, -1 below).
-    let mut side = 0.0;
-    let mut last_zero = None;
-    for k in 0..y.len() {
-        let a = y[k] - m;
-        if k > 0 {
-            let b = y[k - 1] - m;
-            if a == 0.0 || a.signum() != b.signum() {
-                let f = if a == b { 0.0 } else { b / (b - a) };
-                last_zero = Some(tau[k - 1] + f * (tau[k] - tau[k - 1]));
+    let sd = (y.iter().map(|v| (v - m).powi(2)).sum::<f64>() / n).sqrt();
+    [0.25 * sd, 0.0].into_iter().find_map(|band| {
+        let mut crossings = Vec::new();
+        // Side of the band the signal was last on (+1 above, -1 below).
+        let mut side = 0.0;
+        let mut last_zero = None;
+        for k in 0..y.len() {
+            let a = y[k] - m;
+            if k > 0 {
+                let b = y[k - 1] - m;
+                if a == 0.0 || a.signum() != b.signum() {
+                    let f = if a == b { 0.0 } else { b / (b - a) };
+                    last_zero = Some(tau[k - 1] + f * (tau[k] - tau[k - 1]));
+                }
+            }
+            if a.abs() > band && a.signum() != side {
+                if side != 0.0 {
+                    crossings.extend(last_zero);
+                }
+                side = a.signum();
             }
         }
-        if a.abs() > band && a.signum() != side {
-            if side != 0.0 {
-                crossings.extend(last_zero);
-            }
-            side = a.signum();
+        if crossings.len() < 2 {
+            return None;
         }
-    }
-    if crossings.len() < 2 {
-        return None;
-    }
-    let half = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
-    (half > 0.0).then(|| std::f64::consts::PI / half)
+        let half = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f64;
+        (half > 0.0).then(|| std::f64::consts::PI / half)
+    })
 }
 
 fn lag1_autocorrelation(r: &[f64]) -> f64 {

@@ -178,7 +178,12 @@ fn fit_window(
     // The speed record may end a little before the window does (the two
     // loggers stop independently): the trend is taken over the samples with
     // a speed if they cover most of the window, and extended over the rest.
-    let (tf, vf): (Vec<f64>, Vec<f64>) = ts.iter().zip(vs).filter(|(_, v)| v.is_finite()).map(|(t, v)| (*t, *v)).unzip();
+    let (tf, vf): (Vec<f64>, Vec<f64>) = ts
+        .iter()
+        .zip(vs)
+        .filter(|(_, v)| v.is_finite())
+        .map(|(t, v)| (*t, *v))
+        .unzip();
     let trend = if vf.len() > 3 && 5 * vf.len() >= 4 * vs.len() {
         speed_trend(&tf, &vf).map(|(a, b, se)| (a + b * (ts[0] - tf[0]), b, se))
     } else {
