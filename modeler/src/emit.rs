@@ -762,6 +762,7 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             fn forward_speed<T: Scalar>(param: &[T], p: &[T], dp: &[T]) -> T { forward_speed(param, p, dp) }
             fn state_rates<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) { state_rates(param, t, p, dp, out) }
             fn upright_configuration<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) { upright_configuration(param, p, out) }
+            fn upright_velocity_terms_jacobian(param: &[f64], t: f64, p: &[f64], dp: &[f64], out: &mut [f64]) { upright_velocity_terms_jacobian(param, t, p, dp, out) }
             fn linearize_with_rest_exact(param: &[f64], dq0: &[f64]) -> Result<bikedyn_runtime::linearize::WithRest, bikedyn_runtime::linearize::LinearizeError> {
                 bikedyn_runtime::linearize::linearize_with_rest::<Self, #lin_half, #lin_width>(param, dq0)
             }

@@ -273,7 +273,10 @@ pub type WithRest = (Linearization, DMatrix<f64>);
 ///   derivatives along `q'` vanish;
 /// * one real LU factorization of `D_dep` for both eliminations, with dual
 ///   right-hand sides ([`lu_solve_dual`]);
-/// * `N`-wide duals only for the velocity terms (`Qv`, `Qext`, `gamma`);
+/// * the velocity terms (`Qv + Qext`, `gamma`) in `f64` with their
+///   symbolic Jacobian ([`MultibodyModel::upright_velocity_terms_jacobian`]), then
+///   `N`-wide duals (along `q` and `q'`) by the chain rule through the
+///   solved coordinates and velocities;
 /// * the reduced mass matrix `E^T M E` in `f64` (only its value is used).
 pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
     param: &[f64],
@@ -301,7 +304,14 @@ pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
     for &j in ind {
         pf[j] = 0.0;
     }
-    solve_configuration::<M, f64>(param, 0.0, &mut pf, &NewtonOptions::default())?;
+    // The closed-form guess usually satisfies the constraints already: then
+    // Newton has nothing to do.
+    let newton = NewtonOptions::default();
+    let mut res = vec![0.0; nh];
+    M::holonomic_residuals(param, 0.0, &pf, &mut res);
+    if !(param.iter().all(|x| x.is_finite()) && res.iter().all(|r| r.abs() <= newton.tol)) {
+        solve_configuration::<M, f64>(param, 0.0, &mut pf, &newton)?;
+    }
     let singular = |what: &'static str| {
         move |s: crate::linalg::Singular| ConstraintError::SingularJacobian {
             what,
@@ -361,9 +371,6 @@ pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
         }
     }
     // Velocities, now along q and q'.
-    let pn: Vec<Dual<N>> = p.iter().map(|&x| widen(x)).collect();
-    let pdn: Vec<Dual<N>> = param.iter().map(|&x| Dual::cst(x)).collect();
-    let tn = Dual::<N>::zero();
     let mut dp = vec![Dual::<N>::zero(); nq];
     for (k, &j) in ind.iter().enumerate() {
         dp[j] = Dual::variable(dq0[k], ni + k);
@@ -375,12 +382,33 @@ pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
         }
         dp[j] = v;
     }
+    // The velocity terms (Qv + Qext, then gamma) from their symbolic
+    // Jacobian in f64, by the chain rule along the derivatives of the
+    // coordinates (independent and dependent: the others stay put) and of
+    // every velocity: far cheaper than evaluating them in N-wide duals.
+    let nm = ind.len() + dep.len();
+    let cols = 1 + nm + nq;
+    let dpf: Vec<f64> = dp.iter().map(|x| x.re).collect();
+    let mut jac = vec![0.0; (nq + nc) * cols];
+    M::upright_velocity_terms_jacobian(param, 0.0, &pf, &dpf, &mut jac);
+    let mut terms = vec![Dual::<N>::zero(); nq + nc];
+    for (v, row) in terms.iter_mut().zip(jac.chunks_exact(cols)) {
+        v.re = row[0];
+        for (&c, &j) in row[1..=nm].iter().zip(ind.iter().chain(dep)) {
+            for k in 0..H {
+                v.eps[k] += c * p[j].eps[k];
+            }
+        }
+        for (&c, dpj) in row[1 + nm..].iter().zip(&dp) {
+            for k in 0..N {
+                v.eps[k] += c * dpj.eps[k];
+            }
+        }
+    }
+    let (forces, gamma) = terms.split_at_mut(nq);
     // F = [0; -Ddep^-1 gamma].
-    let mut gamma = vec![Dual::<N>::zero(); nc];
-    M::holonomic_convective(&pdn, tn, &pn, &dp, &mut gamma[..nh]);
-    M::nonholonomic_convective(&pdn, tn, &pn, &dp, &mut gamma[nh..]);
     let an: Vec<Dual<N>> = a.iter().map(|&x| widen(x)).collect();
-    lu_solve_dual(&lu, nd, &perm[..nd], &an, &mut gamma, 1);
+    lu_solve_dual(&lu, nd, &perm[..nd], &an, gamma, 1);
     let mut f = vec![Dual::<N>::zero(); nq];
     for (r, &j) in depv.iter().enumerate() {
         f[j] = -gamma[r];
@@ -389,31 +417,27 @@ pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
     M::mass_matrix(&ph, &p, &mut mass);
     let mut qg = vec![Dual::<H>::zero(); nq];
     M::gravity_forces(&ph, &p, &mut qg);
-    let mut qv = vec![Dual::<N>::zero(); nq];
-    M::quadratic_velocity_forces(&pdn, &pn, &dp, &mut qv);
-    let mut qe = vec![Dual::<N>::zero(); nq];
-    M::applied_forces(&pdn, tn, &pn, &dp, &mut qe);
-    // Forces at rest (every velocity zero), for the stiffness at rest.
-    let mut qe_rest = vec![Dual::<N>::zero(); nq];
-    M::applied_forces(&pdn, tn, &pn, &vec![Dual::zero(); nq], &mut qe_rest);
+    // Forces at rest (every velocity zero), for the stiffness at rest:
+    // along q only.
+    let mut qe_rest = vec![Dual::<H>::zero(); nq];
+    M::applied_forces(&ph, th, &p, &vec![Dual::zero(); nq], &mut qe_rest);
     // Qi = E^T (Qv + Qgrav + Qext - M F) (eq. 46-47); Ec = Mi q'' - Qi at
     // q'' = 0, so its derivatives are -Qi's.
     let mut stiffness = DMatrix::zeros(ni, ni);
     let mut damping = DMatrix::zeros(ni, ni);
     let mut rest = DMatrix::zeros(ni, ni);
     let mut qi = [Dual::<N>::zero(); H];
-    let mut qi_rest = [Dual::<N>::zero(); H];
+    let mut qi_rest = [Dual::<H>::zero(); H];
     for r in 0..nq {
-        let mut s = qv[r] + widen(qg[r]) + qe[r];
+        let mut s = forces[r] + widen(qg[r]);
         // F vanishes on the independent rows.
         for &c in &depv {
             s -= widen(mass[r * nq + c]) * f[c];
         }
-        let s_rest = widen(qg[r]) + qe_rest[r];
+        let s_rest = qg[r] + qe_rest[r];
         for k in 0..ni {
-            let ek = widen(e[r * ni + k]);
-            qi[k] += ek * s;
-            qi_rest[k] += ek * s_rest;
+            qi[k] += widen(e[r * ni + k]) * s;
+            qi_rest[k] += e[r * ni + k] * s_rest;
         }
     }
     // Mi = E^T M E, its value only.
