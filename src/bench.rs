@@ -251,7 +251,7 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
     let reduced_flops = Counted::count();
     println!("  reduced equations Ec = Mi q'' - Qi, one evaluation at the solved configuration: {reduced_flops} flops (counted; the f64 Newton iterations before it are not included)");
     println!(
-        "  exact linearization (canonical M0, C1, K0, K2 from the generated equations, once per design): {:>8.2} us (fast upright path: f64 Newton only when the closed-form guess misses the constraints, 2-direction duals for the configuration terms, the velocity terms from their generated symbolic Jacobian in f64 by the chain rule, one real LU; target: under 5 us{})",
+        "  exact linearization (canonical M0, C1, K0, K2 from the generated equations, once per design): {:>8.2} us (fast upright path: f64 Newton only when the closed-form guess misses the constraints, 2-direction duals for the configuration terms, the velocity terms from their generated symbolic Jacobian in f64 by the chain rule, one real LU, scratch buffers on the stack; target: under 5 us{})",
         t_lin * 1e6,
         if t_lin < 5e-6 { ", target met" } else { ", not met here" }
     );

@@ -322,10 +322,11 @@ fn default_model_of(t: &ThesisParameters) -> Option<&'static ModelInfo> {
             })
             .collect()
     });
-    let nonzero = ThesisParameters::SYMBOLS
+    let nonzero = t
+        .values()
         .iter()
         .enumerate()
-        .fold(0u64, |m, (i, s)| m | ((t.get(s).is_some_and(|v| v != 0.0) as u64) << i));
+        .fold(0u64, |m, (i, &v)| m | ((v != 0.0) as u64) << i);
     let k = masks.iter().position(|&(has, _)| nonzero & !has == 0)?;
     (nonzero & masks[k].1 == 0).then(|| models_by_size()[k])
 }
@@ -354,6 +355,18 @@ impl<F: Fn(&str) -> Option<f64>> ModelVisitor for Canonical<'_, F> {
 /// evaluated at radius `h, 2h, 3h` and extrapolated exactly to 0; a fourth
 /// radius `4h` checks that the third difference vanishes.
 pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleError> {
+    // The default model directly (what `Bicycle::canonical_with` does first),
+    // without building a `Bicycle`: this runs once per design in a sweep.
+    if p.rear_wheel_radius != 0.0 && p.front_wheel_radius != 0.0 {
+        if let Some(info) = default_model_of(p) {
+            return with_model(info.name, Canonical(&|s: &str| p.get(s)))
+                .expect("registered model")
+                .map_err(|source| BicycleError::Linearize {
+                    bike: "parameters".into(),
+                    source,
+                });
+        }
+    }
     Bicycle {
         name: "parameters".into(),
         parameters: ParameterSet::Thesis(*p),
