@@ -831,7 +831,10 @@ mod tests {
 
     #[test]
     fn pendulum_derivation_matches_hand_calculation() {
-        let _one_symbolica = crate::codegen::symbolica_guard();
+        crate::codegen::on_symbolica_thread(pendulum_derivation);
+    }
+
+    fn pendulum_derivation() {
         let d = derive(&pendulum());
         let q = |name: &str| d.quantities.iter().find(|q| q.name == name).unwrap();
         let (th, l, mm, i, g) = (
@@ -884,7 +887,10 @@ mod tests {
 
     #[test]
     fn pendulum_emission_shares_subexpressions_and_parses() {
-        let _one_symbolica = crate::codegen::symbolica_guard();
+        crate::codegen::on_symbolica_thread(pendulum_emission);
+    }
+
+    fn pendulum_emission() {
         let d = derive(&pendulum());
         let e = emit(&d).unwrap();
         assert!(e.source.starts_with("// @generated"));
