@@ -179,6 +179,19 @@ impl Bicycle {
 
     /// Canonical matrices through a chosen model (`None`: the default model).
     pub fn canonical_with(&self, model: Option<&str>) -> Result<CanonicalMatrices, BicycleError> {
+        if model.is_none() && self.effects.is_empty() {
+            let t = self.thesis()?;
+            if let Some(info) = default_model_of(&t) {
+                if t.rear_wheel_radius != 0.0 && t.front_wheel_radius != 0.0 {
+                    return with_model(info.name, Canonical(&|s: &str| t.get(s)))
+                        .expect("registered model")
+                        .map_err(|source| BicycleError::Linearize {
+                            bike: self.name.clone(),
+                            source,
+                        });
+                }
+            }
+        }
         let nonzero = self.nonzero_parameters()?;
         let info = self.model_for(model, &nonzero)?;
         let active: Vec<String> = nonzero
@@ -286,6 +299,38 @@ fn models_by_size() -> &'static [&'static ModelInfo] {
     })
 }
 
+/// The default model of a bicycle without effect parameters, as
+/// [`Bicycle::model`] chooses it, by bit masks over the thesis symbols (the
+/// choice is made once per design in a sweep, so it avoids comparing
+/// names). `None` when no model fits or the one chosen has a non-zero
+/// thesis symbol as an effect parameter: the general choice reports why.
+fn default_model_of(t: &ThesisParameters) -> Option<&'static ModelInfo> {
+    // Per model (in `models_by_size` order): the thesis symbols it has, and
+    // those of them that are effect parameters.
+    static MASKS: std::sync::OnceLock<Vec<(u64, u64)>> = std::sync::OnceLock::new();
+    let masks = MASKS.get_or_init(|| {
+        models_by_size()
+            .iter()
+            .map(|m| {
+                ThesisParameters::SYMBOLS
+                    .iter()
+                    .enumerate()
+                    .fold((0u64, 0u64), |(has, effect), (i, s)| match m.parameter(s) {
+                        Some(p) => (has | 1 << i, effect | (p.effect.is_some() as u64) << i),
+                        None => (has, effect),
+                    })
+            })
+            .collect()
+    });
+    let nonzero = t
+        .values()
+        .iter()
+        .enumerate()
+        .fold(0u64, |m, (i, &v)| m | ((v != 0.0) as u64) << i);
+    let k = masks.iter().position(|&(has, _)| nonzero & !has == 0)?;
+    (nonzero & masks[k].1 == 0).then(|| models_by_size()[k])
+}
+
 struct Canonical<'a, F: Fn(&str) -> Option<f64>>(&'a F);
 impl<F: Fn(&str) -> Option<f64>> ModelVisitor for Canonical<'_, F> {
     type Output = Result<CanonicalMatrices, LinearizeError>;
@@ -310,6 +355,18 @@ impl<F: Fn(&str) -> Option<f64>> ModelVisitor for Canonical<'_, F> {
 /// evaluated at radius `h, 2h, 3h` and extrapolated exactly to 0; a fourth
 /// radius `4h` checks that the third difference vanishes.
 pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleError> {
+    // The default model directly (what `Bicycle::canonical_with` does first),
+    // without building a `Bicycle`: this runs once per design in a sweep.
+    if p.rear_wheel_radius != 0.0 && p.front_wheel_radius != 0.0 {
+        if let Some(info) = default_model_of(p) {
+            return with_model(info.name, Canonical(&|s: &str| p.get(s)))
+                .expect("registered model")
+                .map_err(|source| BicycleError::Linearize {
+                    bike: "parameters".into(),
+                    source,
+                });
+        }
+    }
     Bicycle {
         name: "parameters".into(),
         parameters: ParameterSet::Thesis(*p),

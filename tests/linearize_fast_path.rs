@@ -5,7 +5,7 @@
 //! in dual numbers) to 1e-12 on random designs, and fails exactly when it
 //! fails.
 
-use bikedyn::generated::{ThesisExtended, ThesisWhipple, ThesisWhippleFree, WhippleOffset};
+use bikedyn::generated::{ThesisExtended, ThesisExtendedFree, ThesisWhipple, ThesisWhippleFree, WhippleOffset};
 use bikedyn::runtime::linearize::{linearize_with_rest_general, parameter_vector, WithRest};
 use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
 use bikedyn::runtime::MultibodyModel;
@@ -157,6 +157,9 @@ fn fast_upright_linearization_equals_general_path_on_random_designs() {
         let mut dq0 = [0.0; 3];
         dq0[k] = v / t.rear_wheel_radius;
         compare::<ThesisWhippleFree, 6>(&p, &dq0, &label);
+        // Free speed with every effect (speed-dependent applied forces).
+        let p = param_of::<ThesisExtendedFree>(&t, v, 0.05, &mut rng);
+        compare::<ThesisExtendedFree, 6>(&p, &dq0, &label);
     }
     assert!(computed > cases * 9 / 10, "only {computed} of {cases} designs computed");
 }

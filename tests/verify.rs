@@ -105,6 +105,9 @@ mod broken_impl {
         fn upright_configuration<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
             W::upright_configuration(a, p, o)
         }
+        fn upright_velocity_terms_jacobian(a: &[f64], t: f64, p: &[f64], dp: &[f64], o: &mut [f64]) {
+            W::upright_velocity_terms_jacobian(a, t, p, dp, o)
+        }
         fn linearize_with_rest_exact(
             param: &[f64],
             dq0: &[f64],
@@ -242,6 +245,9 @@ mod pumping_impl {
         }
         fn upright_configuration<T: Scalar>(a: &[T], p: &[T], o: &mut [T]) {
             W::upright_configuration(a, p, o)
+        }
+        fn upright_velocity_terms_jacobian(a: &[f64], t: f64, p: &[f64], dp: &[f64], o: &mut [f64]) {
+            W::upright_velocity_terms_jacobian(a, t, p, dp, o)
         }
         fn linearize_with_rest_exact(
             param: &[f64],

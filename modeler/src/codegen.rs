@@ -117,13 +117,40 @@ fn write(path: PathBuf, text: &str) -> Result<(), GenerateError> {
 /// cargo runs in parallel, such as bikedyn's and an example crate's) abort
 /// the process. The guard takes an in-process mutex and an exclusive lock
 /// on a file in the system's temporary folder, and releases both on drop.
+/// It is reentrant: a thread that holds it gets an empty guard.
+///
+/// Within one process the guard is not enough: Symbolica keeps its state
+/// with the thread that first used it, and another thread that starts using
+/// it aborts the process even after the first one released the guard (its
+/// thread may not have finished yet, as with test threads). Code that may
+/// run on several threads of one process (tests) uses Symbolica through
+/// [`on_symbolica_thread`] instead.
 pub struct SymbolicaGuard {
     _file: Option<std::fs::File>,
-    _mutex: std::sync::MutexGuard<'static, ()>,
+    _mutex: Option<std::sync::MutexGuard<'static, ()>>,
+}
+
+thread_local! {
+    /// Whether this thread holds a [`SymbolicaGuard`] (for reentrancy).
+    static HOLDS_SYMBOLICA: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+impl Drop for SymbolicaGuard {
+    fn drop(&mut self) {
+        if self._mutex.is_some() {
+            HOLDS_SYMBOLICA.with(|h| h.set(false));
+        }
+    }
 }
 
 /// Wait for exclusive use of Symbolica (see [`SymbolicaGuard`]).
 pub fn symbolica_guard() -> SymbolicaGuard {
+    if HOLDS_SYMBOLICA.with(|h| h.get()) {
+        return SymbolicaGuard {
+            _file: None,
+            _mutex: None,
+        };
+    }
     static MUTEX: std::sync::Mutex<()> = std::sync::Mutex::new(());
     let mutex = MUTEX.lock().unwrap_or_else(|e| e.into_inner());
     let path = std::env::temp_dir().join("bikedyn-symbolica.lock");
@@ -136,9 +163,42 @@ pub fn symbolica_guard() -> SymbolicaGuard {
         .open(&path)
         .ok()
         .filter(|f| f.lock().is_ok());
+    HOLDS_SYMBOLICA.with(|h| h.set(true));
     SymbolicaGuard {
         _file: file,
-        _mutex: mutex,
+        _mutex: Some(mutex),
+    }
+}
+
+/// Run `f` on this process's one Symbolica thread (started on first use,
+/// alive until the process exits), holding the [`SymbolicaGuard`], and
+/// return its result; a panic in `f` is resumed in the caller. Every use of
+/// Symbolica from code that may run on several threads (parallel tests)
+/// goes through here, so that one thread only ever touches Symbolica.
+pub fn on_symbolica_thread<R: Send + 'static>(f: impl FnOnce() -> R + Send + 'static) -> R {
+    type Job = Box<dyn FnOnce() + Send>;
+    static JOBS: std::sync::OnceLock<std::sync::mpsc::Sender<Job>> = std::sync::OnceLock::new();
+    let jobs = JOBS.get_or_init(|| {
+        let (tx, rx) = std::sync::mpsc::channel::<Job>();
+        std::thread::Builder::new()
+            .name("symbolica".into())
+            .spawn(move || {
+                for job in rx {
+                    job();
+                }
+            })
+            .expect("start the Symbolica thread");
+        tx
+    });
+    let (done, result) = std::sync::mpsc::sync_channel(1);
+    let job: Job = Box::new(move || {
+        let _one_symbolica = symbolica_guard();
+        let _ = done.send(std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)));
+    });
+    jobs.send(job).expect("the Symbolica thread runs");
+    match result.recv().expect("the Symbolica thread answers") {
+        Ok(r) => r,
+        Err(panic) => std::panic::resume_unwind(panic),
     }
 }
 

@@ -6,7 +6,7 @@
 //! point positions. Every derivative here is exact (symbolic).
 
 use crate::expr::Expr;
-use crate::model::{Axis, Force, Holonomic, Model, Nonholonomic, GROUND};
+use crate::model::{Axis, Force, Holonomic, Model, Nonholonomic, Role, GROUND};
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 use symbolica::prelude::*;
@@ -455,6 +455,54 @@ pub fn derive(model: &Model) -> Derived {
             .flat_map(|p| points[p.0].clone())
             .collect();
 
+    // The velocity terms of the reduced equations (Qv + Qext, and the
+    // convective terms gamma that give F) with their first derivatives, for
+    // the exact linearization about upright straight running: the runtime
+    // applies the chain rule through the solved coordinates and velocities
+    // in f64, instead of evaluating these, the costliest functions, in dual
+    // numbers. Only the independent and dependent coordinates move with the
+    // independent ones; every rate does.
+    let moving: Vec<usize> = [Role::Independent, Role::Dependent]
+        .iter()
+        .flat_map(|role| (0..nq).filter(move |&j| d.m.coordinates[j].role == *role))
+        .collect();
+    let velocity_terms: Vec<Atom> = (0..nq)
+        .map(|a| &qv[a] + &applied[a])
+        .chain(dcqdp.iter().cloned())
+        .chain(dbdp.iter().cloned())
+        .collect();
+    let n_vt = velocity_terms.len();
+    let vt_cols = 1 + moving.len() + nq;
+    // Upright, the independent coordinates are zero and the ignorable ones
+    // keep their initial guess: where that is zero, it is substituted after
+    // differentiating, which removes most terms of the derivatives.
+    let at_upright: Vec<Symbol> = (0..nq)
+        .filter(|&j| {
+            let c = &d.m.coordinates[j];
+            c.role == Role::Independent || (c.role == Role::Ignorable && c.upright.is_none() && c.guess == 0.0)
+        })
+        .map(q_at)
+        .collect();
+    let upright_value = |e: Atom| {
+        at_upright.iter().fold(e, |e, &q| {
+            let q = Atom::var(q);
+            e.replace(Symbol::SIN.call((&q,)))
+                .with(zero())
+                .replace(Symbol::COS.call((&q,)))
+                .with(Atom::num(1))
+                .replace(q)
+                .with(zero())
+        })
+    };
+    let velocity_terms_jacobian: Vec<Atom> = velocity_terms
+        .iter()
+        .flat_map(|r| {
+            std::iter::once(r.clone())
+                .chain(moving.iter().map(|&j| r.derivative(q_at(j))))
+                .chain((0..nq).map(|j| r.derivative(rate_syms[j])))
+        })
+        .map(upright_value)
+        .collect();
     let (all, no_t, t_only) = (
         Inputs {
             time: true,
@@ -621,6 +669,14 @@ pub fn derive(model: &Model) -> Derived {
             inputs: no_t,
             shape: Shape::Scalar,
             outputs: vec![forward_speed],
+            shared: false,
+        },
+        Quantity {
+            name: "upright_velocity_terms_jacobian",
+            doc: "Velocity terms and their first derivatives upright, for the exact linearization (row-major): rows Qv + Qext (nq), dCqdp (nh), dBdp (nnh); columns the value, d/dp of the independent then the dependent coordinates, d/dp' of every coordinate. The independent coordinates are taken as zero and the ignorable ones without a closed-form upright value as their initial guess when it is zero: those entries of `p` are not read.",
+            inputs: all,
+            shape: buf(n_vt, vt_cols),
+            outputs: velocity_terms_jacobian,
             shared: false,
         },
     ];

@@ -762,6 +762,7 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             fn forward_speed<T: Scalar>(param: &[T], p: &[T], dp: &[T]) -> T { forward_speed(param, p, dp) }
             fn state_rates<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]) { state_rates(param, t, p, dp, out) }
             fn upright_configuration<T: Scalar>(param: &[T], p: &[T], out: &mut [T]) { upright_configuration(param, p, out) }
+            fn upright_velocity_terms_jacobian(param: &[f64], t: f64, p: &[f64], dp: &[f64], out: &mut [f64]) { upright_velocity_terms_jacobian(param, t, p, dp, out) }
             fn linearize_with_rest_exact(param: &[f64], dq0: &[f64]) -> Result<bikedyn_runtime::linearize::WithRest, bikedyn_runtime::linearize::LinearizeError> {
                 bikedyn_runtime::linearize::linearize_with_rest::<Self, #lin_half, #lin_width>(param, dq0)
             }
@@ -830,7 +831,10 @@ mod tests {
 
     #[test]
     fn pendulum_derivation_matches_hand_calculation() {
-        let _one_symbolica = crate::codegen::symbolica_guard();
+        crate::codegen::on_symbolica_thread(pendulum_derivation);
+    }
+
+    fn pendulum_derivation() {
         let d = derive(&pendulum());
         let q = |name: &str| d.quantities.iter().find(|q| q.name == name).unwrap();
         let (th, l, mm, i, g) = (
@@ -883,7 +887,10 @@ mod tests {
 
     #[test]
     fn pendulum_emission_shares_subexpressions_and_parses() {
-        let _one_symbolica = crate::codegen::symbolica_guard();
+        crate::codegen::on_symbolica_thread(pendulum_emission);
+    }
+
+    fn pendulum_emission() {
         let d = derive(&pendulum());
         let e = emit(&d).unwrap();
         assert!(e.source.starts_with("// @generated"));

@@ -147,6 +147,19 @@ pub fn lu_solve(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64]) {
 /// along the rows of `b`.
 pub fn lu_solve_many(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64], m: usize) {
     assert_eq!(b.len(), n * m, "right-hand side size");
+    // The widths of the dual-number solves: rows of fixed length, which the
+    // compiler unrolls (the same operations in the same order).
+    match m {
+        1 => return lu_solve_rows::<1>(lu, n, perm, b.as_chunks_mut().0),
+        2 => return lu_solve_rows::<2>(lu, n, perm, b.as_chunks_mut().0),
+        3 => return lu_solve_rows::<3>(lu, n, perm, b.as_chunks_mut().0),
+        4 => return lu_solve_rows::<4>(lu, n, perm, b.as_chunks_mut().0),
+        6 => return lu_solve_rows::<6>(lu, n, perm, b.as_chunks_mut().0),
+        8 => return lu_solve_rows::<8>(lu, n, perm, b.as_chunks_mut().0),
+        9 => return lu_solve_rows::<9>(lu, n, perm, b.as_chunks_mut().0),
+        12 => return lu_solve_rows::<12>(lu, n, perm, b.as_chunks_mut().0),
+        _ => {}
+    }
     for k in 0..n {
         if perm[k] != k {
             for c in 0..m {
@@ -184,6 +197,46 @@ pub fn lu_solve_many(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64], m: usi
     }
 }
 
+/// [`lu_solve_many`] with rows of `W` values.
+fn lu_solve_rows<const W: usize>(lu: &[f64], n: usize, perm: &[usize], b: &mut [[f64; W]]) {
+    assert_eq!(b.len(), n, "right-hand side size");
+    for k in 0..n {
+        if perm[k] != k {
+            b.swap(k, perm[k]);
+        }
+    }
+    for i in 0..n {
+        let mut row = b[i];
+        for j in 0..i {
+            let l = lu[i * n + j];
+            if l != 0.0 {
+                let y = &b[j];
+                for c in 0..W {
+                    row[c] -= l * y[c];
+                }
+            }
+        }
+        b[i] = row;
+    }
+    for i in (0..n).rev() {
+        let mut row = b[i];
+        for j in i + 1..n {
+            let u = lu[i * n + j];
+            if u != 0.0 {
+                let y = &b[j];
+                for c in 0..W {
+                    row[c] -= u * y[c];
+                }
+            }
+        }
+        let inv = 1.0 / lu[i * n + i];
+        for x in row.iter_mut() {
+            *x *= inv;
+        }
+        b[i] = row;
+    }
+}
+
 /// Solve `A X = B` for dual-number `A` (`n x n`) and `B` (`n x nrhs`, both
 /// row-major) given the factors of `A`'s real part: `X = A0^-1 B0` and, along
 /// each direction, `X' = A0^-1 (B' - A' X)`. One real factorization replaces
@@ -197,33 +250,98 @@ pub fn lu_solve_dual<const N: usize>(
     b: &mut [Dual<N>],
     nrhs: usize,
 ) {
-    let mut x: Vec<f64> = b.iter().map(|v| v.re).collect();
-    lu_solve_many(lu, n, perm, &mut x, nrhs);
+    lu_solve_dual_narrow(lu, n, perm, a, b, nrhs)
+}
+
+/// [`lu_solve_dual`] for a matrix `A` whose derivatives are along the first
+/// `HA <= N` directions only (the others vanish): e.g. a matrix of the
+/// configuration alone and a right-hand side along the configuration and the
+/// velocities. Equal to widening `A` to `N` directions, without the products
+/// by zero. Allocates nothing for systems of up to 16 values.
+pub fn lu_solve_dual_narrow<const HA: usize, const N: usize>(
+    lu: &[f64],
+    n: usize,
+    perm: &[usize],
+    a: &[Dual<HA>],
+    b: &mut [Dual<N>],
+    nrhs: usize,
+) {
+    assert!(HA <= N, "the matrix has at most the right-hand side's directions");
+    assert_eq!(a.len(), n * n, "matrix size");
+    assert_eq!(b.len(), n * nrhs, "right-hand side size");
+    let mut x = Scratch::<f64, 64>::new(n * nrhs, 0.0);
+    let x = &mut *x;
+    for (xi, bi) in x.iter_mut().zip(b.iter()) {
+        *xi = bi.re;
+    }
+    lu_solve_many(lu, n, perm, x, nrhs);
     // Columns (c, k): direction k of right-hand side c.
     let m = nrhs * N;
-    let mut r = vec![0.0; n * m];
+    let mut r = Scratch::<f64, 256>::new(n * m, 0.0);
+    let r = &mut *r;
     for i in 0..n {
+        let ri = &mut r[i * m..(i + 1) * m];
         for c in 0..nrhs {
-            for k in 0..N {
-                r[i * m + c * N + k] = b[i * nrhs + c].eps[k];
-            }
+            ri[c * N..(c + 1) * N].copy_from_slice(&b[i * nrhs + c].eps);
         }
         for j in 0..n {
             let aij = &a[i * n + j].eps;
             for c in 0..nrhs {
                 let xj = x[j * nrhs + c];
-                for k in 0..N {
-                    r[i * m + c * N + k] -= aij[k] * xj;
+                let rc = &mut ri[c * N..c * N + HA];
+                for k in 0..HA {
+                    rc[k] -= aij[k] * xj;
                 }
             }
         }
     }
-    lu_solve_many(lu, n, perm, &mut r, m);
+    lu_solve_many(lu, n, perm, r, m);
     for i in 0..n {
         for c in 0..nrhs {
             let v = &mut b[i * nrhs + c];
             v.re = x[i * nrhs + c];
             v.eps.copy_from_slice(&r[i * m + c * N..i * m + (c + 1) * N]);
+        }
+    }
+}
+
+/// A scratch buffer of `len` values, all `fill`: on the stack when
+/// `len <= CAP`, on the heap otherwise, so hot paths sized for the bicycle
+/// models allocate nothing and larger models stay correct. Dereferences to
+/// the slice of its `len` values.
+pub enum Scratch<T, const CAP: usize> {
+    Stack([T; CAP], usize),
+    Heap(Vec<T>),
+}
+
+impl<T: Copy, const CAP: usize> Scratch<T, CAP> {
+    #[inline(always)]
+    pub fn new(len: usize, fill: T) -> Self {
+        if len <= CAP {
+            Scratch::Stack([fill; CAP], len)
+        } else {
+            Scratch::Heap(vec![fill; len])
+        }
+    }
+}
+
+impl<T, const CAP: usize> std::ops::Deref for Scratch<T, CAP> {
+    type Target = [T];
+    #[inline(always)]
+    fn deref(&self) -> &[T] {
+        match self {
+            Scratch::Stack(a, n) => &a[..*n],
+            Scratch::Heap(v) => v,
+        }
+    }
+}
+
+impl<T, const CAP: usize> std::ops::DerefMut for Scratch<T, CAP> {
+    #[inline(always)]
+    fn deref_mut(&mut self) -> &mut [T] {
+        match self {
+            Scratch::Stack(a, n) => &mut a[..*n],
+            Scratch::Heap(v) => v,
         }
     }
 }

@@ -13,7 +13,7 @@ use crate::canonical::CanonicalMatrices;
 use crate::constraints::{
     constraint_matrices, dependent_velocities, solve_configuration, ConstraintError, NewtonOptions,
 };
-use crate::linalg::{lu_factor, lu_solve, lu_solve_dual, solve_in_place};
+use crate::linalg::{lu_factor, lu_solve, lu_solve_dual, lu_solve_dual_narrow, solve_in_place, Scratch};
 use crate::model::MultibodyModel;
 use crate::scalar::{Dual, Scalar};
 use nalgebra::{DMatrix, Matrix2};
@@ -273,12 +273,49 @@ pub type WithRest = (Linearization, DMatrix<f64>);
 ///   derivatives along `q'` vanish;
 /// * one real LU factorization of `D_dep` for both eliminations, with dual
 ///   right-hand sides ([`lu_solve_dual`]);
-/// * `N`-wide duals only for the velocity terms (`Qv`, `Qext`, `gamma`);
+/// * the velocity terms (`Qv + Qext`, `gamma`) in `f64` with their
+///   symbolic Jacobian ([`MultibodyModel::upright_velocity_terms_jacobian`]), then
+///   `N`-wide duals (along `q` and `q'`) by the chain rule through the
+///   solved coordinates and velocities;
 /// * the reduced mass matrix `E^T M E` in `f64` (only its value is used).
 pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
     param: &[f64],
     dq0: &[f64],
 ) -> Result<(Linearization, DMatrix<f64>), LinearizeError> {
+    let u = upright_linearization::<M, H, N>(param, dq0)?;
+    let m = |x: &[[f64; H]; H]| DMatrix::from_fn(H, H, |i, j| x[i][j]);
+    Ok((
+        Linearization {
+            mass: m(&u.mass),
+            damping: m(&u.damping),
+            stiffness: m(&u.stiffness),
+        },
+        m(&u.rest),
+    ))
+}
+
+/// [`linearize_with_rest`] in fixed-size matrices: `M`, `C`, `K` and the
+/// stiffness at rest, `H x H` (row-major arrays).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UprightLinearization<const H: usize> {
+    pub mass: [[f64; H]; H],
+    pub damping: [[f64; H]; H],
+    pub stiffness: [[f64; H]; H],
+    pub rest: [[f64; H]; H],
+}
+
+/// Sizes the upright linearization keeps on the stack (larger models use
+/// the heap, see [`Scratch`]): coordinates, constraints, parameters.
+const CAP_Q: usize = 12;
+const CAP_C: usize = 12;
+const CAP_P: usize = 64;
+
+/// The computation of [`linearize_with_rest`], allocating nothing for models
+/// of up to 12 coordinates, 12 constraints and 64 parameters.
+pub fn upright_linearization<M: MultibodyModel, const H: usize, const N: usize>(
+    param: &[f64],
+    dq0: &[f64],
+) -> Result<UprightLinearization<H>, LinearizeError> {
     let ni = M::INDEPENDENT.len();
     assert!(
         ni == H && 2 * H == N,
@@ -290,8 +327,9 @@ pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
     let nh = M::HOLONOMIC.len();
     let nc = nh + M::NONHOLONOMIC.len();
     // Configuration in f64, from the closed-form upright guess.
-    let mut pf = vec![0.0; nq];
-    M::upright_configuration(param, M::INITIAL_GUESS, &mut pf);
+    let mut pf = Scratch::<f64, CAP_Q>::new(nq, 0.0);
+    let pf = &mut *pf;
+    M::upright_configuration(param, M::INITIAL_GUESS, pf);
     if let Some(j) = pf.iter().position(|x| !x.is_finite()) {
         return Err(ConstraintError::NoUprightConfiguration {
             coordinate: M::COORDINATES[j],
@@ -301,7 +339,14 @@ pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
     for &j in ind {
         pf[j] = 0.0;
     }
-    solve_configuration::<M, f64>(param, 0.0, &mut pf, &NewtonOptions::default())?;
+    // The closed-form guess usually satisfies the constraints already: then
+    // Newton has nothing to do.
+    let newton = NewtonOptions::default();
+    let mut res = Scratch::<f64, CAP_C>::new(nh, 0.0);
+    M::holonomic_residuals(param, 0.0, pf, &mut res);
+    if !(param.iter().all(|x| x.is_finite()) && res.iter().all(|r| r.abs() <= newton.tol)) {
+        solve_configuration::<M, f64>(param, 0.0, pf, &newton)?;
+    }
     let singular = |what: &'static str| {
         move |s: crate::linalg::Singular| ConstraintError::SingularJacobian {
             what,
@@ -311,113 +356,179 @@ pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
         }
     };
     // Dependent coordinates' derivatives in q: -Cq_dep^-1 Cq_ind.
-    let mut cq = vec![0.0; nh * nq];
-    M::holonomic_jacobian(param, 0.0, &pf, &mut cq);
-    let mut jd: Vec<f64> = (0..nh * nh).map(|r| cq[(r / nh) * nq + dep[r % nh]]).collect();
+    let mut cq = Scratch::<f64, { CAP_C * CAP_Q }>::new(nh * nq, 0.0);
+    let cq = &mut *cq;
+    M::holonomic_jacobian(param, 0.0, pf, cq);
+    let mut jd = Scratch::<f64, { CAP_C * CAP_C }>::new(nh * nh, 0.0);
+    let jd = &mut *jd;
+    for (r, x) in jd.iter_mut().enumerate() {
+        *x = cq[(r / nh) * nq + dep[r % nh]];
+    }
     let nd = nq - ni;
-    let mut perm = vec![0; nd.max(nh)];
-    lu_factor(&mut jd, nh, &mut perm[..nh]).map_err(singular("holonomic constraints"))?;
-    let mut p: Vec<Dual<H>> = pf.iter().map(|&x| Dual::cst(x)).collect();
-    let mut col = vec![0.0; nh];
+    let mut perm = Scratch::<usize, CAP_Q>::new(nd.max(nh), 0);
+    let perm = &mut *perm;
+    lu_factor(jd, nh, &mut perm[..nh]).map_err(singular("holonomic constraints"))?;
+    let mut p = Scratch::<Dual<H>, CAP_Q>::new(nq, Dual::zero());
+    let p = &mut *p;
+    for (x, &v) in p.iter_mut().zip(pf.iter()) {
+        *x = Dual::cst(v);
+    }
+    let mut col = Scratch::<f64, CAP_C>::new(nh, 0.0);
+    let col = &mut *col;
     for (k, &j) in ind.iter().enumerate() {
         p[j] = Dual::variable(0.0, k);
         for (i, c) in col.iter_mut().enumerate() {
             *c = -cq[i * nq + j];
         }
-        lu_solve(&jd, nh, &perm[..nh], &mut col);
+        lu_solve(jd, nh, &perm[..nh], col);
         for (r, &jj) in dep.iter().enumerate() {
             p[jj].eps[k] = col[r];
         }
     }
-    let ph: Vec<Dual<H>> = param.iter().map(|&x| Dual::cst(x)).collect();
+    let mut ph = Scratch::<Dual<H>, CAP_P>::new(param.len(), Dual::zero());
+    let ph = &mut *ph;
+    for (x, &v) in ph.iter_mut().zip(param) {
+        *x = Dual::cst(v);
+    }
     let th = Dual::<H>::zero();
-    // Coordinate partitioning (eq. 40-45) with one real factorization.
-    let cm = constraint_matrices::<M, Dual<H>>(&ph, th, &p);
-    let depv = dependent_velocities::<M>();
-    let mut a = vec![Dual::<H>::zero(); nd * nd];
-    let mut rhs = vec![Dual::<H>::zero(); nd * (ni + 1)];
+    // Coordinate partitioning (eq. 40-45) with one real factorization:
+    // D = [Cq; B] and d = [-Ct; 0] (see `constraint_matrices`).
+    let mut d = Scratch::<Dual<H>, { CAP_C * CAP_Q }>::new(nc * nq, Dual::zero());
+    let d = &mut *d;
+    M::holonomic_jacobian(ph, th, p, &mut d[..nh * nq]);
+    M::nonholonomic_matrix(ph, th, p, &mut d[nh * nq..]);
+    let mut ct = Scratch::<Dual<H>, CAP_C>::new(nh, Dual::zero());
+    M::holonomic_time_derivative(ph, th, p, &mut ct);
+    let mut depv = Scratch::<usize, CAP_Q>::new(nd, 0);
+    let depv = &mut *depv;
+    for (slot, j) in depv.iter_mut().zip((0..nq).filter(|j| !ind.contains(j))) {
+        *slot = j;
+    }
+    let w = ni + 1;
+    let mut a = Scratch::<Dual<H>, { CAP_C * CAP_C }>::new(nd * nd, Dual::zero());
+    let a = &mut *a;
+    let mut rhs = Scratch::<Dual<H>, { CAP_C * 4 }>::new(nd * w, Dual::zero());
+    let rhs = &mut *rhs;
     for i in 0..nc {
         for (k, &j) in depv.iter().enumerate() {
-            a[i * nd + k] = cm.d[i * nq + j];
+            a[i * nd + k] = d[i * nq + j];
         }
         for (k, &j) in ind.iter().enumerate() {
-            rhs[i * (ni + 1) + k] = cm.d[i * nq + j];
+            rhs[i * w + k] = d[i * nq + j];
         }
-        rhs[i * (ni + 1) + ni] = cm.d_rhs[i];
+        rhs[i * w + ni] = if i < nh { -ct[i] } else { Dual::zero() };
     }
-    let mut lu: Vec<f64> = a.iter().map(|x| x.re).collect();
-    lu_factor(&mut lu, nd, &mut perm[..nd]).map_err(singular("coordinate partitioning"))?;
+    let mut lu = Scratch::<f64, { CAP_C * CAP_C }>::new(nd * nd, 0.0);
+    let lu = &mut *lu;
+    for (l, x) in lu.iter_mut().zip(a.iter()) {
+        *l = x.re;
+    }
+    lu_factor(lu, nd, &mut perm[..nd]).map_err(singular("coordinate partitioning"))?;
     // Checked where the general path checks it: after the partitioning.
-    check_physical_branch::<M>(param, &pf)?;
-    lu_solve_dual(&lu, nd, &perm[..nd], &a, &mut rhs, ni + 1);
+    check_physical_branch::<M>(param, pf)?;
+    let perm = &perm[..nd];
+    lu_solve_dual(lu, nd, perm, a, rhs, w);
     // E = [I; -Ddep^-1 Dind] (configuration only).
-    let mut e = vec![Dual::<H>::zero(); nq * ni];
+    let mut e = Scratch::<Dual<H>, { CAP_Q * 3 }>::new(nq * ni, Dual::zero());
+    let e = &mut *e;
     for (k, &j) in ind.iter().enumerate() {
         e[j * ni + k] = Dual::one();
     }
     for (r, &j) in depv.iter().enumerate() {
         for k in 0..ni {
-            e[j * ni + k] = -rhs[r * (ni + 1) + k];
+            e[j * ni + k] = -rhs[r * w + k];
         }
     }
     // Velocities, now along q and q'.
-    let pn: Vec<Dual<N>> = p.iter().map(|&x| widen(x)).collect();
-    let pdn: Vec<Dual<N>> = param.iter().map(|&x| Dual::cst(x)).collect();
-    let tn = Dual::<N>::zero();
-    let mut dp = vec![Dual::<N>::zero(); nq];
+    let mut dp = Scratch::<Dual<N>, CAP_Q>::new(nq, Dual::zero());
+    let dp = &mut *dp;
     for (k, &j) in ind.iter().enumerate() {
         dp[j] = Dual::variable(dq0[k], ni + k);
     }
     for (r, &j) in depv.iter().enumerate() {
-        let mut v = widen(rhs[r * (ni + 1) + ni]);
+        let mut v = widen(rhs[r * w + ni]);
         for k in 0..ni {
-            v -= widen(rhs[r * (ni + 1) + k]) * dp[ind[k]];
+            v -= widen(rhs[r * w + k]) * dp[ind[k]];
         }
         dp[j] = v;
     }
+    // The velocity terms (Qv + Qext, then gamma) from their symbolic
+    // Jacobian in f64, by the chain rule along the derivatives of the
+    // coordinates (independent and dependent: the others stay put) and of
+    // every velocity: far cheaper than evaluating them in N-wide duals.
+    let nm = ind.len() + dep.len();
+    let cols = 1 + nm + nq;
+    let mut dpf = Scratch::<f64, CAP_Q>::new(nq, 0.0);
+    let dpf = &mut *dpf;
+    for (x, v) in dpf.iter_mut().zip(dp.iter()) {
+        *x = v.re;
+    }
+    let mut jac = Scratch::<f64, { (CAP_Q + CAP_C) * (1 + 2 * CAP_Q) }>::new((nq + nc) * cols, 0.0);
+    let jac = &mut *jac;
+    M::upright_velocity_terms_jacobian(param, 0.0, pf, dpf, jac);
+    let mut terms = Scratch::<Dual<N>, { CAP_Q + CAP_C }>::new(nq + nc, Dual::zero());
+    let terms = &mut *terms;
+    for (v, row) in terms.iter_mut().zip(jac.chunks_exact(cols)) {
+        v.re = row[0];
+        // (Most entries vanish: skipping them changes no value.)
+        for (&c, &j) in row[1..=nm].iter().zip(ind.iter().chain(dep)) {
+            if c != 0.0 {
+                for k in 0..H {
+                    v.eps[k] += c * p[j].eps[k];
+                }
+            }
+        }
+        for (&c, dpj) in row[1 + nm..].iter().zip(dp.iter()) {
+            if c != 0.0 {
+                for k in 0..N {
+                    v.eps[k] += c * dpj.eps[k];
+                }
+            }
+        }
+    }
+    let (forces, gamma) = terms.split_at_mut(nq);
     // F = [0; -Ddep^-1 gamma].
-    let mut gamma = vec![Dual::<N>::zero(); nc];
-    M::holonomic_convective(&pdn, tn, &pn, &dp, &mut gamma[..nh]);
-    M::nonholonomic_convective(&pdn, tn, &pn, &dp, &mut gamma[nh..]);
-    let an: Vec<Dual<N>> = a.iter().map(|&x| widen(x)).collect();
-    lu_solve_dual(&lu, nd, &perm[..nd], &an, &mut gamma, 1);
-    let mut f = vec![Dual::<N>::zero(); nq];
+    lu_solve_dual_narrow(lu, nd, perm, a, gamma, 1);
+    let mut f = Scratch::<Dual<N>, CAP_Q>::new(nq, Dual::zero());
+    let f = &mut *f;
     for (r, &j) in depv.iter().enumerate() {
         f[j] = -gamma[r];
     }
-    let mut mass = vec![Dual::<H>::zero(); nq * nq];
-    M::mass_matrix(&ph, &p, &mut mass);
-    let mut qg = vec![Dual::<H>::zero(); nq];
-    M::gravity_forces(&ph, &p, &mut qg);
-    let mut qv = vec![Dual::<N>::zero(); nq];
-    M::quadratic_velocity_forces(&pdn, &pn, &dp, &mut qv);
-    let mut qe = vec![Dual::<N>::zero(); nq];
-    M::applied_forces(&pdn, tn, &pn, &dp, &mut qe);
-    // Forces at rest (every velocity zero), for the stiffness at rest.
-    let mut qe_rest = vec![Dual::<N>::zero(); nq];
-    M::applied_forces(&pdn, tn, &pn, &vec![Dual::zero(); nq], &mut qe_rest);
+    let mut mass = Scratch::<Dual<H>, { CAP_Q * CAP_Q }>::new(nq * nq, Dual::zero());
+    let mass = &mut *mass;
+    M::mass_matrix(ph, p, mass);
+    let mut qg = Scratch::<Dual<H>, CAP_Q>::new(nq, Dual::zero());
+    let qg = &mut *qg;
+    M::gravity_forces(ph, p, qg);
+    // Forces at rest (every velocity zero), for the stiffness at rest:
+    // along q only.
+    let mut qe_rest = Scratch::<Dual<H>, CAP_Q>::new(nq, Dual::zero());
+    let qe_rest = &mut *qe_rest;
+    let rest_rates = Scratch::<Dual<H>, CAP_Q>::new(nq, Dual::zero());
+    M::applied_forces(ph, th, p, &rest_rates, qe_rest);
     // Qi = E^T (Qv + Qgrav + Qext - M F) (eq. 46-47); Ec = Mi q'' - Qi at
     // q'' = 0, so its derivatives are -Qi's.
-    let mut stiffness = DMatrix::zeros(ni, ni);
-    let mut damping = DMatrix::zeros(ni, ni);
-    let mut rest = DMatrix::zeros(ni, ni);
     let mut qi = [Dual::<N>::zero(); H];
-    let mut qi_rest = [Dual::<N>::zero(); H];
+    let mut qi_rest = [Dual::<H>::zero(); H];
     for r in 0..nq {
-        let mut s = qv[r] + widen(qg[r]) + qe[r];
+        let mut s = forces[r] + widen(qg[r]);
         // F vanishes on the independent rows.
-        for &c in &depv {
+        for &c in depv.iter() {
             s -= widen(mass[r * nq + c]) * f[c];
         }
-        let s_rest = widen(qg[r]) + qe_rest[r];
+        let s_rest = qg[r] + qe_rest[r];
         for k in 0..ni {
-            let ek = widen(e[r * ni + k]);
-            qi[k] += ek * s;
-            qi_rest[k] += ek * s_rest;
+            qi[k] += widen(e[r * ni + k]) * s;
+            qi_rest[k] += e[r * ni + k] * s_rest;
         }
     }
+    let mut u = UprightLinearization {
+        mass: [[0.0; H]; H],
+        damping: [[0.0; H]; H],
+        stiffness: [[0.0; H]; H],
+        rest: [[0.0; H]; H],
+    };
     // Mi = E^T M E, its value only.
-    let mut mi = DMatrix::zeros(ni, ni);
     for k in 0..ni {
         for b in 0..ni {
             let mut m = 0.0;
@@ -428,22 +539,15 @@ pub fn linearize_with_rest<M: MultibodyModel, const H: usize, const N: usize>(
                 }
                 m += e[r * ni + k].re * me;
             }
-            mi[(k, b)] = m;
+            u.mass[k][b] = m;
         }
         for b in 0..ni {
-            stiffness[(k, b)] = -qi[k].eps[b];
-            damping[(k, b)] = -qi[k].eps[ni + b];
-            rest[(k, b)] = -qi_rest[k].eps[b];
+            u.stiffness[k][b] = -qi[k].eps[b];
+            u.damping[k][b] = -qi[k].eps[ni + b];
+            u.rest[k][b] = -qi_rest[k].eps[b];
         }
     }
-    Ok((
-        Linearization {
-            mass: mi,
-            damping,
-            stiffness,
-        },
-        rest,
-    ))
+    Ok(u)
 }
 
 /// A dual along `H` directions as one along `N >= H` (the first `H`).
@@ -487,7 +591,7 @@ pub fn linearize_with_rest_general<M: MultibodyModel, const N: usize>(
 /// the constraints (a flipped frame, the top of the rim) gives the matrices
 /// of another mechanism, so it is refused.
 pub fn check_physical_branch<M: MultibodyModel>(param: &[f64], p: &[f64]) -> Result<(), LinearizeError> {
-    let mut up = vec![0.0; M::nq()];
+    let mut up = Scratch::<f64, CAP_Q>::new(M::nq(), 0.0);
     M::upright_configuration(param, p, &mut up);
     for &j in M::DEPENDENT {
         let d = (p[j] - up[j] + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
@@ -597,9 +701,15 @@ pub fn state_space_dual<M: MultibodyModel, const N: usize>(
 
 /// The parameter vector and independent rates for steady running at `speed`.
 fn speed_setup<M: MultibodyModel>(param: &[f64], speed: f64) -> Result<(Vec<f64>, Vec<f64>), LinearizeError> {
-    let ni = M::INDEPENDENT.len();
     let mut param = param.to_vec();
-    let mut dq0 = vec![0.0; ni];
+    let mut dq0 = vec![0.0; M::INDEPENDENT.len()];
+    speed_rates::<M>(&mut param, speed, &mut dq0)?;
+    Ok((param, dq0))
+}
+
+/// Set `param` and the independent rates `dq0` (one per independent
+/// coordinate, zero on entry) for steady running at `speed`.
+fn speed_rates<M: MultibodyModel>(param: &mut [f64], speed: f64, dq0: &mut [f64]) -> Result<(), LinearizeError> {
     if let Some(k) = M::FORWARD_SPEED_PARAMETER {
         param[k] = speed;
     } else if let Some(c) = M::SPEED_COORDINATE {
@@ -609,10 +719,10 @@ fn speed_setup<M: MultibodyModel>(param: &[f64], speed: f64) -> Result<(Vec<f64>
         for &j in M::INDEPENDENT {
             p[j] = 0.0;
         }
-        solve_configuration::<M, f64>(&param, 0.0, &mut p, &NewtonOptions::default())?;
+        solve_configuration::<M, f64>(param, 0.0, &mut p, &NewtonOptions::default())?;
         let mut unit = vec![0.0; M::nq()];
         unit[c] = 1.0;
-        let slope = M::forward_speed(&param, &p, &unit);
+        let slope = M::forward_speed(param, &p, &unit);
         if !(slope.abs() > 0.0) || !slope.is_finite() {
             return Err(LinearizeError::NoForwardSpeed { model: M::NAME });
         }
@@ -624,7 +734,7 @@ fn speed_setup<M: MultibodyModel>(param: &[f64], speed: f64) -> Result<(Vec<f64>
     } else if speed != 0.0 {
         return Err(LinearizeError::NoForwardSpeed { model: M::NAME });
     }
-    Ok((param, dq0))
+    Ok(())
 }
 
 /// The roll-steer block of a linearization (see [`lateral_indices`]).
@@ -723,7 +833,8 @@ fn canonical_matrices_by<M: MultibodyModel>(
     lookup: impl Fn(&str) -> Option<f64>,
     linearize: impl Fn(&[f64], &[f64]) -> Result<WithRest, LinearizeError>,
 ) -> Result<CanonicalMatrices, LinearizeError> {
-    let param = parameter_vector::<M>(&lookup, 0.0)?;
+    // At speed 1 directly (a driven model's speed parameter).
+    let mut param = parameter_vector::<M>(&lookup, 1.0)?;
     let g = M::GRAVITY_PARAMETER
         .map(|k| param[k])
         .ok_or(LinearizeError::MissingParameter {
@@ -733,17 +844,29 @@ fn canonical_matrices_by<M: MultibodyModel>(
     if !M::STATES.is_empty() {
         return Err(LinearizeError::HasStates { model: M::NAME });
     }
-    let (p1, dq1) = speed_setup::<M>(&param, 1.0)?;
-    let (l1, rest) = linearize(&p1, &dq1)?;
-    let l1 = lateral_block::<M>(&l1);
-    let idx = lateral_indices::<M>();
-    let k0 = DMatrix::from_fn(2, 2, |i, j| rest[(idx[i], idx[j])]);
-    let flip = |m: &DMatrix<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);
+    let mut dq1 = Scratch::<f64, 8>::new(M::INDEPENDENT.len(), 0.0);
+    speed_rates::<M>(&mut param, 1.0, &mut dq1)?;
+    let (l1, rest) = linearize(&param, &dq1)?;
+    // Roll and steer (see `lateral_indices`), without allocating.
+    let mut idx = [0; 2];
+    let mut n = 0;
+    for k in (0..M::INDEPENDENT.len()).filter(|&k| Some(M::INDEPENDENT[k]) != M::SPEED_COORDINATE) {
+        if n < 2 {
+            idx[n] = k;
+        }
+        n += 1;
+    }
+    if n != 2 {
+        return Err(LinearizeError::NotRollSteer { model: M::NAME, n });
+    }
+    let pick = |m: &DMatrix<f64>| Matrix2::from_fn(|i, j| m[(idx[i], idx[j])]);
+    let flip = |m: Matrix2<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);
+    let k0 = pick(&rest);
     Ok(CanonicalMatrices {
-        m0: flip(&l1.mass),
-        c1: flip(&l1.damping),
-        k0: flip(&k0) / g,
-        k2: flip(&(&l1.stiffness - &k0)),
+        m0: flip(pick(&l1.mass)),
+        c1: flip(pick(&l1.damping)),
+        k0: flip(k0) / g,
+        k2: flip(pick(&l1.stiffness) - k0),
         g,
     })
 }

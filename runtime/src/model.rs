@@ -145,6 +145,16 @@ pub trait MultibodyModel: Send + Sync + 'static {
     /// closed form (e.g. frame pitch and the front contact's rim angle from
     /// the geometry) take that value, the others keep their value in `p`.
     fn upright_configuration<T: Scalar>(param: &[T], p: &[T], out: &mut [T]);
+    /// The velocity terms and their first derivatives at `(p, p', t)`
+    /// upright, for the exact linearization (row-major): rows `Qv + Qext`
+    /// (nq), `dCqdp` (nh), `dBdp` (nnh); columns the value, the derivatives
+    /// in the coordinates [`MultibodyModel::INDEPENDENT`] then
+    /// [`MultibodyModel::DEPENDENT`], then in every rate. Symbolic
+    /// derivatives, evaluated in `f64` with the independent coordinates at
+    /// zero and the ignorable ones (without a closed-form upright value) at
+    /// their initial guess when it is zero: those entries of `p` are not
+    /// read.
+    fn upright_velocity_terms_jacobian(param: &[f64], t: f64, p: &[f64], dp: &[f64], out: &mut [f64]);
     /// Exact linearization about the steady motion with independent rates
     /// `dq0`, and the stiffness at rest, with this model's dual width
     /// (generated: `linearize::linearize_with_rest::<Self, {ni}, {2 ni}>`).

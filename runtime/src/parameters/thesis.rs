@@ -99,6 +99,39 @@ impl ThesisParameters {
         "I3z", "I3zx", "I4x", "I4y", "I4z", "I4xz", "I5x", "I5y", "g",
     ];
 
+    /// Values in the order of [`Self::SYMBOLS`] (`values()[i]` is
+    /// `get(SYMBOLS[i])`), without comparing names.
+    pub fn values(&self) -> [f64; 26] {
+        [
+            self.rear_wheel_radius,
+            self.front_wheel_radius,
+            self.frame_com_x,
+            self.frame_com_z,
+            self.steer_point_x,
+            self.steer_point_z,
+            self.front_wheel_x,
+            self.front_wheel_z,
+            self.fork_com_offset,
+            self.rear_wheel_mass,
+            self.frame_mass,
+            self.fork_mass,
+            self.front_wheel_mass,
+            self.rear_wheel_i_diametral,
+            self.rear_wheel_i_axial,
+            self.frame_ixx,
+            self.frame_iyy,
+            self.frame_izz,
+            self.frame_ixz,
+            self.fork_ixx,
+            self.fork_iyy,
+            self.fork_izz,
+            self.fork_ixz,
+            self.front_wheel_i_diametral,
+            self.front_wheel_i_axial,
+            self.g,
+        ]
+    }
+
     /// Value by thesis symbol (the names the generated models use).
     pub fn get(&self, symbol: &str) -> Option<f64> {
         Some(match symbol {
@@ -252,5 +285,19 @@ impl ThesisParameters {
             "g" => "gravitational acceleration (m/s^2)",
             _ => return None,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_follow_the_symbol_order() {
+        let t = ThesisParameters::thesis_bicycle();
+        let v = t.values();
+        for (i, s) in ThesisParameters::SYMBOLS.iter().enumerate() {
+            assert_eq!(Some(v[i]), t.get(s), "{s}");
+        }
     }
 }
