@@ -133,5 +133,9 @@ fn synth_runs_recover_misalignments_kicks_clock_offsets_and_eigenvalues() {
         }
     }
     println!("clock offsets determined by the data: {from_data} of {}", runs.len());
+    // The launches of these runs steer (the hand's steer wander), so the
+    // heading relation determines most offsets; keeping the nominal value
+    // everywhere would pass the coverage check above without refining any.
+    assert!(from_data >= 3, "only {from_data} of 6 clock offsets from the data");
     assert!(reliable >= 4, "only {reliable} reliable fits of 6");
 }

@@ -101,6 +101,50 @@ pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, star
     if usable.len() < 50 {
         return prior;
     }
+    let fit = |samples: &[usize]| profile_fit(angles, samples, &distance, &offsets);
+    let Some((best, stderr)) = fit(&usable) else {
+        return prior;
+    };
+    // Consistency. In a free response roll and steer move in one mode's
+    // fixed ratio, so the heading terms are nearly collinear there and an
+    // offset found from it rests on small differences that a heading drift
+    // can fake. The launch (speed rising while the bicycle steers) is what
+    // determines the offset: the first half of the record, which holds it,
+    // must determine it on its own, or the nominal offset is kept. If the
+    // second half determines it too, a disagreement between the halves
+    // scales the standard error by their Birge ratio sqrt(chi^2).
+    let half = usable.len() / 2;
+    let Some((o1, s1)) = fit(&usable[..half]).filter(|&(_, s)| s < prior.stderr) else {
+        return prior;
+    };
+    let birge = match fit(&usable[half..]) {
+        Some((o2, s2)) => ((o1 - o2).powi(2) / (s1 * s1 + s2 * s2)).sqrt().max(1.0),
+        None => 1.0,
+    };
+    let stderr = stderr * birge;
+    if !(stderr.is_finite()) || stderr > prior.stderr || (best - nominal).abs() > search {
+        return prior;
+    }
+    ClockOffset {
+        value: best,
+        stderr,
+        from_data: true,
+    }
+}
+
+/// The offset minimising the residual of the heading relation over the IMU
+/// samples `usable` (in time order), and its standard error; `None` when
+/// the residual has no interior minimum over `offsets`.
+fn profile_fit(
+    angles: &Angles,
+    usable: &[usize],
+    distance: &dyn Fn(f64) -> Option<f64>,
+    offsets: &[f64],
+) -> Option<(f64, f64)> {
+    let t = &angles.t;
+    if usable.len() < 50 {
+        return None;
+    }
     let t_mean = usable.iter().map(|&k| t[k]).sum::<f64>() / usable.len() as f64;
     let ssr_at = |o: f64| -> Option<(f64, Vec<f64>)> {
         let mut a = nalgebra::SMatrix::<f64, 6, 6>::zeros();
@@ -108,7 +152,7 @@ pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, star
         let mut rows = Vec::with_capacity(usable.len());
         let mut int_steer = 0.0;
         let mut s_prev: Option<f64> = None;
-        for &k in &usable {
+        for &k in usable {
             let s = distance(t[k] - o)?;
             if let Some(sp) = s_prev {
                 int_steer += angles.steer[k] * (s - sp);
@@ -124,23 +168,17 @@ pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, star
         let r: Vec<f64> = rows.iter().map(|(x, y)| y - x.dot(&sol)).collect();
         Some((r.iter().map(|e| e * e).sum(), r))
     };
-    let mut prof: Vec<(f64, f64)> = Vec::new();
-    for &o in &offsets {
-        if let Some((s, _)) = ssr_at(o) {
-            prof.push((o, s));
-        }
-    }
+    let prof: Vec<(f64, f64)> = offsets.iter().filter_map(|&o| ssr_at(o).map(|(s, _)| (o, s))).collect();
     if prof.len() < 5 {
-        return prior;
+        return None;
     }
-    let (ib, _) = prof
+    let ib = prof
         .iter()
         .enumerate()
         .min_by(|a, b| a.1 .1.total_cmp(&b.1 .1))
-        .map(|(i, p)| (i, *p))
-        .unwrap_or((0, (nominal, 0.0)));
+        .map(|(i, _)| i)?;
     if ib == 0 || ib + 1 >= prof.len() {
-        return prior;
+        return None;
     }
     // Parabola through a neighbourhood of the minimum.
     let w = 5.min(ib).min(prof.len() - 1 - ib);
@@ -154,13 +192,12 @@ pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, star
         ata += x * x.transpose();
         atb += x * s;
     }
-    let Some(ch) = ata.cholesky() else { return prior };
-    let c = ch.solve(&atb);
+    let c = ata.cholesky()?.solve(&atb);
     if !(c[2] > 0.0) {
-        return prior;
+        return None;
     }
     let best = x0 - c[1] / (2.0 * c[2]);
-    let Some((ssr, r)) = ssr_at(best) else { return prior };
+    let (ssr, r) = ssr_at(best)?;
     let nn = r.len() as f64;
     // The heading drift is a random walk, not a line: residuals stay
     // correlated over seconds, so the lag-one correlation understates it.
@@ -178,12 +215,5 @@ pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, star
     let s2 = ssr / (nn - 6.0) * tau_int;
     // SSR(o) ~ SSR_min + c2 (o - o*)^2; a change of s^2 is one standard error.
     let stderr = (s2 / c[2]).sqrt();
-    if !(stderr.is_finite()) || stderr > prior.stderr || (best - nominal).abs() > search {
-        return prior;
-    }
-    ClockOffset {
-        value: best,
-        stderr,
-        from_data: true,
-    }
+    stderr.is_finite().then_some((best, stderr))
 }
