@@ -449,13 +449,34 @@ fn lag1_autocorrelation(r: &[f64]) -> f64 {
     }
 }
 
-/// Fit `form` to samples `(t, y)`. For speed-varying forms `speed` gives the
-/// speed (m/s) at each sample.
-pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result<FitResult, FitError> {
+/// What the fits of one signal share: the zero-crossing frequency, the
+/// starts (local minima of the grid, best first) and the constant-eigenvalue
+/// optimum, if one converged to an oscillation. The constant and the
+/// speed-varying forms on the same signal use one [`Prepared`].
+#[derive(Clone, Debug)]
+pub struct Prepared {
+    w_hat: f64,
+    starts: Vec<[f64; 2]>,
+    constant: Option<[f64; 2]>,
+}
+
+/// MINPACK's limit on evaluations is patience x (parameters + 1); a
+/// projected fit that has not converged in 150-250 has left the valley.
+const PATIENCE: usize = 50;
+/// A fitted frequency above this multiple of the zero-crossing rate fits
+/// noise, not the window's oscillation.
+const MAX_FREQUENCY: f64 = 4.0;
+
+/// Converged, at least half a cycle in the window, and not above the band.
+fn oscillates(th: &[f64], span: f64, w_hat: f64) -> bool {
+    th[1].is_finite() && th[1].abs() * span >= std::f64::consts::PI && th[1].abs() <= MAX_FREQUENCY * w_hat
+}
+
+/// Grid, starts and the constant-eigenvalue fit of samples `(t, y)`.
+pub fn prepare(t: &[f64], y: &[f64]) -> Result<Prepared, FitError> {
     let n = t.len();
-    let k = if form.speed_varying() { 7 } else { 5 };
-    if n < 3 * k {
-        return Err(FitError::TooFewSamples { n, k });
+    if n < 15 {
+        return Err(FitError::TooFewSamples { n, k: 5 });
     }
     let t0 = t[0];
     let tau: Vec<f64> = t.iter().map(|x| x - t0).collect();
@@ -484,9 +505,6 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
     // most MAX_STARTS. A growing or fast-decaying response has minima on
     // both sides of a non-oscillating valley; one start can end in it.
     const MAX_STARTS: usize = 4;
-    // MINPACK's limit on evaluations is patience x (parameters + 1); a
-    // projected fit that has not converged in 150-250 has left the valley.
-    const PATIENCE: usize = 50;
     let mut minima: Vec<(f64, usize, usize)> = Vec::new();
     for i in 0..NW {
         for j in 0..NS {
@@ -504,6 +522,62 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
     if minima.is_empty() {
         return Err(FitError::NoOscillation);
     }
+    // Variable projection (Golub and Pereyra 1973): the linear parameters
+    // `c, p, q` are solved exactly for given phases, so Levenberg-Marquardt
+    // sees only the 2 (or 4) nonlinear ones. The full problem is badly
+    // conditioned where a slow drift sits under a fast decay (eq. 94's
+    // amplitude and phase trade against the constant); the projected one is
+    // not, and converges in a few steps, so several starts are affordable.
+    let span = tau[n - 1];
+    // Starts in the order of the grid's residual; the first that converges
+    // to an oscillation is taken (not the smallest residual over all starts:
+    // a far start can end on the slow capsize drift, another mode).
+    let starts: Vec<[f64; 2]> = minima.iter().map(|&(_, i, j)| [grid_s(j), grid_w(i)]).collect();
+    let mut constant = None;
+    for th in &starts {
+        let start = Projected {
+            tau: &tau,
+            y,
+            integral: None,
+            theta: DVector::from_vec(th.to_vec()),
+        };
+        let (pr, report) = LevenbergMarquardt::new().with_patience(PATIENCE).minimize(start);
+        if report.termination.was_successful() && oscillates(pr.theta.as_slice(), span, w_hat) {
+            constant = Some([pr.theta[0], pr.theta[1]]);
+            break;
+        }
+    }
+    Ok(Prepared {
+        w_hat,
+        starts,
+        constant,
+    })
+}
+
+/// Fit `form` to samples `(t, y)`. For speed-varying forms `speed` gives the
+/// speed (m/s) at each sample.
+pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result<FitResult, FitError> {
+    fit_prepared(form, t, y, speed, &prepare(t, y)?)
+}
+
+/// [`fit`] with the signal's shared part already computed ([`prepare`] on
+/// the same `t`, `y`).
+pub fn fit_prepared(
+    form: FitForm,
+    t: &[f64],
+    y: &[f64],
+    speed: Option<&[f64]>,
+    prep: &Prepared,
+) -> Result<FitResult, FitError> {
+    let n = t.len();
+    let k = if form.speed_varying() { 7 } else { 5 };
+    if n < 3 * k {
+        return Err(FitError::TooFewSamples { n, k });
+    }
+    let t0 = t[0];
+    let tau: Vec<f64> = t.iter().map(|x| x - t0).collect();
+    let w_hat = prep.w_hat;
+    let span = tau[n - 1];
     let eq94 = matches!(form, FitForm::RollAngle);
     let integral = if form.speed_varying() {
         let v = speed.expect("speed-varying fit needs the speed");
@@ -516,52 +590,16 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
     } else {
         None
     };
-    // Variable projection (Golub and Pereyra 1973): the linear parameters
-    // `c, p, q` are solved exactly for given phases, so Levenberg-Marquardt
-    // sees only the 2 (or 4) nonlinear ones. The full problem is badly
-    // conditioned where a slow drift sits under a fast decay (eq. 94's
-    // amplitude and phase trade against the constant); the projected one is
-    // not, and converges in a few steps, so several starts are affordable.
-    let span = tau[n - 1];
-    const MAX_FREQUENCY: f64 = 4.0;
-    // Converged, and at least half a cycle in the window.
-    let accept = |pr: &Projected, ok: bool| -> Option<f64> {
-        let th = pr.theta.as_slice();
-        // A frequency far above the signal's zero-crossing rate fits noise,
-        // not the window's oscillation.
-        let oscillates =
-            th[1].is_finite() && th[1].abs() * span >= std::f64::consts::PI && th[1].abs() <= MAX_FREQUENCY * w_hat;
-        (ok && oscillates)
-            .then(|| pr.residuals().map(|r| r.norm_squared()))
-            .flatten()
-    };
-    // Starts in the order of the grid's residual; the first that converges
-    // to an oscillation is taken (not the smallest residual over all starts:
-    // a far start can end on the slow capsize drift, another mode).
     let mut best: Option<Projected> = None;
-    let mut constant = None;
-    for &(_, i, j) in &minima {
-        let start = Projected {
-            tau: &tau,
-            y,
-            integral: None,
-            theta: DVector::from_vec(vec![grid_s(j), grid_w(i)]),
-        };
-        let (pr, report) = LevenbergMarquardt::new().with_patience(PATIENCE).minimize(start);
-        if accept(&pr, report.termination.was_successful()).is_some() {
-            constant = Some(pr);
-            break;
-        }
-    }
     if form.speed_varying() {
         // The speed-varying form nests the constant one (zero slopes): start
         // it from the constant optimum, so it fits at least as well and is
         // not led off by the slopes' first steps. Where the constant form
         // fits no oscillation (a growing response under a capsize drift),
         // the speed-varying one may: start it from the grid's minima then.
-        let starts: Vec<[f64; 2]> = match &constant {
-            Some(c) => vec![[c.theta[0], c.theta[1]]],
-            None => minima.iter().map(|&(_, i, j)| [grid_s(j), grid_w(i)]).collect(),
+        let starts: Vec<[f64; 2]> = match prep.constant {
+            Some(c) => vec![c],
+            None => prep.starts.clone(),
         };
         for th in starts {
             let start = Projected {
@@ -571,13 +609,18 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
                 theta: DVector::from_vec(vec![th[0], th[1], 0.0, 0.0]),
             };
             let (pr, report) = LevenbergMarquardt::new().with_patience(PATIENCE).minimize(start);
-            if accept(&pr, report.termination.was_successful()).is_some() {
+            if report.termination.was_successful() && oscillates(pr.theta.as_slice(), span, w_hat) {
                 best = Some(pr);
                 break;
             }
         }
-    } else {
-        best = constant;
+    } else if let Some(c) = prep.constant {
+        best = Some(Projected {
+            tau: &tau,
+            y,
+            integral: None,
+            theta: DVector::from_vec(c.to_vec()),
+        });
     }
     let p_full = best.and_then(|pr| pr.full_parameters(eq94));
     let problem = Problem {
@@ -586,7 +629,7 @@ pub fn fit(form: FitForm, t: &[f64], y: &[f64], speed: Option<&[f64]>) -> Result
         integral: integral.clone(),
         eq94,
         p: DVector::from_vec(p_full.ok_or(FitError::NotConverged {
-            reason: format!("no start of {} converged to an oscillation", minima.len()),
+            reason: format!("no start of {} converged to an oscillation", prep.starts.len()),
         })?),
     };
     let r = problem.residuals().ok_or(FitError::NotConverged {

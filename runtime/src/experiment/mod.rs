@@ -200,12 +200,18 @@ fn fit_window(
         (FitForm::SpeedVaryingRollAngle, rs, true),
         (FitForm::SpeedVaryingRollRate, qs, true),
     ];
-    for (form, y, varying) in forms {
+    // The grid and the constant fit are shared by both forms on a signal.
+    let prepared = [fit::prepare(ts, rs), fit::prepare(ts, qs)];
+    for (i, (form, y, varying)) in forms.into_iter().enumerate() {
         if varying && !speed_ok {
             failed.push((form, "speed not measurably changing over the window".to_string()));
             continue;
         }
-        match fit::fit(form, ts, y, varying.then_some(v_lin.as_slice())) {
+        let fitted = prepared[i % 2]
+            .as_ref()
+            .map_err(|e| e.clone())
+            .and_then(|p| fit::fit_prepared(form, ts, y, varying.then_some(v_lin.as_slice()), p));
+        match fitted {
             Ok(f) => fits.push(f),
             Err(e) => failed.push((form, e.to_string())),
         }
