@@ -1,5 +1,7 @@
 //! Least-squares fits of a free response (Levenberg-Marquardt, crate
-//! `levenberg-marquardt`), standard errors from the Jacobian, r^2, AIC/BIC.
+//! `levenberg-marquardt`, by variable projection: the linear parameters are
+//! solved exactly for each trial eigenvalue), standard errors from the full
+//! Jacobian at the optimum, r^2, AIC/BIC.
 //!
 //! Forms (`tau = t - t0`, `t0` the window start):
 //! * [`FitForm::RollAngle`], thesis eq. 94: `A e^(a tau) cos(b tau + phi) + c`;
