@@ -156,23 +156,14 @@ impl Problem {
             })
             .collect()
     }
-}
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.p.copy_from(x);
-    }
-    fn params(&self) -> DVector<f64> {
-        self.p.clone()
-    }
+    /// Model minus data at the parameters.
     fn residuals(&self) -> Option<DVector<f64>> {
         let m = self.model();
         let r = DVector::from_iterator(m.len(), m.iter().zip(&self.y).map(|(a, b)| a - b));
         r.iter().all(|x| x.is_finite()).then_some(r)
     }
+    /// Jacobian of the residuals in the parameters (analytic).
     fn jacobian(&self) -> Option<DMatrix<f64>> {
         let n = self.tau.len();
         let k = self.p.len();
@@ -233,28 +224,15 @@ struct Basis {
 impl Projected<'_> {
     fn basis(&self) -> Option<Basis> {
         let th = self.theta.as_slice();
-        let n = self.tau.len();
-        let mut ec_es = Vec::with_capacity(n);
-        match self.integral {
-            // Uniform samples and a phase linear in tau: e^((s + i w) tau) by
-            // recurrence (one complex product per sample).
-            None if uniform(self.tau) => {
-                let dt = self.tau[1] - self.tau[0];
-                let step = complex_exp(th[0] * dt, th[1] * dt);
-                let mut z = complex_exp(th[0] * self.tau[0], th[1] * self.tau[0]);
-                for _ in 0..n {
-                    ec_es.push(z);
-                    z = (z.0 * step.0 - z.1 * step.1, z.0 * step.1 + z.1 * step.0);
-                }
-            }
-            _ => {
-                let (s1, w1) = if th.len() > 2 { (th[2], th[3]) } else { (0.0, 0.0) };
-                for (k, &t) in self.tau.iter().enumerate() {
-                    let i = self.integral.map_or(0.0, |i| i[k]);
-                    ec_es.push(complex_exp(th[0] * t + s1 * i, th[1] * t + w1 * i));
-                }
-            }
-        }
+        let ec_es: Vec<(f64, f64)> = match self.integral {
+            None => exp_basis(self.tau, th[0], th[1]).collect(),
+            Some(int) => self
+                .tau
+                .iter()
+                .zip(int)
+                .map(|(&t, &i)| complex_exp(th[0] * t + th[2] * i, th[1] * t + th[3] * i))
+                .collect(),
+        };
         let mut a = nalgebra::Matrix3::zeros();
         let mut b = nalgebra::Vector3::zeros();
         for (&(ec, es), &y) in ec_es.iter().zip(self.y) {
@@ -359,41 +337,39 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Projected<'_> {
     }
 }
 
+/// `e^((s + i w) tau_k)` at every sample as `(re, im)`: by recurrence on
+/// uniformly sampled windows (one complex product per sample; the grid calls
+/// this hundreds of times per signal), exactly otherwise.
+fn exp_basis(tau: &[f64], s: f64, w: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+    let uniform = uniform(tau);
+    let dt = if tau.len() > 1 { tau[1] - tau[0] } else { 0.0 };
+    let step = complex_exp(s * dt, w * dt);
+    let mut z = complex_exp(
+        s * tau.first().copied().unwrap_or(0.0),
+        w * tau.first().copied().unwrap_or(0.0),
+    );
+    tau.iter().map(move |&t| {
+        if uniform {
+            let out = z;
+            z = (z.0 * step.0 - z.1 * step.1, z.0 * step.1 + z.1 * step.0);
+            out
+        } else {
+            complex_exp(s * t, w * t)
+        }
+    })
+}
+
 /// Linear least squares of `y ~ c + e^(s tau) (p cos w tau + q sin w tau)`
 /// for fixed `s`, `w`: returns `(ssr, [c, p, q])`.
 fn linear_part(tau: &[f64], y: &[f64], s: f64, w: f64) -> Option<(f64, [f64; 3])> {
     let mut a = nalgebra::Matrix3::zeros();
     let mut b = nalgebra::Vector3::zeros();
     let mut yy = 0.0;
-    // e^((s + i w) tau) by recurrence on uniformly sampled windows (the grid
-    // search calls this hundreds of times per fit); exact otherwise.
-    let n = tau.len();
-    let dt = if n > 1 { tau[1] - tau[0] } else { 0.0 };
-    let uniform = uniform(tau);
-    let (step_re, step_im) = {
-        let e = (s * dt).exp();
-        let (sn, cs) = (w * dt).sin_cos();
-        (e * cs, e * sn)
-    };
-    let (mut z_re, mut z_im) = {
-        let e = (s * tau[0]).exp();
-        let (sn, cs) = (w * tau[0]).sin_cos();
-        (e * cs, e * sn)
-    };
-    for (k, &t) in tau.iter().enumerate() {
-        let (ec, es) = if uniform {
-            let out = (z_re, z_im);
-            (z_re, z_im) = (z_re * step_re - z_im * step_im, z_re * step_im + z_im * step_re);
-            out
-        } else {
-            let e = (s * t).exp();
-            let (sn, cs) = (w * t).sin_cos();
-            (e * cs, e * sn)
-        };
+    for ((ec, es), &yk) in exp_basis(tau, s, w).zip(y) {
         let x = nalgebra::Vector3::new(1.0, ec, es);
         a += x * x.transpose();
-        b += x * y[k];
-        yy += y[k] * y[k];
+        b += x * yk;
+        yy += yk * yk;
     }
     let sol = a.cholesky()?.solve(&b);
     let ssr = yy - sol.dot(&b);
@@ -653,9 +629,9 @@ pub fn fit_prepared(
     let pr = &problem.p;
     let mut omega = pr[2];
     let sigma = pr[1];
-    // At least half a cycle in the window, or it is not an oscillation.
-    let span = tau[n - 1];
-    if !(omega.is_finite() && sigma.is_finite()) || omega.abs() * span < std::f64::consts::PI {
+    // At least half a cycle in the window was checked on the start
+    // ([`oscillates`]); the full parameters are the projected optimum's.
+    if !(omega.is_finite() && sigma.is_finite()) {
         return Err(FitError::NoOscillation);
     }
     let mut params: Vec<f64> = pr.iter().copied().collect();

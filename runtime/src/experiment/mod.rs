@@ -194,20 +194,20 @@ fn fit_window(
         Some((a, b, _)) => ts.iter().map(|x| a + b * (x - ts[0])).collect(),
         None => Vec::new(),
     };
-    let forms = [
-        (FitForm::RollAngle, rs, false),
-        (FitForm::RollRate, qs, false),
-        (FitForm::SpeedVaryingRollAngle, rs, true),
-        (FitForm::SpeedVaryingRollRate, qs, true),
-    ];
     // The grid and the constant fit are shared by both forms on a signal.
-    let prepared = [fit::prepare(ts, rs), fit::prepare(ts, qs)];
-    for (i, (form, y, varying)) in forms.into_iter().enumerate() {
+    let (roll_prep, rate_prep) = (fit::prepare(ts, rs), fit::prepare(ts, qs));
+    let forms = [
+        (FitForm::RollAngle, rs, false, &roll_prep),
+        (FitForm::RollRate, qs, false, &rate_prep),
+        (FitForm::SpeedVaryingRollAngle, rs, true, &roll_prep),
+        (FitForm::SpeedVaryingRollRate, qs, true, &rate_prep),
+    ];
+    for (form, y, varying, prep) in forms {
         if varying && !speed_ok {
             failed.push((form, "speed not measurably changing over the window".to_string()));
             continue;
         }
-        let fitted = prepared[i % 2]
+        let fitted = prep
             .as_ref()
             .map_err(|e| e.clone())
             .and_then(|p| fit::fit_prepared(form, ts, y, varying.then_some(v_lin.as_slice()), p));
@@ -275,11 +275,7 @@ pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOpti
     let offset = if opt.refine_clock {
         sync::estimate_offset(&ang, &sp, run.meta.nominal_offset_s, cal.settled_from.max(ang.t[0]))
     } else {
-        ClockOffset {
-            value: run.meta.nominal_offset_s,
-            stderr: sync::NOMINAL_OFFSET_HALF_RANGE / 3f64.sqrt(),
-            from_data: false,
-        }
+        ClockOffset::nominal(run.meta.nominal_offset_s)
     };
     let t = &ang.t;
     let dt = (t[t.len() - 1] - t[0]) / (t.len().max(2) - 1) as f64;

@@ -41,6 +41,18 @@ pub struct ClockOffset {
     pub from_data: bool,
 }
 
+impl ClockOffset {
+    /// The nominal offset (s), not determined by the data: its standard
+    /// error is that of a uniform error within the +-0.3 s bound.
+    pub fn nominal(value: f64) -> Self {
+        ClockOffset {
+            value,
+            stderr: NOMINAL_OFFSET_HALF_RANGE / 3f64.sqrt(),
+            from_data: false,
+        }
+    }
+}
+
 /// A fall ends the usable record: the bicycle lies on the ground from the
 /// first roll beyond 45 deg (FORMAT.md's criterion; rad).
 const MAX_ROLL: f64 = std::f64::consts::FRAC_PI_4;
@@ -48,14 +60,10 @@ const MAX_ROLL: f64 = std::f64::consts::FRAC_PI_4;
 /// Estimate the offset of one run. `start` is the IMU time from which the
 /// orientation output has settled.
 pub fn estimate_offset(angles: &Angles, speed: &SpeedProfile, nominal: f64, start: f64) -> ClockOffset {
-    let prior = ClockOffset {
-        value: nominal,
-        stderr: NOMINAL_OFFSET_HALF_RANGE / 3f64.sqrt(),
-        from_data: false,
-    };
+    let prior = ClockOffset::nominal(nominal);
     let t = &angles.t;
     let n = t.len();
-    if n < 50 || speed.t.len() < 10 {
+    if n < 50 {
         return prior;
     }
     // Distance travelled in magnet spacings (the regression's coefficients
