@@ -2,7 +2,7 @@
 //! wall-clock second for a 5 s kick response of the thesis model at rtol 1e-8,
 //! and right-hand-side evaluations per second. Printed, never asserted.
 
-use crate::generated::{ThesisExtended, ThesisExtendedFree, ThesisWhipple, ThesisWhippleFree};
+use crate::generated::{Extended, ExtendedFree, ThesisWhipple, ThesisWhippleFree};
 use crate::models::default_parameters;
 use bikedyn_runtime::simulate::{
     initial_state, simulate, Evaluator, InitialConditions, Inputs, Kick, SimOptions, Simulation,
@@ -114,8 +114,8 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         ("rho_air", 1.2),
     ];
     variant::<ThesisWhippleFree>("free speed, no effects", &[], reps)?;
-    variant::<ThesisExtended>("driven speed, steer damping", effects, reps)?;
-    variant::<ThesisExtendedFree>("free speed, damping + rolling resistance + drag", effects, reps)?;
+    variant::<Extended>("driven speed, steer damping", effects, reps)?;
+    variant::<ExtendedFree>("free speed, damping + rolling resistance + drag", effects, reps)?;
     println!("  peer anchor: a Python/sympy implementation at about 0.2 ms per right-hand-side evaluation");
     Ok(())
 }

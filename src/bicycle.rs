@@ -4,7 +4,8 @@
 use crate::generated::with_model;
 use crate::models::{effect_parameters, fits, model_names, models};
 use bikedyn_runtime::canonical::CanonicalMatrices;
-use bikedyn_runtime::linearize::{canonical_matrices, LinearizeError};
+use bikedyn_runtime::eigen::LinearBicycle;
+use bikedyn_runtime::linearize::{canonical_matrices, LinearModel, LinearizeError};
 use bikedyn_runtime::parameters::{
     BenchmarkParameters, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
 };
@@ -50,6 +51,8 @@ pub enum BicycleError {
     NoModelFits { bike: String, nonzero: String },
     #[error("the canonical form M0, C1, K0, K2 holds for the Whipple bicycle; with {effects} the linear equations depend on speed otherwise")]
     NotCanonical { effects: String },
+    #[error("model `{model}` has extra first-order states ({states}): its linear analysis is not a roll-steer quartic; choose a model without them (`--model`)")]
+    HasStates { model: String, states: String },
 }
 
 /// A resolved bicycle.
@@ -217,6 +220,45 @@ impl Bicycle {
             })
     }
 
+    /// The linear roll-steer equations of this bicycle at every speed,
+    /// through model `model` (`None`: the default model, [`Bicycle::model`]):
+    /// the canonical matrices when the equations have that form (no effect
+    /// active), otherwise the model linearized at each speed (damping,
+    /// controllers, drag: any effect).
+    pub fn linear_with(&self, model: Option<&str>) -> Result<Linear, BicycleError> {
+        let nonzero = self.nonzero_parameters()?;
+        let info = self.model_for(model, &nonzero)?;
+        match self.canonical_with(model) {
+            Ok(c) => {
+                return Ok(Linear {
+                    model: info.name,
+                    canonical: Some(c),
+                    equations: Box::new(c),
+                })
+            }
+            Err(BicycleError::NotCanonical { .. }) => {}
+            Err(e) => return Err(e),
+        }
+        if !info.states.is_empty() {
+            return Err(BicycleError::HasStates {
+                model: info.name.to_string(),
+                states: info.states.join(", "),
+            });
+        }
+        let lookup = self.lookup()?;
+        let equations = with_model(info.name, MakeLinear(&lookup))
+            .expect("registered model")
+            .map_err(|source| BicycleError::Linearize {
+                bike: self.name.clone(),
+                source,
+            })?;
+        Ok(Linear {
+            model: info.name,
+            canonical: None,
+            equations,
+        })
+    }
+
     /// Thesis-form parameters (converted if given in benchmark form).
     pub fn thesis(&self) -> Result<ThesisParameters, BicycleError> {
         Ok(self.parameters.to_thesis()?)
@@ -329,6 +371,33 @@ fn default_model_of(t: &ThesisParameters) -> Option<&'static ModelInfo> {
         .fold(0u64, |m, (i, &v)| m | ((v != 0.0) as u64) << i);
     let k = masks.iter().position(|&(has, _)| nonzero & !has == 0)?;
     (nonzero & masks[k].1 == 0).then(|| models_by_size()[k])
+}
+
+/// The linear roll-steer equations of a bicycle through the model chosen.
+pub struct Linear {
+    /// The generated model they come from.
+    pub model: &'static str,
+    /// The canonical matrices, when the equations have that form.
+    pub canonical: Option<CanonicalMatrices>,
+    /// The equations at every speed.
+    pub equations: Box<dyn LinearBicycle + Send>,
+}
+
+impl LinearBicycle for Linear {
+    fn at_speed(&self, v: f64) -> Result<bikedyn_runtime::eigen::SpeedMatrices, bikedyn_runtime::eigen::EigenError> {
+        self.equations.at_speed(v)
+    }
+    fn canonical(&self) -> Option<&CanonicalMatrices> {
+        self.canonical.as_ref()
+    }
+}
+
+struct MakeLinear<'a, F: Fn(&str) -> Option<f64>>(&'a F);
+impl<F: Fn(&str) -> Option<f64>> ModelVisitor for MakeLinear<'_, F> {
+    type Output = Result<Box<dyn LinearBicycle + Send>, LinearizeError>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        Ok(Box::new(LinearModel::<M>::new(self.0)?))
+    }
 }
 
 struct Canonical<'a, F: Fn(&str) -> Option<f64>>(&'a F);

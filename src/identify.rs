@@ -135,34 +135,39 @@ const SPECS: &[Spec] = &[
 pub const NOT_CANDIDATES: &[(&str, &str)] = &[];
 
 /// The identification model, its driven twin, and the alternative model
-/// (free speed, with states: the tyre model) if the registry has one.
+/// (free speed, with states: the tyre model) if the registry has one. Each is
+/// chosen by capability: it can represent the bicycle (has every parameter
+/// the bicycle sets) and carries the most effects.
 fn identification_models(
     bike: &Bicycle,
 ) -> Result<(&'static ModelInfo, &'static ModelInfo, Option<&'static ModelInfo>)> {
+    let nonzero = bike.nonzero_parameters()?;
     let (free, driven) = identification_model_pair(bike)?;
-    let base = free.base;
     let alt = MODELS
         .iter()
         .filter(|m| {
-            m.free_speed && m.base == base && !m.states.is_empty() && free.effects.iter().all(|e| m.effects.contains(e))
+            m.free_speed
+                && !m.states.is_empty()
+                && crate::models::fits(m, &nonzero)
+                && free.effects.iter().all(|e| m.effects.contains(e))
         })
         .max_by_key(|m| m.effects.len());
     Ok((free, driven, alt))
 }
 
-/// The free-speed model with every candidate effect (the registry's
-/// free-speed model with the most effects of the bicycle's base) and its
-/// driven-speed twin.
+/// The free-speed model without extra states that can represent the
+/// bicycle and carries the most effects (every candidate of the library on
+/// every geometry), and its driven-speed twin (same effects).
 fn identification_model_pair(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo)> {
-    let base = bike.model(None)?.base;
+    let nonzero = bike.nonzero_parameters()?;
     let free = MODELS
         .iter()
-        .filter(|m| m.free_speed && m.base == base && m.states.is_empty())
+        .filter(|m| m.free_speed && m.states.is_empty() && crate::models::fits(m, &nonzero))
         .max_by_key(|m| m.effects.len())
-        .with_context(|| format!("no free-speed model of base `{base}` in the registry"))?;
+        .with_context(|| format!("no free-speed model in the registry can represent `{}`", bike.name))?;
     let driven = MODELS
         .iter()
-        .find(|m| !m.free_speed && m.base == base && m.effects == free.effects)
+        .find(|m| !m.free_speed && m.effects == free.effects && crate::models::fits(m, &nonzero))
         .with_context(|| format!("no driven-speed model with the effects of `{}`", free.name))?;
     Ok((free, driven))
 }
@@ -732,6 +737,17 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
     let bike = Bicycle::resolve(&a.bike)?;
     let (free, driven, alt) = identification_models(&bike)?;
     let cands = candidates(free, alt, &bike, &a.effects)?;
+    // A conclusion ("no effect warranted") means something only when
+    // effects were tried.
+    if cands.is_empty() {
+        bail!(
+            "no candidate effect for `{}` through model `{}` (effects: {}): identification would conclude without testing anything",
+            bike.name,
+            free.name,
+            if free.effects.is_empty() { "none".to_string() } else { free.effects.join(", ") }
+        );
+    }
+    eprintln!("identify: model {} (driven twin {})", free.name, driven.name);
     let fit_args = FitArgs {
         inputs: a.inputs.clone(),
         calibration: a.calibration.clone(),

@@ -2,7 +2,10 @@
 
 use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::{Bicycle, BUILT_IN};
-use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds, CrossingDirection, CrossingKind};
+use bikedyn::runtime::eigen::{
+    critical_speeds, critical_speeds_of, eigen_sweep, eigen_sweep_of, CriticalSpeeds, CrossingDirection, CrossingKind,
+    LinearBicycle,
+};
 use bikedyn::runtime::output;
 use bikedyn::runtime::plot::{plot_continuation, plot_stability_map, ImageFormat, PlotOptions};
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
@@ -113,6 +116,10 @@ enum Command {
     Canonical {
         #[command(flatten)]
         bike: BikeArg,
+        /// Speeds START:STOP:STEP (m/s) at which to print the state-space
+        /// matrices A(v), B(v) of a bicycle without canonical form.
+        #[arg(long, default_value = "0:10:2")]
+        speeds: String,
         #[arg(long)]
         json: bool,
     },
@@ -417,6 +424,66 @@ fn canonical_text(c: &CanonicalMatrices) -> String {
     )
 }
 
+/// A sweep with failed cells is an error listing them (at most ten), never
+/// a table with messages in it.
+fn refuse_failed_cells<'a>(
+    cells: impl Iterator<Item = (String, &'a bikedyn::runtime::sweep::CellResult)>,
+) -> Result<()> {
+    let failed: Vec<String> = cells
+        .filter_map(|(at, c)| c.as_ref().err().map(|e| format!("  {at}: {}", e.message)))
+        .collect();
+    if failed.is_empty() {
+        return Ok(());
+    }
+    let shown = failed.iter().take(10).cloned().collect::<Vec<_>>().join("\n");
+    let more = if failed.len() > 10 {
+        format!("\n  ... and {} more", failed.len() - 10)
+    } else {
+        String::new()
+    };
+    bail!(
+        "{} of the sweep's designs failed, no table written:\n{shown}{more}",
+        failed.len()
+    )
+}
+
+/// Rows of `B = [0; M^-1]` (inputs roll and steer torque).
+fn state_input_rows(minv: &nalgebra::Matrix2<f64>) -> Vec<[f64; 2]> {
+    vec![
+        [0.0, 0.0],
+        [0.0, 0.0],
+        [minv[(0, 0)], minv[(0, 1)]],
+        [minv[(1, 0)], minv[(1, 1)]],
+    ]
+}
+
+fn state_space_text(v: f64, a: &nalgebra::Matrix4<f64>, minv: &nalgebra::Matrix2<f64>) -> String {
+    let mut s = format!("v = {v} m/s\n");
+    let e: Vec<f64> = (0..4).flat_map(|i| (0..4).map(move |j| a[(i, j)])).collect();
+    let e = output::format_matrix_entries(&e, 10);
+    let w = e.iter().map(String::len).max().unwrap_or(0);
+    for i in 0..4 {
+        let open = if i == 0 { "A = [[" } else { "     [" };
+        let close = if i == 3 { "]]" } else { "]," };
+        s += &format!(
+            "{open}{:>w$}, {:>w$}, {:>w$}, {:>w$}{close}\n",
+            e[4 * i],
+            e[4 * i + 1],
+            e[4 * i + 2],
+            e[4 * i + 3]
+        );
+    }
+    let b: Vec<f64> = state_input_rows(minv).iter().flatten().copied().collect();
+    let b = output::format_matrix_entries(&b, 10);
+    let w = b.iter().map(String::len).max().unwrap_or(0);
+    for i in 0..4 {
+        let open = if i == 0 { "B = [[" } else { "     [" };
+        let close = if i == 3 { "]]" } else { "]," };
+        s += &format!("{open}{:>w$}, {:>w$}{close}\n", b[2 * i], b[2 * i + 1]);
+    }
+    s
+}
+
 fn canonical_json(c: &CanonicalMatrices) -> serde_json::Value {
     serde_json::json!({
         "M0": CanonicalMatrices::rows(&c.m0), "C1": CanonicalMatrices::rows(&c.c1),
@@ -556,14 +623,67 @@ fn run(cli: Cli) -> Result<bool> {
         }
         Command::Canonical {
             bike: BikeArg { spec: bike, model },
+            speeds,
             json,
         } => {
             let b = load(&bike)?;
-            let c = b.canonical_with(model.as_deref())?;
-            if json {
-                println!("{}", serde_json::to_string_pretty(&canonical_json(&c))?);
-            } else {
-                print!("{}", canonical_text(&c));
+            let lin = b.linear_with(model.as_deref())?;
+            eprintln!("model: {}", lin.model);
+            match &lin.canonical {
+                Some(c) => {
+                    if json {
+                        let mut v = canonical_json(c);
+                        v["model"] = serde_json::json!(lin.model);
+                        println!("{}", serde_json::to_string_pretty(&v)?);
+                    } else {
+                        print!("{}", canonical_text(c));
+                    }
+                }
+                None => {
+                    // Why there is no canonical form, then A(v), B(v).
+                    let why = b
+                        .canonical_with(model.as_deref())
+                        .err()
+                        .map(|e| e.to_string())
+                        .unwrap_or_default();
+                    let speeds = parse_range(&speeds, "--speeds")?;
+                    let mut rows = Vec::new();
+                    for &v in &speeds {
+                        let m = lin.at_speed(v)?;
+                        let a = m
+                            .state_matrix()
+                            .with_context(|| format!("singular mass matrix at {v} m/s"))?;
+                        let minv = m.mass.try_inverse().context("singular mass matrix")?;
+                        rows.push((v, a, minv));
+                    }
+                    if json {
+                        let v: Vec<_> = rows
+                            .iter()
+                            .map(|(v, a, minv)| {
+                                serde_json::json!({
+                                    "speed": v,
+                                    "A": (0..4).map(|i| (0..4).map(|j| a[(i, j)]).collect::<Vec<_>>()).collect::<Vec<_>>(),
+                                    "B": state_input_rows(minv),
+                                })
+                            })
+                            .collect();
+                        let out = serde_json::json!({
+                            "model": lin.model,
+                            "canonical": null,
+                            "why": why,
+                            "state": ["roll", "steer", "roll_rate", "steer_rate"],
+                            "inputs": ["roll_torque", "steer_torque"],
+                            "state_space": v,
+                        });
+                        println!("{}", serde_json::to_string_pretty(&out)?);
+                    } else {
+                        println!("no canonical form: {why}");
+                        println!("state-space form x' = A(v) x + B(v) u, x = [roll, steer, roll rate, steer rate] (rad, rad/s), u = [roll torque, steer torque] (N m), benchmark signs:");
+                        for (v, a, minv) in &rows {
+                            print!("{}", state_space_text(*v, a, minv));
+                        }
+                    }
+                }
             }
             Ok(true)
         }
@@ -594,14 +714,16 @@ fn run(cli: Cli) -> Result<bool> {
                 }
                 _ => e,
             })?;
-            let c = b.canonical_with(model.as_deref())?;
+            let lin = b.linear_with(model.as_deref())?;
+            eprintln!("model: {}", lin.model);
+            let c: &dyn LinearBicycle = &lin;
             let speed = |k: usize| start + k as f64 * step;
             let stream = |fmt: output::StreamFormat| -> Result<()> {
                 match &out {
-                    Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep(&c, n, speed, fmt, w))?,
+                    Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep(c, n, speed, fmt, w))?,
                     None => {
                         let mut w = std::io::BufWriter::new(std::io::stdout().lock());
-                        output::stream_eigen_sweep(&c, n, speed, fmt, &mut w).map_err(|e| anyhow::anyhow!(e))?;
+                        output::stream_eigen_sweep(c, n, speed, fmt, &mut w).map_err(|e| anyhow::anyhow!(e))?;
                         std::io::Write::flush(&mut w)?;
                     }
                 }
@@ -610,7 +732,7 @@ fn run(cli: Cli) -> Result<bool> {
             match format {
                 Format::Table => {
                     let speeds: Vec<f64> = (0..n).map(speed).collect();
-                    emit(&output::format_eigen_table(&eigen_sweep(&c, &speeds)?), &out)?;
+                    emit(&output::format_eigen_table(&eigen_sweep_of(c, &speeds)?), &out)?;
                 }
                 Format::Csv => stream(output::StreamFormat::Csv)?,
                 Format::Json => stream(output::StreamFormat::Json)?,
@@ -627,9 +749,9 @@ fn run(cli: Cli) -> Result<bool> {
                         .map(|k| start + (last - start) * k as f64 / (PLOT_POINTS - 1) as f64)
                         .collect()
                 };
-                let sweep = eigen_sweep(&c, &speeds)?;
+                let sweep = eigen_sweep_of(c, &speeds)?;
                 let vmax = last.max(start + 1e-9);
-                let crit = critical_speeds(&c, start, vmax).ok();
+                let crit = critical_speeds_of(c, start, vmax).ok();
                 plot_continuation(&p, &sweep, crit.as_ref(), &PlotOptions::default())?;
                 eprintln!("wrote {}", p.display());
             }
@@ -641,10 +763,14 @@ fn run(cli: Cli) -> Result<bool> {
             json,
         } => {
             let b = load(&bike)?;
-            let crit = critical(&b.canonical_with(model.as_deref())?, speed_max)?;
+            let lin = b.linear_with(model.as_deref())?;
+            let crit = critical_speeds_of(&lin, 0.0, speed_max)?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&stability_json(&bike, &crit))?);
+                let mut v = stability_json(&bike, &crit);
+                v["model"] = serde_json::json!(lin.model);
+                println!("{}", serde_json::to_string_pretty(&v)?);
             } else {
+                println!("model: {}", lin.model);
                 print!("{}", stability_text(&bike, &crit));
             }
             Ok(true)
@@ -685,6 +811,25 @@ fn run(cli: Cli) -> Result<bool> {
                 }
             }
             let xs = parse_range(&values, "--values")?;
+            // One model for every cell: the one that represents the design
+            // with the swept parameters at their first non-zero values (a
+            // sweep of c_steer from 0 runs wholly through the model with
+            // steer damping), unless the user names it.
+            let model: Option<String> = match model {
+                Some(m) => Some(m),
+                None => {
+                    let pick = |b: &Bicycle, name: &str, vals: &[f64]| -> Result<Bicycle> {
+                        let v = vals.iter().copied().find(|&v| v != 0.0).unwrap_or(vals[0]);
+                        Ok(b.with_parameter(name, v)?)
+                    };
+                    let mut probe = pick(&b, &param, &xs)?;
+                    if let (Some(p2), Some(v2)) = (&param2, &values2) {
+                        probe = pick(&probe, p2, &parse_range(v2, "--values2")?)?;
+                    }
+                    Some(probe.model(None)?.name.to_string())
+                }
+            };
+            eprintln!("model: {}", model.as_deref().unwrap_or_default());
             let opts = SweepOptions {
                 probe_speed: at_speed,
                 ..SweepOptions::with_speed_range(0.0, speed_max)
@@ -709,10 +854,14 @@ fn run(cli: Cli) -> Result<bool> {
                         |x, y| {
                             b.with_parameter(&param, x)
                                 .and_then(|b| b.with_parameter(&p2, y))
-                                .and_then(|b| b.canonical_with(model.as_deref()))
+                                .and_then(|b| b.linear_with(model.as_deref()))
                         },
                         &opts,
                     )?;
+                    refuse_failed_cells(map.cells.iter().enumerate().map(|(k, c)| {
+                        let (ny, x, y) = (map.y.values.len(), &map.x.values, &map.y.values);
+                        (format!("{param} = {}, {p2} = {}", x[k / ny], y[k % ny]), c)
+                    }))?;
                     if let Some(p) = &plot {
                         let opts = PlotOptions {
                             x_label: Some(axis_label(&param)),
@@ -741,9 +890,15 @@ fn run(cli: Cli) -> Result<bool> {
                         ParamAxis::new(param.clone(), xs),
                         |x| {
                             b.with_parameter(&param, x)
-                                .and_then(|b| b.canonical_with(model.as_deref()))
+                                .and_then(|b| b.linear_with(model.as_deref()))
                         },
                         &opts,
+                    )?;
+                    refuse_failed_cells(
+                        s.points
+                            .iter()
+                            .zip(&s.param.values)
+                            .map(|(c, x)| (format!("{param} = {x}"), c)),
                     )?;
                     match format {
                         Format::Table => output::format_parameter_table(&s),

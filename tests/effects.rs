@@ -4,7 +4,7 @@
 //! the linearization.
 
 use bikedyn::bicycle::{Bicycle, BicycleError};
-use bikedyn::generated::{ThesisExtended, ThesisWhipple};
+use bikedyn::generated::{Extended, ThesisWhipple, WhippleOffset};
 use bikedyn::models::{default_bicycle, model_names};
 use bikedyn::registry::ModelInfo;
 use bikedyn_runtime::linearize::{canonical_matrices, lateral_block, linearize_at_speed, parameter_vector};
@@ -51,7 +51,7 @@ fn a_parameter_file_carries_effect_parameters() {
     assert_eq!(b.effects.get("c_steer"), Some(&0.25));
     assert_eq!(b.value("Crr_rear"), Some(0.008));
     // The smallest model with those parameters: the thesis model with effects.
-    assert_eq!(b.model(None).unwrap().name, "thesis_extended");
+    assert_eq!(b.model(None).unwrap().name, "extended");
     // Through a model without them: refused, naming the parameter.
     let err = b.model(Some("thesis_whipple")).unwrap_err();
     assert!(err.to_string().contains("c_steer"), "{err}");
@@ -77,9 +77,9 @@ fn steer_damping_adds_its_coefficient_to_the_steer_damping() {
     let c = canonical_matrices::<ThesisWhipple>(|s| p.get(s)).unwrap();
     let coefficient = 0.37;
     let param =
-        parameter_vector::<ThesisExtended>(|s| if s == "c_steer" { Some(coefficient) } else { p.get(s) }, 0.0).unwrap();
+        parameter_vector::<Extended>(|s| if s == "c_steer" { Some(coefficient) } else { p.get(s) }, 0.0).unwrap();
     for v in [1.0, 4.0, 7.5] {
-        let lin = lateral_block::<ThesisExtended>(&linearize_at_speed::<ThesisExtended>(&param, v).unwrap());
+        let lin = lateral_block::<Extended>(&linearize_at_speed::<Extended>(&param, v).unwrap());
         let want = c.damping(v);
         assert!((lin.damping[(0, 0)] - want[(0, 0)]).abs() < 1e-12);
         assert!(
@@ -92,14 +92,22 @@ fn steer_damping_adds_its_coefficient_to_the_steer_damping() {
 }
 
 #[test]
-fn with_every_effect_absent_the_extended_model_is_the_thesis_model() {
-    let p = default_bicycle(&ModelInfo::of::<ThesisExtended>());
-    let a = canonical_matrices::<ThesisWhipple>(|s| p.get(s)).unwrap();
-    let b = canonical_matrices::<ThesisExtended>(|s| p.get(s)).unwrap();
-    assert!((a.m0 - b.m0).abs().max() < 1e-12);
-    assert!((a.c1 - b.c1).abs().max() < 1e-9, "{} {}", a.c1, b.c1);
-    assert!((a.k0 - b.k0).abs().max() < 1e-12);
-    assert!((a.k2 - b.k2).abs().max() < 1e-9);
+fn with_every_effect_absent_the_extended_model_is_the_whipple_model() {
+    // The extended model is the offset geometry: with d4 = 0 (the thesis
+    // bicycle) it is the thesis model, with the benchmark's d4 the offset one.
+    let thesis = ThesisParameters::thesis_bicycle();
+    let bench = default_bicycle(&ModelInfo::of::<Extended>());
+    assert!(bench.get("d4").unwrap() != 0.0);
+    for (p, a) in [
+        (thesis, canonical_matrices::<ThesisWhipple>(|s| thesis.get(s)).unwrap()),
+        (bench, canonical_matrices::<WhippleOffset>(|s| bench.get(s)).unwrap()),
+    ] {
+        let b = canonical_matrices::<Extended>(|s| p.get(s)).unwrap();
+        assert!((a.m0 - b.m0).abs().max() < 1e-12);
+        assert!((a.c1 - b.c1).abs().max() < 1e-9, "{} {}", a.c1, b.c1);
+        assert!((a.k0 - b.k0).abs().max() < 1e-12);
+        assert!((a.k2 - b.k2).abs().max() < 1e-9);
+    }
 }
 
 #[test]
@@ -132,7 +140,7 @@ fn models_json_lists_every_registered_model() {
         .as_array()
         .unwrap()
         .iter()
-        .find(|m| m["name"] == "thesis_extended_free")
+        .find(|m| m["name"] == "extended_free")
         .unwrap();
     assert_eq!(ext["free_speed"], true);
     assert!(ext["effects"].as_array().unwrap().iter().any(|e| e == "steer_damping"));
@@ -186,7 +194,7 @@ fn commands_take_a_model() {
 /// the state-space linearization.
 #[test]
 fn stiff_tyres_recover_the_rolling_without_slip_weave() {
-    use bikedyn::generated::{ThesisTyreFree, ThesisWhippleFree};
+    use bikedyn::generated::{ThesisWhippleFree, TyreFree};
     use bikedyn_runtime::linearize::state_space_at_speed;
     use bikedyn_runtime::MultibodyModel;
     let p = ThesisParameters::thesis_bicycle();
@@ -198,10 +206,10 @@ fn stiff_tyres_recover_the_rolling_without_slip_weave() {
         .filter(|z| z.im > 0.0)
         .max_by(|a, b| a.im.total_cmp(&b.im))
         .unwrap();
-    assert_eq!(ThesisTyreFree::STATES.len(), 2);
+    assert_eq!(TyreFree::STATES.len(), 2);
     let mut last_err = f64::INFINITY;
     for (ca, sigma) in [(14.0, 0.2), (200.0, 0.02), (3000.0, 0.002)] {
-        let param = parameter_vector::<ThesisTyreFree>(
+        let param = parameter_vector::<TyreFree>(
             |s| match s {
                 "Ca_rear" | "Ca_front" => Some(ca),
                 "sigma_rear" | "sigma_front" => Some(sigma),
@@ -210,7 +218,7 @@ fn stiff_tyres_recover_the_rolling_without_slip_weave() {
             0.0,
         )
         .unwrap();
-        let ss = state_space_at_speed::<ThesisTyreFree>(&param, v).unwrap();
+        let ss = state_space_at_speed::<TyreFree>(&param, v).unwrap();
         assert_eq!(ss.a.nrows(), 12);
         let schur = nalgebra::linalg::Schur::try_new(ss.a.clone(), 1e-14, 10_000).expect("Schur converges");
         let eig = schur.complex_eigenvalues();

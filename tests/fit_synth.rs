@@ -67,7 +67,7 @@ fn synth_runs_recover_misalignments_kicks_clock_offsets_and_eigenvalues() {
     println!("misalignment errors: frame {err_f:.3} deg, handlebar {err_h:.3} deg");
     assert!(err_f < 1.5 && err_h < 1.5, "misalignment errors {err_f} {err_h} deg");
 
-    let driven = bike.model(Some("thesis_extended")).unwrap();
+    let driven = bike.model(Some("extended")).unwrap();
     let mut effects = BTreeMap::new();
     effects.insert("c_steer".to_string(), t1["parameters"]["c_steer"].as_f64().unwrap());
     let (mut reliable, mut from_data) = (0, 0);

@@ -177,7 +177,7 @@ fn hidden_tyre_relaxation_is_found() {
     // no-slip model and fits the relaxation length.
     recovers_with(
         "tyre",
-        Some("thesis_tyre_free"),
+        Some("tyre_free"),
         "sigma_rear=0.4,sigma_front=0.4",
         28,
         "tyre_relaxation",

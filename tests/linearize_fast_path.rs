@@ -5,7 +5,7 @@
 //! in dual numbers) to 1e-12 on random designs, and fails exactly when it
 //! fails.
 
-use bikedyn::generated::{ThesisExtended, ThesisExtendedFree, ThesisWhipple, ThesisWhippleFree, WhippleOffset};
+use bikedyn::generated::{Extended, ExtendedFree, ThesisWhipple, ThesisWhippleFree, WhippleOffset};
 use bikedyn::runtime::linearize::{linearize_with_rest_general, parameter_vector, WithRest};
 use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
 use bikedyn::runtime::MultibodyModel;
@@ -146,8 +146,8 @@ fn fast_upright_linearization_equals_general_path_on_random_designs() {
         let p = param_of::<WhippleOffset>(&t4, v, 0.0, &mut rng);
         compare::<WhippleOffset, 4>(&p, &[0.0; 2], &label);
         // Every effect present (applied forces at speed and at rest).
-        let p = param_of::<ThesisExtended>(&t, v, 0.05, &mut rng);
-        compare::<ThesisExtended, 4>(&p, &[0.0; 2], &label);
+        let p = param_of::<Extended>(&t, v, 0.05, &mut rng);
+        compare::<Extended, 4>(&p, &[0.0; 2], &label);
         // Free speed: three independent coordinates, the speed in a rate.
         let p = param_of::<ThesisWhippleFree>(&t, v, 0.0, &mut rng);
         let k = ThesisWhippleFree::INDEPENDENT
@@ -158,8 +158,8 @@ fn fast_upright_linearization_equals_general_path_on_random_designs() {
         dq0[k] = v / t.rear_wheel_radius;
         compare::<ThesisWhippleFree, 6>(&p, &dq0, &label);
         // Free speed with every effect (speed-dependent applied forces).
-        let p = param_of::<ThesisExtendedFree>(&t, v, 0.05, &mut rng);
-        compare::<ThesisExtendedFree, 6>(&p, &dq0, &label);
+        let p = param_of::<ExtendedFree>(&t, v, 0.05, &mut rng);
+        compare::<ExtendedFree, 6>(&p, &dq0, &label);
     }
     assert!(computed > cases * 9 / 10, "only {computed} of {cases} designs computed");
 }

@@ -520,7 +520,7 @@ fn free_kick<N: MultibodyModel>(param: &[f64], opts: &SimOptions) -> bikedyn_run
 /// Tyre parameters scaled `k` times stiffer: cornering stiffness times `k`,
 /// relaxation length divided by `k`.
 fn stiff_tyres(k: f64) -> Vec<f64> {
-    type T = bikedyn::generated::ThesisTyreFree;
+    type T = bikedyn::generated::TyreFree;
     let mut p = default_parameters::<T>();
     for w in ["rear", "front"] {
         p[T::parameter_index(&format!("Ca_{w}")).unwrap()] *= k;
@@ -534,7 +534,7 @@ fn stiff_tyres(k: f64) -> Vec<f64> {
 /// the no-slip model's.
 #[test]
 fn stiff_tyres_approach_the_no_slip_kick_response() {
-    type T = bikedyn::generated::ThesisTyreFree;
+    type T = bikedyn::generated::TyreFree;
     type W = bikedyn::generated::ThesisWhippleFree;
     let opts = SimOptions::default();
     let reference = free_kick::<W>(&default_parameters::<W>(), &opts);
@@ -582,7 +582,7 @@ fn stiff_tyres_approach_the_no_slip_kick_response() {
 /// speed `S = sqrt(|v_c|^2 + 0.05^2)`, and the tyre force rate has slope
 /// `-S / sigma` in the force.
 fn tyre_loads(param: &[f64], p: &[f64], dp: &[f64]) -> [f64; 2] {
-    type T = bikedyn::generated::ThesisTyreFree;
+    type T = bikedyn::generated::TyreFree;
     let nq = T::nq();
     let np = T::PARAMETERS.len();
     let mut q = param.to_vec();
@@ -616,7 +616,7 @@ fn tyre_loads(param: &[f64], p: &[f64], dp: &[f64]) -> [f64; 2] {
 /// increases.
 #[test]
 fn tyre_relaxation_never_increases_the_energy() {
-    type T = bikedyn::generated::ThesisTyreFree;
+    type T = bikedyn::generated::TyreFree;
     let mut param = default_parameters::<T>();
     for w in ["rear", "front"] {
         param[T::parameter_index(&format!("Cg_{w}")).unwrap()] = 0.0;
@@ -675,7 +675,7 @@ fn cli_simulates_the_tyre_model() {
     let out = cli(&[
         "simulate",
         "--model",
-        "thesis_tyre_free",
+        "tyre_free",
         "--speed",
         "4.5",
         "--kick",
@@ -713,7 +713,7 @@ fn cli_simulates_the_tyre_model() {
 /// stiffness detection) and says to use Radau5, which integrates it.
 #[test]
 fn stiff_tyres_need_far_fewer_evaluations_with_radau5() {
-    type T = bikedyn::generated::ThesisTyreFree;
+    type T = bikedyn::generated::TyreFree;
     let run = |param: &[f64], method| {
         let inputs = Inputs {
             kicks: vec![Kick::at_saddle(0.0, 3.0)],
@@ -782,7 +782,7 @@ fn stiff_tyres_need_far_fewer_evaluations_with_radau5() {
     let out = cli(&[
         "simulate",
         "--model",
-        "thesis_tyre_free",
+        "tyre_free",
         "--speed",
         "4.5",
         "--kick",
@@ -890,7 +890,7 @@ fn kick_to_peak_of<N: MultibodyModel>(param: &[f64], speed: f64, peak: f64) -> b
 /// Prints the README's speed-decay table.
 #[test]
 fn weave_fit_with_speed_decay() {
-    type E = bikedyn::generated::ThesisExtendedFree;
+    type E = bikedyn::generated::ExtendedFree;
     let peak = 10f64.to_radians();
     let idx = |n: &str| E::parameter_index(n).unwrap();
     println!("| V0 (m/s) | Crr | CdA (m^2) | speed over the window (m/s) | mean V | a (1/s) | b (rad/s) | driven fit at mean V: a, b | linear at mean V: a, b | a - driven a | b vs driven b |");

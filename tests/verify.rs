@@ -218,7 +218,7 @@ struct PumpingDamper;
 
 mod pumping_impl {
     use super::PumpingDamper;
-    use bikedyn::generated::ThesisExtendedFree as W;
+    use bikedyn::generated::ExtendedFree as W;
     use bikedyn::runtime::{MultibodyModel, Scalar};
 
     fn flip<T: Scalar>(o: &mut [T]) {
@@ -329,7 +329,7 @@ mod pumping_impl {
 
 #[test]
 fn verification_catches_a_dissipative_force_that_pumps_energy() {
-    use bikedyn::generated::ThesisExtendedFree as W;
+    use bikedyn::generated::ExtendedFree as W;
     use bikedyn::runtime::verify::{verify, with_effects_switched_on};
     let param = with_effects_switched_on::<W>(&bikedyn::models::default_parameters::<W>());
     let opts = VerifyOptions {

@@ -695,6 +695,19 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             .find(|&i| names.contains(&("rate", m.coordinates[i].name.clone())))
     }));
     let gravity_param = opt(m.gravity.as_ref().and_then(|(g, _)| param_pos(g)));
+    // Declared meanings (roll, steer, wheel radii, ...), in declaration order.
+    let coord_roles = m.coordinates.iter().enumerate().filter_map(|(i, c)| {
+        c.meaning.map(|r| {
+            let v = proc_macro2::Ident::new(r.variant(), proc_macro2::Span::call_site());
+            quote!((bikedyn_runtime::model::CoordinateRole::#v, #i))
+        })
+    });
+    let param_roles = m.parameters.iter().enumerate().filter_map(|(i, p)| {
+        p.meaning.map(|r| {
+            let v = proc_macro2::Ident::new(r.variant(), proc_macro2::Span::call_site());
+            quote!((bikedyn_runtime::model::ParameterRole::#v, #i))
+        })
+    });
     let nforces = m.forces.len();
     // Dual widths of this model's linearizations, fixed here so that only
     // they are compiled.
@@ -731,6 +744,8 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             const FORWARD_SPEED_PARAMETER: Option<usize> = #speed_param;
             const SPEED_COORDINATE: Option<usize> = #speed_coord;
             const GRAVITY_PARAMETER: Option<usize> = #gravity_param;
+            const COORDINATE_ROLES: &'static [(bikedyn_runtime::model::CoordinateRole, usize)] = &[#(#coord_roles),*];
+            const PARAMETER_ROLES: &'static [(bikedyn_runtime::model::ParameterRole, usize)] = &[#(#param_roles),*];
             const STATES: &'static [&'static str] = &[#(#states),*];
             const STATE_DOCS: &'static [&'static str] = &[#(#state_docs),*];
             const COORDINATES: &'static [&'static str] = COORDINATES;

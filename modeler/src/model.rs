@@ -53,6 +53,73 @@ pub enum Role {
     Ignorable,
 }
 
+/// What a coordinate means to the jobs that read it (simulation output and
+/// plots, measured-run residuals, identification). A model file declares
+/// the meanings it has with [`ModelBuilder::coordinate_role`]; the emitted
+/// metadata carries them (`MultibodyModel::COORDINATE_ROLES`), so no job
+/// finds a coordinate by its name. The variant names mirror
+/// `bikedyn_runtime::model::CoordinateRole` (the emitted code names them).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum CoordinateRole {
+    /// Ground-plane position of the rear contact, forward axis X (m).
+    RearContactX,
+    /// Ground-plane position of the rear contact, lateral axis Y (m).
+    RearContactY,
+    /// Heading of the rear frame (rad).
+    Yaw,
+    /// Lean of the rear frame (rad).
+    Roll,
+    /// Pitch of the rear frame (rad).
+    Pitch,
+    /// Steer angle about the steer axis (rad).
+    Steer,
+    /// Rotation of the rear wheel relative to the rear frame (rad).
+    RearWheelRotation,
+    /// Rotation of the front wheel relative to the fork (rad).
+    FrontWheelRotation,
+    /// Angle locating the front contact on the rim (rad).
+    FrontContactRimAngle,
+}
+
+impl CoordinateRole {
+    /// The variant's name, as the emitted code spells it.
+    pub fn variant(self) -> &'static str {
+        match self {
+            CoordinateRole::RearContactX => "RearContactX",
+            CoordinateRole::RearContactY => "RearContactY",
+            CoordinateRole::Yaw => "Yaw",
+            CoordinateRole::Roll => "Roll",
+            CoordinateRole::Pitch => "Pitch",
+            CoordinateRole::Steer => "Steer",
+            CoordinateRole::RearWheelRotation => "RearWheelRotation",
+            CoordinateRole::FrontWheelRotation => "FrontWheelRotation",
+            CoordinateRole::FrontContactRimAngle => "FrontContactRimAngle",
+        }
+    }
+}
+
+/// What a parameter means to the jobs that need it (see
+/// [`CoordinateRole`]); mirrors `bikedyn_runtime::model::ParameterRole`.
+/// The forward-speed and gravity parameters are declared by
+/// [`ModelBuilder::forward_speed`] and [`ModelBuilder::gravity`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum ParameterRole {
+    /// Rear wheel radius (m).
+    RearWheelRadius,
+    /// Front wheel radius (m).
+    FrontWheelRadius,
+}
+
+impl ParameterRole {
+    /// The variant's name, as the emitted code spells it.
+    pub fn variant(self) -> &'static str {
+        match self {
+            ParameterRole::RearWheelRadius => "RearWheelRadius",
+            ParameterRole::FrontWheelRadius => "FrontWheelRadius",
+        }
+    }
+}
+
 /// A generalized coordinate.
 #[derive(Clone, Debug)]
 pub struct Coordinate {
@@ -67,6 +134,8 @@ pub struct Coordinate {
     /// constraint solver starts there and the runtime checks that it lands
     /// on this branch (not a flipped frame or the top of a rim).
     pub upright: Option<Expr>,
+    /// What the coordinate means to the jobs (roll, steer, ...), if declared.
+    pub meaning: Option<CoordinateRole>,
 }
 
 /// A parameter.
@@ -81,6 +150,8 @@ pub struct Parameter {
     pub default: Option<f64>,
     /// The effect that declared this parameter, if any.
     pub effect: Option<String>,
+    /// What the parameter means to the jobs (wheel radii), if declared.
+    pub meaning: Option<ParameterRole>,
 }
 
 /// An extra first-order state (beyond the coordinates and their rates),
@@ -344,6 +415,9 @@ pub struct ModelBuilder {
     m: Model,
     /// The effect being applied (see [`ModelBuilder::begin_effect`]).
     effect: Option<String>,
+    /// Roles given to names that were not declared: `(name, role)`,
+    /// reported by [`ModelBuilder::build`].
+    unresolved_roles: Vec<(String, &'static str)>,
 }
 
 impl Model {
@@ -351,6 +425,7 @@ impl Model {
     pub fn builder(name: &str) -> ModelBuilder {
         ModelBuilder {
             effect: None,
+            unresolved_roles: Vec::new(),
             m: Model {
                 name: name.to_string(),
                 doc: String::new(),
@@ -430,6 +505,7 @@ impl ModelBuilder {
             role,
             guess,
             upright: None,
+            meaning: None,
         });
         Expr::Coord(name.into())
     }
@@ -440,6 +516,7 @@ impl ModelBuilder {
             doc: doc.into(),
             default: None,
             effect: self.effect.clone(),
+            meaning: None,
         });
         Expr::Param(name.into())
     }
@@ -451,6 +528,7 @@ impl ModelBuilder {
             doc: doc.into(),
             default: Some(default),
             effect: self.effect.clone(),
+            meaning: None,
         });
         Expr::Param(name.into())
     }
@@ -459,6 +537,22 @@ impl ModelBuilder {
     pub fn upright_value(&mut self, coordinate: &str, value: Expr) {
         if let Some(c) = self.m.coordinates.iter_mut().find(|c| c.name == coordinate) {
             c.upright = Some(value);
+        }
+    }
+    /// Declare what coordinate `coordinate` means (see [`CoordinateRole`]).
+    /// An undeclared name or a meaning given to two coordinates is reported
+    /// by [`ModelBuilder::build`].
+    pub fn coordinate_role(&mut self, coordinate: &str, role: CoordinateRole) {
+        match self.m.coordinates.iter_mut().find(|c| c.name == coordinate) {
+            Some(c) => c.meaning = Some(role),
+            None => self.unresolved_roles.push((coordinate.to_string(), role.variant())),
+        }
+    }
+    /// Declare what parameter `parameter` means (see [`ParameterRole`]).
+    pub fn parameter_role(&mut self, parameter: &str, role: ParameterRole) {
+        match self.m.parameters.iter_mut().find(|c| c.name == parameter) {
+            Some(c) => c.meaning = Some(role),
+            None => self.unresolved_roles.push((parameter.to_string(), role.variant())),
         }
     }
     /// Change a coordinate's role (for model variants, e.g. free speed).
@@ -595,7 +689,16 @@ impl ModelBuilder {
 
     /// Validate everything and freeze the model.
     pub fn build(self) -> Result<Model, ModelError> {
-        let problems = validate(&self.m);
+        let mut problems: Vec<Diagnostic> = self
+            .unresolved_roles
+            .iter()
+            .map(|(name, role)| Diagnostic::Undeclared {
+                kind: "coordinate or parameter",
+                name: name.clone(),
+                used_in: format!("the role `{role}`"),
+            })
+            .collect();
+        problems.extend(validate(&self.m));
         if problems.is_empty() {
             Ok(self.m)
         } else {
@@ -623,6 +726,20 @@ fn duplicates<'a>(kind: &'static str, names: impl Iterator<Item = &'a str>, out:
 pub fn validate(m: &Model) -> Vec<Diagnostic> {
     let mut out = Vec::new();
     duplicates("coordinate", m.coordinates.iter().map(|c| c.name.as_str()), &mut out);
+    duplicates(
+        "coordinate role",
+        m.coordinates
+            .iter()
+            .filter_map(|c| c.meaning.map(CoordinateRole::variant)),
+        &mut out,
+    );
+    duplicates(
+        "parameter role",
+        m.parameters
+            .iter()
+            .filter_map(|c| c.meaning.map(ParameterRole::variant)),
+        &mut out,
+    );
     duplicates("parameter", m.parameters.iter().map(|c| c.name.as_str()), &mut out);
     duplicates("frame", m.frames.iter().map(|c| c.name.as_str()), &mut out);
     duplicates("point", m.points.iter().map(|c| c.name.as_str()), &mut out);

@@ -59,9 +59,11 @@ use nalgebra::{Complex, Matrix2};
 use crate::canonical::CanonicalMatrices;
 
 mod critical;
+mod general;
 mod quartic;
 
 pub use critical::critical_speeds;
+pub use general::{critical_speeds_of, eigen_sweep_of, eigenvalues_of, LinearBicycle, SpeedMatrices};
 use quartic::{quartic_roots, sort_desc, C64};
 
 /// Errors of the eigen analysis. Functions never panic and never return NaN.
@@ -85,6 +87,14 @@ pub enum EigenError {
     #[error("no convergence: {what}")]
     NoConvergence {
         /// Which step failed.
+        what: String,
+    },
+    /// The linear equations of a model could not be formed at a speed.
+    #[error("linearization at {speed} m/s: {what}")]
+    Linearization {
+        /// Speed (m/s).
+        speed: f64,
+        /// What failed.
         what: String,
     },
     /// Invalid argument (e.g. `v_min > v_max`).
@@ -405,6 +415,43 @@ impl CharPoly {
     }
 }
 
+/// A family of characteristic quartics over speed: what the mode tracking
+/// and the critical-speed search need. [`CharPoly`] (the canonical form,
+/// coefficients polynomial in the speed) and the general roll-steer
+/// equations of any model (`general.rs`) implement it.
+pub(crate) trait Spectrum {
+    /// Coefficients `[k0, k1, k2, k3, k4]` at speed `v`.
+    fn coefficients(&self, v: f64) -> Result<[f64; 5], EigenError>;
+    /// Their derivatives in the speed.
+    fn coefficient_rates(&self, v: f64) -> Result<[f64; 5], EigenError>;
+    /// Roots at speed `v`, sorted by descending real then imaginary part.
+    fn roots_at(&self, v: f64) -> Result<[C64; 4], EigenError>;
+    /// A speed scale of the bicycle (m/s), where gravity and speed terms
+    /// balance; it places the anchor of the mode labels.
+    fn scale(&self) -> f64;
+    /// Whether `roots(-v) = -roots(v)` (true for the canonical form, whose
+    /// equations are even in `v` up to the sign of time).
+    fn mirror_symmetric(&self) -> bool;
+}
+
+impl Spectrum for CharPoly {
+    fn coefficients(&self, v: f64) -> Result<[f64; 5], EigenError> {
+        Ok(self.coeffs(v))
+    }
+    fn coefficient_rates(&self, v: f64) -> Result<[f64; 5], EigenError> {
+        Ok(self.dcoeffs(v))
+    }
+    fn roots_at(&self, v: f64) -> Result<[C64; 4], EigenError> {
+        self.roots(v)
+    }
+    fn scale(&self) -> f64 {
+        speed_scale(self)
+    }
+    fn mirror_symmetric(&self) -> bool {
+        true
+    }
+}
+
 /// `-z` without producing `-0.0` imaginary parts for real roots.
 fn neg(z: C64) -> C64 {
     C64::new(-z.re, if z.im == 0.0 { 0.0 } else { -z.im })
@@ -611,7 +658,7 @@ fn pair_rule(z: &[C64; 4], mut l: [Mode; 4]) -> [Mode; 4] {
 }
 
 /// Continue labelled roots from `v0` (>= 0) to `v1` (>= 0) adaptively.
-fn continue_to(cp: &CharPoly, start: Labelled, v0: f64, v1: f64) -> Result<Labelled, EigenError> {
+fn continue_to<S: Spectrum + ?Sized>(cp: &S, start: Labelled, v0: f64, v1: f64) -> Result<Labelled, EigenError> {
     let mut cur = start;
     let mut v = v0;
     if v0 == v1 {
@@ -632,7 +679,7 @@ fn continue_to(cp: &CharPoly, start: Labelled, v0: f64, v1: f64) -> Result<Label
         } else {
             v + h
         };
-        let z = cp.roots(vt)?;
+        let z = cp.roots_at(vt)?;
         let (m, ok) = match_roots(&cur, &z);
         if ok || h.abs() <= hmin {
             cur = Labelled {
@@ -671,8 +718,8 @@ fn speed_scale(cp: &CharPoly) -> f64 {
 /// requested speeds): the first speed of the ladder `30 vs * 2^k` (k = 0..10), then
 /// `30 vs / 1.25^k` (k = 1..80), with the pattern *one complex pair + two real roots*
 /// (`vs` = [`speed_scale`]); otherwise the fallback classification at `30 vs`.
-fn anchor(cp: &CharPoly) -> Result<(f64, Labelled), EigenError> {
-    let base = 30.0 * speed_scale(cp);
+fn anchor<S: Spectrum + ?Sized>(cp: &S) -> Result<(f64, Labelled), EigenError> {
+    let base = 30.0 * cp.scale();
     let ladder = (0..=10)
         .map(|k| base * 2f64.powi(k))
         .chain((1..=80).map(|k| base / 1.25f64.powi(k)));
@@ -680,14 +727,14 @@ fn anchor(cp: &CharPoly) -> Result<(f64, Labelled), EigenError> {
         // A ladder speed where the quartic solver does not converge (extreme
         // speeds of unusual designs, e.g. 4.6e5 m/s for a two-mass-skate
         // variant) is skipped: the anchor is only a starting point.
-        let Ok(z) = cp.roots(v) else {
+        let Ok(z) = cp.roots_at(v) else {
             continue;
         };
         if let Some(l) = classify_anchor(&z) {
             return Ok((v, Labelled { roots: z, labels: l }));
         }
     }
-    let z = cp.roots(base)?;
+    let z = cp.roots_at(base)?;
     Ok((
         base,
         Labelled {
@@ -700,7 +747,7 @@ fn anchor(cp: &CharPoly) -> Result<(f64, Labelled), EigenError> {
 /// Labels at every `|v|` of `speeds` (any order, any sign). Returns labelled roots in
 /// canonical order, one per input speed. Every speed is reached by continuation
 /// from the anchor, so labels do not depend on which other speeds are requested.
-pub(crate) fn track(cp: &CharPoly, speeds: &[f64]) -> Result<Vec<Labelled>, EigenError> {
+pub(crate) fn track<S: Spectrum + ?Sized>(cp: &S, speeds: &[f64]) -> Result<Vec<Labelled>, EigenError> {
     if speeds.is_empty() {
         return Ok(Vec::new());
     }
@@ -713,24 +760,28 @@ pub(crate) fn track(cp: &CharPoly, speeds: &[f64]) -> Result<Vec<Labelled>, Eige
     }
     let (va, start) = anchor(cp)?;
     let mut out = vec![start; speeds.len()];
-    let by_abs = |i: &usize, j: &usize| {
-        speeds[*i]
-            .abs()
-            .partial_cmp(&speeds[*j].abs())
+    // A mirror-symmetric family is tracked in |v| and mirrored; any other
+    // family (damping, controllers: not even in v) along the signed speed,
+    // continuing through zero.
+    let sym = cp.mirror_symmetric();
+    let key = |v: f64| if sym { v.abs() } else { v };
+    let by_key = |i: &usize, j: &usize| {
+        key(speeds[*i])
+            .partial_cmp(&key(speeds[*j]))
             .unwrap_or(std::cmp::Ordering::Equal)
     };
     // above the anchor: ascending; below: descending
-    let mut up: Vec<usize> = (0..speeds.len()).filter(|&i| speeds[i].abs() > va).collect();
-    up.sort_by(by_abs);
-    let mut down: Vec<usize> = (0..speeds.len()).filter(|&i| speeds[i].abs() <= va).collect();
-    down.sort_by(|i, j| by_abs(j, i));
+    let mut up: Vec<usize> = (0..speeds.len()).filter(|&i| key(speeds[i]) > va).collect();
+    up.sort_by(by_key);
+    let mut down: Vec<usize> = (0..speeds.len()).filter(|&i| key(speeds[i]) <= va).collect();
+    down.sort_by(|i, j| by_key(j, i));
     for chain in [up, down] {
         let (mut vcur, mut cur) = (va, start);
         for i in chain {
-            let v = speeds[i].abs();
+            let v = key(speeds[i]);
             cur = continue_to(cp, cur, vcur, v)?.canonical();
             vcur = v;
-            out[i] = if speeds[i] < 0.0 { cur.mirrored() } else { cur };
+            out[i] = if sym && speeds[i] < 0.0 { cur.mirrored() } else { cur };
         }
     }
     Ok(out)
@@ -743,10 +794,20 @@ pub(crate) fn track(cp: &CharPoly, speeds: &[f64]) -> Result<Vec<Labelled>, Eige
 /// `P(s) = M0 s^2 + v C1 s + g K0 + v^2 K2`; `x = [u, s u]`, unit 2-norm, phase fixed so
 /// that the larger-modulus component of `u` is real and positive.
 pub fn eigenvector(c: &CanonicalMatrices, v: f64, s: Complex<f64>) -> [Complex<f64>; 4] {
+    eigenvector_of(
+        &SpeedMatrices {
+            mass: c.m0,
+            damping: c.damping(v),
+            stiffness: c.stiffness(v),
+        },
+        s,
+    )
+}
+
+/// [`eigenvector`] of the equations `M q'' + C q' + K q = 0` at one speed.
+pub fn eigenvector_of(m: &SpeedMatrices, s: Complex<f64>) -> [Complex<f64>; 4] {
     let s2 = s * s;
-    let kk = c.stiffness(v);
-    let cc = c.damping(v);
-    let p = |i: usize, j: usize| s2 * c.m0[(i, j)] + s * cc[(i, j)] + C64::new(kk[(i, j)], 0.0);
+    let p = |i: usize, j: usize| s2 * m.mass[(i, j)] + s * m.damping[(i, j)] + C64::new(m.stiffness[(i, j)], 0.0);
     let (p11, p12, p21, p22) = (p(0, 0), p(0, 1), p(1, 0), p(1, 1));
     let n1 = p11.norm_sqr() + p12.norm_sqr();
     let n2 = p21.norm_sqr() + p22.norm_sqr();

@@ -13,8 +13,9 @@ use crate::canonical::CanonicalMatrices;
 use crate::constraints::{
     constraint_matrices, dependent_velocities, solve_configuration, ConstraintError, NewtonOptions,
 };
+use crate::eigen::{EigenError, LinearBicycle, SpeedMatrices};
 use crate::linalg::{lu_factor, lu_solve, lu_solve_dual, lu_solve_dual_narrow, solve_in_place, Scratch};
-use crate::model::MultibodyModel;
+use crate::model::{CoordinateRole, MissingRole, MultibodyModel};
 use crate::scalar::{Dual, Scalar};
 use nalgebra::{DMatrix, Matrix2};
 use thiserror::Error;
@@ -24,6 +25,8 @@ use thiserror::Error;
 pub enum LinearizeError {
     #[error(transparent)]
     Constraint(#[from] ConstraintError),
+    #[error(transparent)]
+    MissingRole(#[from] MissingRole),
     #[error("model `{model}` has no parameter `{name}`")]
     MissingParameter { model: &'static str, name: String },
     #[error("the canonical form needs exactly 2 independent coordinates (roll, steer), model `{model}` has {n}")]
@@ -914,4 +917,63 @@ pub fn canonical_matrices_two_speeds<M: MultibodyModel>(
         k2: flip(&(&l1.stiffness - &l0.stiffness)),
         g,
     })
+}
+
+/// A generated model with its parameters, as a [`LinearBicycle`]: its
+/// roll-steer equations at each speed come from the exact linearization at
+/// that speed ([`linearize_at_speed`]), in the benchmark's sign convention
+/// (the steer angle of the thesis axes is minus the benchmark's, so the
+/// off-diagonal entries change sign). Any effect enters: damping,
+/// friction's describing function, a speed-scheduled controller.
+///
+/// Models with extra first-order states (tyre forces) have no
+/// second-order roll-steer form and are refused ([`LinearizeError::HasStates`]).
+pub struct LinearModel<M: MultibodyModel> {
+    param: Vec<f64>,
+    /// Positions of roll and steer within the independent coordinates.
+    roll_steer: [usize; 2],
+    _model: std::marker::PhantomData<M>,
+}
+
+impl<M: MultibodyModel> LinearModel<M> {
+    /// The model with its parameters filled from `lookup` (missing ones:
+    /// the model's defaults).
+    pub fn new(lookup: impl Fn(&str) -> Option<f64>) -> Result<Self, LinearizeError> {
+        if !M::STATES.is_empty() {
+            return Err(LinearizeError::HasStates { model: M::NAME });
+        }
+        let param = parameter_vector::<M>(&lookup, 0.0)?;
+        let position = |role| -> Result<usize, LinearizeError> {
+            let j = M::require_coordinate(role, "the linear roll-steer analysis")?;
+            M::INDEPENDENT
+                .iter()
+                .position(|&i| i == j)
+                .ok_or(LinearizeError::NotRollSteer {
+                    model: M::NAME,
+                    n: M::INDEPENDENT.len(),
+                })
+        };
+        let roll_steer = [position(CoordinateRole::Roll)?, position(CoordinateRole::Steer)?];
+        Ok(LinearModel {
+            param,
+            roll_steer,
+            _model: std::marker::PhantomData,
+        })
+    }
+}
+
+impl<M: MultibodyModel> LinearBicycle for LinearModel<M> {
+    fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError> {
+        let lin = linearize_at_speed::<M>(&self.param, v).map_err(|e| EigenError::Linearization {
+            speed: v,
+            what: e.to_string(),
+        })?;
+        let [r, s] = self.roll_steer;
+        let pick = |m: &DMatrix<f64>| Matrix2::new(m[(r, r)], -m[(r, s)], -m[(s, r)], m[(s, s)]);
+        Ok(SpeedMatrices {
+            mass: pick(&lin.mass),
+            damping: pick(&lin.damping),
+            stiffness: pick(&lin.stiffness),
+        })
+    }
 }

@@ -36,6 +36,97 @@ pub struct ForceInfo {
     pub dissipative: bool,
 }
 
+/// What a coordinate means to the jobs that read it: simulation output and
+/// plots, measured-run residuals, identification. A model file declares the
+/// meanings it has; jobs look coordinates up by meaning
+/// ([`MultibodyModel::coordinate_with_role`]), never by name, and a model
+/// without a meaning a job needs is refused with a message naming both
+/// ([`MissingRole`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum CoordinateRole {
+    /// Ground-plane position of the rear contact, forward axis X (m).
+    RearContactX,
+    /// Ground-plane position of the rear contact, lateral axis Y (m).
+    RearContactY,
+    /// Heading of the rear frame (rad).
+    Yaw,
+    /// Lean of the rear frame (rad).
+    Roll,
+    /// Pitch of the rear frame (rad).
+    Pitch,
+    /// Steer angle about the steer axis (rad).
+    Steer,
+    /// Rotation of the rear wheel relative to the rear frame (rad).
+    RearWheelRotation,
+    /// Rotation of the front wheel relative to the fork (rad).
+    FrontWheelRotation,
+    /// Angle locating the front contact on the rim (rad).
+    FrontContactRimAngle,
+}
+
+impl CoordinateRole {
+    /// Every role, in order.
+    pub const ALL: [CoordinateRole; 9] = [
+        CoordinateRole::RearContactX,
+        CoordinateRole::RearContactY,
+        CoordinateRole::Yaw,
+        CoordinateRole::Roll,
+        CoordinateRole::Pitch,
+        CoordinateRole::Steer,
+        CoordinateRole::RearWheelRotation,
+        CoordinateRole::FrontWheelRotation,
+        CoordinateRole::FrontContactRimAngle,
+    ];
+    /// The role in words (`"roll"`, `"rear wheel rotation"`).
+    pub fn describe(self) -> &'static str {
+        match self {
+            CoordinateRole::RearContactX => "rear contact X",
+            CoordinateRole::RearContactY => "rear contact Y",
+            CoordinateRole::Yaw => "yaw",
+            CoordinateRole::Roll => "roll",
+            CoordinateRole::Pitch => "pitch",
+            CoordinateRole::Steer => "steer",
+            CoordinateRole::RearWheelRotation => "rear wheel rotation",
+            CoordinateRole::FrontWheelRotation => "front wheel rotation",
+            CoordinateRole::FrontContactRimAngle => "front contact rim angle",
+        }
+    }
+}
+
+/// What a parameter means to the jobs that need it (see
+/// [`CoordinateRole`]). Forward speed and gravity have their own constants
+/// ([`MultibodyModel::FORWARD_SPEED_PARAMETER`],
+/// [`MultibodyModel::GRAVITY_PARAMETER`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ParameterRole {
+    /// Rear wheel radius (m).
+    RearWheelRadius,
+    /// Front wheel radius (m).
+    FrontWheelRadius,
+}
+
+impl ParameterRole {
+    /// The role in words.
+    pub fn describe(self) -> &'static str {
+        match self {
+            ParameterRole::RearWheelRadius => "rear wheel radius",
+            ParameterRole::FrontWheelRadius => "front wheel radius",
+        }
+    }
+}
+
+/// A model lacks a meaning (role) that a job needs.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("model `{model}` declares no {kind} with the role `{role}`, which {job} needs (declare it in the model file: `coordinate_role` / `parameter_role`)")]
+pub struct MissingRole {
+    pub model: &'static str,
+    /// `"coordinate"` or `"parameter"`.
+    pub kind: &'static str,
+    pub role: &'static str,
+    /// The job that needs it, e.g. `"simulation output"`.
+    pub job: &'static str,
+}
+
 /// A generated model. All functions are associated (no `self`): a model is a
 /// type, its code is monomorphised for each scalar.
 pub trait MultibodyModel: Send + Sync + 'static {
@@ -62,6 +153,10 @@ pub trait MultibodyModel: Send + Sync + 'static {
     const SPEED_COORDINATE: Option<usize>;
     /// Index of the gravitational-acceleration parameter, if any.
     const GRAVITY_PARAMETER: Option<usize>;
+    /// Declared meanings of coordinates: `(role, coordinate index)`.
+    const COORDINATE_ROLES: &'static [(CoordinateRole, usize)] = &[];
+    /// Declared meanings of parameters: `(role, parameter index)`.
+    const PARAMETER_ROLES: &'static [(ParameterRole, usize)] = &[];
     /// Extra first-order states (e.g. lagged tyre forces). Generated code
     /// reads them from the `param` slice after the parameters: slices passed
     /// to a model with states hold `PARAMETERS.len() + STATES.len()` values.
@@ -103,6 +198,34 @@ pub trait MultibodyModel: Send + Sync + 'static {
     /// Index of a parameter by name.
     fn parameter_index(name: &str) -> Option<usize> {
         Self::PARAMETERS.iter().position(|c| *c == name)
+    }
+    /// Index of the coordinate with meaning `role`, if the model declares it.
+    fn coordinate_with_role(role: CoordinateRole) -> Option<usize> {
+        Self::COORDINATE_ROLES.iter().find(|(r, _)| *r == role).map(|&(_, i)| i)
+    }
+    /// Index of the parameter with meaning `role`, if the model declares it.
+    fn parameter_with_role(role: ParameterRole) -> Option<usize> {
+        Self::PARAMETER_ROLES.iter().find(|(r, _)| *r == role).map(|&(_, i)| i)
+    }
+    /// [`MultibodyModel::coordinate_with_role`], or an error naming the
+    /// role and the job that needs it.
+    fn require_coordinate(role: CoordinateRole, job: &'static str) -> Result<usize, MissingRole> {
+        Self::coordinate_with_role(role).ok_or(MissingRole {
+            model: Self::NAME,
+            kind: "coordinate",
+            role: role.describe(),
+            job,
+        })
+    }
+    /// [`MultibodyModel::parameter_with_role`], or an error naming the
+    /// role and the job that needs it.
+    fn require_parameter(role: ParameterRole, job: &'static str) -> Result<usize, MissingRole> {
+        Self::parameter_with_role(role).ok_or(MissingRole {
+            model: Self::NAME,
+            kind: "parameter",
+            role: role.describe(),
+            job,
+        })
     }
 
     /// Mass matrix `M(p)`, `nq x nq` (thesis eq. 32).

@@ -545,14 +545,16 @@ pub const STREAM_BLOCK: usize = 4096;
 /// is labelled by continuation from the bicycle's anchor speed, independent
 /// of the other requested speeds.
 pub fn stream_eigen_sweep(
-    c: &crate::canonical::CanonicalMatrices,
+    c: &dyn crate::eigen::LinearBicycle,
     n: usize,
     speed: impl Fn(usize) -> f64,
     format: StreamFormat,
     w: &mut dyn Write,
 ) -> Result<(), BoxError> {
     // Fail before writing anything if the bicycle has no eigen analysis.
-    crate::eigen::CharPoly::new(c)?;
+    if n > 0 {
+        crate::eigen::eigenvalues_of(c, speed(0))?;
+    }
     let for_each_point = |f: &mut dyn FnMut(usize, &EigenPoint) -> Result<(), BoxError>| -> Result<(), BoxError> {
         let mut speeds = Vec::with_capacity(STREAM_BLOCK.min(n));
         let mut start = 0;
@@ -560,7 +562,7 @@ pub fn stream_eigen_sweep(
             let end = (start + STREAM_BLOCK).min(n);
             speeds.clear();
             speeds.extend((start..end).map(&speed));
-            let sweep = crate::eigen::eigen_sweep(c, &speeds)?;
+            let sweep = crate::eigen::eigen_sweep_of(c, &speeds)?;
             for (i, p) in sweep.points.iter().enumerate() {
                 f(start + i, p)?;
             }

@@ -3,7 +3,7 @@
 //! ([`ModelVisitor`]; the generated registry's `with_model(name, visitor)`
 //! matches the name and calls `visitor.visit::<ThatModel>()`).
 
-use crate::model::{MultibodyModel, ParameterInfo};
+use crate::model::{CoordinateRole, MultibodyModel, ParameterInfo};
 
 /// What a generated model is, for listings and model selection.
 #[derive(Clone, Copy, Debug)]
@@ -18,6 +18,8 @@ pub struct ModelInfo {
     pub parameters: &'static [ParameterInfo],
     /// Extra first-order states (e.g. lagged tyre forces).
     pub states: &'static [&'static str],
+    /// Declared meanings of coordinates: `(role, coordinate index)`.
+    pub coordinate_roles: &'static [(CoordinateRole, usize)],
 }
 
 impl ModelInfo {
@@ -33,7 +35,16 @@ impl ModelInfo {
             independent: M::INDEPENDENT,
             parameters: M::PARAMETER_INFO,
             states: M::STATES,
+            coordinate_roles: M::COORDINATE_ROLES,
         }
+    }
+
+    /// The coordinate with meaning `role`, by name.
+    pub fn coordinate_with_role(&self, role: CoordinateRole) -> Option<&'static str> {
+        self.coordinate_roles
+            .iter()
+            .find(|(r, _)| *r == role)
+            .map(|&(_, i)| self.coordinates[i])
     }
 
     /// The parameter called `name`.

@@ -28,7 +28,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::canonical::CanonicalMatrices;
-use crate::eigen::{critical_speeds, eigen_sweep, CriticalSpeeds, EigenError, EigenSweep};
+use crate::eigen::{critical_speeds_of, eigen_sweep, CriticalSpeeds, EigenError, EigenSweep, LinearBicycle};
 
 /// Options shared by the parameter sweeps.
 #[derive(Clone, Debug, PartialEq)]
@@ -306,9 +306,10 @@ pub fn speed_sweep(c: &CanonicalMatrices, speeds: &[f64]) -> Result<EigenSweep, 
 /// `map` is where the caller linearizes its model at the parameter value. Its
 /// errors (and panics) are recorded per value, as are eigen-analysis errors.
 /// Fails as a whole only for an invalid speed range.
-pub fn parameter_sweep<F, E>(param: ParamAxis, map: F, opts: &SweepOptions) -> Result<ParameterSweep, SweepError>
+pub fn parameter_sweep<F, L, E>(param: ParamAxis, map: F, opts: &SweepOptions) -> Result<ParameterSweep, SweepError>
 where
-    F: Fn(f64) -> Result<CanonicalMatrices, E> + Sync,
+    F: Fn(f64) -> Result<L, E> + Sync,
+    L: LinearBicycle,
     E: Display,
 {
     opts.validate()?;
@@ -333,9 +334,15 @@ where
 /// Critical speeds over the grid `x.values x y.values` (row-major, `x` outer), in parallel.
 ///
 /// Same error policy as [`parameter_sweep`].
-pub fn stability_map<F, E>(x: ParamAxis, y: ParamAxis, map: F, opts: &SweepOptions) -> Result<StabilityMap, SweepError>
+pub fn stability_map<F, L, E>(
+    x: ParamAxis,
+    y: ParamAxis,
+    map: F,
+    opts: &SweepOptions,
+) -> Result<StabilityMap, SweepError>
 where
-    F: Fn(f64, f64) -> Result<CanonicalMatrices, E> + Sync,
+    F: Fn(f64, f64) -> Result<L, E> + Sync,
+    L: LinearBicycle,
     E: Display,
 {
     opts.validate()?;
@@ -359,7 +366,7 @@ where
     })
 }
 
-fn evaluate_cell<E: Display>(map: impl FnOnce() -> Result<CanonicalMatrices, E>, opts: &SweepOptions) -> CellResult {
+fn evaluate_cell<L: LinearBicycle, E: Display>(map: impl FnOnce() -> Result<L, E>, opts: &SweepOptions) -> CellResult {
     let c = match catch_unwind(AssertUnwindSafe(map)) {
         Ok(Ok(c)) => c,
         Ok(Err(e)) => {
@@ -384,11 +391,11 @@ fn evaluate_cell<E: Display>(map: impl FnOnce() -> Result<CanonicalMatrices, E>,
         stage: CellStage::Eigen,
         message: e.to_string(),
     };
-    let mut summary = critical_speeds(&c, opts.speed_min, opts.speed_max)
+    let mut summary = critical_speeds_of(&c, opts.speed_min, opts.speed_max)
         .map(|cs| StabilitySummary::from_critical(&cs, opts.speed_max))
         .map_err(eigen_error)?;
     if let Some(v) = opts.probe_speed {
-        let z = crate::eigen::eigenvalues(&c, v).map_err(eigen_error)?;
+        let z = crate::eigen::eigenvalues_of(&c, v).map_err(eigen_error)?;
         summary.least_stable_real_part = Some(z.iter().map(|s| s.re).fold(f64::NEG_INFINITY, f64::max));
     }
     Ok(summary)

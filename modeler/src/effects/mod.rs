@@ -5,7 +5,7 @@
 //! An effect adds parameters (each with a meaning, a unit and a default at
 //! which the effect is absent) and applied forces, or moves mass centres.
 //! Applying effects to a model is part of its declaration (see
-//! `models/thesis_extended.rs`), so the derivation treats them like any
+//! `models/extended.rs`), so the derivation treats them like any
 //! other force: exact derivatives, verified by `bikedyn verify`, including
 //! the power identity and the sign of each dissipative force's power.
 //!

@@ -1,18 +1,31 @@
 //! A steer-torque state-feedback controller `T_steer = K(v) x`, with
 //! `x = [roll, steer, roll rate, steer rate]` (thesis signs: roll positive
 //! leaning right, steer positive turning left) and each gain linear in the
-//! forward speed `v`: `K_i(v) = K_i + K_i_v v`.
+//! forward speed `v` inside a speed window:
+//! `K_i(v) = (K_i + K_i_v v) S(v - Kc_v_min) S(Kc_v_max - v)`,
+//! with `S` a unit step. The window is how assist laws that switch off are
+//! written: the balance-assist law of Moore's lab, `k (v_s - v)` on the
+//! roll rate below `v_s` and nothing above, is `Kc_roll_rate = k v_s`,
+//! `Kc_roll_rate_v = -k`, `Kc_v_max = v_s`.
+//!
+//! The step is smooth, `S(x) = (1 + x / sqrt(x^2 + w^2)) / 2` with
+//! `w = 1e-6 m/s`, so that the equations keep exact, finite derivatives at
+//! every speed (the linearization and the integrator need them; an
+//! exponential step such as `tanh` overflows in its derivative far from the
+//! switch). It is within `w^2 / (4 x^2)` of 0 or 1 at a distance `x` from
+//! the switch: 3e-11 at 0.1 m/s, and 1 to rounding at the defaults
+//! (`Kc_v_min = -1e6`, `Kc_v_max = 1e6` m/s).
 //!
 //! The TU Delft steer-by-wire bicycle's steer-into-lean assist (after Schwab
 //! et al. 2008; `../shared/realdata/README.md`) is, below 6.5 m/s, a steer
 //! torque `2 (6.5 - v)` times the roll rate in the benchmark convention
 //! (steer positive to the right). In thesis signs the steer torque changes
 //! sign, so it is `Kc_roll_rate = -13`, `Kc_roll_rate_v = 2`, all other
-//! gains 0. Above 6.5 m/s that law switches to roll feedback; give a
-//! parameter file per speed range for such runs.
+//! gains 0, with `Kc_v_max = 6.5`. Above 6.5 m/s that law switches to roll
+//! feedback; give a parameter file per speed range for such runs.
 
 use super::{BicycleParts, Effect};
-use crate::expr::{coord, rate, Expr};
+use crate::expr::{coord, num, rate, ratio, Expr};
 use crate::model::{Force, ModelBuilder};
 
 fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
@@ -27,7 +40,20 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
         ("roll_rate", "N m s/rad", rate(&parts.roll)),
         ("steer_rate", "N m s/rad", rate(&parts.steer)),
     ];
-    let mut torque = crate::expr::num(0);
+    let v_min = m.parameter_with_default(
+        "Kc_v_min",
+        "speed below which the steer controller is off (m/s)",
+        -1e6,
+    );
+    let v_max = m.parameter_with_default(
+        "Kc_v_max",
+        "speed above which the steer controller is off (m/s)",
+        1e6,
+    );
+    // Smooth unit step of width w = 0.01 m/s (see the module docs).
+    let step = |x: Expr| ratio(1, 2) * (num(1) + x.clone() / (x.powi(2) + ratio(1, 1_000_000_000_000)).sqrt());
+    let window = step(v.clone() - v_min) * step(v_max - v.clone());
+    let mut torque = num(0);
     for (name, unit, x) in states {
         let k = m.parameter_with_default(
             &format!("Kc_{name}"),
@@ -47,7 +73,7 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     m.force(Force::Generalized {
         name: "steer_controller".into(),
         coordinate: parts.steer.clone(),
-        expr: torque,
+        expr: window * torque,
     });
 }
 
@@ -55,7 +81,7 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
 pub fn effect() -> Effect {
     Effect {
         name: "steer_controller",
-        doc: "steer-torque state feedback T = K(v) [roll, steer, roll rate, steer rate], gains linear in speed",
+        doc: "steer-torque state feedback T = K(v) [roll, steer, roll rate, steer rate], gains linear in speed within a speed window [Kc_v_min, Kc_v_max]",
         apply,
     }
 }

@@ -21,7 +21,7 @@ models!(
     whipple_offset,
     thesis_whipple_free,
     whipple_offset_free,
-    thesis_extended,
-    thesis_extended_free,
-    thesis_tyre_free,
+    extended,
+    extended_free,
+    tyre_free,
 );

@@ -6,7 +6,9 @@
 
 use crate::effects::BicycleParts;
 use crate::expr::{exact, inertia_wheel, inertia_xz, num, rate, time, vec3};
-use crate::model::{Axis, BodyId, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, Role, GROUND};
+use crate::model::{
+    Axis, BodyId, CoordinateRole, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, ParameterRole, Role, GROUND,
+};
 use std::f64::consts::PI;
 
 const SOURCE: &str = "modeler/src/models/thesis_whipple.rs";
@@ -75,6 +77,22 @@ pub fn declare(name: &str, source: &str, speed: Speed) -> (ModelBuilder, Bicycle
         "angle of the front contact point on the rim (rad)",
     );
 
+    // What each coordinate means to the jobs (simulation output, residuals,
+    // identification): declared here, never inferred from the names.
+    for (c, r) in [
+        ("xc", CoordinateRole::RearContactX),
+        ("yc", CoordinateRole::RearContactY),
+        ("phi", CoordinateRole::Yaw),
+        ("theta", CoordinateRole::Roll),
+        ("psi", CoordinateRole::RearWheelRotation),
+        ("beta", CoordinateRole::Pitch),
+        ("gamma", CoordinateRole::Steer),
+        ("eps", CoordinateRole::FrontWheelRotation),
+        ("xi", CoordinateRole::FrontContactRimAngle),
+    ] {
+        m.coordinate_role(c, r);
+    }
+
     // Parameters (section 4.4, Parametros.m).
     let v = (speed == Speed::Driven).then(|| m.parameter("V", "forward speed imposed by the driving constraint (m/s)"));
     let rt = m.parameter("Rt", "rear wheel radius (m)");
@@ -101,6 +119,8 @@ pub fn declare(name: &str, source: &str, speed: Speed) -> (ModelBuilder, Bicycle
     let i4xz = m.parameter("I4xz", "handlebar + fork inertia xz (kg m^2)");
     let i5x = m.parameter("I5x", "front wheel moment about a diameter (kg m^2)");
     let i5y = m.parameter("I5y", "front wheel moment about its axle (kg m^2)");
+    m.parameter_role("Rt", ParameterRole::RearWheelRadius);
+    m.parameter_role("Rd", ParameterRole::FrontWheelRadius);
     m.parameter("g", "gravitational acceleration (m/s^2)");
     m.gravity("g", Axis::Z);
 

@@ -42,9 +42,10 @@ fn quadratic_real_roots(a: f64, b: f64, c: f64) -> Vec<f64> {
 }
 
 /// `(p, p_s, p_ss, p_v, p_sv)` at complex `s` and speed `v`.
-fn derivs(cp: &CharPoly, s: C64, v: f64) -> (C64, C64, C64, C64, C64) {
-    let k = cp.coeffs(v);
-    let kd = cp.dcoeffs(v);
+fn derivs<S: Spectrum + ?Sized>(cp: &S, s: C64, v: f64) -> (C64, C64, C64, C64, C64) {
+    let nan = [f64::NAN; 5];
+    let k = cp.coefficients(v).unwrap_or(nan);
+    let kd = cp.coefficient_rates(v).unwrap_or(nan);
     let zero = C64::new(0.0, 0.0);
     let (mut p, mut ps, mut pss, mut pv, mut psv) = (zero, zero, zero, zero, zero);
     for i in (0..5).rev() {
@@ -57,9 +58,9 @@ fn derivs(cp: &CharPoly, s: C64, v: f64) -> (C64, C64, C64, C64, C64) {
     (p, ps, pss, pv, psv)
 }
 
-fn direction(cp: &CharPoly, s: C64, v: f64) -> Option<CrossingDirection> {
+fn direction<S: Spectrum + ?Sized>(cp: &S, s: C64, v: f64) -> Option<CrossingDirection> {
     let (_, ps, _, pv, _) = derivs(cp, s, v);
-    if ps.norm_sqr() == 0.0 {
+    if ps.norm_sqr() == 0.0 || !ps.norm_sqr().is_finite() {
         return None;
     }
     let dsdv = -pv / ps;
@@ -152,13 +153,25 @@ pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<
     }
     cands.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
 
+    finish(&cp, cands, v_min, v_max)
+}
+
+/// Labels, directions, the named critical speeds, the stable intervals and
+/// the weave merge from the crossing candidates `(speed, kind, frequency)`
+/// (sorted by speed) of any family.
+pub(crate) fn finish<S: Spectrum + ?Sized>(
+    cp: &S,
+    cands: Vec<(f64, CrossingKind, f64)>,
+    v_min: f64,
+    v_max: f64,
+) -> Result<CriticalSpeeds, EigenError> {
     // Labels at the crossing speeds.
     let speeds: Vec<f64> = cands.iter().map(|x| x.0).collect();
-    let labelled = track(&cp, &speeds)?;
+    let labelled = track(cp, &speeds)?;
     let mut crossings = Vec::new();
     for ((v, kind, w), l) in cands.iter().zip(&labelled) {
         let target = C64::new(0.0, *w);
-        let Some(dir) = direction(&cp, target, *v) else {
+        let Some(dir) = direction(cp, target, *v) else {
             continue;
         };
         let mut best = 0;
@@ -204,7 +217,7 @@ pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<
     breaks.extend(crossings.iter().map(|x| x.speed).filter(|&v| v > v_min && v < v_max));
     breaks.push(v_max);
     breaks.dedup();
-    let stable_at = |v: f64| -> Result<bool, EigenError> { Ok(cp.roots(v)?.iter().all(|z| z.re < 0.0)) };
+    let stable_at = |v: f64| -> Result<bool, EigenError> { Ok(cp.roots_at(v)?.iter().all(|z| z.re < 0.0)) };
     let mut stable_intervals: Vec<[f64; 2]> = Vec::new();
     if breaks.len() == 1 {
         if stable_at(v_min)? {
@@ -221,7 +234,7 @@ pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<
         }
     }
 
-    let (weave_real_pair_merge, weave_merge_eigenvalue) = match weave_merge(&cp, v_min.max(0.0), v_max)? {
+    let (weave_real_pair_merge, weave_merge_eigenvalue) = match weave_merge(cp, v_min.max(0.0), v_max)? {
         Some((v, s)) => (Some(v), Some(s)),
         None => (None, None),
     };
@@ -266,7 +279,7 @@ fn weave_mean(l: &Labelled) -> f64 {
 /// of the *weave-labelled* roots (labels carried by continuation from the cell's
 /// lower end, so another pair merging in the same cell cannot be mistaken for it),
 /// then `(s, v)` is polished by Newton on `p = p_s = 0`.
-fn weave_merge(cp: &CharPoly, lo: f64, hi: f64) -> Result<Option<(f64, f64)>, EigenError> {
+fn weave_merge<S: Spectrum + ?Sized>(cp: &S, lo: f64, hi: f64) -> Result<Option<(f64, f64)>, EigenError> {
     if !(hi > lo) {
         return Ok(None);
     }
@@ -310,7 +323,7 @@ fn weave_merge(cp: &CharPoly, lo: f64, hi: f64) -> Result<Option<(f64, f64)>, Ei
 }
 
 /// Newton on `p(s, v) = 0`, `p_s(s, v) = 0` (real `s`).
-fn double_root_newton(cp: &CharPoly, mut s: f64, mut v: f64) -> Option<(f64, f64)> {
+fn double_root_newton<S: Spectrum + ?Sized>(cp: &S, mut s: f64, mut v: f64) -> Option<(f64, f64)> {
     for _ in 0..30 {
         let (p, ps, pss, pv, psv) = derivs(cp, C64::new(s, 0.0), v);
         let (p, ps, pss, pv, psv) = (p.re, ps.re, pss.re, pv.re, psv.re);

@@ -151,8 +151,10 @@ impl ParameterSet {
         Ok((set, extras, warnings))
     }
 
-    /// Read and validate a parameter file, accepting the `extra` symbols in
-    /// TOML files (see [`from_toml_str_with_extra`](Self::from_toml_str_with_extra)).
+    /// Read and validate a parameter file, accepting the `extra` symbols
+    /// (effect parameters) in TOML and text files alike (see
+    /// [`from_toml_str_with_extra`](Self::from_toml_str_with_extra),
+    /// [`MeasuredBenchmark::from_text_str_with_extra`]).
     #[allow(clippy::type_complexity)]
     pub fn load_with_extra(
         path: impl AsRef<Path>,
@@ -163,7 +165,8 @@ impl ParameterSet {
         if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
             Self::from_toml_str_with_extra(&text, path, extra)
         } else {
-            Self::from_text_str(&text, path).map(|(s, w)| (s, BTreeMap::new(), w))
+            MeasuredBenchmark::from_text_str_with_extra(&text, path, extra)
+                .map(|(m, effects, w)| (ParameterSet::Benchmark(m.parameters), effects, w))
         }
     }
 

@@ -99,7 +99,21 @@ impl MeasuredBenchmark {
 
     /// Parse and validate text; `path` is only used in messages.
     pub fn from_text_str(text: &str, path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+        Self::from_text_str_with_extra(text, path, &[]).map(|(m, _, w)| (m, w))
+    }
+
+    /// [`MeasuredBenchmark::from_text_str`] that also accepts the symbols in
+    /// `accepted` (the effect parameters of the generated models, e.g.
+    /// `c_steer`, `Kc_roll_rate`), returned by name beside the set: a user
+    /// adds the effects of a real bicycle to its bicycleparameters file.
+    #[allow(clippy::type_complexity)]
+    pub fn from_text_str_with_extra(
+        text: &str,
+        path: impl AsRef<Path>,
+        accepted: &[&str],
+    ) -> Result<(Self, BTreeMap<String, f64>, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
+        let mut accepted_values = BTreeMap::new();
         let pb = || path.to_path_buf();
         let mut values: BTreeMap<String, (f64, usize)> = BTreeMap::new();
         let mut uncertainties = BTreeMap::new();
@@ -152,7 +166,12 @@ impl MeasuredBenchmark {
                 }
                 uncertainties.insert(name.to_string(), s);
             }
-            if let Some(&(_, meaning)) = EXTRA_TEXT_FIELDS.iter().find(|(n, _)| *n == name) {
+            if accepted.contains(&name) {
+                if !value.is_finite() {
+                    return Err(syntax(format!("value of `{name}` is not finite")));
+                }
+                accepted_values.insert(name.to_string(), value);
+            } else if let Some(&(_, meaning)) = EXTRA_TEXT_FIELDS.iter().find(|(n, _)| *n == name) {
                 extras.insert(name.to_string(), value);
                 warnings.push(ParameterWarning::ExtraField {
                     field: name.to_string(),
@@ -165,7 +184,11 @@ impl MeasuredBenchmark {
                     path: pb(),
                     line,
                     field: name.to_string(),
-                    why: "not a benchmark symbol nor a known extra name",
+                    why: if accepted.is_empty() {
+                        "not a benchmark symbol nor a known extra name"
+                    } else {
+                        "not a benchmark symbol, an effect parameter (see `bikedyn params show`) nor a known extra name"
+                    },
                 });
             }
             values.insert(name.to_string(), (value, line));
@@ -195,6 +218,7 @@ impl MeasuredBenchmark {
                 uncertainties,
                 extras,
             },
+            accepted_values,
             warnings,
         ))
     }

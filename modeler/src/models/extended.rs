@@ -1,0 +1,21 @@
+//! The Whipple bicycle of any geometry (front-assembly mass centre anywhere,
+//! as in Meijaard et al. 2007) with every effect of the library, driven
+//! speed. Each effect's parameters default to the value at which it is
+//! absent, so with a plain bicycle this model is the Whipple model; with
+//! `d4 = 0` it is the thesis geometry. The linear analysis of a bicycle with
+//! effect parameters (damping, a steer controller, ...) runs through it.
+
+use super::thesis_whipple::Speed;
+use super::whipple_offset::declare;
+use crate::effects;
+use crate::model::{Model, ModelError};
+
+/// Every effect on the benchmark-compatible geometry, driven speed.
+pub fn model() -> Result<Model, ModelError> {
+    let (mut m, parts) = declare("extended", "modeler/src/models/extended.rs", Speed::Driven);
+    m.set_doc("Whipple bicycle of any geometry (front mass centre offset d4) with driven speed and every effect of the library, each absent at its default");
+    for e in effects::all() {
+        effects::apply(&mut m, &parts, &e);
+    }
+    m.build()
+}

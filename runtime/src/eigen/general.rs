@@ -1,0 +1,291 @@
+//! Linear analysis of any model: the roll-steer equations
+//! `M(v) q'' + C(v) q' + K(v) q = 0` at each forward speed `v`, whatever
+//! their dependence on the speed (steer damping, friction's describing
+//! function, a speed-scheduled controller, drag and rolling resistance).
+//!
+//! The canonical form of Meijaard et al. (2007) is the special case where
+//! `M` is constant, `C` linear and `K` quadratic in `v`: [`LinearBicycle`]s
+//! that have it ([`CanonicalMatrices`]) keep the exact closed-form path
+//! ([`eigen_sweep`], [`critical_speeds`]). Every other one goes through the
+//! same mode tracking (labels by continuation from an anchor speed, see the
+//! module docs of [`crate::eigen`]) on the characteristic quartic
+//! `det(M s^2 + C s + K)` formed at each speed, and its critical speeds are
+//! found as the canonical ones are, from smooth functions of the speed: a
+//! real root crosses zero where `k0(v) = det K(v) = 0`, a complex pair
+//! crosses the imaginary axis where the Hurwitz determinant
+//! `H = k1 k2 k3 - k4 k1^2 - k0 k3^2` vanishes with `k1 / k3 > 0`. Without
+//! closed forms, both are bracketed on a grid of the speed range and
+//! bisected to rounding; the direction of each crossing uses speed
+//! derivatives of the coefficients by central differences.
+
+use super::critical::finish;
+use super::*;
+use nalgebra::Matrix4;
+
+/// The linear roll-steer equations at one speed, `M q'' + C q' + K q = 0`,
+/// `q = [roll phi, steer delta]` in the benchmark's sign convention.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpeedMatrices {
+    /// Mass matrix (kg m^2).
+    pub mass: Matrix2<f64>,
+    /// Damping matrix (kg m^2/s).
+    pub damping: Matrix2<f64>,
+    /// Stiffness matrix (kg m^2/s^2).
+    pub stiffness: Matrix2<f64>,
+}
+
+impl SpeedMatrices {
+    /// State matrix `A` of `x' = A x`, `x = [phi, delta, phi', delta']`;
+    /// `None` when the mass matrix is singular.
+    pub fn state_matrix(&self) -> Option<Matrix4<f64>> {
+        let minv = self.mass.try_inverse()?;
+        let mut a = Matrix4::zeros();
+        a[(0, 2)] = 1.0;
+        a[(1, 3)] = 1.0;
+        a.fixed_view_mut::<2, 2>(2, 0).copy_from(&(-(minv * self.stiffness)));
+        a.fixed_view_mut::<2, 2>(2, 2).copy_from(&(-(minv * self.damping)));
+        Some(a)
+    }
+
+    /// Coefficients `[k0, k1, k2, k3, k4]` of `det(M s^2 + C s + K)`.
+    pub fn characteristic(&self) -> [f64; 5] {
+        let (m, c, k) = (&self.mass, &self.damping, &self.stiffness);
+        [det2(k), mixed(c, k), mixed(m, k) + det2(c), mixed(m, c), det2(m)]
+    }
+}
+
+/// A bicycle whose linear roll-steer equations are known at every speed:
+/// the canonical matrices of a Whipple bicycle, or any generated model
+/// linearized at each speed (`bikedyn_runtime::linearize::LinearModel`).
+pub trait LinearBicycle: Sync {
+    /// The equations at forward speed `v` (m/s).
+    fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError>;
+    /// The canonical form, when the equations have it (the exact path).
+    fn canonical(&self) -> Option<&CanonicalMatrices> {
+        None
+    }
+}
+
+impl LinearBicycle for CanonicalMatrices {
+    fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError> {
+        Ok(SpeedMatrices {
+            mass: self.m0,
+            damping: self.damping(v),
+            stiffness: self.stiffness(v),
+        })
+    }
+    fn canonical(&self) -> Option<&CanonicalMatrices> {
+        Some(self)
+    }
+}
+
+impl<T: LinearBicycle + ?Sized> LinearBicycle for Box<T> {
+    fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError> {
+        (**self).at_speed(v)
+    }
+    fn canonical(&self) -> Option<&CanonicalMatrices> {
+        (**self).canonical()
+    }
+}
+
+impl<T: LinearBicycle + ?Sized> LinearBicycle for &T {
+    fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError> {
+        (**self).at_speed(v)
+    }
+    fn canonical(&self) -> Option<&CanonicalMatrices> {
+        (**self).canonical()
+    }
+}
+
+/// The characteristic quartics of a [`LinearBicycle`] without canonical
+/// form.
+struct General<'a> {
+    bike: &'a dyn LinearBicycle,
+    scale: f64,
+}
+
+impl<'a> General<'a> {
+    fn new(bike: &'a dyn LinearBicycle) -> Result<Self, EigenError> {
+        // The speed scale as for the canonical form: where the gravity and
+        // speed parts of k2 balance, k2(v) ~ k2(0) + v^2 (k2(1) - k2(0)).
+        let k0 = bike.at_speed(0.0)?.characteristic();
+        let k1 = bike.at_speed(1.0)?.characteristic();
+        let r = (k0[2] / (k1[2] - k0[2])).abs().sqrt();
+        let scale = if r.is_finite() && r > 0.0 { r } else { 1.0 };
+        Ok(General { bike, scale })
+    }
+
+    fn checked(&self, v: f64) -> Result<[f64; 5], EigenError> {
+        if !v.is_finite() {
+            return Err(EigenError::NonFinite {
+                what: format!("speed {v}"),
+            });
+        }
+        let m = self.bike.at_speed(v)?;
+        let k = m.characteristic();
+        if !k.iter().all(|x| x.is_finite()) {
+            return Err(EigenError::NonFinite {
+                what: format!("linear equations at {v} m/s"),
+            });
+        }
+        let scale = (m.mass[(0, 0)] * m.mass[(1, 1)]).abs() + (m.mass[(0, 1)] * m.mass[(1, 0)]).abs();
+        if !(k[4].abs() > 1e-12 * scale) {
+            return Err(EigenError::SingularMassMatrix { det: k[4], scale });
+        }
+        Ok(k)
+    }
+}
+
+impl Spectrum for General<'_> {
+    fn coefficients(&self, v: f64) -> Result<[f64; 5], EigenError> {
+        self.checked(v)
+    }
+    fn coefficient_rates(&self, v: f64) -> Result<[f64; 5], EigenError> {
+        // Central differences: only the sign of Re ds/dv at a crossing and
+        // the Newton polish of the weave merge use them.
+        let h = 1e-5 * v.abs().max(1.0);
+        let (a, b) = (self.checked(v + h)?, self.checked(v - h)?);
+        Ok(std::array::from_fn(|i| (a[i] - b[i]) / (2.0 * h)))
+    }
+    fn roots_at(&self, v: f64) -> Result<[C64; 4], EigenError> {
+        quartic_roots(&self.checked(v)?).ok_or_else(|| EigenError::NoConvergence {
+            what: format!("quartic roots at v = {v}"),
+        })
+    }
+    fn scale(&self) -> f64 {
+        self.scale
+    }
+    fn mirror_symmetric(&self) -> bool {
+        false
+    }
+}
+
+/// The four eigenvalues at speed `v` (no labels), sorted by descending real
+/// part, then imaginary part.
+pub fn eigenvalues_of(bike: &dyn LinearBicycle, v: f64) -> Result<[Complex<f64>; 4], EigenError> {
+    match bike.canonical() {
+        Some(c) => eigenvalues(c, v),
+        None => General::new(bike)?.roots_at(v),
+    }
+}
+
+/// [`eigen_sweep`] for any [`LinearBicycle`]: eigenvalues, continuous mode
+/// labels and mode shapes at each speed.
+pub fn eigen_sweep_of(bike: &dyn LinearBicycle, speeds: &[f64]) -> Result<EigenSweep, EigenError> {
+    if let Some(c) = bike.canonical() {
+        return eigen_sweep(c, speeds);
+    }
+    let family = General::new(bike)?;
+    let tracked = track(&family, speeds)?;
+    let mut points = Vec::with_capacity(speeds.len());
+    for (&v, l) in speeds.iter().zip(tracked) {
+        let m = bike.at_speed(v)?;
+        points.push(EigenPoint {
+            v,
+            eigenvalues: l.roots,
+            modes: l.labels,
+            eigenvectors: vectors(&m, &l.roots),
+        });
+    }
+    Ok(EigenSweep { points })
+}
+
+/// [`critical_speeds`] for any [`LinearBicycle`] over `[v_min, v_max]`.
+pub fn critical_speeds_of(bike: &dyn LinearBicycle, v_min: f64, v_max: f64) -> Result<CriticalSpeeds, EigenError> {
+    if let Some(c) = bike.canonical() {
+        return critical_speeds(c, v_min, v_max);
+    }
+    if !v_min.is_finite() || !v_max.is_finite() {
+        return Err(EigenError::NonFinite {
+            what: format!("speed range [{v_min}, {v_max}]"),
+        });
+    }
+    if v_min > v_max {
+        return Err(EigenError::InvalidArgument {
+            what: format!("v_min = {v_min} > v_max = {v_max}"),
+        });
+    }
+    let family = General::new(bike)?;
+    let hurwitz = |k: &[f64; 5]| k[1] * k[2] * k[3] - k[4] * k[1] * k[1] - k[0] * k[3] * k[3];
+    let mut cands: Vec<(f64, CrossingKind, f64)> = Vec::new();
+    if v_max > v_min {
+        let grid: Vec<f64> = (0..=CROSSING_GRID)
+            .map(|i| v_min + (v_max - v_min) * (i as f64 / CROSSING_GRID as f64))
+            .collect();
+        let ks: Vec<[f64; 5]> = grid.iter().map(|&v| family.coefficients(v)).collect::<Result<_, _>>()?;
+        for i in 0..CROSSING_GRID {
+            let (a, b) = (grid[i], grid[i + 1]);
+            // A real root through zero: k0 changes sign.
+            if let Some(v) = bisect(&family, a, b, |k| k[0], ks[i][0], ks[i + 1][0])? {
+                cands.push((v, CrossingKind::RealRoot, 0.0));
+            }
+            // A complex pair through the imaginary axis: H changes sign with
+            // w^2 = k1 / k3 > 0 there.
+            if let Some(v) = bisect(&family, a, b, hurwitz, hurwitz(&ks[i]), hurwitz(&ks[i + 1]))? {
+                let k = family.coefficients(v)?;
+                let w2 = k[1] / k[3];
+                if w2 > 0.0 && w2.is_finite() {
+                    cands.push((v, CrossingKind::ComplexPair, w2.sqrt()));
+                }
+            }
+        }
+    }
+    cands.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
+    finish(&family, cands, v_min, v_max)
+}
+
+/// Grid intervals over the speed range that bracket the crossings of a
+/// general model (crossings closer than a cell apart may be missed; a
+/// bicycle's are tenths of m/s apart or more over 0-10 m/s).
+const CROSSING_GRID: usize = 400;
+
+/// The zero of `f(coefficients(v))` in `[a, b]` when `fa`, `fb` have opposite
+/// signs (bisection to rounding), `None` otherwise. An exact zero at the
+/// lower end counts for the cell below, so a grid point is found once.
+fn bisect(
+    family: &General<'_>,
+    mut a: f64,
+    mut b: f64,
+    f: impl Fn(&[f64; 5]) -> f64,
+    mut fa: f64,
+    fb: f64,
+) -> Result<Option<f64>, EigenError> {
+    if fb == 0.0 {
+        return Ok(Some(b));
+    }
+    if !(fa * fb < 0.0) {
+        return Ok(None);
+    }
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if m <= a || m >= b {
+            break;
+        }
+        let fm = f(&family.coefficients(m)?);
+        if fm == 0.0 {
+            return Ok(Some(m));
+        }
+        if (fm < 0.0) == (fa < 0.0) {
+            a = m;
+            fa = fm;
+        } else {
+            b = m;
+        }
+    }
+    Ok(Some(0.5 * (a + b)))
+}
+
+/// Eigenvectors of the four roots, conjugate pairs exactly conjugate.
+fn vectors(m: &SpeedMatrices, roots: &[C64; 4]) -> [[Complex<f64>; 4]; 4] {
+    let mut vecs = [[C64::new(0.0, 0.0); 4]; 4];
+    for k in 0..4 {
+        let s = roots[k];
+        vecs[k] = if s.im < 0.0 {
+            let up = eigenvector_of(m, s.conj());
+            [up[0].conj(), up[1].conj(), up[2].conj(), up[3].conj()]
+        } else {
+            eigenvector_of(m, s)
+        };
+    }
+    vecs
+}

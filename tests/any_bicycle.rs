@@ -1,0 +1,258 @@
+//! Any bicycle, any model: real parameter sets with effect parameters
+//! (a bicycleparameters file with a balance-assist controller, the TU Delft
+//! steer-by-wire bicycle with its assist) run through the linear analysis
+//! of the model that carries the effects, on the benchmark-compatible
+//! geometry; the general linear path agrees with the closed-form canonical
+//! one where both apply, and with independent eigenvalue computations where
+//! only it does.
+
+use bikedyn::bicycle::Bicycle;
+use bikedyn::generated::Extended;
+use bikedyn_runtime::eigen::{
+    critical_speeds, critical_speeds_of, eigen_sweep_of, eigenvalues_of, LinearBicycle, Mode,
+};
+use bikedyn_runtime::linearize::LinearModel;
+use bikedyn_runtime::MultibodyModel;
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn bikedyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
+}
+
+fn data(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// The balance-assist Gazelle of `tests/data` with the assist law of Moore's
+/// lab, `k (v_s - v)` on the roll rate below `v_s = 4.7 m/s` (benchmark
+/// signs: steer torque `k (v_s - v) phi'`), written in a copy of its
+/// bicycleparameters file. Thesis signs flip the steer torque.
+fn balance_assist_file(k: f64) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bikedyn-any-bicycle-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("Balanceassistv1_k{k}.txt"));
+    let mut text = std::fs::read_to_string(data("Balanceassistv1Benchmark.txt")).unwrap();
+    text += &format!("Kc_roll_rate = {}\nKc_roll_rate_v = {}\nKc_v_max = 4.7\n", -k * 4.7, k);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn a_bicycleparameters_file_carries_effect_parameters() {
+    let path = balance_assist_file(10.0);
+    let b = Bicycle::resolve(path.to_str().unwrap()).unwrap();
+    assert_eq!(b.effects.get("Kc_v_max"), Some(&4.7));
+    // Front-assembly mass centre off the steer axis and a controller: the
+    // model with every effect on the offset geometry.
+    assert!(b.thesis().unwrap().get("d4").unwrap() != 0.0);
+    assert_eq!(b.model(None).unwrap().name, "extended");
+    // An unknown name is still refused with its line.
+    let bad = path.with_file_name("typo.txt");
+    let text = std::fs::read_to_string(&path).unwrap() + "c_stear = 0.1\n";
+    std::fs::write(&bad, text).unwrap();
+    let err = Bicycle::resolve(bad.to_str().unwrap()).unwrap_err().to_string();
+    assert!(err.contains("c_stear") && err.contains("typo.txt:30"), "{err}");
+}
+
+/// With every effect absent, the general path (the extended model
+/// linearized at each speed, no canonical form assumed) gives the canonical
+/// closed form's weave and capsize speeds.
+#[test]
+fn the_general_path_agrees_with_the_canonical_form() {
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let canonical = b.canonical().unwrap();
+    let lookup = b.lookup().unwrap();
+    let general = LinearModel::<Extended>::new(&lookup).unwrap();
+    assert!(general.canonical().is_none());
+    let exact = critical_speeds(&canonical, 0.0, 10.0).unwrap();
+    let found = critical_speeds_of(&general, 0.0, 10.0).unwrap();
+    let (vw, vc) = (exact.weave_speed.unwrap(), exact.capsize_speed.unwrap());
+    assert!((found.weave_speed.unwrap() - vw).abs() < 1e-9, "{found:?}");
+    assert!((found.capsize_speed.unwrap() - vc).abs() < 1e-9, "{found:?}");
+    assert!((found.weave_real_pair_merge.unwrap() - exact.weave_real_pair_merge.unwrap()).abs() < 1e-7);
+    assert_eq!(found.crossings.len(), exact.crossings.len());
+    for (a, e) in found.crossings.iter().zip(&exact.crossings) {
+        assert_eq!((a.mode, a.direction, a.kind), (e.mode, e.direction, e.kind));
+    }
+    // Labels and eigenvalues along speed.
+    let speeds: Vec<f64> = (0..=40).map(|k| 0.25 * k as f64).collect();
+    let g = eigen_sweep_of(&general, &speeds).unwrap();
+    let c = eigen_sweep_of(&canonical, &speeds).unwrap();
+    for (p, q) in g.points.iter().zip(&c.points) {
+        assert_eq!(p.modes, q.modes, "v = {}", p.v);
+        for k in 0..4 {
+            assert!((p.eigenvalues[k] - q.eigenvalues[k]).norm() < 1e-8, "v = {}", p.v);
+        }
+    }
+}
+
+/// Steer damping and roll-rate feedback enter the linear equations exactly
+/// where their torques say: `c_steer` on the steer-steer damping entry, a
+/// roll-rate gain `K(v)` on the steer row's roll-rate entry (benchmark
+/// signs: a thesis steer torque `T` is `-T` about the benchmark's steer axis).
+#[test]
+fn effects_enter_the_linear_equations_where_their_torques_act() {
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let canonical = b.canonical().unwrap();
+    let base = b.lookup().unwrap();
+    let (c, k, k_v, v_max) = (0.3, -12.0, 2.5, 4.7);
+    let lookup = |s: &str| match s {
+        "c_steer" => Some(c),
+        "Kc_roll_rate" => Some(k),
+        "Kc_roll_rate_v" => Some(k_v),
+        "Kc_v_max" => Some(v_max),
+        _ => base(s),
+    };
+    let model = LinearModel::<Extended>::new(lookup).unwrap();
+    for v in [0.5, 2.0, 4.0, 6.0, 8.0] {
+        let m = model.at_speed(v).unwrap();
+        let r = canonical.at_speed(v).unwrap();
+        // Smooth switch of width 1e-6 m/s: off by far more than that here.
+        let gain = if v < v_max { k + k_v * v } else { 0.0 };
+        let mut expected = r.damping;
+        expected[(1, 1)] += c;
+        expected[(1, 0)] += gain;
+        assert!(
+            (m.damping - expected).abs().max() < 1e-9,
+            "v = {v}: {} vs {}",
+            m.damping,
+            expected
+        );
+        assert!((m.mass - r.mass).abs().max() < 1e-12);
+        assert!((m.stiffness - r.stiffness).abs().max() < 1e-9);
+    }
+}
+
+/// The eigenvalues of the general path are those of the state matrix,
+/// computed independently by nalgebra's Schur decomposition.
+#[test]
+fn general_eigenvalues_are_those_of_the_state_matrix() {
+    let path = balance_assist_file(10.0);
+    let b = Bicycle::resolve(path.to_str().unwrap()).unwrap();
+    let lin = b.linear_with(None).unwrap();
+    assert_eq!(lin.model, "extended");
+    for v in [1.0, 3.0, 4.5, 6.0] {
+        let a = lin.at_speed(v).unwrap().state_matrix().unwrap();
+        let schur = nalgebra::linalg::Schur::try_new(a, 1e-14, 10_000).unwrap();
+        let mut reference: Vec<_> = schur.complex_eigenvalues().iter().copied().collect();
+        let ours = eigenvalues_of(&lin, v).unwrap();
+        for z in ours {
+            let (i, d) = reference
+                .iter()
+                .enumerate()
+                .map(|(i, r)| (i, (r - z).norm()))
+                .fold((0, f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
+            assert!(
+                d < 1e-8 * (1.0 + z.norm()),
+                "v = {v}: {z} not among the Schur eigenvalues"
+            );
+            reference.remove(i);
+        }
+    }
+}
+
+/// The balance assist stabilizes the bicycle at low speed, where the bare
+/// bicycle weaves unstably, and switches off above 4.7 m/s, where the
+/// assisted and bare bicycles coincide.
+#[test]
+fn the_balance_assist_stabilizes_the_weave_below_its_switch_speed() {
+    let assisted = Bicycle::resolve(balance_assist_file(10.0).to_str().unwrap()).unwrap();
+    let bare = Bicycle::resolve(&data("Balanceassistv1Benchmark.txt")).unwrap();
+    let (la, lb) = (assisted.linear_with(None).unwrap(), bare.linear_with(None).unwrap());
+    let weave_re = |l: &dyn LinearBicycle, v: f64| {
+        let p = &eigen_sweep_of(l, &[v]).unwrap().points[0];
+        let k = p.index_of(Mode::Weave).expect("weave labelled");
+        p.eigenvalues[k].re
+    };
+    let (a, b) = (weave_re(&la, 3.0), weave_re(&lb, 3.0));
+    assert!(b > 0.0 && a < b, "weave at 3 m/s: assisted {a}, bare {b}");
+    for v in [5.5, 7.0] {
+        let (za, zb) = (eigenvalues_of(&la, v).unwrap(), eigenvalues_of(&lb, v).unwrap());
+        for k in 0..4 {
+            assert!((za[k] - zb[k]).norm() < 1e-6, "v = {v}");
+        }
+    }
+    let crit = critical_speeds_of(&la, 0.0, 10.0).unwrap();
+    let bare_crit = critical_speeds_of(&lb, 0.0, 10.0).unwrap();
+    assert!(crit.stable_intervals.first().unwrap()[0] < bare_crit.weave_speed.unwrap());
+}
+
+#[test]
+fn the_tudelft_bicycle_with_its_assist_runs_through_the_linear_commands() {
+    let bike = data("tudelft_sbw_bicycle.toml");
+    let out = bikedyn(&["stability", "--bike", &bike, "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["model"], "extended");
+    assert!(v["crossings"].is_array());
+
+    let out = bikedyn(&["eig", "--bike", &bike, "--speeds", "0.5:6:0.5", "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("model: extended"));
+    let points: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(points.as_array().unwrap().len(), 12);
+
+    // No canonical form: the command says why and prints A(v), B(v).
+    let out = bikedyn(&["canonical", "--bike", &bike, "--speeds", "2:4:2", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["canonical"].is_null());
+    assert!(v["why"].as_str().unwrap().contains("Kc_roll_rate"));
+    assert_eq!(v["state_space"].as_array().unwrap().len(), 2);
+    assert_eq!(v["state_space"][0]["A"].as_array().unwrap().len(), 4);
+}
+
+#[test]
+fn a_sweep_over_an_effect_parameter_uses_one_model_and_fails_loudly() {
+    let out = bikedyn(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c_steer",
+        "--values",
+        "0:0.4:0.2",
+        "--format",
+        "json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("model: extended"));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v["points"].as_array().or_else(|| v.as_array()).unwrap().clone();
+    assert_eq!(rows.len(), 3);
+    // Every row analysed; steer damping moves the weave speed.
+    assert!(rows.iter().all(|r| r["error"].is_null()), "{rows:?}");
+    let vw: Vec<f64> = rows.iter().map(|r| r["weave_speed"].as_f64().unwrap()).collect();
+    assert!(vw[0] < vw[1] && vw[1] < vw[2], "{vw:?}");
+
+    // A design that cannot be analysed (a skate front wheel that keeps its
+    // spin inertia): an error naming it, no table.
+    let out = bikedyn(&["sweep", "--bike", "benchmark", "--param", "rF", "--values", "0:0.6:0.3"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("rF = 0:") && err.contains("1 of the sweep's designs failed"),
+        "{err}"
+    );
+    assert!(out.stdout.is_empty(), "{}", String::from_utf8_lossy(&out.stdout));
+}
+
+/// Declared roles: the models name their roll and steer coordinates.
+#[test]
+fn every_bicycle_model_declares_roll_and_steer() {
+    use bikedyn_runtime::model::CoordinateRole;
+    for m in bikedyn::registry::MODELS {
+        for role in [CoordinateRole::Roll, CoordinateRole::Steer, CoordinateRole::Yaw] {
+            assert!(m.coordinate_with_role(role).is_some(), "{}: {role:?}", m.name);
+        }
+    }
+    assert_eq!(
+        Extended::coordinate_with_role(CoordinateRole::Roll).map(|i| Extended::COORDINATES[i]),
+        Some("theta")
+    );
+}
