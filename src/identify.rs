@@ -16,6 +16,7 @@ use bikedyn_runtime::identify::{
     SegmentError, Setup,
 };
 use bikedyn_runtime::linearize::{lateral_block, linearize_at_speed, parameter_vector, state_space_at_speed};
+use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent, Signature};
 use bikedyn_runtime::output::{save_json, write_string_atomic};
 use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
 use bikedyn_runtime::MultibodyModel;
@@ -58,82 +59,6 @@ pub struct IdentifyArgs {
     pub folds: usize,
 }
 
-/// How each effect of the library is identified: the parameters fitted (a
-/// tied symbol takes the same value), their scale, whether they dissipate,
-/// fixed companions, and the residual pattern that points to the effect.
-struct Spec {
-    effect: &'static str,
-    /// Fitted with the free-speed model that has this effect instead of the
-    /// base identification model (the tyre model replaces no-slip).
-    alternative_model: bool,
-    parameters: &'static [(&'static str, &'static [&'static str], f64, bool)],
-    fixed: &'static [(&'static str, f64)],
-    speed_decay: bool,
-    reason: &'static str,
-}
-
-const SPECS: &[Spec] = &[
-    Spec {
-        alternative_model: false,
-        effect: "steer_damping",
-        parameters: &[("c_steer", &[], 0.1, true)],
-        fixed: &[],
-        speed_decay: false,
-        reason: "excess weave damping with a lower weave frequency: viscous damping in the headset slows the steer",
-    },
-    Spec {
-        alternative_model: false,
-        effect: "steer_friction",
-        parameters: &[("T_steer", &[], 0.05, true)],
-        fixed: &[],
-        speed_decay: false,
-        reason: "decay that depends on amplitude (faster at small amplitude): Coulomb friction in the headset",
-    },
-    Spec {
-        alternative_model: false,
-        effect: "lateral_mass_offset",
-        parameters: &[("y3", &[], 0.01, false)],
-        fixed: &[],
-        speed_decay: false,
-        reason: "a steady lean and steer bias after the kick: a mass centre off the plane of symmetry (electronics, battery)",
-    },
-    Spec {
-        alternative_model: false,
-        effect: "steer_controller",
-        parameters: &[("Kc_roll_rate", &[], 1.0, false)],
-        fixed: &[],
-        speed_decay: false,
-        reason: "a steer torque in phase with the roll rate: a controller or rider acting on the handlebar",
-    },
-    Spec {
-        alternative_model: false,
-        effect: "rolling_resistance",
-        parameters: &[("Crr_rear", &["Crr_front"], 0.005, true)],
-        fixed: &[],
-        speed_decay: true,
-        reason: "the speed falls during the response about evenly at all speeds: rolling resistance of the tyres",
-    },
-    Spec {
-        alternative_model: false,
-        effect: "aero_drag",
-        parameters: &[("CdA", &[], 0.3, true)],
-        fixed: &[("rho_air", 1.2)],
-        speed_decay: true,
-        reason: "the speed falls faster at higher speed: aerodynamic drag",
-    },
-    Spec {
-        alternative_model: true,
-        effect: "tyre_relaxation",
-        parameters: &[("sigma_rear", &["sigma_front"], 0.2, true)],
-        fixed: &[],
-        speed_decay: false,
-        reason: "a weave frequency shift growing with speed: lateral tyre slip with relaxation (fitted: the relaxation length; cornering and camber stiffness at the model's defaults)",
-    },
-];
-
-/// Effects of the library identification does not yet consider, and why.
-pub const NOT_CANDIDATES: &[(&str, &str)] = &[];
-
 /// The identification model, its driven twin, and the alternative model
 /// (free speed, with states: the tyre model) if the registry has one. Each is
 /// chosen by capability: it can represent the bicycle (has every parameter
@@ -172,37 +97,53 @@ fn identification_model_pair(bike: &Bicycle) -> Result<(&'static ModelInfo, &'st
     Ok((free, driven))
 }
 
-/// The candidates for a model: every effect of it that has a spec (and is
-/// in `only` when given).
+/// The candidates for a model: every effect it carries whose effect file
+/// declares it a candidate (and is in `only` when given), with what its
+/// declaration says: fitted parameters, ties, floors, held companions,
+/// speed decay and the reason. An effect declared "own model" (tyre slip)
+/// comes from the alternative model `alt`.
 pub fn candidates(
     info: &ModelInfo,
     alt: Option<&ModelInfo>,
     bike: &Bicycle,
     only: &[String],
 ) -> Result<Vec<Candidate>> {
+    let declared = |m: &ModelInfo| -> Vec<(&'static str, CandidateDeclaration)> {
+        m.effect_declarations
+            .iter()
+            .filter_map(|e| match e.identification {
+                Some(EffectIdentification::Candidate(c)) => Some((e.name, c)),
+                _ => None,
+            })
+            .collect()
+    };
+    let mut pool: Vec<(&ModelInfo, &'static str, CandidateDeclaration)> = declared(info)
+        .into_iter()
+        .filter(|(_, c)| !c.own_model)
+        .map(|(n, c)| (info, n, c))
+        .collect();
+    if let Some(a) = alt {
+        pool.extend(
+            declared(a)
+                .into_iter()
+                .filter(|(_, c)| c.own_model)
+                .map(|(n, c)| (a, n, c)),
+        );
+    }
     for o in only {
-        if !SPECS.iter().any(|s| s.effect == o) {
-            let known: Vec<&str> = SPECS.iter().map(|s| s.effect).collect();
+        if !pool.iter().any(|(_, n, _)| n == o) {
+            let known: Vec<&str> = pool.iter().map(|(_, n, _)| *n).collect();
             bail!(
-                "--effects: `{o}` is not an effect identification supports ({})",
+                "--effects: `{o}` is not a candidate effect of the identification models ({})",
                 known.join(", ")
             );
         }
     }
     let mut out = Vec::new();
-    for s in SPECS {
-        let model = if s.alternative_model {
-            match alt {
-                Some(a) if a.effects.contains(&s.effect) => a,
-                _ => continue,
-            }
-        } else {
-            info
-        };
-        if !model.effects.contains(&s.effect) || !(only.is_empty() || only.iter().any(|o| o == s.effect)) {
+    for (info, effect, d) in pool {
+        if !(only.is_empty() || only.iter().any(|o| o == effect)) {
             continue;
         }
-        let info = model;
         let unit = |sym: &str| {
             info.parameter(sym)
                 .map(|p| {
@@ -214,40 +155,48 @@ pub fn candidates(
                 .unwrap_or_default()
         };
         out.push(Candidate {
-            name: s.effect.to_string(),
-            effects: vec![s.effect.to_string()],
-            parameters: s
-                .parameters
+            name: effect.to_string(),
+            effects: vec![effect.to_string()],
+            parameters: d
+                .fitted
                 .iter()
-                .map(|(sym, tied, scale, diss)| EffectParameter {
-                    symbol: sym.to_string(),
-                    tied: tied.iter().map(|t| t.to_string()).collect(),
-                    scale: *scale,
-                    dissipative: *diss,
-                    unit: unit(sym),
-                    // The tyre model's relaxation starts from its default,
-                    // not from a tenth of it (a stiff start).
-                    initial: s
-                        .alternative_model
-                        .then(|| info.parameter(sym).and_then(|p| p.default))
+                .map(|f| EffectParameter {
+                    symbol: f.symbol.to_string(),
+                    tied: f.tied.iter().map(|t| t.to_string()).collect(),
+                    scale: f.scale,
+                    dissipative: f.dissipative,
+                    unit: unit(f.symbol),
+                    initial: f
+                        .start_at_default
+                        .then(|| info.parameter(f.symbol).and_then(|p| p.default))
                         .flatten(),
-                    // A relaxation length toward zero is a rigid, stiff
-                    // tyre: below 1 cm the model is held there (tyres
-                    // measure 0.1-0.3 m).
-                    lower: s.alternative_model.then_some(0.01),
+                    lower: f.floor,
                 })
                 .collect(),
-            fixed: s
-                .fixed
+            fixed: d
+                .held
                 .iter()
-                .map(|(sym, v)| (sym.to_string(), bike.value(sym).filter(|x| *x != 0.0).unwrap_or(*v)))
+                .filter_map(|sym| bike.value(sym).map(|v| (sym.to_string(), v)))
                 .collect(),
-            speed_decay: s.speed_decay,
-            reason: s.reason.to_string(),
-            alternative_model: s.alternative_model,
+            speed_decay: d.speed_decay,
+            reason: d.reason.to_string(),
+            alternative_model: d.own_model,
         });
     }
     Ok(out)
+}
+
+/// Effects a model carries that identification never tests, with the
+/// reason their files give (or that they declare nothing).
+pub fn not_candidates(info: &ModelInfo) -> Vec<(&'static str, String)> {
+    info.effect_declarations
+        .iter()
+        .filter_map(|e| match e.identification {
+            Some(EffectIdentification::Candidate(_)) => None,
+            Some(EffectIdentification::OptOut(why)) => Some((e.name, why.to_string())),
+            None => Some((e.name, "its effect file declares no identification".to_string())),
+        })
+        .collect()
 }
 
 /// The measured segments of a processed set: every kick with a free
@@ -454,23 +403,37 @@ fn mean_abs_rate(t: &[f64], x: &[f64]) -> f64 {
     d.iter().sum::<f64>() / d.len().max(1) as f64
 }
 
-/// Effect values for a linear (eigenvalue) prediction. Coulomb steer
+/// Effect values for a linear (eigenvalue) prediction: each effect whose
+/// file declares a linear equivalent is replaced by it. Coulomb steer
 /// friction has no useful linearization about upright (the smoothed law
-/// linearizes to a stiff damper `T / w`), so it is replaced by its
+/// linearizes to a stiff damper `T / w`), so it declares its
 /// describing-function equivalent viscous damping at the response's steer
 /// rate: for a sinusoid of amplitude `A`, `c_eq = 4 T / (pi A)`, with
 /// `A = (pi / 2) mean|rate|`.
-fn linear_equivalent(values: &BTreeMap<String, f64>, mean_abs_steer_rate: f64) -> BTreeMap<String, f64> {
+fn linear_equivalent(
+    info: &ModelInfo,
+    values: &BTreeMap<String, f64>,
+    mean_abs_steer_rate: f64,
+) -> BTreeMap<String, f64> {
     let mut v = values.clone();
-    if let Some(t) = v.get("T_steer").copied().filter(|t| *t != 0.0) {
-        let amp = std::f64::consts::FRAC_PI_2 * mean_abs_steer_rate;
-        let c_eq = if amp > 0.0 {
-            4.0 * t / (std::f64::consts::PI * amp)
-        } else {
-            0.0
+    for e in info.effect_declarations {
+        let Some(EffectIdentification::Candidate(CandidateDeclaration {
+            linear_equivalent: Some(LinearEquivalent::DescribingFunctionDamping { torque, damping }),
+            ..
+        })) = e.identification
+        else {
+            continue;
         };
-        *v.entry("c_steer".into()).or_insert(0.0) += c_eq;
-        v.insert("T_steer".into(), 0.0);
+        if let Some(t) = v.get(torque).copied().filter(|t| *t != 0.0) {
+            let amp = std::f64::consts::FRAC_PI_2 * mean_abs_steer_rate;
+            let c_eq = if amp > 0.0 {
+                4.0 * t / (std::f64::consts::PI * amp)
+            } else {
+                0.0
+            };
+            *v.entry(damping.into()).or_insert(0.0) += c_eq;
+            v.insert(torque.into(), 0.0);
+        }
     }
     v
 }
@@ -619,11 +582,26 @@ fn slope(x: &[f64], y: &[f64]) -> (f64, f64) {
 /// Relate the base model's residuals to candidate effects (issue 9,
 /// point 2). Significance: two standard errors.
 fn diagnose(
+    models: &[&ModelInfo],
     segs: &[Segment],
     predicted: &[Option<[f64; 2]>],
     before: &[SegmentError],
     sims_mean_roll: &[f64],
 ) -> Vec<Finding> {
+    // The effects whose files declare a pattern, in the models' order.
+    let suspects = |sig: Signature| -> Vec<String> {
+        let mut out: Vec<String> = Vec::new();
+        for m in models {
+            for e in m.effect_declarations {
+                if let Some(EffectIdentification::Candidate(c)) = e.identification {
+                    if c.signatures.contains(&sig) && !out.iter().any(|x| x == e.name) {
+                        out.push(e.name.to_string());
+                    }
+                }
+            }
+        }
+        out
+    };
     let mut f = Vec::new();
     let pairs: Vec<(usize, [f64; 2], [f64; 2])> = segs
         .iter()
@@ -641,7 +619,7 @@ fn diagnose(
             pairs.len()
         ),
         suspects: if mre < 0.0 && mim < 0.0 {
-            vec!["steer_damping".into(), "steer_friction".into()]
+            suspects(Signature::WeaveDampingAndFrequency)
         } else {
             vec![]
         },
@@ -657,7 +635,7 @@ fn diagnose(
         evidence: format!(
             "slope of the real-part residual against ln(peak roll): {b:+.3} +- {sb:.3} 1/s (positive: more damping at small amplitude)"
         ),
-        suspects: vec!["steer_friction".into()],
+        suspects: suspects(Signature::AmplitudeDependentDamping),
         significant: b > 2.0 * sb,
     });
     let (mb, sbias) = mean_se(sims_mean_roll);
@@ -668,7 +646,7 @@ fn diagnose(
             mb.to_degrees(),
             sbias.to_degrees()
         ),
-        suspects: vec!["lateral_mass_offset".into()],
+        suspects: suspects(Signature::SteadyLean),
         significant: mb.abs() > 2.0 * sbias,
     });
     let sp: Vec<f64> = pairs.iter().map(|p| segs[p.0].mean_speed).collect();
@@ -676,7 +654,11 @@ fn diagnose(
     f.push(Finding {
         pattern: "frequency shift growing with speed".into(),
         evidence: format!("slope of the imaginary-part residual against speed: {bs:+.3} +- {sbs:.3} rad/s per m/s"),
-        suspects: vec!["tyre_relaxation".into(), "inertia errors".into()],
+        // Inertia errors shift the frequency too; they are not candidates yet.
+        suspects: suspects(Signature::FrequencyShiftWithSpeed)
+            .into_iter()
+            .chain(["inertia errors".to_string()])
+            .collect(),
         significant: bs.abs() > 2.0 * sbs,
     });
     let decel: Vec<f64> = segs
@@ -692,7 +674,7 @@ fn diagnose(
         evidence: format!(
             "mean measured speed slope over the windows {md:+.3} +- {sd:.3} m/s^2; the base model (no loss) misses it by {speed_rms:.3} m/s RMS"
         ),
-        suspects: vec!["rolling_resistance".into(), "aero_drag".into()],
+        suspects: suspects(Signature::SpeedDecay),
         significant: md < -2.0 * sd,
     });
     f
@@ -808,7 +790,7 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
         .collect();
     let mut predicted_after = Vec::with_capacity(segs.len());
     for (i, &v) in speeds.iter().enumerate() {
-        let vals = linear_equivalent(&values_after, steer_rate[i]);
+        let vals = linear_equivalent(driven, &values_after, steer_rate[i]);
         predicted_after.push(predict(driven, &bike, &vals, &[v])?[0]);
     }
     // Held out: each segment predicted with the values fitted without its fold.
@@ -818,8 +800,12 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
         let sp: Vec<f64> = idx.iter().map(|&s| speeds[s]).collect();
         let fold_vals = effect_values(&id.after, vals, &cands);
         for (k, &s) in idx.iter().enumerate() {
-            predicted_held_out[s] =
-                predict(driven, &bike, &linear_equivalent(&fold_vals, steer_rate[s]), &sp[k..=k])?[0];
+            predicted_held_out[s] = predict(
+                driven,
+                &bike,
+                &linear_equivalent(driven, &fold_vals, steer_rate[s]),
+                &sp[k..=k],
+            )?[0];
         }
     }
     // Steady bias: the base model's roll residual over the second half of
@@ -838,7 +824,8 @@ pub fn run_identify(a: &IdentifyArgs) -> Result<Outcome> {
                 .collect()
         })
         .unwrap_or_default();
-    let findings = diagnose(&segs, &predicted_before, &id.before.errors, &bias);
+    let models: Vec<&ModelInfo> = std::iter::once(free).chain(alt).collect();
+    let findings = diagnose(&models, &segs, &predicted_before, &id.before.errors, &bias);
     Ok(Outcome {
         identification: id,
         segments: segs,
@@ -1109,8 +1096,10 @@ fn report_markdown(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> String {
             p.join(", ")
         );
     }
-    for (e, why) in NOT_CANDIDATES {
-        let _ = writeln!(s, "* `{e}` is not a candidate: {why}.");
+    if let Some(info) = MODELS.iter().find(|m| m.name == o.model) {
+        for (e, why) in not_candidates(info) {
+            let _ = writeln!(s, "* `{e}` is not a candidate: {why}.");
+        }
     }
     let _ = writeln!(s, "\n## Ranking of the candidates\n");
     for (k, step) in id.steps.iter().enumerate() {
@@ -1291,11 +1280,15 @@ pub fn write_report(o: &Outcome, a: &IdentifyArgs, dir: &Path) -> Result<()> {
     let mut rates: Vec<f64> = o.steer_rate.iter().copied().filter(|x| x.is_finite()).collect();
     rates.sort_by(f64::total_cmp);
     let median_rate = rates.get(rates.len() / 2).copied().unwrap_or(f64::NAN);
+    let driven_info = MODELS
+        .iter()
+        .find(|m| m.name == o.driven_model)
+        .context("the identification's driven model is registered")?;
     for ext in ["svg", "png"] {
         plot_continuation(
             &dir.join(format!("continuation.{ext}")),
             &curve(&BTreeMap::new())?,
-            &curve(&linear_equivalent(&o.values_after, median_rate))?,
+            &curve(&linear_equivalent(driven_info, &o.values_after, median_rate))?,
             &label,
             &measured,
         )?;

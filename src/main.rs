@@ -628,7 +628,6 @@ fn run(cli: Cli) -> Result<bool> {
         } => {
             let b = load(&bike)?;
             let lin = b.linear_with(model.as_deref())?;
-            eprintln!("model: {}", lin.model);
             match &lin.canonical {
                 Some(c) => {
                     if json {
@@ -636,6 +635,7 @@ fn run(cli: Cli) -> Result<bool> {
                         v["model"] = serde_json::json!(lin.model);
                         println!("{}", serde_json::to_string_pretty(&v)?);
                     } else {
+                        println!("model: {}", lin.model);
                         print!("{}", canonical_text(c));
                     }
                 }
@@ -677,6 +677,7 @@ fn run(cli: Cli) -> Result<bool> {
                         });
                         println!("{}", serde_json::to_string_pretty(&out)?);
                     } else {
+                        println!("model: {}", lin.model);
                         println!("no canonical form: {why}");
                         println!("state-space form x' = A(v) x + B(v) u, x = [roll, steer, roll rate, steer rate] (rad, rad/s), u = [roll torque, steer torque] (N m), benchmark signs:");
                         for (v, a, minv) in &rows {

@@ -241,3 +241,53 @@ fn stiff_tyres_recover_the_rolling_without_slip_weave() {
         "stiff tyres: weave within 2 % of rolling without slip ({last_err:.3})"
     );
 }
+
+/// Each effect file declares what identification needs (issue 16, point 2):
+/// an effect without a declaration is never silently skipped, and what a
+/// declaration names exists in the models that carry the effect.
+#[test]
+fn every_effect_declares_its_identification() {
+    use bikedyn_runtime::model::EffectIdentification;
+    let mut seen = std::collections::BTreeSet::new();
+    for m in bikedyn::registry::MODELS {
+        assert_eq!(m.effects.len(), m.effect_declarations.len(), "{}", m.name);
+        for e in m.effect_declarations {
+            seen.insert(e.name);
+            let id = e
+                .identification
+                .unwrap_or_else(|| panic!("{}: effect `{}` declares no identification", m.name, e.name));
+            let c = match id {
+                EffectIdentification::Candidate(c) => c,
+                EffectIdentification::OptOut(why) => {
+                    assert!(why.len() > 10, "{}: `{}` opts out without a reason", m.name, e.name);
+                    continue;
+                }
+            };
+            assert!(!c.fitted.is_empty() && !c.signatures.is_empty() && !c.reason.is_empty());
+            let of_effect = |sym: &str| {
+                let p = m
+                    .parameter(sym)
+                    .unwrap_or_else(|| panic!("{}: `{sym}` of `{}` missing", m.name, e.name));
+                assert_eq!(p.effect, Some(e.name), "{}: `{sym}` belongs to another effect", m.name);
+            };
+            for f in c.fitted {
+                of_effect(f.symbol);
+                f.tied.iter().for_each(|t| of_effect(t));
+                assert!(f.scale > 0.0);
+            }
+            c.held.iter().for_each(|h| of_effect(h));
+        }
+    }
+    // The whole library is in the registry.
+    for name in [
+        "steer_damping",
+        "steer_friction",
+        "rolling_resistance",
+        "aero_drag",
+        "lateral_mass_offset",
+        "steer_controller",
+        "tyre_relaxation",
+    ] {
+        assert!(seen.contains(name), "{name}");
+    }
+}

@@ -1,9 +1,10 @@
 //! Nonlinear simulation (issue 7): constraint residuals, energy, small-amplitude
 //! agreement with the linearized equations, events, kicks and pulses.
 
-use bikedyn::models::default_parameters;
 use bikedyn::ThesisWhipple;
 use bikedyn_runtime::linearize::linearize;
+use bikedyn_runtime::linearize::parameter_vector;
+use bikedyn_runtime::parameters::ThesisParameters;
 use bikedyn_runtime::simulate::{
     simulate, Events, InitialConditions, Inputs, Kick, Method, PulseShape, PulseTarget, SimOptions, StopReason,
     TorquePulse,
@@ -12,6 +13,14 @@ use bikedyn_runtime::MultibodyModel;
 use nalgebra::{Matrix2, Matrix4, Vector4};
 
 type M = ThesisWhipple;
+
+/// The thesis bicycle's parameters for model `M` (every model here has the
+/// thesis geometry or the offset one, which is the thesis's at `d4 = 0`),
+/// effects absent, speed parameter 4.5 m/s.
+fn default_parameters<M: MultibodyModel>() -> Vec<f64> {
+    let p = ThesisParameters::thesis_bicycle();
+    parameter_vector::<M>(|s| p.get(s), 4.5).expect("the thesis bicycle gives every parameter")
+}
 
 fn thesis_at(speed: f64) -> Vec<f64> {
     let mut p = default_parameters::<M>();

@@ -8634,6 +8634,7 @@ impl MultibodyModel for ThesisWhipple {
     const FORWARD_SPEED_PARAMETER: Option<usize> = Some(0usize);
     const SPEED_COORDINATE: Option<usize> = None;
     const GRAVITY_PARAMETER: Option<usize> = Some(25usize);
+    const EFFECT_DECLARATIONS: &'static [bikedyn_runtime::model::EffectDeclaration] = &[];
     const COORDINATE_ROLES: &'static [(bikedyn_runtime::model::CoordinateRole, usize)] = &[
         (bikedyn_runtime::model::CoordinateRole::RearContactX, 0usize),
         (bikedyn_runtime::model::CoordinateRole::RearContactY, 1usize),

@@ -8432,6 +8432,7 @@ impl MultibodyModel for ThesisWhippleFree {
     const FORWARD_SPEED_PARAMETER: Option<usize> = None;
     const SPEED_COORDINATE: Option<usize> = Some(4usize);
     const GRAVITY_PARAMETER: Option<usize> = Some(24usize);
+    const EFFECT_DECLARATIONS: &'static [bikedyn_runtime::model::EffectDeclaration] = &[];
     const COORDINATE_ROLES: &'static [(bikedyn_runtime::model::CoordinateRole, usize)] = &[
         (bikedyn_runtime::model::CoordinateRole::RearContactX, 0usize),
         (bikedyn_runtime::model::CoordinateRole::RearContactY, 1usize),

@@ -695,6 +695,8 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             .find(|&i| names.contains(&("rate", m.coordinates[i].name.clone())))
     }));
     let gravity_param = opt(m.gravity.as_ref().and_then(|(g, _)| param_pos(g)));
+    // Effects with their identification declarations.
+    let effect_decls = m.effects.iter().map(effect_declaration_tokens);
     // Declared meanings (roll, steer, wheel radii, ...), in declaration order.
     let coord_roles = m.coordinates.iter().enumerate().filter_map(|(i, c)| {
         c.meaning.map(|r| {
@@ -744,6 +746,7 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             const FORWARD_SPEED_PARAMETER: Option<usize> = #speed_param;
             const SPEED_COORDINATE: Option<usize> = #speed_coord;
             const GRAVITY_PARAMETER: Option<usize> = #gravity_param;
+            const EFFECT_DECLARATIONS: &'static [bikedyn_runtime::model::EffectDeclaration] = &[#(#effect_decls),*];
             const COORDINATE_ROLES: &'static [(bikedyn_runtime::model::CoordinateRole, usize)] = &[#(#coord_roles),*];
             const PARAMETER_ROLES: &'static [(bikedyn_runtime::model::ParameterRole, usize)] = &[#(#param_roles),*];
             const STATES: &'static [&'static str] = &[#(#states),*];
@@ -933,4 +936,54 @@ mod tests {
         assert_eq!(fnv1a(b"bikedyn"), fnv1a(b"bikedyn"));
         assert_ne!(fnv1a(b"a"), fnv1a(b"b"));
     }
+}
+
+/// The runtime's `EffectDeclaration` literal of an applied effect.
+fn effect_declaration_tokens(e: &crate::model::EffectInfo) -> TokenStream {
+    use crate::effects::{Identification, LinearEquivalent};
+    let (name, doc) = (&e.name, &e.doc);
+    let rt = quote!(bikedyn_runtime::model);
+    let opt_f64 = |x: Option<f64>| match x {
+        Some(v) => {
+            let l = proc_macro2::Literal::f64_suffixed(v);
+            quote!(Some(#l))
+        }
+        None => quote!(None),
+    };
+    let ident = match e.identification {
+        None => quote!(None),
+        Some(Identification::OptOut(why)) => quote!(Some(#rt::EffectIdentification::OptOut(#why))),
+        Some(Identification::Candidate(c)) => {
+            let fitted = c.fitted.iter().map(|f| {
+                let (sym, tied, dis, sad) = (f.symbol, f.tied, f.dissipative, f.start_at_default);
+                let scale = proc_macro2::Literal::f64_suffixed(f.scale);
+                let floor = opt_f64(f.floor);
+                quote!(#rt::FittedParameter {
+                    symbol: #sym, tied: &[#(#tied),*], scale: #scale, dissipative: #dis, floor: #floor, start_at_default: #sad
+                })
+            });
+            let held = c.held;
+            let sigs = c.signatures.iter().map(|s| {
+                let v = proc_macro2::Ident::new(s.variant(), proc_macro2::Span::call_site());
+                quote!(#rt::Signature::#v)
+            });
+            let (decay, reason, own) = (c.speed_decay, c.reason, c.own_model);
+            let lin = match c.linear_equivalent {
+                None => quote!(None),
+                Some(LinearEquivalent::DescribingFunctionDamping { torque, damping }) => {
+                    quote!(Some(#rt::LinearEquivalent::DescribingFunctionDamping { torque: #torque, damping: #damping }))
+                }
+            };
+            quote!(Some(#rt::EffectIdentification::Candidate(#rt::CandidateDeclaration {
+                fitted: &[#(#fitted),*],
+                held: &[#(#held),*],
+                speed_decay: #decay,
+                signatures: &[#(#sigs),*],
+                reason: #reason,
+                linear_equivalent: #lin,
+                own_model: #own,
+            })))
+        }
+    };
+    quote!(#rt::EffectDeclaration { name: #name, doc: #doc, identification: #ident })
 }

@@ -171,6 +171,9 @@ pub struct State {
 pub struct EffectInfo {
     pub name: String,
     pub doc: String,
+    /// How identification tests it (see [`crate::effects::Identification`]);
+    /// `None` for an effect declared without the effect library's `apply`.
+    pub identification: Option<crate::effects::Identification>,
 }
 
 /// A frame: its parent and the elementary rotations (about the rotated
@@ -583,8 +586,15 @@ impl ModelBuilder {
         self.m.effects.push(EffectInfo {
             name: name.into(),
             doc: doc.into(),
+            identification: None,
         });
         self.effect = Some(name.to_string());
+    }
+    /// How identification tests the effect being applied.
+    pub fn declare_identification(&mut self, identification: crate::effects::Identification) {
+        if let Some(e) = self.m.effects.last_mut() {
+            e.identification = Some(identification);
+        }
     }
     /// Stop attributing declarations to the current effect.
     pub fn end_effect(&mut self) {

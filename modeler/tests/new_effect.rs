@@ -5,7 +5,7 @@
 //! non-commercial licence allows one Symbolica thread at a time.
 
 use bikedyn_modeler::codegen::generate;
-use bikedyn_modeler::effects::{self, BicycleParts, Effect};
+use bikedyn_modeler::effects::{self, BicycleParts, Candidate, Effect, Fitted, Identification, Signature};
 use bikedyn_modeler::expr::rate;
 use bikedyn_modeler::model::{Force, ModelBuilder};
 use bikedyn_modeler::models::thesis_whipple::{self, Speed};
@@ -20,11 +20,21 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
         expr: -(c * rate(&parts.front_wheel_rotation)),
     });
 }
+const BRAKE_FITTED: &[Fitted] = &[Fitted::plain("c_brake", 0.05, true)];
 fn front_brake() -> Effect {
     Effect {
         name: "front_brake",
         doc: "viscous front hub brake, torque -c_brake eps'",
         apply,
+        identification: Identification::Candidate(Candidate {
+            fitted: BRAKE_FITTED,
+            held: &[],
+            speed_decay: true,
+            signatures: &[Signature::SpeedDecay],
+            reason: "the speed falls during the response: a dragging front brake",
+            linear_equivalent: None,
+            own_model: false,
+        }),
     }
 }
 // --------------------------------------------------------------------------

@@ -127,6 +127,100 @@ pub struct MissingRole {
     pub job: &'static str,
 }
 
+/// An effect applied to a model, with what identification needs to test it,
+/// as its effect file declares (see the modeler's `effects` module, whose
+/// types these mirror).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EffectDeclaration {
+    pub name: &'static str,
+    pub doc: &'static str,
+    /// `None` for an effect declared without the effect library's `apply`
+    /// (identification then never tests it, and says so).
+    pub identification: Option<EffectIdentification>,
+}
+
+/// How identification tests an effect, or why it never does.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EffectIdentification {
+    /// A candidate.
+    Candidate(CandidateDeclaration),
+    /// Never a candidate, for this reason.
+    OptOut(&'static str),
+}
+
+/// How a candidate effect is fitted and recognised.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CandidateDeclaration {
+    /// The parameters fitted.
+    pub fitted: &'static [FittedParameter],
+    /// Parameters held at the bicycle's value (or their default).
+    pub held: &'static [&'static str],
+    /// It shows as a loss of speed during the response.
+    pub speed_decay: bool,
+    /// The residual patterns of the base model that point to it.
+    pub signatures: &'static [Signature],
+    /// Why those patterns point to it.
+    pub reason: &'static str,
+    /// Its stand-in in the linear (eigenvalue) prediction, if any.
+    pub linear_equivalent: Option<LinearEquivalent>,
+    /// Fitted with a model of its own (it changes the degrees of freedom).
+    pub own_model: bool,
+}
+
+/// A fitted parameter of a candidate effect.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FittedParameter {
+    pub symbol: &'static str,
+    /// Parameters that take the same value.
+    pub tied: &'static [&'static str],
+    /// Typical magnitude, in the parameter's unit.
+    pub scale: f64,
+    /// It dissipates energy (must come out positive to be physical).
+    pub dissipative: bool,
+    /// Floor of the fit, if any.
+    pub floor: Option<f64>,
+    /// The fit starts from the parameter's default.
+    pub start_at_default: bool,
+}
+
+/// Residual patterns of the base model that the diagnosis tests.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Signature {
+    /// Measured weave more damped and slower than predicted.
+    WeaveDampingAndFrequency,
+    /// Damping that grows as the amplitude falls.
+    AmplitudeDependentDamping,
+    /// A steady lean after the kick.
+    SteadyLean,
+    /// A weave frequency error that grows with speed.
+    FrequencyShiftWithSpeed,
+    /// A loss of speed during the response.
+    SpeedDecay,
+}
+
+impl Signature {
+    /// Every pattern, in the order the diagnosis reports them.
+    pub const ALL: [Signature; 5] = [
+        Signature::WeaveDampingAndFrequency,
+        Signature::AmplitudeDependentDamping,
+        Signature::SteadyLean,
+        Signature::FrequencyShiftWithSpeed,
+        Signature::SpeedDecay,
+    ];
+}
+
+/// A linear stand-in for an effect whose linearization is not useful.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LinearEquivalent {
+    /// Coulomb friction torque `torque` as the viscous damping `damping` of
+    /// its describing function at the response's amplitude (`c_eq = 4 T /
+    /// (pi A)` for a sinusoid of rate amplitude `A`).
+    DescribingFunctionDamping {
+        torque: &'static str,
+        damping: &'static str,
+    },
+}
+
 /// A generated model. All functions are associated (no `self`): a model is a
 /// type, its code is monomorphised for each scalar.
 pub trait MultibodyModel: Send + Sync + 'static {
@@ -153,6 +247,8 @@ pub trait MultibodyModel: Send + Sync + 'static {
     const SPEED_COORDINATE: Option<usize>;
     /// Index of the gravitational-acceleration parameter, if any.
     const GRAVITY_PARAMETER: Option<usize>;
+    /// The effects applied, with their identification declarations.
+    const EFFECT_DECLARATIONS: &'static [EffectDeclaration] = &[];
     /// Declared meanings of coordinates: `(role, coordinate index)`.
     const COORDINATE_ROLES: &'static [(CoordinateRole, usize)] = &[];
     /// Declared meanings of parameters: `(role, parameter index)`.

@@ -3,7 +3,7 @@
 //! ([`ModelVisitor`]; the generated registry's `with_model(name, visitor)`
 //! matches the name and calls `visitor.visit::<ThatModel>()`).
 
-use crate::model::{CoordinateRole, MultibodyModel, ParameterInfo};
+use crate::model::{CoordinateRole, EffectDeclaration, MultibodyModel, ParameterInfo};
 
 /// What a generated model is, for listings and model selection.
 #[derive(Clone, Copy, Debug)]
@@ -20,6 +20,8 @@ pub struct ModelInfo {
     pub states: &'static [&'static str],
     /// Declared meanings of coordinates: `(role, coordinate index)`.
     pub coordinate_roles: &'static [(CoordinateRole, usize)],
+    /// The effects applied, with their identification declarations.
+    pub effect_declarations: &'static [EffectDeclaration],
 }
 
 impl ModelInfo {
@@ -36,6 +38,7 @@ impl ModelInfo {
             parameters: M::PARAMETER_INFO,
             states: M::STATES,
             coordinate_roles: M::COORDINATE_ROLES,
+            effect_declarations: M::EFFECT_DECLARATIONS,
         }
     }
 
@@ -45,6 +48,11 @@ impl ModelInfo {
             .iter()
             .find(|(r, _)| *r == role)
             .map(|&(_, i)| self.coordinates[i])
+    }
+
+    /// The declaration of the applied effect `name`.
+    pub fn effect(&self, name: &str) -> Option<&'static EffectDeclaration> {
+        self.effect_declarations.iter().find(|e| e.name == name)
     }
 
     /// The parameter called `name`.

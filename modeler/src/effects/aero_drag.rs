@@ -4,7 +4,7 @@
 //! `|v|` is regularised as `sqrt(v.v + v0^2)` with `v0 = 0.01 m/s` so that
 //! exact derivatives exist at rest.
 
-use super::{BicycleParts, Effect};
+use super::{BicycleParts, Candidate, Effect, Fitted, Identification, Signature};
 use crate::expr::{ratio, smooth_norm, velocity};
 use crate::model::{Force, ModelBuilder};
 
@@ -21,11 +21,23 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     });
 }
 
+/// The parameters identification fits for this effect.
+const FITTED: &[Fitted] = &[Fitted::plain("CdA", 0.3, true)];
+
 /// The effect.
 pub fn effect() -> Effect {
     Effect {
         name: "aero_drag",
         doc: "aerodynamic drag -1/2 rho_air CdA |v| v at the rear frame's mass centre",
         apply,
+        identification: Identification::Candidate(Candidate {
+            fitted: FITTED,
+            held: &["rho_air"],
+            speed_decay: true,
+            signatures: &[Signature::SpeedDecay],
+            reason: "the speed falls faster at higher speed: aerodynamic drag",
+            linear_equivalent: None,
+            own_model: false,
+        }),
     }
 }

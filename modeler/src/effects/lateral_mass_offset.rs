@@ -4,7 +4,7 @@
 //! model assumes both bodies symmetric about their x-z planes; an offset
 //! makes the bicycle lean steadily to one side in straight running.
 
-use super::{BicycleParts, Effect};
+use super::{BicycleParts, Candidate, Effect, Fitted, Identification, Signature};
 use crate::expr::{num, vec3};
 use crate::model::ModelBuilder;
 
@@ -21,11 +21,23 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     }
 }
 
+/// The parameters identification fits for this effect.
+const FITTED: &[Fitted] = &[Fitted::plain("y3", 0.01, false)];
+
 /// The effect.
 pub fn effect() -> Effect {
     Effect {
         name: "lateral_mass_offset",
         doc: "lateral offsets y3 (rear frame) and y4 (front assembly) of the mass centres",
         apply,
+        identification: Identification::Candidate(Candidate {
+            fitted: FITTED,
+            held: &[],
+            speed_decay: false,
+            signatures: &[Signature::SteadyLean],
+            reason: "a steady lean and steer bias after the kick: a mass centre off the plane of symmetry (electronics, battery)",
+            linear_equivalent: None,
+            own_model: false,
+        }),
     }
 }

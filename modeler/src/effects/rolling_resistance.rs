@@ -9,7 +9,7 @@
 //! `v0 = 0.05 m/s` so that exact derivatives exist at rest; above 1 m/s the
 //! force differs from the unregularised one by less than 0.13 %.
 
-use super::{BicycleParts, Effect};
+use super::{BicycleParts, Candidate, Effect, Fitted, Identification, Signature};
 use crate::expr::{ratio, smooth_norm, velocity};
 use crate::model::{Force, ModelBuilder};
 
@@ -32,11 +32,26 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     }
 }
 
+/// The parameters identification fits for this effect.
+const FITTED: &[Fitted] = &[Fitted {
+        tied: &["Crr_front"],
+        ..Fitted::plain("Crr_rear", 0.005, true)
+    }];
+
 /// The effect.
 pub fn effect() -> Effect {
     Effect {
         name: "rolling_resistance",
         doc: "rolling resistance, force Crr N opposing each contact point's travel (N: quasi-static load)",
         apply,
+        identification: Identification::Candidate(Candidate {
+            fitted: FITTED,
+            held: &[],
+            speed_decay: true,
+            signatures: &[Signature::SpeedDecay],
+            reason: "the speed falls during the response about evenly at all speeds: rolling resistance of the tyres",
+            linear_equivalent: None,
+            own_model: false,
+        }),
     }
 }

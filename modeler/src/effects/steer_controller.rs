@@ -24,7 +24,7 @@
 //! gains 0, with `Kc_v_max = 6.5`. Above 6.5 m/s that law switches to roll
 //! feedback; give a parameter file per speed range for such runs.
 
-use super::{BicycleParts, Effect};
+use super::{BicycleParts, Candidate, Effect, Fitted, Identification, Signature};
 use crate::expr::{coord, num, rate, ratio, Expr};
 use crate::model::{Force, ModelBuilder};
 
@@ -77,11 +77,23 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     });
 }
 
+/// The parameters identification fits for this effect.
+const FITTED: &[Fitted] = &[Fitted::plain("Kc_roll_rate", 1.0, false)];
+
 /// The effect.
 pub fn effect() -> Effect {
     Effect {
         name: "steer_controller",
         doc: "steer-torque state feedback T = K(v) [roll, steer, roll rate, steer rate], gains linear in speed within a speed window [Kc_v_min, Kc_v_max]",
         apply,
+        identification: Identification::Candidate(Candidate {
+            fitted: FITTED,
+            held: &[],
+            speed_decay: false,
+            signatures: &[Signature::WeaveDampingAndFrequency],
+            reason: "a steer torque in phase with the roll rate: a controller or rider acting on the handlebar",
+            linear_equivalent: None,
+            own_model: false,
+        }),
     }
 }

@@ -1,7 +1,7 @@
 //! Steer-axis viscous damping: a torque `-c_steer gamma'` between the fork
 //! and the rear frame (bearing and headset seals, cable drag).
 
-use super::{BicycleParts, Effect};
+use super::{BicycleParts, Candidate, Effect, Fitted, Identification, Signature};
 use crate::expr::rate;
 use crate::model::{Force, ModelBuilder};
 
@@ -14,11 +14,23 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     });
 }
 
+/// The parameters identification fits for this effect.
+const FITTED: &[Fitted] = &[Fitted::plain("c_steer", 0.1, true)];
+
 /// The effect.
 pub fn effect() -> Effect {
     Effect {
         name: "steer_damping",
         doc: "steer-axis viscous damping, torque -c_steer gamma'",
         apply,
+        identification: Identification::Candidate(Candidate {
+            fitted: FITTED,
+            held: &[],
+            speed_decay: false,
+            signatures: &[Signature::WeaveDampingAndFrequency],
+            reason: "excess weave damping with a lower weave frequency: viscous damping in the headset slows the steer",
+            linear_equivalent: None,
+            own_model: false,
+        }),
     }
 }

@@ -10,7 +10,7 @@
 //! of a few ms), while steer rates of a weave (about 1 rad/s) are ten times
 //! `w`, where `tanh` is within 1e-8 of its limit.
 
-use super::{BicycleParts, Effect};
+use super::{BicycleParts, Candidate, Effect, Fitted, Identification, LinearEquivalent, Signature};
 use crate::expr::rate;
 use crate::model::{Force, ModelBuilder};
 
@@ -28,11 +28,29 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     });
 }
 
+/// The parameters identification fits for this effect.
+const FITTED: &[Fitted] = &[Fitted::plain("T_steer", 0.05, true)];
+
 /// The effect.
 pub fn effect() -> Effect {
     Effect {
         name: "steer_friction",
         doc: "steer Coulomb friction, torque -T_steer tanh(gamma'/w_steer)",
         apply,
+        // Coulomb friction's smoothed law linearizes to a stiff damper
+        // `T / w` about upright: the eigenvalue prediction uses its
+        // describing function instead.
+        identification: Identification::Candidate(Candidate {
+            fitted: FITTED,
+            held: &["w_steer"],
+            speed_decay: false,
+            signatures: &[Signature::AmplitudeDependentDamping, Signature::WeaveDampingAndFrequency],
+            reason: "decay that depends on amplitude (faster at small amplitude): Coulomb friction in the headset",
+            linear_equivalent: Some(LinearEquivalent::DescribingFunctionDamping {
+                torque: "T_steer",
+                damping: "c_steer",
+            }),
+            own_model: false,
+        }),
     }
 }

@@ -28,7 +28,7 @@
 //! camber stiffness 0.9 per rad times the load (Dressel 2013: about 0.7-1.1),
 //! relaxation length 0.2 m (0.1-0.3 m).
 
-use super::{BicycleParts, Effect};
+use super::{BicycleParts, Candidate, Effect, Fitted, Identification, Signature};
 use crate::expr::{dot3, frame_axis, material_velocity, num, ratio, smooth_norm, velocity, Vec3};
 use crate::model::{Axis, Force, ModelBuilder, Nonholonomic, Role};
 
@@ -106,11 +106,31 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     m.set_role(&parts.yaw, Role::Independent);
 }
 
+/// The parameters identification fits for this effect.
+const FITTED: &[Fitted] = &[Fitted {
+    tied: &["sigma_front"],
+    floor: Some(0.01),
+    start_at_default: true,
+    ..Fitted::plain("sigma_rear", 0.2, true)
+}];
+
 /// The effect.
 pub fn effect() -> Effect {
     Effect {
         name: "tyre_relaxation",
         doc: "tyre lateral slip, cornering and camber stiffness with relaxation length, replacing lateral no-slip",
         apply,
+        // A relaxation length toward zero is a rigid, stiff tyre: below 1 cm
+        // the fit is held there (tyres measure 0.1-0.3 m), and it starts
+        // from the default rather than a stiff tenth of it.
+        identification: Identification::Candidate(Candidate {
+            fitted: FITTED,
+            held: &[],
+            speed_decay: false,
+            signatures: &[Signature::FrequencyShiftWithSpeed],
+            reason: "a weave frequency shift growing with speed: lateral tyre slip with relaxation (fitted: the relaxation length; cornering and camber stiffness at the model's defaults)",
+            linear_equivalent: None,
+            own_model: true,
+        }),
     }
 }
