@@ -21,6 +21,7 @@ use bikedyn::runtime::eigen::eigenvalues;
 use bikedyn::runtime::experiment::synth::{rest_trajectory, write_run, RunKind, SensorModel, Trajectory};
 use bikedyn::runtime::linearize::parameter_vector;
 use bikedyn::runtime::output::{save_json, write_atomic};
+use bikedyn::runtime::random::SplitMix64;
 use bikedyn::runtime::simulate::trajectory::{trajectory_for_run, RunPlan, RunTrajectory};
 use bikedyn::runtime::simulate::{SimOptions, Simulation};
 use bikedyn::runtime::MultibodyModel;
@@ -59,13 +60,10 @@ pub struct SynthArgs {
 }
 
 /// A per-run clock offset: the nominal one plus up to +/- 0.3 s, as in
-/// FORMAT.md (SplitMix64 of the seed, so runs are reproducible).
+/// FORMAT.md (the first draw of the seed's generator, so runs are
+/// reproducible).
 fn clock_offset(nominal: f64, seed: u64) -> f64 {
-    let mut z = seed.wrapping_add(0x9E3779B97F4A7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-    z ^= z >> 31;
-    nominal + 0.6 * ((z >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    nominal + 0.6 * (SplitMix64::new(seed).next_f64() - 0.5)
 }
 
 /// Time the bicycle stands still, held upright, before the launch (s): the

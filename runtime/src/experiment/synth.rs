@@ -3,6 +3,7 @@
 //! imperfections, and a simple launch-kick-response motion for tests.
 
 pub use super::read::RunKind;
+use crate::random::SplitMix64;
 use crate::CanonicalMatrices;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use serde::Serialize;
@@ -134,30 +135,10 @@ pub enum SynthError {
     Trajectory(&'static str),
 }
 
-/// Small deterministic generator (splitmix64) with normal deviates.
-pub struct Rng(u64);
-
-impl Rng {
-    /// Seeded generator.
-    pub fn new(seed: u64) -> Self {
-        Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
-    }
-    /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Standard normal (Box-Muller).
-    pub fn normal(&mut self) -> f64 {
-        let u1 = self.uniform().max(1e-300);
-        let u2 = self.uniform();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
-}
+/// Stream of a run's sensor errors: the seed mixed with a constant, so it
+/// differs from the streams that start from the seed itself (the hand
+/// disturbances and clock offsets of `bikedyn synth`).
+const SENSOR_STREAM: u64 = SplitMix64::GAMMA;
 
 fn interp(t: &[f64], x: &[f64], s: f64) -> f64 {
     let k = t.partition_point(|&v| v <= s);
@@ -203,7 +184,7 @@ pub fn write_run(
         path: dir.to_path_buf(),
         source,
     })?;
-    let mut rng = Rng::new(seed);
+    let mut rng = SplitMix64::new(seed ^ SENSOR_STREAM);
     let e = |a: [f64; 3]| Rotation3::from_euler_angles(a[0], a[1], a[2]);
     let mf = e(sensors.frame_misalignment);
     let mh = e(sensors.handlebar_misalignment);
@@ -285,7 +266,7 @@ pub fn write_run(
             });
             let mut out = closed;
             if closed && !was_closed {
-                bounce_next = rng.uniform() < sensors.bounce_probability;
+                bounce_next = rng.next_f64() < sensors.bounce_probability;
             } else if closed && bounce_next {
                 out = false;
                 bounce_next = false;

@@ -5,6 +5,7 @@
 use serde::Serialize;
 
 use super::{SimulateError, Simulation};
+use crate::random::SplitMix64;
 
 /// Angles of a run against time (thesis conventions, rad, s): yaw phi, roll
 /// theta (positive leaning right), frame pitch beta, steer gamma (positive
@@ -91,14 +92,10 @@ pub struct RunPlan {
     pub seed: u64,
 }
 
-/// splitmix64: a small, well-known generator, enough for run plans.
-fn splitmix(state: &mut u64) -> f64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-}
+/// Stream of a run plan's draws: the seed mixed with a constant, so it
+/// differs from the hand disturbances' stream, which starts from the seed
+/// itself.
+const PLAN_STREAM: u64 = 0x0005_EED0_FB1C_7C1E;
 
 impl RunPlan {
     /// A plan drawn like the thesis's field tests (section 5): launch 2-3 s
@@ -106,8 +103,8 @@ impl RunPlan {
     /// kick 0.6-1.4 s after release with 2-5 N s toward either side, 4-6 s of
     /// free response, samples every 1 ms.
     pub fn random(seed: u64) -> Self {
-        let mut s = seed ^ 0x0005_EED0_FB1C_7C1E;
-        let mut u = |lo: f64, hi: f64| lo + (hi - lo) * splitmix(&mut s);
+        let mut rng = SplitMix64::new(seed ^ PLAN_STREAM);
+        let mut u = |lo: f64, hi: f64| rng.uniform(lo, hi);
         let side = if u(0.0, 1.0) < 0.5 { -1.0 } else { 1.0 };
         RunPlan {
             launch_duration: u(2.0, 3.0),
@@ -130,10 +127,10 @@ struct Hand {
 }
 
 impl Hand {
-    fn new(amplitude: f64, state: &mut u64) -> Self {
+    fn new(amplitude: f64, rng: &mut SplitMix64) -> Self {
         let mut part = || {
-            let f = 0.3 + 1.2 * splitmix(state);
-            let ph = 2.0 * std::f64::consts::PI * splitmix(state);
+            let f = 0.3 + 1.2 * rng.next_f64();
+            let ph = 2.0 * std::f64::consts::PI * rng.next_f64();
             (amplitude / 3.0, 2.0 * std::f64::consts::PI * f, ph)
         };
         Hand {
@@ -172,9 +169,9 @@ pub fn trajectory_for_run<M: crate::model::MultibodyModel>(
     if !(plan.kick_delay >= 0.0 && plan.free_duration > 0.0) {
         return bad("kick delay must be >= 0 and free duration positive");
     }
-    let mut state = plan.seed;
-    let hand_roll = Hand::new(plan.hand_roll, &mut state);
-    let hand_steer = Hand::new(plan.hand_steer, &mut state);
+    let mut rng = SplitMix64::new(plan.seed);
+    let hand_roll = Hand::new(plan.hand_roll, &mut rng);
+    let hand_steer = Hand::new(plan.hand_steer, &mut rng);
     let fade = 0.3 * plan.launch_duration;
     let tl = plan.launch_duration;
     let v_at = |t: f64| {
