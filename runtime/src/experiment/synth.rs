@@ -4,32 +4,12 @@
 
 pub use super::read::RunKind;
 use crate::random::SplitMix64;
+use crate::simulate::trajectory::Trajectory;
 use crate::CanonicalMatrices;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// A sampled motion of the bicycle, thesis conventions: yaw phi, roll theta
-/// (positive leaning right), frame pitch beta (the model coordinate; about
-/// minus the steer-axis tilt when upright), steer gamma (positive turning
-/// left), rear wheel rotation psi (increases when rolling forward); rad; t in
-/// s of physical time (increasing). The IMU logger starts at `t[0]`.
-#[derive(Clone, Debug, Default)]
-pub struct Trajectory {
-    /// Time (s).
-    pub t: Vec<f64>,
-    /// Yaw (rad).
-    pub yaw: Vec<f64>,
-    /// Roll (rad).
-    pub roll: Vec<f64>,
-    /// Frame pitch (rad).
-    pub pitch: Vec<f64>,
-    /// Steer (rad).
-    pub steer: Vec<f64>,
-    /// Rear wheel rotation (rad).
-    pub rear_wheel_angle: Vec<f64>,
-}
 
 /// Sensor imperfections. `Default` = values like `shared/data/dev`.
 #[derive(Clone, Debug, Serialize)]
@@ -160,7 +140,9 @@ fn write(path: &Path, text: &str) -> Result<(), SynthError> {
 }
 
 /// Write `imu_frame.csv`, `imu_handlebar.csv`, `speed_switch.csv` and
-/// `run.toml` of one run into `dir` (created), following FORMAT.md.
+/// `run.toml` of one run into `dir` (created), following FORMAT.md, from the
+/// angles of `traj` (the reed switch follows its wheel rotation; its speed
+/// series is not read).
 pub fn write_run(
     dir: &Path,
     name: &str,
@@ -431,6 +413,7 @@ impl ResponseSpec {
             tr.pitch.push(self.frame_pitch);
             tr.steer.push(steer);
             tr.rear_wheel_angle.push(psi);
+            tr.speed.push(v);
         }
         tr
     }
@@ -446,6 +429,7 @@ pub fn rest_trajectory(duration: f64, frame_pitch: f64, yaw: f64) -> Trajectory 
         pitch: vec![frame_pitch; n],
         steer: vec![0.0; n],
         rear_wheel_angle: vec![0.0; n],
+        speed: vec![0.0; n],
     }
 }
 
@@ -482,6 +466,7 @@ pub fn linear_model_trajectory(c: &CanonicalMatrices, spec: &ResponseSpec) -> Op
         tr.pitch.push(spec.frame_pitch);
         tr.steer.push(-delta);
         tr.rear_wheel_angle.push(psi);
+        tr.speed.push(v);
         // Steer gamma = -delta: turning left raises the yaw.
         yaw += (v * (-delta) + trail * (-delta_rate)) * lam.cos() / w * dt;
         psi += v / r_wheel * dt;
