@@ -18,10 +18,11 @@ use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::{canonical_of, Bicycle};
 use bikedyn::registry::{with_model, ModelVisitor};
 use bikedyn::runtime::eigen::eigenvalues;
-use bikedyn::runtime::experiment::synth::{rest_trajectory, write_run, RunKind, SensorModel, Trajectory};
+use bikedyn::runtime::experiment::synth::{rest_trajectory, write_run, RunKind, SensorModel};
 use bikedyn::runtime::linearize::parameter_vector;
 use bikedyn::runtime::output::{save_json, write_atomic};
-use bikedyn::runtime::simulate::trajectory::{trajectory_for_run, RunPlan, RunTrajectory};
+use bikedyn::runtime::random::SplitMix64;
+use bikedyn::runtime::simulate::trajectory::{trajectory_for_run, RunPlan, Trajectory};
 use bikedyn::runtime::simulate::{SimOptions, Simulation};
 use bikedyn::runtime::MultibodyModel;
 use clap::Args;
@@ -59,13 +60,10 @@ pub struct SynthArgs {
 }
 
 /// A per-run clock offset: the nominal one plus up to +/- 0.3 s, as in
-/// FORMAT.md (SplitMix64 of the seed, so runs are reproducible).
+/// FORMAT.md (the first draw of the seed's generator, so runs are
+/// reproducible).
 fn clock_offset(nominal: f64, seed: u64) -> f64 {
-    let mut z = seed.wrapping_add(0x9E3779B97F4A7C15);
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-    z ^= z >> 31;
-    nominal + 0.6 * ((z >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    nominal + 0.6 * (SplitMix64::new(seed).next_f64() - 0.5)
 }
 
 /// Time the bicycle stands still, held upright, before the launch (s): the
@@ -75,7 +73,7 @@ const REST_BEFORE_LAUNCH: f64 = 2.5;
 
 /// The sensor-side motion: the rest before the launch, then the simulated
 /// run shifted by it.
-fn sensor_trajectory(tr: &RunTrajectory) -> Trajectory {
+fn sensor_trajectory(tr: &Trajectory) -> Trajectory {
     let dt = tr.t.get(1).map_or(0.01, |t1| t1 - tr.t[0]).max(1e-4);
     let n_rest = (REST_BEFORE_LAUNCH / dt).round() as usize;
     let rest = |v: &[f64]| -> Vec<f64> {
@@ -92,10 +90,11 @@ fn sensor_trajectory(tr: &RunTrajectory) -> Trajectory {
         pitch: rest(&tr.pitch),
         steer: rest(&tr.steer),
         rear_wheel_angle: rest(&tr.rear_wheel_angle),
+        speed: rest(&tr.speed),
     }
 }
 
-fn write_physical_run(dir: &Path, name: &str, tr: &RunTrajectory, truth: &serde_json::Value) -> Result<()> {
+fn write_physical_run(dir: &Path, name: &str, tr: &Trajectory, truth: &serde_json::Value) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     write_atomic(dir.join(format!("{name}_trajectory.csv")), |w: &mut dyn Write| {
         writeln!(w, "t,yaw,roll,pitch,steer,rear_wheel_angle,speed")?;
@@ -115,7 +114,7 @@ fn write_physical_run(dir: &Path, name: &str, tr: &RunTrajectory, truth: &serde_
 fn one_run<M: MultibodyModel>(
     lookup: &dyn Fn(&str) -> Option<f64>,
     plan: &RunPlan,
-) -> Result<(RunTrajectory, Simulation, Vec<f64>)> {
+) -> Result<(Trajectory, Simulation, Vec<f64>)> {
     let param = parameter_vector::<M>(lookup, plan.speed)?;
     let (tr, sim) = trajectory_for_run::<M>(&param, plan, &SimOptions::default())?;
     Ok((tr, sim, param))
@@ -127,7 +126,7 @@ struct OneRun<'a, F: Fn(&str) -> Option<f64>> {
 }
 impl<F: Fn(&str) -> Option<f64>> ModelVisitor for OneRun<'_, F> {
     #[allow(clippy::type_complexity)]
-    type Output = Result<(RunTrajectory, Simulation, Vec<f64>, &'static [&'static str])>;
+    type Output = Result<(Trajectory, Simulation, Vec<f64>, &'static [&'static str])>;
     fn visit<M: MultibodyModel>(self) -> Self::Output {
         let (t, s, pv) = one_run::<M>(self.lookup, self.plan)?;
         Ok((t, s, pv, M::PARAMETERS))

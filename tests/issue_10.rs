@@ -7,6 +7,7 @@ use bikedyn::bicycle::{canonical_of, Bicycle};
 use bikedyn::runtime::benchmark_oracle::meijaard_canonical;
 use bikedyn::runtime::eigen::critical_speeds;
 use bikedyn::runtime::parameters::{BenchmarkParameters, ParameterSet, ThesisParameters};
+use bikedyn::runtime::random::SplitMix64;
 use bikedyn::runtime::CanonicalMatrices;
 use nalgebra::Matrix2;
 use std::path::{Path, PathBuf};
@@ -118,73 +119,57 @@ fn issue_10_1_thesis_z5_plus_5_matches_closed_form() {
     assert!(d < 1e-9, "relative difference {d:e}");
 }
 
-/// A small deterministic generator (SplitMix64), so that a failure names a
-/// reproducible case.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.next()
-    }
-}
-
 /// A random design around `b`, over wide ranges: wheelbase x0.6-1.6, trail
 /// -0.2..0.4 m, steer tilt -1.2..1.4 rad, radii x0.2-3 (front up to 5 m; a
 /// point-mass skate wheel 5 % of the time), masses and tensors x0.3-3 (which keeps
 /// them positive definite), mass centres moved by up to half a wheelbase.
-fn random_design(b: &BenchmarkParameters, rng: &mut Rng) -> BenchmarkParameters {
+fn random_design(b: &BenchmarkParameters, rng: &mut SplitMix64) -> BenchmarkParameters {
     let mut d = *b;
-    d.wheelbase *= rng.range(0.6, 1.6);
-    d.trail = rng.range(-0.2, 0.4);
-    d.steer_axis_tilt = rng.range(-1.2, 1.4);
-    d.rear_wheel_radius = (b.rear_wheel_radius.max(0.2) * rng.range(0.2, 3.0)).min(5.0);
-    d.front_wheel_radius = if rng.next() < 0.2 {
-        rng.range(0.02, 5.0)
+    d.wheelbase *= rng.uniform(0.6, 1.6);
+    d.trail = rng.uniform(-0.2, 0.4);
+    d.steer_axis_tilt = rng.uniform(-1.2, 1.4);
+    d.rear_wheel_radius = (b.rear_wheel_radius.max(0.2) * rng.uniform(0.2, 3.0)).min(5.0);
+    d.front_wheel_radius = if rng.next_f64() < 0.2 {
+        rng.uniform(0.02, 5.0)
     } else {
-        b.front_wheel_radius.max(0.2) * rng.range(0.2, 3.0)
+        b.front_wheel_radius.max(0.2) * rng.uniform(0.2, 3.0)
     };
-    if rng.next() < 0.05 {
+    if rng.next_f64() < 0.05 {
         d.rear_wheel_radius = 0.0;
         d.rear_wheel_ixx = 0.0;
         d.rear_wheel_iyy = 0.0;
     }
-    if rng.next() < 0.05 {
+    if rng.next_f64() < 0.05 {
         d.front_wheel_radius = 0.0;
         d.front_wheel_ixx = 0.0;
         d.front_wheel_iyy = 0.0;
     }
-    let s = rng.range(0.3, 3.0);
+    let s = rng.uniform(0.3, 3.0);
     d.rear_wheel_mass *= s;
     d.rear_wheel_ixx *= s;
     d.rear_wheel_iyy *= s;
-    let s = rng.range(0.3, 3.0);
+    let s = rng.uniform(0.3, 3.0);
     d.front_wheel_mass *= s;
     d.front_wheel_ixx *= s;
     d.front_wheel_iyy *= s;
-    let s = rng.range(0.3, 3.0);
+    let s = rng.uniform(0.3, 3.0);
     d.rear_frame_mass *= s;
     d.rear_frame_ixx *= s;
     d.rear_frame_iyy *= s;
     d.rear_frame_izz *= s;
     d.rear_frame_ixz *= s;
-    let s = rng.range(0.3, 3.0);
+    let s = rng.uniform(0.3, 3.0);
     d.front_frame_mass *= s;
     d.front_frame_ixx *= s;
     d.front_frame_iyy *= s;
     d.front_frame_izz *= s;
     d.front_frame_ixz *= s;
     let half = 0.5 * d.wheelbase;
-    d.rear_frame_com_x += rng.range(-half, half);
-    d.rear_frame_com_z += rng.range(-half, half);
-    d.front_frame_com_x += rng.range(-half, half);
-    d.front_frame_com_z += rng.range(-half, half);
-    d.g = rng.range(1.0, 25.0);
+    d.rear_frame_com_x += rng.uniform(-half, half);
+    d.rear_frame_com_z += rng.uniform(-half, half);
+    d.front_frame_com_x += rng.uniform(-half, half);
+    d.front_frame_com_z += rng.uniform(-half, half);
+    d.g = rng.uniform(1.0, 25.0);
     d
 }
 
@@ -195,7 +180,7 @@ fn random_design(b: &BenchmarkParameters, rng: &mut Rng) -> BenchmarkParameters 
 #[test]
 fn issue_10_1_random_designs_match_closed_form() {
     let bases = bases();
-    let mut rng = Rng(20261123);
+    let mut rng = SplitMix64::new(20261123);
     let cases = 10_000;
     let mut worst = (0.0f64, String::new());
     for case in 0..cases {
@@ -401,7 +386,7 @@ fn issue_10_7_capsize_castering_pair_is_named() {
 #[test]
 fn issue_10_7_random_designs_have_continuous_mode_labels() {
     let bases = bases();
-    let mut rng = Rng(720_261_123);
+    let mut rng = SplitMix64::new(720_261_123);
     let speeds: Vec<f64> = (0..=200).map(|k| k as f64 * 0.05).collect();
     let (mut checked, mut refused) = (0, 0);
     for case in 0..10_000 {
@@ -521,7 +506,7 @@ fn issue_10_10_fast_linearization_equals_two_speed_method() {
         canonical_matrices, canonical_matrices_two_speeds, parameter_vector, static_stiffness,
     };
     let bases = bases();
-    let mut rng = Rng(10);
+    let mut rng = SplitMix64::new(10);
     let mut checked = 0;
     for case in 0..500 {
         let (name, base) = &bases[case % bases.len()];

@@ -8,64 +8,50 @@
 use bikedyn::generated::{Extended, ExtendedFree, ThesisWhipple, ThesisWhippleFree, WhippleOffset};
 use bikedyn::runtime::linearize::{linearize_with_rest_general, parameter_vector, WithRest};
 use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
+use bikedyn::runtime::random::SplitMix64;
 use bikedyn::runtime::MultibodyModel;
 use nalgebra::DMatrix;
 
-/// SplitMix64, so that a failure names a reproducible case.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.next()
-    }
-}
-
 /// A random design around the benchmark or thesis bicycle: geometry, radii,
 /// masses and inertias scaled, mass centres moved, gravity changed.
-fn random_design(rng: &mut Rng) -> ThesisParameters {
-    let mut d = if rng.next() < 0.5 {
+fn random_design(rng: &mut SplitMix64) -> ThesisParameters {
+    let mut d = if rng.next_f64() < 0.5 {
         BenchmarkParameters::benchmark_bicycle()
     } else {
         ThesisParameters::thesis_bicycle().to_benchmark().unwrap()
     };
-    d.wheelbase *= rng.range(0.7, 1.4);
-    d.trail = rng.range(-0.1, 0.3);
-    d.steer_axis_tilt = rng.range(-0.5, 0.8);
-    d.rear_wheel_radius *= rng.range(0.5, 2.0);
-    d.front_wheel_radius *= rng.range(0.5, 2.0);
+    d.wheelbase *= rng.uniform(0.7, 1.4);
+    d.trail = rng.uniform(-0.1, 0.3);
+    d.steer_axis_tilt = rng.uniform(-0.5, 0.8);
+    d.rear_wheel_radius *= rng.uniform(0.5, 2.0);
+    d.front_wheel_radius *= rng.uniform(0.5, 2.0);
     for (m, ixx, iyy) in [
         (&mut d.rear_wheel_mass, &mut d.rear_wheel_ixx, &mut d.rear_wheel_iyy),
         (&mut d.front_wheel_mass, &mut d.front_wheel_ixx, &mut d.front_wheel_iyy),
     ] {
-        let s = rng.range(0.3, 3.0);
+        let s = rng.uniform(0.3, 3.0);
         *m *= s;
         *ixx *= s;
         *iyy *= s;
     }
-    let s = rng.range(0.3, 3.0);
+    let s = rng.uniform(0.3, 3.0);
     d.rear_frame_mass *= s;
     d.rear_frame_ixx *= s;
     d.rear_frame_iyy *= s;
     d.rear_frame_izz *= s;
     d.rear_frame_ixz *= s;
-    let s = rng.range(0.3, 3.0);
+    let s = rng.uniform(0.3, 3.0);
     d.front_frame_mass *= s;
     d.front_frame_ixx *= s;
     d.front_frame_iyy *= s;
     d.front_frame_izz *= s;
     d.front_frame_ixz *= s;
     let q = 0.3 * d.wheelbase;
-    d.rear_frame_com_x += rng.range(-q, q);
-    d.rear_frame_com_z += rng.range(-q, q);
-    d.front_frame_com_x += rng.range(-q, q);
-    d.front_frame_com_z += rng.range(-q, q);
-    d.g = rng.range(1.0, 25.0);
+    d.rear_frame_com_x += rng.uniform(-q, q);
+    d.rear_frame_com_z += rng.uniform(-q, q);
+    d.front_frame_com_x += rng.uniform(-q, q);
+    d.front_frame_com_z += rng.uniform(-q, q);
+    d.g = rng.uniform(1.0, 25.0);
     d.to_thesis().unwrap()
 }
 
@@ -119,11 +105,11 @@ fn compare<M: MultibodyModel, const N: usize>(param: &[f64], dq0: &[f64], case: 
 
 /// Parameters of model `M` for design `t` at forward speed `v`, with every
 /// effect parameter moved from its default (absent) by up to `effects`.
-fn param_of<M: MultibodyModel>(t: &ThesisParameters, v: f64, effects: f64, rng: &mut Rng) -> Vec<f64> {
+fn param_of<M: MultibodyModel>(t: &ThesisParameters, v: f64, effects: f64, rng: &mut SplitMix64) -> Vec<f64> {
     let mut p = parameter_vector::<M>(|s| t.get(s), v).unwrap();
     for (i, info) in M::PARAMETER_INFO.iter().enumerate() {
         if info.effect.is_some() {
-            p[i] += effects * rng.next();
+            p[i] += effects * rng.next_f64();
         }
     }
     p
@@ -131,18 +117,18 @@ fn param_of<M: MultibodyModel>(t: &ThesisParameters, v: f64, effects: f64, rng: 
 
 #[test]
 fn fast_upright_linearization_equals_general_path_on_random_designs() {
-    let mut rng = Rng(1010);
+    let mut rng = SplitMix64::new(1010);
     let mut computed = 0;
     let cases = 300;
     for case in 0..cases {
         let t = random_design(&mut rng);
-        let v = rng.range(0.0, 10.0);
+        let v = rng.uniform(0.0, 10.0);
         let label = format!("case {case} (V = {v})");
         let p = param_of::<ThesisWhipple>(&t, v, 0.0, &mut rng);
         computed += compare::<ThesisWhipple, 4>(&p, &[0.0; 2], &label) as usize;
         // The fork mass centre off the steer axis.
         let mut t4 = t;
-        t4.fork_com_offset = rng.range(-0.05, 0.05);
+        t4.fork_com_offset = rng.uniform(-0.05, 0.05);
         let p = param_of::<WhippleOffset>(&t4, v, 0.0, &mut rng);
         compare::<WhippleOffset, 4>(&p, &[0.0; 2], &label);
         // Every effect present (applied forces at speed and at rest).

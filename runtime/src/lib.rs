@@ -17,6 +17,7 @@ pub mod model;
 pub mod output;
 pub mod parameters;
 pub mod plot;
+pub mod random;
 pub mod registry;
 pub mod scalar;
 pub mod simulate;

@@ -1,5 +1,17 @@
 //! Small dense linear algebra generic over [`Scalar`], so that dual numbers
 //! pass through constraint solves and the coordinate partitioning.
+//!
+//! One LU kernel ([`lu_factor`], [`lu_solve`]; [`solve_in_place`] is both)
+//! does every small dense solve of bikedyn: the constraint Newton steps, the
+//! coordinate partitioning of the linearization and of the simulation's
+//! right-hand side, the reduced mass matrix, the Bairstow step of the quartic
+//! solver. It is our own code rather than nalgebra's `lu()` because it is
+//! generic over [`Scalar`] (dual numbers flow through it and give exact
+//! derivatives of the solution), it works in the caller's buffers (stack
+//! [`Scratch`] in the linearization, the simulation's workspace), so the hot
+//! paths allocate nothing, and its singularity test is relative to the
+//! matrix scale and reports where it failed ([`Singular`]). Plain `f64`
+//! `DMatrix` solves off the hot paths use nalgebra.
 
 use crate::scalar::{Dual, Scalar};
 
@@ -15,79 +27,32 @@ pub struct Singular {
     pub scale: f64,
 }
 
-/// Solve `A X = B` in place by Gaussian elimination with partial pivoting
-/// (on the real parts). `a` is `n x n` row-major, `b` is `n x nrhs`
-/// row-major and receives `X`.
+/// Solve `A X = B` in place by LU factorization with partial pivoting (on
+/// the real parts): [`lu_factor`] then [`lu_solve`]. `a` is `n x n`
+/// row-major and receives the factors, `b` is `n x nrhs` row-major and
+/// receives `X`.
 pub fn solve_in_place<T: Scalar>(a: &mut [T], n: usize, b: &mut [T], nrhs: usize) -> Result<(), Singular> {
-    assert_eq!(a.len(), n * n, "matrix size");
     assert_eq!(b.len(), n * nrhs, "right-hand side size");
+    let mut perm = Scratch::<usize, 32>::new(n, 0);
+    lu_factor(a, n, &mut perm)?;
+    lu_solve(a, n, &perm, b, nrhs);
+    Ok(())
+}
+
+/// LU factorization with partial pivoting of an `n x n` matrix (row-major,
+/// in place): `P A = L U` with unit lower `L` below the diagonal and `U` on
+/// and above it. Pivots are chosen on the real parts; a pivot below `1e-14`
+/// times the largest entry is [`Singular`]. `perm[k]` is the row swapped
+/// with row `k` at step `k` (whole rows, multipliers included). With
+/// real factors, dual-number systems are solved by [`lu_solve_dual`].
+pub fn lu_factor<T: Scalar>(a: &mut [T], n: usize, perm: &mut [usize]) -> Result<(), Singular> {
+    assert_eq!(a.len(), n * n, "matrix size");
+    assert_eq!(perm.len(), n, "permutation size");
     let scale = a.iter().fold(0.0f64, |m, x| m.max(x.re().abs())).max(f64::MIN_POSITIVE);
     for k in 0..n {
         let (mut piv, mut best) = (k, a[k * n + k].re().abs());
         for i in k + 1..n {
             let v = a[i * n + k].re().abs();
-            if v > best {
-                piv = i;
-                best = v;
-            }
-        }
-        if !(best > scale * 1e-14) {
-            return Err(Singular {
-                column: k,
-                pivot: best,
-                scale,
-            });
-        }
-        if piv != k {
-            for j in 0..n {
-                a.swap(k * n + j, piv * n + j);
-            }
-            for j in 0..nrhs {
-                b.swap(k * nrhs + j, piv * nrhs + j);
-            }
-        }
-        let inv = T::one() / a[k * n + k];
-        for i in k + 1..n {
-            let f = a[i * n + k] * inv;
-            if f.re() == 0.0 && f == T::zero() {
-                continue;
-            }
-            for j in k..n {
-                let t = a[k * n + j];
-                a[i * n + j] -= f * t;
-            }
-            for j in 0..nrhs {
-                let t = b[k * nrhs + j];
-                b[i * nrhs + j] -= f * t;
-            }
-        }
-    }
-    for k in (0..n).rev() {
-        let inv = T::one() / a[k * n + k];
-        for j in 0..nrhs {
-            let mut s = b[k * nrhs + j];
-            for i in k + 1..n {
-                s -= a[k * n + i] * b[i * nrhs + j];
-            }
-            b[k * nrhs + j] = s * inv;
-        }
-    }
-    Ok(())
-}
-
-/// LU factorization with partial pivoting of a real `n x n` matrix (row-major,
-/// in place), with the same pivot rule and singularity test as
-/// [`solve_in_place`]. `perm[k]` is the row swapped with row `k` at step `k`.
-/// Used to solve dual-number systems with one real factorization (see
-/// [`lu_solve_dual`]).
-pub fn lu_factor(a: &mut [f64], n: usize, perm: &mut [usize]) -> Result<(), Singular> {
-    assert_eq!(a.len(), n * n, "matrix size");
-    assert_eq!(perm.len(), n, "permutation size");
-    let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(f64::MIN_POSITIVE);
-    for k in 0..n {
-        let (mut piv, mut best) = (k, a[k * n + k].abs());
-        for i in k + 1..n {
-            let v = a[i * n + k].abs();
             if v > best {
                 piv = i;
                 best = v;
@@ -106,60 +71,54 @@ pub fn lu_factor(a: &mut [f64], n: usize, perm: &mut [usize]) -> Result<(), Sing
                 a.swap(k * n + j, piv * n + j);
             }
         }
-        let inv = 1.0 / a[k * n + k];
+        let inv = T::one() / a[k * n + k];
         for i in k + 1..n {
             let f = a[i * n + k] * inv;
             a[i * n + k] = f;
-            if f == 0.0 {
+            if is_zero(f) {
                 continue;
             }
             for j in k + 1..n {
-                a[i * n + j] -= f * a[k * n + j];
+                let u = a[k * n + j];
+                a[i * n + j] -= f * u;
             }
         }
     }
     Ok(())
 }
 
-/// Solve `A x = b` in place with the factors of [`lu_factor`].
-pub fn lu_solve(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64]) {
-    for k in 0..n {
-        b.swap(k, perm[k]);
-    }
-    for i in 0..n {
-        let mut s = b[i];
-        for j in 0..i {
-            s -= lu[i * n + j] * b[j];
-        }
-        b[i] = s;
-    }
-    for i in (0..n).rev() {
-        let mut s = b[i];
-        for j in i + 1..n {
-            s -= lu[i * n + j] * b[j];
-        }
-        b[i] = s / lu[i * n + i];
-    }
+/// Exactly zero, derivatives included: a product by it changes nothing, so
+/// the kernel skips it (the constraint matrices are sparse).
+#[inline(always)]
+fn is_zero<T: Scalar>(x: T) -> bool {
+    x.re() == 0.0 && x == T::zero()
 }
 
 /// Solve `A X = B` in place with the factors of [`lu_factor`], for `m`
 /// right-hand sides at once (`b` is `n x m`, row-major): the inner loops run
 /// along the rows of `b`.
-pub fn lu_solve_many(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64], m: usize) {
+pub fn lu_solve<T: Scalar>(lu: &[T], n: usize, perm: &[usize], b: &mut [T], m: usize) {
+    assert_eq!(lu.len(), n * n, "matrix size");
     assert_eq!(b.len(), n * m, "right-hand side size");
-    // The widths of the dual-number solves: rows of fixed length, which the
-    // compiler unrolls (the same operations in the same order).
+    // The widths of the linearization's solves as constants, so that the
+    // compiler unrolls the rows of each (the same kernel, specialised).
     match m {
-        1 => return lu_solve_rows::<1>(lu, n, perm, b.as_chunks_mut().0),
-        2 => return lu_solve_rows::<2>(lu, n, perm, b.as_chunks_mut().0),
-        3 => return lu_solve_rows::<3>(lu, n, perm, b.as_chunks_mut().0),
-        4 => return lu_solve_rows::<4>(lu, n, perm, b.as_chunks_mut().0),
-        6 => return lu_solve_rows::<6>(lu, n, perm, b.as_chunks_mut().0),
-        8 => return lu_solve_rows::<8>(lu, n, perm, b.as_chunks_mut().0),
-        9 => return lu_solve_rows::<9>(lu, n, perm, b.as_chunks_mut().0),
-        12 => return lu_solve_rows::<12>(lu, n, perm, b.as_chunks_mut().0),
-        _ => {}
+        1 => substitute(lu, n, perm, b, 1),
+        2 => substitute(lu, n, perm, b, 2),
+        3 => substitute(lu, n, perm, b, 3),
+        4 => substitute(lu, n, perm, b, 4),
+        6 => substitute(lu, n, perm, b, 6),
+        8 => substitute(lu, n, perm, b, 8),
+        9 => substitute(lu, n, perm, b, 9),
+        12 => substitute(lu, n, perm, b, 12),
+        _ => substitute(lu, n, perm, b, m),
     }
+}
+
+/// The substitutions of [`lu_solve`]: the row interchanges, `L y = P b`
+/// forward, `U x = y` backward (times the reciprocal of each pivot).
+#[inline(always)]
+fn substitute<T: Scalar>(lu: &[T], n: usize, perm: &[usize], b: &mut [T], m: usize) {
     for k in 0..n {
         if perm[k] != k {
             for c in 0..m {
@@ -172,8 +131,8 @@ pub fn lu_solve_many(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64], m: usi
         let row = &mut rest[..m];
         for j in 0..i {
             let l = lu[i * n + j];
-            if l != 0.0 {
-                for (x, y) in row.iter_mut().zip(&done[j * m..(j + 1) * m]) {
+            if !is_zero(l) {
+                for (x, &y) in row.iter_mut().zip(&done[j * m..(j + 1) * m]) {
                     *x -= l * y;
                 }
             }
@@ -184,56 +143,16 @@ pub fn lu_solve_many(lu: &[f64], n: usize, perm: &[usize], b: &mut [f64], m: usi
         let row = &mut head[i * m..];
         for j in i + 1..n {
             let u = lu[i * n + j];
-            if u != 0.0 {
-                for (x, y) in row.iter_mut().zip(&tail[(j - i - 1) * m..(j - i) * m]) {
+            if !is_zero(u) {
+                for (x, &y) in row.iter_mut().zip(&tail[(j - i - 1) * m..(j - i) * m]) {
                     *x -= u * y;
                 }
             }
         }
-        let inv = 1.0 / lu[i * n + i];
+        let inv = T::one() / lu[i * n + i];
         for x in row.iter_mut() {
             *x *= inv;
         }
-    }
-}
-
-/// [`lu_solve_many`] with rows of `W` values.
-fn lu_solve_rows<const W: usize>(lu: &[f64], n: usize, perm: &[usize], b: &mut [[f64; W]]) {
-    assert_eq!(b.len(), n, "right-hand side size");
-    for k in 0..n {
-        if perm[k] != k {
-            b.swap(k, perm[k]);
-        }
-    }
-    for i in 0..n {
-        let mut row = b[i];
-        for j in 0..i {
-            let l = lu[i * n + j];
-            if l != 0.0 {
-                let y = &b[j];
-                for c in 0..W {
-                    row[c] -= l * y[c];
-                }
-            }
-        }
-        b[i] = row;
-    }
-    for i in (0..n).rev() {
-        let mut row = b[i];
-        for j in i + 1..n {
-            let u = lu[i * n + j];
-            if u != 0.0 {
-                let y = &b[j];
-                for c in 0..W {
-                    row[c] -= u * y[c];
-                }
-            }
-        }
-        let inv = 1.0 / lu[i * n + i];
-        for x in row.iter_mut() {
-            *x *= inv;
-        }
-        b[i] = row;
     }
 }
 
@@ -274,7 +193,7 @@ pub fn lu_solve_dual_narrow<const HA: usize, const N: usize>(
     for (xi, bi) in x.iter_mut().zip(b.iter()) {
         *xi = bi.re;
     }
-    lu_solve_many(lu, n, perm, x, nrhs);
+    lu_solve(lu, n, perm, x, nrhs);
     // Columns (c, k): direction k of right-hand side c.
     let m = nrhs * N;
     let mut r = Scratch::<f64, 256>::new(n * m, 0.0);
@@ -295,7 +214,7 @@ pub fn lu_solve_dual_narrow<const HA: usize, const N: usize>(
             }
         }
     }
-    lu_solve_many(lu, n, perm, r, m);
+    lu_solve(lu, n, perm, r, m);
     for i in 0..n {
         for c in 0..nrhs {
             let v = &mut b[i * nrhs + c];
@@ -390,6 +309,83 @@ mod tests {
             for k in 0..2 {
                 assert!((x.eps[k] - y.eps[k]).abs() < 1e-13);
             }
+        }
+    }
+
+    /// Every width of right-hand sides, the specialised ones (1, 2, 3, 4,
+    /// 6, 8, 9, 12) and the others, gives bit for bit what solving column by
+    /// column gives (the same operations in the same order), and solves
+    /// `A X = B` to `n eps |A| |X|`. The zero leading entry forces a row
+    /// interchange.
+    #[test]
+    fn every_width_of_right_hand_sides_is_the_same_kernel() {
+        let n = 5;
+        let a: Vec<f64> = (0..n * n)
+            .map(|k| {
+                if k == 0 {
+                    0.0
+                } else {
+                    ((k * 7 + 3) % 11) as f64 - 5.0 + 0.1 * k as f64
+                }
+            })
+            .collect();
+        let mut lu = a.clone();
+        let mut perm = [0; 5];
+        lu_factor(&mut lu, n, &mut perm).unwrap();
+        assert_ne!(perm[0], 0, "the zero pivot is interchanged");
+        let norm_a = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for m in 1..=13 {
+            let b: Vec<f64> = (0..n * m).map(|k| (0.37 * k as f64).sin()).collect();
+            let mut x = b.clone();
+            lu_solve(&lu, n, &perm, &mut x, m);
+            for c in 0..m {
+                let mut col: Vec<f64> = (0..n).map(|i| b[i * m + c]).collect();
+                lu_solve(&lu, n, &perm, &mut col, 1);
+                let norm_x = col.iter().fold(0.0f64, |s, x| s.max(x.abs()));
+                for i in 0..n {
+                    assert_eq!(
+                        x[i * m + c].to_bits(),
+                        col[i].to_bits(),
+                        "width {m}, column {c}, row {i}"
+                    );
+                    let r: f64 = (0..n).map(|j| a[i * n + j] * col[j]).sum::<f64>() - b[i * m + c];
+                    assert!(
+                        r.abs() <= 8.0 * n as f64 * f64::EPSILON * norm_a * norm_x,
+                        "residual {r:e}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Dual numbers through the kernel give the derivative of the solution:
+    /// `A(s) x(s) = b(s)` with `A' = A1`, `b' = b1` has `x' = A^-1 (b1 - A1 x)`.
+    #[test]
+    fn dual_numbers_through_the_kernel_give_the_derivative() {
+        let re = [0.0, 2.0, 1.0, 1.0, 1.0, 0.0, 3.0, 0.0, 1.0];
+        let a1 = [0.5, -1.0, 0.0, 0.25, 0.0, 2.0, -0.75, 1.0, 0.0];
+        let (b0, b1) = ([1.0, -2.0, 0.5], [0.3, 0.0, -1.0]);
+        let mut a: Vec<Dual<1>> = (0..9)
+            .map(|k| Dual {
+                re: re[k],
+                eps: [a1[k]],
+            })
+            .collect();
+        let mut b: Vec<Dual<1>> = (0..3)
+            .map(|k| Dual {
+                re: b0[k],
+                eps: [b1[k]],
+            })
+            .collect();
+        solve_in_place(&mut a, 3, &mut b, 1).unwrap();
+        let x: Vec<f64> = b.iter().map(|v| v.re).collect();
+        let mut want: Vec<f64> = (0..3)
+            .map(|i| b1[i] - (0..3).map(|j| a1[i * 3 + j] * x[j]).sum::<f64>())
+            .collect();
+        let mut m = re;
+        solve_in_place(&mut m, 3, &mut want, 1).unwrap();
+        for i in 0..3 {
+            assert!((b[i].eps[0] - want[i]).abs() < 1e-14, "{} vs {}", b[i].eps[0], want[i]);
         }
     }
 

@@ -121,9 +121,9 @@ pub fn reduced_system<M: MultibodyModel, T: Scalar>(
         p[j] = q[k];
     }
     solve_configuration::<M, T>(param, t, &mut p, &NewtonOptions::default())?;
-    // One elimination on D_dep gives E = [I; -Ddep^-1 Dind] and the
-    // dependent velocities (eq. 40-45); a second, after gamma, gives
-    // F = [0; -Ddep^-1 gamma].
+    // One factorization of D_dep gives E = [I; -Ddep^-1 Dind] and the
+    // dependent velocities (eq. 40-45) and, after gamma, F = [0; -Ddep^-1
+    // gamma].
     let nc = M::HOLONOMIC.len() + M::NONHOLONOMIC.len();
     let cm = constraint_matrices::<M, T>(param, t, &p);
     let depv = dependent_velocities::<M>();
@@ -146,8 +146,9 @@ pub fn reduced_system<M: MultibodyModel, T: Scalar>(
         }
         rhs[i * (ni + 1) + ni] = cm.d_rhs[i];
     }
-    let a_dep = a.clone();
-    solve_in_place(&mut a, nd, &mut rhs, ni + 1).map_err(singular)?;
+    let mut perm = vec![0; nd];
+    lu_factor(&mut a, nd, &mut perm).map_err(singular)?;
+    lu_solve(&a, nd, &perm, &mut rhs, ni + 1);
     let mut dp = vec![T::zero(); nq];
     for (k, &j) in ind.iter().enumerate() {
         dp[j] = dq[k];
@@ -163,8 +164,7 @@ pub fn reduced_system<M: MultibodyModel, T: Scalar>(
     let mut gamma = vec![T::zero(); nc];
     M::holonomic_convective(param, t, &p, &dp, &mut gamma[..nh]);
     M::nonholonomic_convective(param, t, &p, &dp, &mut gamma[nh..]);
-    let mut a = a_dep;
-    solve_in_place(&mut a, nd, &mut gamma, 1).map_err(singular)?;
+    lu_solve(&a, nd, &perm, &mut gamma, 1);
     let mut e = vec![T::zero(); nq * ni];
     let mut f = vec![T::zero(); nq];
     for (k, &j) in ind.iter().enumerate() {
@@ -383,7 +383,7 @@ pub fn upright_linearization<M: MultibodyModel, const H: usize, const N: usize>(
         for (i, c) in col.iter_mut().enumerate() {
             *c = -cq[i * nq + j];
         }
-        lu_solve(jd, nh, &perm[..nh], col);
+        lu_solve(jd, nh, &perm[..nh], col, 1);
         for (r, &jj) in dep.iter().enumerate() {
             p[jj].eps[k] = col[r];
         }

@@ -5,6 +5,7 @@
 use crate::constraints::{constraint_matrices, solve_configuration, solve_velocities, NewtonOptions};
 use crate::linalg::solve_in_place;
 use crate::model::MultibodyModel;
+use crate::random::SplitMix64;
 use nalgebra::{DMatrix, SymmetricEigen};
 use serde::Serialize;
 
@@ -48,22 +49,6 @@ impl Default for VerifyOptions {
             seed: 1,
             fd_tolerance: 1e-6,
         }
-    }
-}
-
-/// SplitMix64: a tiny, seeded generator so that a report is reproducible.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E3779B97F4A7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58476D1CE4E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D049BB133111EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn uniform(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.next()
     }
 }
 
@@ -118,7 +103,7 @@ pub fn verify<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions) -> VerifyR
     let nq = M::nq();
     let nh = M::HOLONOMIC.len();
     let nnh = M::NONHOLONOMIC.len();
-    let mut rng = Rng(opts.seed);
+    let mut rng = SplitMix64::new(opts.seed);
     let tol = opts.fd_tolerance;
     let (mut a_cq, mut a_ct, mut a_dcq) = (Acc::new("Cq", tol), Acc::new("Ct", tol), Acc::new("dCqdp", tol));
     let (mut a_b, mut a_dbdp) = (Acc::new("B", tol), Acc::new("dBdp", tol));
@@ -336,7 +321,7 @@ pub fn with_effects_switched_on<M: MultibodyModel>(base: &[f64]) -> Vec<f64> {
 /// balance `d(T + V)/dt = p'^T Qext + (power of the constraint forces)` by a
 /// central difference in time, each dissipative force's power `p'^T Q_f <= 0`,
 /// and `applied_forces` = the sum of `applied_force_terms`.
-fn power_checks<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions, rng: &mut Rng) -> (Acc, Acc, Acc) {
+fn power_checks<M: MultibodyModel>(param: &[f64], opts: &VerifyOptions, rng: &mut SplitMix64) -> (Acc, Acc, Acc) {
     let nq = M::nq();
     let nh = M::HOLONOMIC.len();
     let nc = nh + M::NONHOLONOMIC.len();

@@ -23,6 +23,8 @@
 
 use nalgebra::{Complex, Matrix4};
 
+use crate::linalg::solve_in_place;
+
 pub(crate) type C64 = Complex<f64>;
 
 const EPS: f64 = f64::EPSILON;
@@ -240,15 +242,17 @@ fn refine_factors(a: f64, b: f64, c: f64, d: f64, mut f: [f64; 4]) -> [f64; 4] {
             break;
         }
         let [p1, q1, p2, q2] = f;
-        let j = [
-            [1.0, 0.0, 1.0, 0.0],
-            [p2, 1.0, p1, 1.0],
-            [q2, p2, q1, p1],
-            [0.0, q2, 0.0, q1],
+        #[rustfmt::skip]
+        let mut j = [
+            1.0, 0.0, 1.0, 0.0,
+            p2, 1.0, p1, 1.0,
+            q2, p2, q1, p1,
+            0.0, q2, 0.0, q1,
         ];
-        let Some(dx) = solve4(j, [-r[0], -r[1], -r[2], -r[3]]) else {
+        let mut dx = [-r[0], -r[1], -r[2], -r[3]];
+        if solve_in_place(&mut j, 4, &mut dx, 1).is_err() || !dx.iter().all(|v| v.is_finite()) {
             break;
-        };
+        }
         let fnew = [p1 + dx[0], q1 + dx[1], p2 + dx[2], q2 + dx[3]];
         let rnew = factor_residual(a, b, c, d, &fnew);
         let rnn = nrm(&rnew);
@@ -260,39 +264,6 @@ fn refine_factors(a: f64, b: f64, c: f64, d: f64, mut f: [f64; 4]) -> [f64; 4] {
         rn = rnn;
     }
     f
-}
-
-/// Gaussian elimination with partial pivoting.
-fn solve4(mut m: [[f64; 4]; 4], mut rhs: [f64; 4]) -> Option<[f64; 4]> {
-    for col in 0..4 {
-        let mut piv = col;
-        for row in col + 1..4 {
-            if m[row][col].abs() > m[piv][col].abs() {
-                piv = row;
-            }
-        }
-        if m[piv][col] == 0.0 || !m[piv][col].is_finite() {
-            return None;
-        }
-        m.swap(col, piv);
-        rhs.swap(col, piv);
-        for row in col + 1..4 {
-            let fct = m[row][col] / m[col][col];
-            for k in col..4 {
-                m[row][k] -= fct * m[col][k];
-            }
-            rhs[row] -= fct * rhs[col];
-        }
-    }
-    let mut x = [0.0; 4];
-    for row in (0..4).rev() {
-        let mut s = rhs[row];
-        for k in row + 1..4 {
-            s -= m[row][k] * x[k];
-        }
-        x[row] = s / m[row][row];
-    }
-    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// Roots of `z^2 + p z + q` (real roots: larger first; complex: upper first).

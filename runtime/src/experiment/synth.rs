@@ -3,32 +3,13 @@
 //! imperfections, and a simple launch-kick-response motion for tests.
 
 pub use super::read::RunKind;
+use crate::random::SplitMix64;
+use crate::simulate::trajectory::Trajectory;
 use crate::CanonicalMatrices;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-
-/// A sampled motion of the bicycle, thesis conventions: yaw phi, roll theta
-/// (positive leaning right), frame pitch beta (the model coordinate; about
-/// minus the steer-axis tilt when upright), steer gamma (positive turning
-/// left), rear wheel rotation psi (increases when rolling forward); rad; t in
-/// s of physical time (increasing). The IMU logger starts at `t[0]`.
-#[derive(Clone, Debug, Default)]
-pub struct Trajectory {
-    /// Time (s).
-    pub t: Vec<f64>,
-    /// Yaw (rad).
-    pub yaw: Vec<f64>,
-    /// Roll (rad).
-    pub roll: Vec<f64>,
-    /// Frame pitch (rad).
-    pub pitch: Vec<f64>,
-    /// Steer (rad).
-    pub steer: Vec<f64>,
-    /// Rear wheel rotation (rad).
-    pub rear_wheel_angle: Vec<f64>,
-}
 
 /// Sensor imperfections. `Default` = values like `shared/data/dev`.
 #[derive(Clone, Debug, Serialize)]
@@ -134,30 +115,10 @@ pub enum SynthError {
     Trajectory(&'static str),
 }
 
-/// Small deterministic generator (splitmix64) with normal deviates.
-pub struct Rng(u64);
-
-impl Rng {
-    /// Seeded generator.
-    pub fn new(seed: u64) -> Self {
-        Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
-    }
-    /// Uniform in [0, 1).
-    pub fn uniform(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^= z >> 31;
-        (z >> 11) as f64 / (1u64 << 53) as f64
-    }
-    /// Standard normal (Box-Muller).
-    pub fn normal(&mut self) -> f64 {
-        let u1 = self.uniform().max(1e-300);
-        let u2 = self.uniform();
-        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
-    }
-}
+/// Stream of a run's sensor errors: the seed mixed with a constant, so it
+/// differs from the streams that start from the seed itself (the hand
+/// disturbances and clock offsets of `bikedyn synth`).
+const SENSOR_STREAM: u64 = SplitMix64::GAMMA;
 
 fn interp(t: &[f64], x: &[f64], s: f64) -> f64 {
     let k = t.partition_point(|&v| v <= s);
@@ -179,7 +140,9 @@ fn write(path: &Path, text: &str) -> Result<(), SynthError> {
 }
 
 /// Write `imu_frame.csv`, `imu_handlebar.csv`, `speed_switch.csv` and
-/// `run.toml` of one run into `dir` (created), following FORMAT.md.
+/// `run.toml` of one run into `dir` (created), following FORMAT.md, from the
+/// angles of `traj` (the reed switch follows its wheel rotation; its speed
+/// series is not read).
 pub fn write_run(
     dir: &Path,
     name: &str,
@@ -203,7 +166,7 @@ pub fn write_run(
         path: dir.to_path_buf(),
         source,
     })?;
-    let mut rng = Rng::new(seed);
+    let mut rng = SplitMix64::new(seed ^ SENSOR_STREAM);
     let e = |a: [f64; 3]| Rotation3::from_euler_angles(a[0], a[1], a[2]);
     let mf = e(sensors.frame_misalignment);
     let mh = e(sensors.handlebar_misalignment);
@@ -285,7 +248,7 @@ pub fn write_run(
             });
             let mut out = closed;
             if closed && !was_closed {
-                bounce_next = rng.uniform() < sensors.bounce_probability;
+                bounce_next = rng.next_f64() < sensors.bounce_probability;
             } else if closed && bounce_next {
                 out = false;
                 bounce_next = false;
@@ -450,6 +413,7 @@ impl ResponseSpec {
             tr.pitch.push(self.frame_pitch);
             tr.steer.push(steer);
             tr.rear_wheel_angle.push(psi);
+            tr.speed.push(v);
         }
         tr
     }
@@ -465,6 +429,7 @@ pub fn rest_trajectory(duration: f64, frame_pitch: f64, yaw: f64) -> Trajectory 
         pitch: vec![frame_pitch; n],
         steer: vec![0.0; n],
         rear_wheel_angle: vec![0.0; n],
+        speed: vec![0.0; n],
     }
 }
 
@@ -501,6 +466,7 @@ pub fn linear_model_trajectory(c: &CanonicalMatrices, spec: &ResponseSpec) -> Op
         tr.pitch.push(spec.frame_pitch);
         tr.steer.push(-delta);
         tr.rear_wheel_angle.push(psi);
+        tr.speed.push(v);
         // Steer gamma = -delta: turning left raises the yaw.
         yaw += (v * (-delta) + trail * (-delta_rate)) * lam.cos() / w * dt;
         psi += v / r_wheel * dt;

@@ -462,6 +462,8 @@ impl<const N: usize> Solout<f64, [f64; N]> for Sampler<'_> {
 /// the start of the step where it stopped early.
 type RadauRun = (Vec<f64>, Vec<Vec<f64>>, usize, usize, Option<(f64, Vec<f64>)>);
 
+/// Radau5 on the state padded to `N` components, sampled at `times` (the
+/// last one the end) and stopped by `stop` (for [`integrate`]).
 fn radau_padded<const N: usize>(
     f: &dyn Fn(&[f64], &mut [f64]),
     stop: &dyn Fn(&[f64]) -> bool,
@@ -513,54 +515,6 @@ fn radau_padded<const N: usize>(
     Ok((sol.t, ys, sol.steps.accepted, sol.steps.rejected, from))
 }
 
-/// Integrate with Radau5 from `(t0, y0)` and sample at `times` (increasing,
-/// after `t0`, the last one the end), stopping early when an event of
-/// `events` fires. Returns the samples and, after an early stop, the start
-/// of the last step.
-fn radau_samples<M: MultibodyModel>(
-    eval: &Evaluator<'_, M>,
-    opts: &SimOptions,
-    events: Events,
-    t0: f64,
-    y0: &[f64],
-    times: Vec<f64>,
-    stats: &mut SimStats,
-) -> Result<RadauSamples, SimulateError> {
-    let f = |y: &[f64], dy: &mut [f64]| {
-        if eval.error.borrow().is_some() {
-            dy.fill(f64::NAN);
-            return;
-        }
-        if let Err(e) = eval.derivative(y[eval.layout.time()], y, dy) {
-            *eval.error.borrow_mut() = Some(e);
-            dy.fill(f64::NAN);
-        }
-    };
-    let stop = |y: &[f64]| eval.error.borrow().is_some() || event_value(eval, &events, y).0 <= 0.0;
-    // A few padded sizes (each is a monomorphisation of the solver).
-    let r = match y0.len() {
-        0..=12 => radau_padded::<12>(&f, &stop, opts, t0, y0, times),
-        13..=16 => radau_padded::<16>(&f, &stop, opts, t0, y0, times),
-        17..=32 => radau_padded::<32>(&f, &stop, opts, t0, y0, times),
-        n => {
-            return Err(SimulateError::InvalidInput(format!(
-                "Radau5 supports states of up to 32 components, model `{}` has {n}",
-                M::NAME
-            )))
-        }
-    };
-    if let Some(e) = eval.error.borrow_mut().take() {
-        return Err(e);
-    }
-    let (ts, ys, accepted, rejected, from) = r.map_err(|(t, message)| SimulateError::Integrator { t, message })?;
-    stats.accepted_steps += accepted as u64;
-    stats.rejected_steps += rejected as u64;
-    Ok((ts, ys, from))
-}
-
-/// Samples of [`radau_samples`] and the start of the step where it stopped.
-type RadauSamples = (Vec<f64>, Vec<Vec<f64>>, Option<(f64, Vec<f64>)>);
-
 /// Smallest event margin (`limit - |angle|`, rad) and which event it is
 /// (0 roll, 1 steer).
 fn event_value<M: MultibodyModel>(eval: &Evaluator<'_, M>, ev: &Events, y: &[f64]) -> (f64, usize) {
@@ -578,8 +532,162 @@ fn event_value<M: MultibodyModel>(eval: &Evaluator<'_, M>, ev: &Events, y: &[f64
     g
 }
 
-/// Integrate from `(t0, y0)` to `t1` and return the final state (no dense
-/// output).
+/// No event: integration to a given time (event location, the end of a
+/// segment whose samples stopped short).
+const NO_EVENTS: Events = Events {
+    roll_limit: None,
+    steer_limit: None,
+};
+
+/// What [`integrate`] returns.
+#[derive(Clone, Copy, Debug)]
+enum Sampling {
+    /// Dense output at `t0 + k (t1 - t0) / n`, `k = 0..=n` (the start
+    /// included, the last exactly `t1`), stopping after the first step at
+    /// whose end an event of `events` fires.
+    Grid { n: usize, events: Events },
+    /// The state at `t1` alone, from the last step point (no dense output,
+    /// no events).
+    End,
+}
+
+/// Samples of [`integrate`]: times (s), states and, after an early stop of
+/// Radau5, the start `(t, y)` of its last step (a step point, more accurate
+/// than its samples, to locate the event from).
+struct Samples {
+    t: Vec<f64>,
+    y: Vec<Vec<f64>>,
+    stopped_from: Option<(f64, Vec<f64>)>,
+}
+
+/// Integrate from `(t0, y0)` to `t1 > t0` with `opts.method`, sampled as
+/// `sampling` says: the one place where DOP853 and Radau5 are run. Counts the
+/// steps into `stats`; an error of the model's evaluation takes precedence
+/// over the integrator's own.
+fn integrate<M: MultibodyModel>(
+    eval: &Evaluator<'_, M>,
+    opts: &SimOptions,
+    t0: f64,
+    y0: &[f64],
+    t1: f64,
+    sampling: Sampling,
+    stats: &mut SimStats,
+) -> Result<Samples, SimulateError> {
+    let (grid, events) = match sampling {
+        Sampling::Grid { n, events } => (Some(n), events),
+        Sampling::End => (None, NO_EVENTS),
+    };
+    let dx = |n: usize| (t1 - t0) / n as f64;
+    let samples = match opts.method {
+        Method::Dop853 => {
+            let (x_end, dx, output) = match grid {
+                // Integrate slightly past the segment end: ode_solvers 0.6.2
+                // pushes an *extrapolated* dense sample at `x_end` whenever its
+                // next grid time is within 1e-9 of `x_end`, even from a step
+                // that ends before it. With the end off the grid the sample at
+                // `t1` is interpolated from the step that contains it.
+                Some(n) => (t1 + (1e-6f64).min(0.01 * dx(n)).max(1e-8), dx(n), OutputType::Dense),
+                None => (t1, t1 - t0, OutputType::Sparse),
+            };
+            let mut s = Dop853::new(
+                Rhs { eval, events },
+                t0,
+                x_end,
+                dx,
+                DVector::from_column_slice(y0),
+                opts.rtol,
+                opts.atol,
+            );
+            s.set_output(output);
+            let r = s.integrate();
+            if let Some(e) = eval.error.borrow_mut().take() {
+                return Err(e);
+            }
+            let st = r.map_err(|e| SimulateError::Integrator {
+                t: t0,
+                message: format!("DOP853: {e} (for stiff effects use the Radau5 method, --method radau5)"),
+            })?;
+            stats.accepted_steps += st.accepted_steps as u64;
+            stats.rejected_steps += st.rejected_steps as u64;
+            let mut t = s.x_out().clone();
+            if grid.is_some() {
+                if let Some(last) = t.last_mut() {
+                    if (*last - t1).abs() <= 1e-9 * t1.abs().max(1.0) {
+                        *last = t1;
+                    }
+                }
+            }
+            // Without a grid only the end point is wanted (not every step's).
+            let from = if grid.is_some() { 0 } else { t.len().saturating_sub(1) };
+            let y = s.y_out()[from..].iter().map(|v| v.as_slice().to_vec()).collect();
+            Samples {
+                t: t.split_off(from),
+                y,
+                stopped_from: None,
+            }
+        }
+        Method::Radau5 => {
+            let times: Vec<f64> = match grid {
+                Some(n) => (1..=n)
+                    .map(|k| if k == n { t1 } else { t0 + k as f64 * dx(n) })
+                    .collect(),
+                None => vec![t1],
+            };
+            let f = |y: &[f64], dy: &mut [f64]| {
+                if eval.error.borrow().is_some() {
+                    dy.fill(f64::NAN);
+                    return;
+                }
+                if let Err(e) = eval.derivative(y[eval.layout.time()], y, dy) {
+                    *eval.error.borrow_mut() = Some(e);
+                    dy.fill(f64::NAN);
+                }
+            };
+            let stop = |y: &[f64]| eval.error.borrow().is_some() || event_value(eval, &events, y).0 <= 0.0;
+            // A few padded sizes (each is a monomorphisation of the solver).
+            let r = match y0.len() {
+                0..=12 => radau_padded::<12>(&f, &stop, opts, t0, y0, times),
+                13..=16 => radau_padded::<16>(&f, &stop, opts, t0, y0, times),
+                17..=32 => radau_padded::<32>(&f, &stop, opts, t0, y0, times),
+                n => {
+                    return Err(SimulateError::InvalidInput(format!(
+                        "Radau5 supports states of up to 32 components, model `{}` has {n}",
+                        M::NAME
+                    )))
+                }
+            };
+            if let Some(e) = eval.error.borrow_mut().take() {
+                return Err(e);
+            }
+            let (mut t, mut y, accepted, rejected, stopped_from) =
+                r.map_err(|(t, message)| SimulateError::Integrator { t, message })?;
+            stats.accepted_steps += accepted as u64;
+            stats.rejected_steps += rejected as u64;
+            if grid.is_some() {
+                t.insert(0, t0);
+                y.insert(0, y0.to_vec());
+            }
+            Samples { t, y, stopped_from }
+        }
+    };
+    if samples.y.is_empty() {
+        return Err(SimulateError::Integrator {
+            t: t0,
+            message: format!(
+                "{} returned no end point",
+                if opts.method == Method::Radau5 {
+                    "Radau5"
+                } else {
+                    "DOP853"
+                }
+            ),
+        });
+    }
+    Ok(samples)
+}
+
+/// Integrate from `(t0, y0)` to `t1` and return the final state ([`integrate`]
+/// without samples or events).
 fn integrate_to<M: MultibodyModel>(
     eval: &Evaluator<'_, M>,
     t0: f64,
@@ -591,49 +699,8 @@ fn integrate_to<M: MultibodyModel>(
     if t1 <= t0 {
         return Ok(y0.to_vec());
     }
-    if opts.method == Method::Radau5 {
-        let none = Events {
-            roll_limit: None,
-            steer_limit: None,
-        };
-        let (_, ys, _) = radau_samples(eval, opts, none, t0, y0, vec![t1], stats)?;
-        return ys.into_iter().last().ok_or_else(|| SimulateError::Integrator {
-            t: t0,
-            message: "Radau5 returned no end point".into(),
-        });
-    }
-    let rhs = Rhs {
-        eval,
-        events: Events {
-            roll_limit: None,
-            steer_limit: None,
-        },
-    };
-    let mut s = Dop853::new(
-        rhs,
-        t0,
-        t1,
-        t1 - t0,
-        DVector::from_column_slice(y0),
-        opts.rtol,
-        opts.atol,
-    );
-    s.set_output(OutputType::Sparse);
-    let r = s.integrate();
-    if let Some(e) = eval.error.borrow_mut().take() {
-        return Err(e);
-    }
-    let st = r.map_err(|e| SimulateError::Integrator {
-        t: t0,
-        message: format!("DOP853: {e} (for stiff effects use the Radau5 method, --method radau5)"),
-    })?;
-    stats.accepted_steps += st.accepted_steps as u64;
-    stats.rejected_steps += st.rejected_steps as u64;
-    Ok(s.y_out()
-        .last()
-        .expect("the integrator outputs its end point")
-        .as_slice()
-        .to_vec())
+    let samples = integrate(eval, opts, t0, y0, t1, Sampling::End, stats)?;
+    Ok(samples.y.into_iter().last().expect("integrate checks the end point"))
 }
 
 /// The state vector for given initial conditions (consistent with all
@@ -900,59 +967,14 @@ pub fn simulate<M: MultibodyModel>(
             let qhat = eval.lateral_impulse(&p, kick_point(k), k.impulse, rt);
             eval.apply_impulse(t0, &mut y, &qhat)?;
         }
-        let n = ((t1 - t0) / opts.output_interval - 1e-9).ceil().max(1.0);
-        let dx = (t1 - t0) / n;
+        let n = ((t1 - t0) / opts.output_interval - 1e-9).ceil().max(1.0) as usize;
         eval.segment.set((t0, t1));
-        let mut stopped_from = None;
-        let (ts, ys) = if opts.method == Method::Radau5 {
-            let times: Vec<f64> = (1..=n as usize)
-                .map(|k| if k == n as usize { t1 } else { t0 + k as f64 * dx })
-                .collect();
-            let (mut ts, mut ys, from) = radau_samples(&eval, opts, opts.events, t0, &y, times, &mut sim.stats)?;
-            stopped_from = from;
-            ts.insert(0, t0);
-            ys.insert(0, y.clone());
-            (ts, ys)
-        } else {
-            let rhs = Rhs {
-                eval: &eval,
-                events: opts.events,
-            };
-            // Integrate slightly past the segment end: ode_solvers 0.6.2 pushes
-            // an *extrapolated* dense sample at `x_end` whenever its next grid
-            // time is within 1e-9 of `x_end`, even from a step that ends before
-            // it. With the end off the grid the sample at `t1` is interpolated
-            // from the step that contains it.
-            let overshoot = (1e-6f64).min(0.01 * dx).max(1e-8);
-            let mut s = Dop853::new(
-                rhs,
-                t0,
-                t1 + overshoot,
-                dx,
-                DVector::from_column_slice(&y),
-                opts.rtol,
-                opts.atol,
-            );
-            s.set_output(OutputType::Dense);
-            let r = s.integrate();
-            if let Some(e) = eval.error.borrow_mut().take() {
-                return Err(e);
-            }
-            let st = r.map_err(|e| SimulateError::Integrator {
-                t: t0,
-                message: format!("DOP853: {e} (for stiff effects use the Radau5 method, --method radau5)"),
-            })?;
-            sim.stats.accepted_steps += st.accepted_steps as u64;
-            sim.stats.rejected_steps += st.rejected_steps as u64;
-            let (mut ts, ys) = (s.x_out().clone(), s.y_out().clone());
-            if let Some(last) = ts.last_mut() {
-                if (*last - t1).abs() <= 1e-9 * t1.abs().max(1.0) {
-                    *last = t1;
-                }
-            }
-            let ys: Vec<Vec<f64>> = ys.iter().map(|v| v.as_slice().to_vec()).collect();
-            (ts, ys)
-        };
+        let sampling = Sampling::Grid { n, events: opts.events };
+        let Samples {
+            t: ts,
+            y: ys,
+            mut stopped_from,
+        } = integrate(&eval, opts, t0, &y, t1, sampling, &mut sim.stats)?;
         // The first sample is the segment start: skip it unless this is the
         // first segment or a kick changed the state.
         let skip = if first || kicked { 0 } else { 1 };

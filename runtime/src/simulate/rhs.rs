@@ -4,6 +4,7 @@
 use std::cell::{Cell, RefCell};
 
 use crate::constraints::dependent_velocities;
+use crate::linalg::{lu_factor, lu_solve};
 use crate::model::MultibodyModel;
 use crate::scalar::{Dual, Scalar};
 
@@ -156,78 +157,6 @@ pub fn rolling_radius<M: MultibodyModel>(param: &[f64], c: &BicycleCoordinates) 
             "model `{}`: no positive rolling radius from its kinematics ({r})",
             M::NAME
         )))
-    }
-}
-
-/// LU factorisation with partial pivoting of an `n x n` row-major matrix in
-/// place; `Err(column)` if singular to working precision.
-fn lu_factor(a: &mut [f64], n: usize, piv: &mut [usize]) -> Result<(), (usize, f64)> {
-    let scale = a[..n * n]
-        .iter()
-        .fold(0.0f64, |m, x| m.max(x.abs()))
-        .max(f64::MIN_POSITIVE);
-    for k in 0..n {
-        let (mut p, mut best) = (k, a[k * n + k].abs());
-        for i in k + 1..n {
-            let v = a[i * n + k].abs();
-            if v > best {
-                p = i;
-                best = v;
-            }
-        }
-        if !(best > scale * 1e-14) {
-            return Err((k, best));
-        }
-        piv[k] = p;
-        if p != k {
-            for j in 0..n {
-                a.swap(k * n + j, p * n + j);
-            }
-        }
-        let inv = 1.0 / a[k * n + k];
-        for i in k + 1..n {
-            let f = a[i * n + k] * inv;
-            a[i * n + k] = f;
-            if f != 0.0 {
-                for j in k + 1..n {
-                    a[i * n + j] -= f * a[k * n + j];
-                }
-            }
-        }
-    }
-    Ok(())
-}
-
-/// Solve with the factors of [`lu_factor`]; `b` is `n x nrhs` row-major.
-fn lu_solve(a: &[f64], n: usize, piv: &[usize], b: &mut [f64], nrhs: usize) {
-    // The factors were stored with whole-row swaps: apply every interchange
-    // first, then substitute forward.
-    for k in 0..n {
-        if piv[k] != k {
-            for j in 0..nrhs {
-                b.swap(k * nrhs + j, piv[k] * nrhs + j);
-            }
-        }
-    }
-    for k in 0..n {
-        for i in k + 1..n {
-            let f = a[i * n + k];
-            if f != 0.0 {
-                for j in 0..nrhs {
-                    b[i * nrhs + j] -= f * b[k * nrhs + j];
-                }
-            }
-        }
-    }
-    for k in (0..n).rev() {
-        let inv = 1.0 / a[k * n + k];
-        for j in 0..nrhs {
-            let mut s = b[k * nrhs + j];
-            for i in k + 1..n {
-                s -= a[k * n + i] * b[i * nrhs + j];
-            }
-            b[k * nrhs + j] = s * inv;
-        }
     }
 }
 
@@ -390,13 +319,13 @@ fn newton<M: MultibodyModel>(param: &[f64], t: f64, w: &mut Workspace) -> Result
                 w.jac[i * nh + k] = w.cq[i * nq + j];
             }
         }
-        lu_factor(&mut w.jac, nh, &mut w.piv).map_err(|(column, pivot)| SimulateError::Singular {
+        lu_factor(&mut w.jac, nh, &mut w.piv[..nh]).map_err(|s| SimulateError::Singular {
             t,
             what: "holonomic constraint Jacobian",
-            column,
-            pivot,
+            column: s.column,
+            pivot: s.pivot,
         })?;
-        lu_solve(&w.jac, nh, &w.piv, &mut w.res, 1);
+        lu_solve(&w.jac, nh, &w.piv[..nh], &mut w.res, 1);
         // Damped step: halve until the residual decreases (keeps Newton on
         // the branch it starts on).
         w.step.copy_from_slice(&w.res);
@@ -537,8 +466,8 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
                     w.jac[i * nh + k] = w.d[i * nq + j];
                 }
             }
-            if lu_factor(&mut w.jac, nh, &mut w.piv).is_ok() {
-                lu_solve(&w.jac, nh, &w.piv, &mut w.res, 1);
+            if lu_factor(&mut w.jac, nh, &mut w.piv[..nh]).is_ok() {
+                lu_solve(&w.jac, nh, &w.piv[..nh], &mut w.res, 1);
                 for (k, &j) in M::DEPENDENT.iter().enumerate() {
                     w.p[j] -= w.res[k];
                 }
@@ -568,13 +497,13 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
             }
             w.x[i * (ni + 1) + ni] = if i < nh { -w.ct[i] } else { 0.0 };
         }
-        lu_factor(&mut w.ddep, nd, &mut w.piv).map_err(|(column, pivot)| SimulateError::Singular {
+        lu_factor(&mut w.ddep, nd, &mut w.piv[..nd]).map_err(|s| SimulateError::Singular {
             t,
             what: "velocity constraints (coordinate partitioning)",
-            column,
-            pivot,
+            column: s.column,
+            pivot: s.pivot,
         })?;
-        lu_solve(&w.ddep, nd, &w.piv, &mut w.x, ni + 1);
+        lu_solve(&w.ddep, nd, &w.piv[..nd], &mut w.x, ni + 1);
         for (k, &j) in l.independent.iter().enumerate() {
             w.dp[j] = y[l.rates() + k];
         }
@@ -592,7 +521,7 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
         let nnh = nc - nh;
         w.gamma[..nh].copy_from_slice(&w.all[o.hconv..o.hconv + nh]);
         w.gamma[nh..].copy_from_slice(&w.all[o.nhconv..o.nhconv + nnh]);
-        lu_solve(&w.ddep, nd, &w.piv, &mut w.gamma, 1);
+        lu_solve(&w.ddep, nd, &w.piv[..nd], &mut w.gamma, 1);
         w.e.iter_mut().for_each(|x| *x = 0.0);
         w.f.iter_mut().for_each(|x| *x = 0.0);
         for (k, &j) in l.independent.iter().enumerate() {
@@ -644,13 +573,13 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
                 w.mi[a * ni + b] = m;
             }
         }
-        lu_factor(&mut w.mi, ni, &mut w.piv).map_err(|(column, pivot)| SimulateError::Singular {
+        lu_factor(&mut w.mi, ni, &mut w.piv[..ni]).map_err(|s| SimulateError::Singular {
             t,
             what: "reduced mass matrix",
-            column,
-            pivot,
+            column: s.column,
+            pivot: s.pivot,
         })?;
-        lu_solve(&w.mi, ni, &w.piv, &mut w.ddq, 1);
+        lu_solve(&w.mi, ni, &w.piv[..ni], &mut w.ddq, 1);
         Ok(())
     }
 
@@ -735,7 +664,7 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
         let mut rhs: Vec<f64> = (0..ni)
             .map(|a| (0..nq).map(|r| w.e[r * ni + a] * qhat[r]).sum())
             .collect();
-        lu_solve(&w.mi, ni, &w.piv[..ni.max(1)], &mut rhs, 1);
+        lu_solve(&w.mi, ni, &w.piv[..ni], &mut rhs, 1);
         let r = self.layout.rates();
         for k in 0..ni {
             y[r + k] += rhs[k];

@@ -1,28 +1,40 @@
-//! Orientation histories of a simulated run, in the form the synthetic
-//! measured-run writer of issue 8 takes (`experiment::synth::Trajectory`:
-//! `t, yaw, roll, pitch, steer, rear_wheel_angle`, thesis conventions, rad, s).
+//! The sampled motion of the bicycle ([`Trajectory`]): what a simulated run
+//! gives ([`trajectory_for_run`]) and what the synthetic measured-run writer
+//! takes (`experiment::synth::write_run`, issue 8), with the test motions of
+//! `experiment::synth`.
 
 use serde::Serialize;
 
 use super::{SimulateError, Simulation};
+use crate::random::SplitMix64;
 
-/// Angles of a run against time (thesis conventions, rad, s): yaw phi, roll
-/// theta (positive leaning right), frame pitch beta, steer gamma (positive
-/// turning left) and rear wheel rotation psi.
+/// A sampled motion of the bicycle, thesis conventions: yaw phi, roll theta
+/// (positive leaning right), frame pitch beta (the model coordinate; about
+/// minus the steer-axis tilt when upright), steer gamma (positive turning
+/// left), rear wheel rotation psi (increases when rolling forward), and the
+/// forward speed. All series have the length of `t`, which increases; the
+/// IMU logger of a synthetic run starts at `t[0]`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct RunTrajectory {
+pub struct Trajectory {
+    /// Time (s).
     pub t: Vec<f64>,
+    /// Yaw (rad).
     pub yaw: Vec<f64>,
+    /// Roll (rad).
     pub roll: Vec<f64>,
+    /// Frame pitch (rad).
     pub pitch: Vec<f64>,
+    /// Steer (rad).
     pub steer: Vec<f64>,
+    /// Rear wheel rotation (rad).
     pub rear_wheel_angle: Vec<f64>,
-    /// Forward speed of the rear contact point (m/s), for the truth file.
+    /// Forward speed of the rear contact point (m/s): for the truth files;
+    /// the sensor writer reads the wheel rotation instead.
     pub speed: Vec<f64>,
 }
 
-impl RunTrajectory {
-    /// Extract the angles from a simulation. Duplicate samples at kick times
+impl Trajectory {
+    /// The angles and speed of a simulation. Duplicate samples at kick times
     /// (before and after the velocity jump) are merged: angles are continuous.
     pub fn from_simulation(sim: &Simulation) -> Result<Self, SimulateError> {
         let col = |name: &'static str| {
@@ -30,7 +42,7 @@ impl RunTrajectory {
                 .ok_or(SimulateError::MissingCoordinate { model: sim.model, name })
         };
         let (yaw, roll, pitch, steer, psi) = (col("phi")?, col("theta")?, col("beta")?, col("gamma")?, col("psi")?);
-        let mut r = RunTrajectory::default();
+        let mut r = Trajectory::default();
         for i in 0..sim.t.len() {
             if i > 0 && sim.t[i] <= sim.t[i - 1] {
                 continue;
@@ -49,7 +61,7 @@ impl RunTrajectory {
     /// Append another trajectory that starts where this one ends (its first
     /// sample is dropped if it repeats the last time), shifting its time by
     /// `offset`.
-    pub fn append(&mut self, other: &RunTrajectory, offset: f64) {
+    pub fn append(&mut self, other: &Trajectory, offset: f64) {
         for i in 0..other.t.len() {
             let t = other.t[i] + offset;
             if let Some(&last) = self.t.last() {
@@ -91,14 +103,10 @@ pub struct RunPlan {
     pub seed: u64,
 }
 
-/// splitmix64: a small, well-known generator, enough for run plans.
-fn splitmix(state: &mut u64) -> f64 {
-    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-}
+/// Stream of a run plan's draws: the seed mixed with a constant, so it
+/// differs from the hand disturbances' stream, which starts from the seed
+/// itself.
+const PLAN_STREAM: u64 = 0x0005_EED0_FB1C_7C1E;
 
 impl RunPlan {
     /// A plan drawn like the thesis's field tests (section 5): launch 2-3 s
@@ -106,8 +114,8 @@ impl RunPlan {
     /// kick 0.6-1.4 s after release with 2-5 N s toward either side, 4-6 s of
     /// free response, samples every 1 ms.
     pub fn random(seed: u64) -> Self {
-        let mut s = seed ^ 0x0005_EED0_FB1C_7C1E;
-        let mut u = |lo: f64, hi: f64| lo + (hi - lo) * splitmix(&mut s);
+        let mut rng = SplitMix64::new(seed ^ PLAN_STREAM);
+        let mut u = |lo: f64, hi: f64| rng.uniform(lo, hi);
         let side = if u(0.0, 1.0) < 0.5 { -1.0 } else { 1.0 };
         RunPlan {
             launch_duration: u(2.0, 3.0),
@@ -130,10 +138,10 @@ struct Hand {
 }
 
 impl Hand {
-    fn new(amplitude: f64, state: &mut u64) -> Self {
+    fn new(amplitude: f64, rng: &mut SplitMix64) -> Self {
         let mut part = || {
-            let f = 0.3 + 1.2 * splitmix(state);
-            let ph = 2.0 * std::f64::consts::PI * splitmix(state);
+            let f = 0.3 + 1.2 * rng.next_f64();
+            let ph = 2.0 * std::f64::consts::PI * rng.next_f64();
             (amplitude / 3.0, 2.0 * std::f64::consts::PI * f, ph)
         };
         Hand {
@@ -163,7 +171,7 @@ pub fn trajectory_for_run<M: crate::model::MultibodyModel>(
     param: &[f64],
     plan: &RunPlan,
     opts: &super::SimOptions,
-) -> Result<(RunTrajectory, Simulation), SimulateError> {
+) -> Result<(Trajectory, Simulation), SimulateError> {
     use super::{initial_state, simulate, Evaluator, InitialConditions, Inputs, Kick};
     let bad = |m: &str| Err(SimulateError::InvalidInput(format!("run plan: {m} ({plan:?})")));
     if !(plan.launch_duration > 0.1 && plan.speed > 0.0 && plan.sample_interval > 0.0) {
@@ -172,9 +180,9 @@ pub fn trajectory_for_run<M: crate::model::MultibodyModel>(
     if !(plan.kick_delay >= 0.0 && plan.free_duration > 0.0) {
         return bad("kick delay must be >= 0 and free duration positive");
     }
-    let mut state = plan.seed;
-    let hand_roll = Hand::new(plan.hand_roll, &mut state);
-    let hand_steer = Hand::new(plan.hand_steer, &mut state);
+    let mut rng = SplitMix64::new(plan.seed);
+    let hand_roll = Hand::new(plan.hand_roll, &mut rng);
+    let hand_steer = Hand::new(plan.hand_steer, &mut rng);
     let fade = 0.3 * plan.launch_duration;
     let tl = plan.launch_duration;
     let v_at = |t: f64| {
@@ -199,7 +207,7 @@ pub fn trajectory_for_run<M: crate::model::MultibodyModel>(
     let c = eval.coords;
     let l = eval.layout.clone();
     let n = (tl / plan.sample_interval).round() as usize;
-    let mut traj = RunTrajectory::default();
+    let mut traj = Trajectory::default();
     let (mut yaw, mut last_rate) = (0.0, 0.0);
     let mut at_release = (0.0, 0.0, 0.0, 0.0);
     for k in 0..=n {
@@ -252,7 +260,7 @@ pub fn trajectory_for_run<M: crate::model::MultibodyModel>(
         ..*opts
     };
     let sim = simulate::<M>(param, &ic, &inputs, plan.kick_delay + plan.free_duration, &o)?;
-    let mut free = RunTrajectory::from_simulation(&sim)?;
+    let mut free = Trajectory::from_simulation(&sim)?;
     let psi0 = dist_at(tl) / rt;
     for x in &mut free.rear_wheel_angle {
         *x += psi0;
