@@ -20,6 +20,7 @@ use bikedyn::registry::{with_model, ModelVisitor};
 use bikedyn::runtime::eigen::eigenvalues;
 use bikedyn::runtime::experiment::synth::{rest_trajectory, write_run, RunKind, SensorModel};
 use bikedyn::runtime::linearize::parameter_vector;
+use bikedyn::runtime::model::CoordinateRole;
 use bikedyn::runtime::output::{save_json, write_atomic};
 use bikedyn::runtime::random::SplitMix64;
 use bikedyn::runtime::simulate::trajectory::{trajectory_for_run, RunPlan, Trajectory};
@@ -203,7 +204,7 @@ pub fn run(a: SynthArgs) -> Result<bool> {
             "release": {
                 "time": plan.launch_duration,
                 "roll": tr.roll[release], "steer": tr.steer[release], "yaw": tr.yaw[release],
-                "roll_rate": sim.rate("theta").map(|r| r[0]), "steer_rate": sim.rate("gamma").map(|r| r[0]),
+                "roll_rate": sim.rate_of(CoordinateRole::Roll).map(|r| r[0]), "steer_rate": sim.rate_of(CoordinateRole::Steer).map(|r| r[0]),
                 "speed": plan.speed,
             },
             "kick_time": plan.launch_duration + plan.kick_delay,

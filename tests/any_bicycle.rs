@@ -256,3 +256,56 @@ fn every_bicycle_model_declares_roll_and_steer() {
         Some("theta")
     );
 }
+
+/// Declared meaning, not names: no code outside the model files, the
+/// parameter-file readers and the tests names a coordinate or parameter of
+/// the thesis model as a string literal (the jobs find them by role).
+#[test]
+fn no_job_names_a_thesis_symbol() {
+    const SYMBOLS: &[&str] = &[
+        "xc", "yc", "phi", "theta", "psi", "beta", "gamma", "eps", "xi", "V", "Rt", "Rd", "x3", "z3", "x4", "z4", "x5",
+        "z5", "m2", "m3", "m4", "m5", "I2x", "I2y", "I3x", "I3y", "I3z", "I3zx", "I4x", "I4y", "I4z", "I4xz", "I5x",
+        "I5y", "d4",
+    ];
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut offences = Vec::new();
+    let mut stack = vec![root.join("src"), root.join("runtime/src")];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap().flatten() {
+            let path = entry.path();
+            // The parameter-file readers map the thesis form by name.
+            if path.ends_with("runtime/src/parameters") {
+                continue;
+            }
+            if path.is_dir() {
+                stack.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "rs") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            let mut in_tests = false;
+            for (i, line) in text.lines().enumerate() {
+                // Unit tests at the bottom of a file may name what they check.
+                if line.starts_with("#[cfg(test)]") {
+                    in_tests = true;
+                }
+                let code = line.split("//").next().unwrap_or("");
+                if in_tests {
+                    continue;
+                }
+                for s in SYMBOLS {
+                    if code.contains(&format!("\"{s}\"")) {
+                        offences.push(format!("{}:{}: {}", path.display(), i + 1, line.trim()));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        offences.is_empty(),
+        "thesis symbols named outside the model files:\n{}",
+        offences.join("\n")
+    );
+}

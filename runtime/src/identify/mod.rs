@@ -314,8 +314,13 @@ fn simulate_segment<M: MultibodyModel>(
             simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &stiff)
         })
         .map_err(|e| e.to_string())?;
-    let roll = sim.coordinate("theta").ok_or("model has no roll coordinate theta")?;
-    let steer = sim.coordinate("gamma").ok_or("model has no steer coordinate gamma")?;
+    use crate::model::CoordinateRole as R;
+    let roll = sim
+        .require_coordinate(R::Roll, "identification residuals")
+        .map_err(|e| e.to_string())?;
+    let steer = sim
+        .require_coordinate(R::Steer, "identification residuals")
+        .map_err(|e| e.to_string())?;
     Ok(Sim {
         roll: seg.t.iter().map(|&t| interp(&sim.t, &roll, t)).collect(),
         steer: seg.t.iter().map(|&t| interp(&sim.t, &steer, t)).collect(),

@@ -104,12 +104,16 @@ use crate::output::{write_atomic, OutputError};
 /// Why a simulation failed.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum SimulateError {
-    /// The model lacks a coordinate the simulation needs by name.
-    #[error("model `{model}` has no coordinate `{name}` (the simulation needs the thesis's coordinates xc yc phi theta psi beta gamma)")]
-    MissingCoordinate { model: &'static str, name: &'static str },
+    /// The model lacks a coordinate role the simulation needs.
+    #[error(transparent)]
+    MissingRole(#[from] crate::model::MissingRole),
     /// Roll and steer must be independent coordinates.
-    #[error("coordinate `{name}` of model `{model}` is not independent")]
-    NotIndependent { model: &'static str, name: &'static str },
+    #[error("the {role} coordinate `{name}` of model `{model}` is not independent")]
+    NotIndependent {
+        model: &'static str,
+        role: &'static str,
+        name: &'static str,
+    },
     #[error("model `{model}` takes {expected} parameters, {got} given")]
     ParameterCount {
         model: &'static str,
@@ -225,6 +229,9 @@ pub struct Simulation {
     pub model: &'static str,
     /// Coordinate names, in the order of `p` and `dp`.
     pub coordinates: Vec<&'static str>,
+    /// What the coordinates mean, as the model declares it: `(role, index)`.
+    #[serde(skip)]
+    pub roles: &'static [(crate::model::CoordinateRole, usize)],
     /// Parameter vector used.
     pub parameters: Vec<f64>,
     /// Sample times (s). A kick gives two samples at its time: before and after.
@@ -258,6 +265,29 @@ impl Simulation {
     pub fn coordinate(&self, name: &str) -> Option<Vec<f64>> {
         let j = self.coordinates.iter().position(|c| *c == name)?;
         Some(self.p.iter().map(|p| p[j]).collect())
+    }
+    /// Column of the coordinate with meaning `role` (roll, steer, ...).
+    pub fn coordinate_of(&self, role: crate::model::CoordinateRole) -> Option<Vec<f64>> {
+        let j = self.roles.iter().find(|(r, _)| *r == role)?.1;
+        Some(self.p.iter().map(|p| p[j]).collect())
+    }
+    /// Rate of the coordinate with meaning `role`.
+    pub fn rate_of(&self, role: crate::model::CoordinateRole) -> Option<Vec<f64>> {
+        let j = self.roles.iter().find(|(r, _)| *r == role)?.1;
+        Some(self.dp.iter().map(|p| p[j]).collect())
+    }
+    /// [`Simulation::coordinate_of`], or an error naming the role and the job.
+    pub fn require_coordinate(
+        &self,
+        role: crate::model::CoordinateRole,
+        job: &'static str,
+    ) -> Result<Vec<f64>, crate::model::MissingRole> {
+        self.coordinate_of(role).ok_or(crate::model::MissingRole {
+            model: self.model,
+            kind: "coordinate",
+            role: role.describe(),
+            job,
+        })
     }
     /// Rate of a coordinate by name.
     pub fn rate(&self, name: &str) -> Option<Vec<f64>> {
@@ -911,6 +941,7 @@ pub fn simulate<M: MultibodyModel>(
     let mut sim = Simulation {
         model: M::NAME,
         coordinates: M::COORDINATES.to_vec(),
+        roles: M::COORDINATE_ROLES,
         parameters: param.clone(),
         t: vec![],
         p: vec![],

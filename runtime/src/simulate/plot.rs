@@ -23,7 +23,8 @@ struct TimeHistory<'a> {
 pub fn plot_simulation(path: impl AsRef<Path>, sim: &Simulation, opts: &PlotOptions) -> Result<(), PlotError> {
     let path = path.as_ref();
     crate::plot::ImageFormat::from_path(path)?;
-    let (roll, steer) = match (sim.coordinate("theta"), sim.coordinate("gamma")) {
+    use crate::model::CoordinateRole as R;
+    let (roll, steer) = match (sim.coordinate_of(R::Roll), sim.coordinate_of(R::Steer)) {
         (Some(r), Some(s)) if sim.t.len() >= 2 => (r, s),
         _ => {
             return Err(PlotError::NoData {

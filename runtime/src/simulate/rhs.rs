@@ -77,7 +77,7 @@ impl StateLayout {
 }
 
 /// Indices of the coordinates the simulation needs by role. All registered
-/// bicycle models share the thesis's names (section 3.2).
+/// bicycle models declare these roles (the thesis's coordinates, section 3.2).
 #[derive(Clone, Copy, Debug)]
 pub struct BicycleCoordinates {
     pub xc: usize,
@@ -93,29 +93,32 @@ pub struct BicycleCoordinates {
 }
 
 impl BicycleCoordinates {
-    /// Resolve the thesis coordinate names in model `M`.
+    /// The coordinates of model `M` by their declared roles.
     pub fn of<M: MultibodyModel>() -> Result<Self, SimulateError> {
-        let find = |name: &'static str| {
-            M::coordinate_index(name).ok_or(SimulateError::MissingCoordinate { model: M::NAME, name })
-        };
-        let roll = find("theta")?;
-        let steer = find("gamma")?;
-        let ind = |j: usize, name: &'static str| {
+        use crate::model::CoordinateRole as R;
+        let find = |role| M::require_coordinate(role, "the nonlinear simulation");
+        let roll = find(R::Roll)?;
+        let steer = find(R::Steer)?;
+        let ind = |j: usize, role: R| {
             M::INDEPENDENT
                 .iter()
                 .position(|&k| k == j)
-                .ok_or(SimulateError::NotIndependent { model: M::NAME, name })
+                .ok_or(SimulateError::NotIndependent {
+                    model: M::NAME,
+                    role: role.describe(),
+                    name: M::COORDINATES[j],
+                })
         };
         Ok(BicycleCoordinates {
-            xc: find("xc")?,
-            yc: find("yc")?,
-            yaw: find("phi")?,
+            xc: find(R::RearContactX)?,
+            yc: find(R::RearContactY)?,
+            yaw: find(R::Yaw)?,
             roll,
-            pitch: find("beta")?,
+            pitch: find(R::Pitch)?,
             steer,
-            rear_wheel: find("psi")?,
-            roll_ind: ind(roll, "theta")?,
-            steer_ind: ind(steer, "gamma")?,
+            rear_wheel: find(R::RearWheelRotation)?,
+            roll_ind: ind(roll, R::Roll)?,
+            steer_ind: ind(steer, R::Steer)?,
         })
     }
 }

@@ -37,11 +37,15 @@ impl Trajectory {
     /// The angles and speed of a simulation. Duplicate samples at kick times
     /// (before and after the velocity jump) are merged: angles are continuous.
     pub fn from_simulation(sim: &Simulation) -> Result<Self, SimulateError> {
-        let col = |name: &'static str| {
-            sim.coordinate(name)
-                .ok_or(SimulateError::MissingCoordinate { model: sim.model, name })
-        };
-        let (yaw, roll, pitch, steer, psi) = (col("phi")?, col("theta")?, col("beta")?, col("gamma")?, col("psi")?);
+        use crate::model::CoordinateRole as R;
+        let col = |role| sim.require_coordinate(role, "the run's trajectory");
+        let (yaw, roll, pitch, steer, psi) = (
+            col(R::Yaw)?,
+            col(R::Roll)?,
+            col(R::Pitch)?,
+            col(R::Steer)?,
+            col(R::RearWheelRotation)?,
+        );
         let mut r = Trajectory::default();
         for i in 0..sim.t.len() {
             if i > 0 && sim.t[i] <= sim.t[i - 1] {
