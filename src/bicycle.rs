@@ -47,6 +47,8 @@ pub enum BicycleError {
         bike: String,
         missing: String,
     },
+    #[error("{file}: {why}")]
+    EffectParameter { file: String, why: String },
     #[error("no generated model has every parameter `{bike}` sets ({nonzero})")]
     NoModelFits { bike: String, nonzero: String },
     #[error("the canonical form M0, C1, K0, K2 holds for the Whipple bicycle; with {effects} the linear equations depend on speed otherwise")]
@@ -87,6 +89,9 @@ impl Bicycle {
             path if Path::new(path).exists() => {
                 let extra: Vec<&str> = effect_parameters().iter().map(|p| p.name).collect();
                 let (set, effects, warnings) = ParameterSet::load_with_extra(path, &extra)?;
+                for (name, &value) in &effects {
+                    check_effect_value(name, value, path)?;
+                }
                 return Ok(Bicycle {
                     name: spec.to_string(),
                     parameters: set,
@@ -274,6 +279,7 @@ impl Bicycle {
     /// symbol (`Rt`, `x4`, `d4`, ...) or a benchmark symbol (`c`, `lam`, ...).
     pub fn with_parameter(&self, symbol: &str, value: f64) -> Result<Bicycle, BicycleError> {
         if effect_parameters().iter().any(|p| p.name == symbol) {
+            check_effect_value(symbol, value, &self.name)?;
             let mut b = self.clone();
             b.effects.insert(symbol.to_string(), value);
             b.name = format!("{} ({symbol} = {value})", self.name);
@@ -312,6 +318,22 @@ impl Bicycle {
                     .find(|p| p.name == symbol)
                     .and_then(|p| p.default)
             })
+    }
+}
+
+/// Refuse a non-physical value of effect parameter `name` (not finite, or
+/// below the lower bound its effect file declares), naming `file`.
+pub fn check_effect_value(name: &str, value: f64, file: &str) -> Result<(), BicycleError> {
+    match effect_parameters()
+        .iter()
+        .find(|p| p.name == name)
+        .and_then(|p| p.refuses(value))
+    {
+        Some(why) => Err(BicycleError::EffectParameter {
+            file: file.to_string(),
+            why,
+        }),
+        None => Ok(()),
     }
 }
 

@@ -291,3 +291,29 @@ fn every_effect_declares_its_identification() {
         assert!(seen.contains(name), "{name}");
     }
 }
+
+/// Effect parameters are physical or refused, naming the file and the
+/// field: not a number, negative damping, a zero relaxation length (which
+/// would otherwise divide by zero in the tyre law).
+#[test]
+fn non_physical_effect_parameters_are_refused() {
+    for (line, field, why) in [
+        ("c_steer = nan\n", "c_steer", "finite"),
+        ("c_steer = -0.1\n", "c_steer", "at least 0"),
+        ("CdA = -0.3\n", "CdA", "at least 0"),
+        ("sigma_rear = 0.0\n", "sigma_rear", "greater than 0"),
+        ("w_steer = 0.0\n", "w_steer", "greater than 0"),
+    ] {
+        let path = thesis_file_with(line, &format!("bad_{field}.toml"));
+        let err = Bicycle::resolve(path.to_str().unwrap()).unwrap_err().to_string();
+        assert!(
+            err.contains(path.to_str().unwrap()) && err.contains(field) && err.contains(why),
+            "{line}: {err}"
+        );
+    }
+    // A sweep into non-physical values is refused the same way.
+    let b = Bicycle::resolve("thesis").unwrap();
+    let err = b.with_parameter("c_steer", -1.0).unwrap_err().to_string();
+    assert!(err.contains("c_steer") && err.contains("at least 0"), "{err}");
+    assert!(b.with_parameter("c_steer", 0.3).is_ok());
+}

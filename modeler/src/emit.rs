@@ -664,7 +664,14 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             Some(e) => quote!(Some(#e)),
             None => quote!(None),
         };
-        quote!(bikedyn_runtime::model::ParameterInfo { name: #n, doc: #pd, default: #default, effect: #effect })
+        let lower = match p.lower {
+            Some((b, strict)) => {
+                let l = proc_macro2::Literal::f64_suffixed(b);
+                quote!(Some((#l, #strict)))
+            }
+            None => quote!(None),
+        };
+        quote!(bikedyn_runtime::model::ParameterInfo { name: #n, doc: #pd, default: #default, effect: #effect, lower: #lower })
     });
     let force_info = m.forces.iter().map(|f| {
         let n = f.name();

@@ -152,6 +152,9 @@ pub struct Parameter {
     pub effect: Option<String>,
     /// What the parameter means to the jobs (wheel radii), if declared.
     pub meaning: Option<ParameterRole>,
+    /// Physical lower bound, if any: `(bound, strict)`; a value below it (or
+    /// at it, when strict) is refused when a bicycle is read.
+    pub lower: Option<(f64, bool)>,
 }
 
 /// An extra first-order state (beyond the coordinates and their rates),
@@ -520,6 +523,7 @@ impl ModelBuilder {
             default: None,
             effect: self.effect.clone(),
             meaning: None,
+            lower: None,
         });
         Expr::Param(name.into())
     }
@@ -532,6 +536,7 @@ impl ModelBuilder {
             default: Some(default),
             effect: self.effect.clone(),
             meaning: None,
+            lower: None,
         });
         Expr::Param(name.into())
     }
@@ -540,6 +545,15 @@ impl ModelBuilder {
     pub fn upright_value(&mut self, coordinate: &str, value: Expr) {
         if let Some(c) = self.m.coordinates.iter_mut().find(|c| c.name == coordinate) {
             c.upright = Some(value);
+        }
+    }
+    /// A physical lower bound of parameter `parameter`: values below
+    /// `bound` (or equal to it, when `strict`) are refused when a bicycle is
+    /// read, e.g. a negative damping coefficient or a zero relaxation length.
+    pub fn lower_bound(&mut self, parameter: &str, bound: f64, strict: bool) {
+        match self.m.parameters.iter_mut().find(|c| c.name == parameter) {
+            Some(p) => p.lower = Some((bound, strict)),
+            None => self.unresolved_roles.push((parameter.to_string(), "lower bound")),
         }
     }
     /// Declare what coordinate `coordinate` means (see [`CoordinateRole`]).

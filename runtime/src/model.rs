@@ -24,6 +24,29 @@ pub struct ParameterInfo {
     pub default: Option<f64>,
     /// The effect that declared it.
     pub effect: Option<&'static str>,
+    /// Physical lower bound `(bound, strict)`, if declared.
+    pub lower: Option<(f64, bool)>,
+}
+
+impl ParameterInfo {
+    /// Why `value` is not a physical value of this parameter, if it is not:
+    /// not finite, or below its declared lower bound.
+    pub fn refuses(&self, value: f64) -> Option<String> {
+        if !value.is_finite() {
+            return Some(format!("`{}` must be a finite number, found {value}", self.name));
+        }
+        match self.lower {
+            Some((b, true)) if value <= b => Some(format!(
+                "`{}` must be greater than {b}, found {value} ({})",
+                self.name, self.doc
+            )),
+            Some((b, false)) if value < b => Some(format!(
+                "`{}` must be at least {b}, found {value} ({})",
+                self.name, self.doc
+            )),
+            _ => None,
+        }
+    }
 }
 
 /// An applied force of a generated model (one row of

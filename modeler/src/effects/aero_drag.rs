@@ -11,6 +11,9 @@ use crate::model::{Force, ModelBuilder};
 fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     let cda = m.parameter_with_default("CdA", "drag area, drag coefficient times frontal area (m^2)", 0.0);
     let rho = m.parameter_with_default("rho_air", "air density (kg/m^3)", 1.2);
+    // Physical values only: a negative coefficient would feed energy in.
+    m.lower_bound("CdA", 0.0, false);
+    m.lower_bound("rho_air", 0.0, false);
     let point = parts.rear_frame_mass_centre;
     let v = velocity(point);
     let scale = -(ratio(1, 2) * rho * cda * smooth_norm(&v, ratio(1, 100)));

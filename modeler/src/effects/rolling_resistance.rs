@@ -16,6 +16,9 @@ use crate::model::{Force, ModelBuilder};
 fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     let crr_r = m.parameter_with_default("Crr_rear", "rolling resistance coefficient of the rear tyre (-)", 0.0);
     let crr_f = m.parameter_with_default("Crr_front", "rolling resistance coefficient of the front tyre (-)", 0.0);
+    // Physical values only: a negative coefficient would feed energy in.
+    m.lower_bound("Crr_rear", 0.0, false);
+    m.lower_bound("Crr_front", 0.0, false);
     let (n_rear, n_front) = super::static_normal_loads(m, parts);
     for (name, crr, n, contact) in [
         ("rolling_resistance_rear", crr_r, n_rear, parts.rear_contact),

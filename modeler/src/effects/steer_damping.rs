@@ -7,6 +7,8 @@ use crate::model::{Force, ModelBuilder};
 
 fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
     let c = m.parameter_with_default("c_steer", "steer-axis viscous damping coefficient (N m s/rad)", 0.0);
+    // Physical values only: a negative coefficient would feed energy in.
+    m.lower_bound("c_steer", 0.0, false);
     m.dissipative_force(Force::Generalized {
         name: "steer_damping".into(),
         coordinate: parts.steer.clone(),

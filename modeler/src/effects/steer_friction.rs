@@ -21,6 +21,10 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
         "smoothing rate of the steer friction, tanh(gamma'/w) (rad/s)",
         0.1,
     );
+    // Physical values only: negative friction would feed energy in, and the
+    // smoothing rate divides.
+    m.lower_bound("T_steer", 0.0, false);
+    m.lower_bound("w_steer", 0.0, true);
     m.dissipative_force(Force::Generalized {
         name: "steer_friction".into(),
         coordinate: parts.steer.clone(),

@@ -71,6 +71,11 @@ fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {
             &format!("{wheel} tyre relaxation length (m)"),
             sigma,
         );
+        // The relaxation length divides (a zero length is the no-slip limit,
+        // which is another model); stiffnesses cannot be negative.
+        m.lower_bound(&format!("sigma_{wheel}"), 0.0, true);
+        m.lower_bound(&format!("Ca_{wheel}"), 0.0, false);
+        m.lower_bound(&format!("Cg_{wheel}"), 0.0, false);
         // Ground-plane heading t = axle x Z and lateral direction n = Z x t.
         let axle = frame_axis(axes, Axis::Y);
         let heading: Vec3 = [axle[1].clone(), -axle[0].clone(), num(0)];
