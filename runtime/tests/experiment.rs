@@ -518,3 +518,47 @@ fn tudelft_logs_every_kick_found_and_fitted() {
         assert!(fitted.iter().all(|(_, f)| f.r2.is_finite() && f.eigenvalue[1] > 0.0));
     }
 }
+
+/// Counts, rates and file names read from `run.toml` are bounded and kept
+/// inside the run folder; oversized inputs are refused before memory grows.
+#[test]
+fn run_metadata_is_bounded_and_kept_inside_the_run() {
+    use bikedyn_runtime::experiment::read::{read_capped, read_meta};
+    let good = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/data/hidden_steer_damping/run01/run.toml"),
+    )
+    .unwrap();
+    let dir = tmp("bounded_meta");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("run.toml");
+    std::fs::write(&path, &good).unwrap();
+    assert!(read_meta(&path).is_ok());
+    for (from, to, says) in [
+        ("magnets = 9", "magnets = 1e9", "from 1 to 1000"),
+        ("magnets = 9", "magnets = 2.5", "whole number"),
+        ("rate_hz = 120", "rate_hz = 1e300", "sample rate"),
+        (
+            "files = [\"imu_frame.csv\", \"imu_handlebar.csv\"]",
+            "files = [\"/etc/passwd\", \"imu_handlebar.csv\"]",
+            "inside the run folder",
+        ),
+        (
+            "file = \"speed_switch.csv\"",
+            "file = \"../run02/speed_switch.csv\"",
+            "inside the run folder",
+        ),
+        (
+            "wheel_circumference_m = 2.0",
+            "wheel_circumference_m = 2000.0",
+            "circumference",
+        ),
+    ] {
+        assert!(good.contains(from), "{from}");
+        std::fs::write(&path, good.replacen(from, to, 1)).unwrap();
+        let err = read_meta(&path).unwrap_err().to_string();
+        assert!(err.contains("run.toml") && err.contains(says), "{to}: {err}");
+    }
+    // An endless device is refused at the cap, not read whole.
+    let err = read_capped(Path::new("/dev/zero"), 1 << 20).unwrap_err();
+    assert!(err.to_string().contains("larger than 1 MiB"), "{err}");
+}

@@ -650,3 +650,13 @@ IFyy=0.28
         }
     }
 }
+
+/// A parameter "file" that never ends (`--bike /dev/zero`) is refused at a
+/// few megabytes instead of filling memory.
+#[test]
+fn an_endless_parameter_file_is_refused() {
+    let err = bikedyn_runtime::parameters::ParameterSet::load("/dev/zero")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("/dev/zero") && err.contains("larger than"), "{err}");
+}

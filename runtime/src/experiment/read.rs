@@ -195,10 +195,39 @@ fn normalise_name(s: &str) -> String {
     s.trim().trim_matches('"').to_ascii_lowercase().replace([' ', '-'], "_")
 }
 
+/// The largest data file read (a sensor log of hours at kilohertz rates
+/// is far smaller): anything larger is not a log, and reading it whole
+/// would exhaust memory (a device such as `/dev/zero` never ends).
+pub const MAX_DATA_FILE_BYTES: u64 = 512 << 20;
+
+/// The largest metadata or parameter file read.
+pub const MAX_TEXT_FILE_BYTES: u64 = 4 << 20;
+
+/// Read at most `limit` bytes of `path`; a longer file (or an endless
+/// device) is an error that says so, before memory grows.
+pub fn read_capped(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut out = Vec::new();
+    std::fs::File::open(path)?.take(limit + 1).read_to_end(&mut out)?;
+    if out.len() as u64 > limit {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            format!("larger than {} MiB: not a file this reads", limit >> 20),
+        ));
+    }
+    Ok(out)
+}
+
+/// [`read_capped`] as text (invalid UTF-8 is an error).
+pub fn read_text_capped(path: &Path, limit: u64) -> std::io::Result<String> {
+    String::from_utf8(read_capped(path, limit)?)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "not UTF-8 text"))
+}
+
 /// Read a comma-separated numeric table. `wanted` lists, per column, the
 /// accepted header names (first = canonical name used in messages).
 fn read_table(path: &Path, wanted: &[&[&'static str]]) -> Result<Table, ReadError> {
-    let bytes = std::fs::read(path).map_err(|source| ReadError::Io {
+    let bytes = read_capped(path, MAX_DATA_FILE_BYTES).map_err(|source| ReadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -457,9 +486,15 @@ pub struct RunMeta {
     pub supply_v: Option<f64>,
 }
 
+/// Most magnets a wheel carries (real set-ups use 1 to a few dozen).
+pub const MAX_MAGNETS: usize = 1000;
+
+/// Highest sample rate accepted (Hz).
+pub const MAX_RATE_HZ: f64 = 1e6;
+
 /// Read `run.toml`.
 pub fn read_meta(path: &Path) -> Result<RunMeta, ReadError> {
-    let text = std::fs::read_to_string(path).map_err(|source| ReadError::Io {
+    let text = read_text_capped(path, MAX_TEXT_FILE_BYTES).map_err(|source| ReadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -491,30 +526,53 @@ pub fn read_meta(path: &Path) -> Result<RunMeta, ReadError> {
             )))
         }
     };
+    // A run's files live in its folder: a plain file name, never an
+    // absolute path or a way out of the folder (`..`), so that reading a run
+    // cannot reach, or echo in a message, another file of the machine.
+    let inside = |key: &str, name: &str| -> Result<String, ReadError> {
+        let p = Path::new(name);
+        let plain = !name.is_empty() && p.components().all(|c| matches!(c, std::path::Component::Normal(_)));
+        if plain {
+            Ok(name.to_string())
+        } else {
+            Err(meta(format!(
+                "{key} = \"{name}\" must name a file inside the run folder (no absolute path, no `..`)"
+            )))
+        }
+    };
     let imu_files = match v.get("imu").and_then(|s| s.get("files")).and_then(|f| f.as_array()) {
         Some(a) if a.len() == 2 && a.iter().all(|x| x.is_str()) => [
-            a[0].as_str().unwrap_or_default().to_string(),
-            a[1].as_str().unwrap_or_default().to_string(),
+            inside("[imu] files", a[0].as_str().unwrap_or_default())?,
+            inside("[imu] files", a[1].as_str().unwrap_or_default())?,
         ],
         Some(_) => return Err(meta("[imu] files must list two file names (frame, handlebar)".into())),
         None => ["imu_frame.csv".into(), "imu_handlebar.csv".into()],
     };
+    // Counts and rates in plausible ranges: a count sizes the arrays built
+    // from it (`magnets = 1e9` would ask for gigabytes).
     let magnets = num("speed_switch", "magnets")?;
-    if !(magnets >= 1.0 && magnets.fract() == 0.0) {
+    if !(magnets >= 1.0 && magnets.fract() == 0.0 && magnets <= MAX_MAGNETS as f64) {
         return Err(meta(format!(
-            "[speed_switch] magnets = {magnets} is not a positive integer"
+            "[speed_switch] magnets = {magnets} is not a whole number from 1 to {MAX_MAGNETS}"
         )));
     }
     let circ = num("speed_switch", "wheel_circumference_m")?;
-    if !(circ > 0.0) {
+    if !(circ > 0.1 && circ < 10.0) {
         return Err(meta(format!(
-            "[speed_switch] wheel_circumference_m = {circ} is not positive"
+            "[speed_switch] wheel_circumference_m = {circ} is not a wheel's circumference in metres (0.1 to 10)"
         )));
     }
     let imu_rate_hz = num("imu", "rate_hz")?;
     let switch_rate_hz = num("speed_switch", "rate_hz")?;
-    if !(imu_rate_hz > 0.0 && switch_rate_hz > 0.0) {
-        return Err(meta("sample rates must be positive".into()));
+    for (key, r) in [
+        ("[imu] rate_hz", imu_rate_hz),
+        ("[speed_switch] rate_hz", switch_rate_hz),
+    ] {
+        if !(r >= 1.0 && r <= MAX_RATE_HZ) {
+            return Err(meta(format!(
+                "{key} = {r} is not a sample rate from 1 to {MAX_RATE_HZ} Hz"
+            )));
+        }
     }
     Ok(RunMeta {
         name: v
@@ -536,8 +594,9 @@ pub fn read_meta(path: &Path) -> Result<RunMeta, ReadError> {
             .get("speed_switch")
             .and_then(|s| s.get("file"))
             .and_then(|f| f.as_str())
-            .unwrap_or("speed_switch.csv")
-            .to_string(),
+            .map(|f| inside("[speed_switch] file", f))
+            .transpose()?
+            .unwrap_or_else(|| "speed_switch.csv".to_string()),
         magnets: magnets as usize,
         wheel_circumference_m: circ,
         supply_v: num("speed_switch", "supply_v").ok(),

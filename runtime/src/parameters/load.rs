@@ -303,9 +303,13 @@ impl BenchmarkParameters {
 }
 
 pub(crate) fn read(path: &Path) -> Result<String, ParameterError> {
-    std::fs::read_to_string(path).map_err(|source| ParameterError::Io {
-        path: path.to_path_buf(),
-        source,
+    // Capped: a parameter file is kilobytes; `--bike /dev/zero` must not
+    // grow without end.
+    crate::experiment::read::read_text_capped(path, crate::experiment::read::MAX_TEXT_FILE_BYTES).map_err(|source| {
+        ParameterError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
     })
 }
 
