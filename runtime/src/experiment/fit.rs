@@ -46,7 +46,8 @@ impl FitForm {
             FitForm::SpeedVaryingRollRate => "speed_varying_roll_rate",
         }
     }
-    fn speed_varying(self) -> bool {
+    /// Whether the eigenvalue of this form varies with the speed.
+    pub fn speed_varying(self) -> bool {
         matches!(self, FitForm::SpeedVaryingRollAngle | FitForm::SpeedVaryingRollRate)
     }
 }
@@ -80,17 +81,34 @@ pub struct FitResult {
     pub t0: f64,
     /// Lag-one autocorrelation of the residuals.
     pub residual_autocorrelation: f64,
+    /// The speed over the window as the speed-varying forms saw it: its
+    /// straight line `v(tau) = v0 + slope tau` and the window mean `vm`,
+    /// `[v0, slope, vm]` (m/s, m/s^2, m/s). The eigenvalue varies with
+    /// `I(tau) = int_0^tau (v - vm)`, so [`FitResult::evaluate`] needs it to
+    /// draw the fitted curve (`None` for the constant forms).
+    #[serde(skip)]
+    pub speed_line: Option<[f64; 3]>,
+}
+
+/// `I(tau) = int_0^tau (v0 + slope s - vm) ds` of a speed line `[v0, slope, vm]`.
+fn line_integral(line: [f64; 3], tau: f64) -> f64 {
+    let [v0, slope, vm] = line;
+    (v0 - vm) * tau + 0.5 * slope * tau * tau
 }
 
 impl FitResult {
-    /// Fitted curve at times `t` (same clock as the data; `integral` is
-    /// `I(tau)` for speed-varying forms).
-    pub fn evaluate(&self, t: &[f64], integral: Option<&[f64]>) -> Vec<f64> {
+    /// Fitted curve at times `t` (same clock as the data), the speed-varying
+    /// forms with the speed line they were fitted with.
+    pub fn evaluate(&self, t: &[f64]) -> Vec<f64> {
         let tau: Vec<f64> = t.iter().map(|x| x - self.t0).collect();
+        let integral = self
+            .speed_line
+            .filter(|_| self.form.speed_varying())
+            .map(|line| tau.iter().map(|&x| line_integral(line, x)).collect());
         let p = Problem {
             tau,
             y: vec![0.0; t.len()],
-            integral: integral.filter(|_| self.form.speed_varying()).map(|i| i.to_vec()),
+            integral,
             eq94: matches!(self.form, FitForm::RollAngle),
             p: DVector::from_vec(self.params.clone()),
         };
@@ -557,17 +575,21 @@ pub fn fit_prepared(
     let w_hat = prep.w_hat;
     let span = tau[n - 1];
     let eq94 = matches!(form, FitForm::RollAngle);
-    let integral = if form.speed_varying() {
+    // The speed enters through its straight line over the window (the
+    // pipeline passes its linear trend): kept in the result, so that the
+    // curve can be drawn again at any time.
+    let speed_line = if form.speed_varying() {
         let v = speed.expect("speed-varying fit needs the speed");
         let vm = v.iter().sum::<f64>() / n as f64;
-        let mut int = vec![0.0; n];
-        for i in 1..n {
-            int[i] = int[i - 1] + 0.5 * (v[i] + v[i - 1] - 2.0 * vm) * (tau[i] - tau[i - 1]);
-        }
-        Some(int)
+        let tm = tau.iter().sum::<f64>() / n as f64;
+        let stt: f64 = tau.iter().map(|x| (x - tm).powi(2)).sum();
+        let stv: f64 = tau.iter().zip(v).map(|(x, y)| (x - tm) * (y - vm)).sum();
+        let slope = if stt > 0.0 { stv / stt } else { 0.0 };
+        Some([vm - slope * tm, slope, vm])
     } else {
         None
     };
+    let integral: Option<Vec<f64>> = speed_line.map(|line| tau.iter().map(|&x| line_integral(line, x)).collect());
     let mut best: Option<Projected> = None;
     if form.speed_varying() {
         // The speed-varying form nests the constant one (zero slopes): start
@@ -663,16 +685,6 @@ pub fn fit_prepared(
         params,
         t0,
         residual_autocorrelation: rho,
+        speed_line,
     })
-}
-
-/// `I(tau) = int_0^tau (v - v_mean)` for plotting a speed-varying fit.
-pub fn speed_integral(t: &[f64], v: &[f64]) -> Vec<f64> {
-    let n = t.len();
-    let vm = v.iter().sum::<f64>() / n.max(1) as f64;
-    let mut int = vec![0.0; n];
-    for i in 1..n {
-        int[i] = int[i - 1] + 0.5 * (v[i] + v[i - 1] - 2.0 * vm) * (t[i] - t[i - 1]);
-    }
-    int
 }

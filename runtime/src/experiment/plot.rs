@@ -3,7 +3,7 @@
 //! each measured weave eigenvalue on its speed segment with error bars
 //! (Figures 14-15).
 
-use super::fit::{speed_integral, FitForm};
+use super::fit::FitForm;
 use super::KickFit;
 use crate::eigen::{eigen_sweep, Mode};
 use crate::output::write_string_atomic;
@@ -57,10 +57,7 @@ pub fn plot_response(path: &Path, k: &KickFit) -> Result<(), PlotError> {
         .map(|v| v.to_degrees())
         .collect();
     let fitted: Vec<f64> = match fit {
-        Some(f) => {
-            let int = speed_integral(&s.t, &s.speed);
-            f.evaluate(&s.t, Some(&int)).iter().map(|v| v.to_degrees()).collect()
-        }
+        Some(f) => f.evaluate(&s.t).iter().map(|v| v.to_degrees()).collect(),
         None => Vec::new(),
     };
     let mut svg = String::new();
