@@ -10,9 +10,13 @@ use bikedyn_runtime::registry::ModelInfo;
 /// show and the effects it points to.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Finding {
+    /// The residual pattern looked for.
     pub pattern: String,
+    /// What the residuals show, with standard errors.
     pub evidence: String,
+    /// The effects whose files declare this pattern.
     pub suspects: Vec<String>,
+    /// Whether the pattern exceeds two standard errors.
     pub significant: bool,
 }
 

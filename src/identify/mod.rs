@@ -85,17 +85,29 @@ pub struct Plan {
 
 /// Everything identification found, and what the report needs.
 pub struct Outcome {
+    /// The stepwise selection: fits before and after, each step's verdicts.
     pub identification: Identification,
+    /// The measured segments fitted (one per kick).
     pub segments: Vec<Segment>,
+    /// Runs and kicks left out, with the reason.
     pub skipped: Vec<String>,
+    /// The candidate effects tried.
     pub candidates: Vec<Candidate>,
+    /// The residual diagnosis of the base model.
     pub findings: Vec<Finding>,
+    /// Weave eigenvalue `[re, im]` (1/s) of each segment, base model.
     pub predicted_before: Vec<Option<[f64; 2]>>,
+    /// The same with the identified effects.
     pub predicted_after: Vec<Option<[f64; 2]>>,
+    /// The same with the values fitted without the segment's fold.
     pub predicted_held_out: Vec<Option<[f64; 2]>>,
+    /// Identified effect values by symbol (tied symbols and held companions included).
     pub values_after: BTreeMap<String, f64>,
+    /// The free-speed model fitted.
     pub model: &'static str,
+    /// Its driven-speed twin (the weave predictions).
     pub driven_model: &'static str,
+    /// Wall-clock time of the run (s).
     pub seconds: f64,
     /// Mean |steer rate| of each segment in the fitted simulation (rad/s).
     pub steer_rate: Vec<f64>,
