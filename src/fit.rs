@@ -2,45 +2,62 @@
 //! sets and TU Delft kick logs), with the model's prediction when a bicycle
 //! is given.
 
-use crate::bicycle::Bicycle;
-use anyhow::{Context, Result};
+use crate::bicycle::{Bicycle, BicycleError};
+use crate::progress::{OnProgress, Progress};
 use bikedyn_runtime::experiment::{
     self,
     angles::{AngleMethod, Calibration},
     compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
 };
+use bikedyn_runtime::parameters::ParameterError;
+use bikedyn_runtime::plot::PlotError;
 use bikedyn_runtime::CanonicalMatrices;
-use clap::Args;
 use serde_json::{json, Value};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use thiserror::Error;
 
-/// Arguments of `bikedyn fit`.
-#[derive(Args, Debug)]
-pub struct FitArgs {
+/// What `fit` processes and how.
+#[derive(Clone, Debug, Default)]
+pub struct FitOptions {
     /// Set folders (all runs), run folders, TU Delft log files, or folders of logs.
-    #[arg(required = true)]
     pub inputs: Vec<PathBuf>,
     /// Calibration run (default: `calibration/` beside the runs).
-    #[arg(long)]
     pub calibration: Option<PathBuf>,
     /// Bicycle for the prediction and the frame pitch at rest (built-in name
     /// or parameter file). Without it the thesis bicycle's frame pitch is used
     /// and no prediction is made.
-    #[arg(long)]
     pub bike: Option<String>,
-    /// JSON output (one entry per kick).
-    #[arg(long)]
-    pub json: bool,
-    /// Write plots (responses with speed, continuation diagram) to this folder.
-    #[arg(long)]
-    pub plot: Option<PathBuf>,
-    /// Angle method: direct (default) or thesis (eq. 87-93).
-    #[arg(long, default_value = "direct")]
-    pub angles: String,
+    /// How roll and steer are computed from the orientations (default: direct).
+    pub angles: AngleMethod,
     /// Keep the nominal clock offset instead of estimating it.
-    #[arg(long)]
     pub nominal_clock: bool,
+}
+
+/// Why `fit` could not run. A run that cannot be processed is not an error
+/// of the whole: it is listed in [`FitOutcome::errors`].
+#[derive(Debug, Error)]
+pub enum FitError {
+    /// The bicycle could not be resolved or has no canonical form it should have.
+    #[error(transparent)]
+    Bicycle(#[from] BicycleError),
+    /// The frame pitch at rest of the bicycle (from its geometry) failed.
+    #[error("frame pitch of {bicycle}")]
+    FramePitch {
+        bicycle: String,
+        #[source]
+        source: ParameterError,
+    },
+    /// A folder of plots could not be created.
+    #[error("creating {}", path.display())]
+    CreateDir {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A plot could not be drawn or written.
+    #[error(transparent)]
+    Plot(#[from] PlotError),
 }
 
 /// Everything `fit` found: reports per run and errors per skipped run.
@@ -55,13 +72,14 @@ pub struct FitOutcome {
     pub calibrations: Vec<(PathBuf, Calibration)>,
 }
 
-/// Run the pipeline on the inputs.
-pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
-    let bike = args.bike.as_deref().map(Bicycle::resolve).transpose()?;
+/// Run the pipeline on the inputs. `progress` is called after each run or
+/// log (step `"runs"`, with the total found).
+pub fn run_fit(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome, FitError> {
+    let bike = opts.bike.as_deref().map(Bicycle::resolve).transpose()?;
     // A bicycle with effect parameters has no canonical form (identify
     // passes such bicycles for the frame pitch): no prediction then.
     let canonical = match bike.as_ref().map(|b| b.canonical()) {
-        Some(Err(crate::bicycle::BicycleError::NotCanonical { .. })) | None => None,
+        Some(Err(BicycleError::NotCanonical { .. })) | None => None,
         Some(r) => Some(r?),
     };
     let pitch_bike = match &bike {
@@ -71,21 +89,19 @@ pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
     let frame_pitch = pitch_bike
         .thesis()?
         .frame_pitch()
-        .with_context(|| format!("frame pitch of {}", pitch_bike.name))?;
-    let angle_method = match args.angles.as_str() {
-        "direct" => AngleMethod::Direct,
-        "thesis" => AngleMethod::Thesis,
-        other => anyhow::bail!("--angles {other}: expected direct or thesis"),
-    };
+        .map_err(|source| FitError::FramePitch {
+            bicycle: pitch_bike.name.clone(),
+            source,
+        })?;
     let opt = PipelineOptions {
-        angle_method,
+        angle_method: opts.angles,
         frame_pitch,
-        refine_clock: !args.nominal_clock,
+        refine_clock: !opts.nominal_clock,
         ..PipelineOptions::default()
     };
     let mut inputs = Vec::new();
     let mut errors = Vec::new();
-    for p in &args.inputs {
+    for p in &opts.inputs {
         match experiment::classify(p) {
             Ok(i) => inputs.extend(i),
             Err(e) => errors.push(e.to_string()),
@@ -98,11 +114,16 @@ pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
             Input::Log(_) => 1,
         })
         .sum();
-    let bar = indicatif::ProgressBar::new(total as u64);
-    if !(std::io::stderr().is_terminal() && total > 3) {
-        bar.set_draw_target(indicatif::ProgressDrawTarget::hidden());
-    }
-    let tick = || bar.inc(1);
+    // Runs of a set are processed in parallel: count with an atomic.
+    let done = AtomicUsize::new(0);
+    let tick = || {
+        let done = done.fetch_add(1, Ordering::Relaxed) + 1;
+        progress(Progress {
+            step: "runs",
+            done,
+            total: Some(total),
+        })
+    };
     let mut reports = Vec::new();
     let mut calibrations = Vec::new();
     for input in inputs {
@@ -118,7 +139,7 @@ pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
                 if runs.is_empty() {
                     continue;
                 }
-                let cal = args.calibration.clone().or(calibration);
+                let cal = opts.calibration.clone().or(calibration);
                 let Some(cal) = cal else {
                     let expected = runs[0].parent().unwrap_or(Path::new(".")).join("calibration");
                     for r in &runs {
@@ -147,7 +168,6 @@ pub fn run_fit(args: &FitArgs) -> Result<FitOutcome> {
             }
         }
     }
-    bar.finish_and_clear();
     Ok(FitOutcome {
         reports,
         errors,
@@ -314,58 +334,14 @@ pub fn kicks_table(out: &FitOutcome) -> String {
     bikedyn_runtime::output::format_table(&header, &rows)
 }
 
-/// The `fit` command: prints the table or JSON, writes plots; `Ok(false)`
-/// when some run was skipped (its error is on stderr; the others are output).
-pub fn command(args: &FitArgs) -> Result<bool> {
-    let out = run_fit(args)?;
-    for e in &out.errors {
-        eprintln!("skipped: {e}");
-    }
-    for r in &out.reports {
-        for n in &r.notes {
-            eprintln!("{}: {n}", r.run.display());
-        }
-        for g in &r.gaps {
-            eprintln!("{g}");
-        }
-        if r.renormalised.iter().any(|&n| n > 0) {
-            eprintln!(
-                "{}: normalised {} frame and {} handlebar quaternions",
-                r.run.display(),
-                r.renormalised[0],
-                r.renormalised[1]
-            );
-        }
-    }
-    if args.json {
-        eprint!("{}", calibration_text(&out));
-        let list: Vec<Value> = out
-            .reports
-            .iter()
-            .flat_map(|r| r.kicks.iter())
-            .map(|k| kick_json(k, out.canonical.as_ref()))
-            .collect();
-        println!("{}", serde_json::to_string_pretty(&list)?);
-    } else {
-        print!("{}", calibration_text(&out));
-        print!("{}", kicks_table(&out));
-        let rows = residuals(&out);
-        if !rows.is_empty() {
-            println!("\nmeasured against predicted weave eigenvalue (z = difference / standard error)");
-            print!("{}", compare::format_residuals(&rows));
-        }
-    }
-    if let Some(dir) = &args.plot {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        crate::fit::plots(&out, dir)?;
-    }
-    Ok(out.errors.is_empty())
-}
-
 /// Response plots (one per kick) and, with a bicycle, the continuation
-/// diagram with the measured eigenvalues.
-pub fn plots(out: &FitOutcome, dir: &Path) -> Result<()> {
+/// diagram with the measured eigenvalues, in `dir` (created).
+pub fn plots(out: &FitOutcome, dir: &Path) -> Result<(), FitError> {
     use bikedyn_runtime::experiment::plot as xplot;
+    std::fs::create_dir_all(dir).map_err(|source| FitError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     for r in &out.reports {
         let stem = r
             .run
@@ -380,85 +356,6 @@ pub fn plots(out: &FitOutcome, dir: &Path) -> Result<()> {
     let kicks: Vec<&KickFit> = out.reports.iter().flat_map(|r| r.kicks.iter()).collect();
     if let Some(c) = &out.canonical {
         xplot::plot_measured_continuation(&dir.join("continuation_measured.svg"), c, &kicks)?;
-    }
-    Ok(())
-}
-
-/// `bikedyn bench` section: time to process one thesis-style run end to end
-/// (read, angles, speed, clock, kick, fits) and one TU Delft log, on one
-/// core. Uses `../shared` when present, else a synthetic run written to a
-/// temporary folder (and no TU Delft figure).
-pub fn bench_experiment(quick: bool) -> Result<()> {
-    use bikedyn_runtime::experiment::angles::Calibration;
-    use bikedyn_runtime::experiment::synth::{rest_trajectory, write_run, ResponseSpec, SensorModel};
-    use std::time::Instant;
-    let reps = if quick { 5 } else { 30 };
-    println!("\n== measured runs (bikedyn fit), median of {reps}, one thread ==");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared");
-    let (run_dir, cal_dir, log) = if root.join("data/dev/run01").is_dir() {
-        (
-            root.join("data/dev/run01"),
-            root.join("data/dev/calibration"),
-            Some(root.join("realdata/tudelft_sbw_kicks/logs/eigen_normal_sil6.5n2_16.2kph.log")),
-        )
-    } else {
-        let d = std::env::temp_dir().join(format!("bikedyn-bench-{}", std::process::id()));
-        let spec = ResponseSpec::default();
-        let s = SensorModel::default();
-        write_run(
-            &d.join("calibration"),
-            "calibration",
-            read::RunKind::Calibration,
-            &rest_trajectory(10.0, spec.frame_pitch, 0.3),
-            &s,
-            1,
-        )?;
-        write_run(&d.join("run01"), "run01", read::RunKind::Run, &spec.trajectory(), &s, 2)?;
-        (d.join("run01"), d.join("calibration"), None)
-    };
-    let opt = PipelineOptions::default();
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    let cal_run = read::read_run(&cal_dir)?;
-    let mut times = Vec::new();
-    for _ in 0..reps {
-        let t = Instant::now();
-        std::hint::black_box(Calibration::estimate(&cal_run, opt.frame_pitch));
-        times.push(t.elapsed().as_secs_f64());
-    }
-    println!(
-        "calibration run (misalignment estimate, read excluded): {:>8.2} ms",
-        1e3 * median(times)
-    );
-    let cal = Calibration::estimate(&cal_run, opt.frame_pitch);
-    let mut times = Vec::new();
-    for _ in 0..reps {
-        let t = Instant::now();
-        let run = read::read_run(&run_dir)?;
-        std::hint::black_box(experiment::process_thesis_run(&run, &cal, &opt));
-        times.push(t.elapsed().as_secs_f64());
-    }
-    println!(
-        "thesis-style run, end to end ({}): {:>8.2} ms",
-        run_dir.display(),
-        1e3 * median(times)
-    );
-    if let Some(log) = log.filter(|l| l.is_file()) {
-        let mut times = Vec::new();
-        let mut kicks = 0;
-        for _ in 0..reps.min(10) {
-            let t = Instant::now();
-            let l = read::read_tudelft(&log)?;
-            kicks = experiment::process_tudelft(&l, &opt).kicks.len();
-            times.push(t.elapsed().as_secs_f64());
-        }
-        println!(
-            "TU Delft log, end to end ({kicks} kicks, {}): {:>8.2} ms",
-            log.display(),
-            1e3 * median(times)
-        );
     }
     Ok(())
 }

@@ -16,9 +16,10 @@ pub mod registry {
     pub use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
 }
 
-pub mod bench;
-pub mod bench_simulate;
 pub mod bicycle;
 pub mod fit;
 pub mod identify;
 pub mod models;
+pub mod progress;
+pub mod simulate;
+pub mod synth;

@@ -102,7 +102,7 @@ fn synth_runs_recover_misalignments_kicks_clock_offsets_and_eigenvalues() {
         };
         let [lo, hi] = k.speed_interval;
         let speeds: Vec<f64> = (0..=10).map(|i| lo + (hi - lo) * i as f64 / 10.0).collect();
-        let curve = bikedyn::identify::predict(driven, &bike, &effects, &speeds).unwrap();
+        let curve = bikedyn::identify::predict::predict(driven, &bike, &effects, &speeds).unwrap();
         let curve: Vec<[f64; 2]> = curve.into_iter().flatten().collect();
         assert_eq!(curve.len(), speeds.len(), "{name}: model weave over {lo}-{hi} m/s");
         let range = |i: usize| {

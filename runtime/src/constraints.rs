@@ -2,9 +2,9 @@
 //! Jacobian) and dependent velocities, for any generated model.
 
 use crate::linalg::{solve_in_place, Singular};
+pub use crate::linear_types::ConstraintError;
 use crate::model::MultibodyModel;
 use crate::scalar::Scalar;
-use thiserror::Error;
 
 /// Options of the Newton solver, with documented defaults.
 #[derive(Clone, Copy, Debug)]
@@ -29,35 +29,6 @@ pub struct NewtonInfo {
     pub iterations: usize,
     /// Max-norm of the residuals at the solution.
     pub residual: f64,
-}
-
-/// Why the configuration could not be found.
-#[derive(Clone, Debug, Error, PartialEq)]
-pub enum ConstraintError {
-    /// Newton did not converge: for a bicycle this means the geometry has no
-    /// ground contact (e.g. the front wheel cannot reach the ground).
-    #[error("holonomic constraint `{constraint}` cannot be satisfied (residual {residual:.3e} after {iterations} Newton iterations): the geometry has no ground contact or the initial guess is too far")]
-    NotSatisfiable {
-        constraint: &'static str,
-        residual: f64,
-        iterations: usize,
-    },
-    /// The constraint Jacobian with respect to the dependent coordinates is singular.
-    #[error("the constraint Jacobian is singular at column {column} for the {what}: its largest available pivot {pivot:.3e} is below 1e-14 times its largest entry {scale:.3e}, so the dependent coordinates are not determined by the constraints here")]
-    SingularJacobian {
-        what: &'static str,
-        column: usize,
-        pivot: f64,
-        /// Largest entry magnitude of the Jacobian.
-        scale: f64,
-    },
-    /// The model's closed-form upright configuration has no real value
-    /// (e.g. the frame pitch when the front wheel cannot reach the ground).
-    #[error("the front wheel cannot touch the ground: the model's upright configuration has no real value for `{coordinate}` with these parameters")]
-    NoUprightConfiguration { coordinate: &'static str },
-    /// A parameter, coordinate or result is NaN or infinite.
-    #[error("non-finite value in {what}")]
-    NotFinite { what: &'static str },
 }
 
 fn singular(what: &'static str) -> impl Fn(Singular) -> ConstraintError {

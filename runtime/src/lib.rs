@@ -12,6 +12,7 @@ pub mod experiment;
 pub mod geometry;
 pub mod identify;
 pub mod linalg;
+pub mod linear_types;
 pub mod linearize;
 pub mod model;
 pub mod output;

@@ -10,59 +10,16 @@
 //! cross-check it.
 
 use crate::canonical::CanonicalMatrices;
-use crate::constraints::{
-    constraint_matrices, dependent_velocities, solve_configuration, ConstraintError, NewtonOptions,
-};
+use crate::constraints::{constraint_matrices, dependent_velocities, solve_configuration, NewtonOptions};
 use crate::eigen::{EigenError, LinearBicycle, SpeedMatrices};
 use crate::linalg::{lu_factor, lu_solve, lu_solve_dual, lu_solve_dual_narrow, solve_in_place, Scratch};
-use crate::model::{CoordinateRole, MissingRole, MultibodyModel};
+use crate::model::{CoordinateRole, MultibodyModel};
+// The types the `MultibodyModel` trait names live below it; their public
+// paths stay here.
+use crate::linear_types::ConstraintError;
+pub use crate::linear_types::{Linearization, LinearizeError, StateMatrix, WithRest};
 use crate::scalar::{Dual, Scalar};
 use nalgebra::{DMatrix, Matrix2};
-use thiserror::Error;
-
-/// Linearization failures.
-#[derive(Clone, Debug, Error, PartialEq)]
-pub enum LinearizeError {
-    #[error(transparent)]
-    Constraint(#[from] ConstraintError),
-    #[error(transparent)]
-    MissingRole(#[from] MissingRole),
-    #[error("model `{model}` has no parameter `{name}`")]
-    MissingParameter { model: &'static str, name: String },
-    #[error("the canonical form needs exactly 2 independent coordinates (roll, steer), model `{model}` has {n}")]
-    NotRollSteer { model: &'static str, n: usize },
-    #[error("the reduced mass matrix is singular")]
-    SingularMass,
-    /// The constraint solver converged to a root that is not the physical
-    /// upright configuration: refusing is better than returning the
-    /// matrices of another mechanism.
-    #[error("the constraint solution is not the physical upright bicycle: {coordinate} = {value:.6} rad, but {what} gives {expected:.6} rad")]
-    OffBranch {
-        coordinate: &'static str,
-        value: f64,
-        expected: f64,
-        what: &'static str,
-    },
-    /// A wheel of zero radius (a skate) that has a spin inertia: its spin
-    /// rate, and so its gyroscopic moment, would be infinite.
-    #[error("the {wheel} has zero radius ({radius_symbol} = 0) but a non-zero spin inertia ({inertia_symbol} = {inertia}): a skate wheel must have zero spin inertia")]
-    SkateWithSpinInertia {
-        wheel: &'static str,
-        radius_symbol: &'static str,
-        inertia_symbol: &'static str,
-        inertia: f64,
-    },
-    /// The zero-radius limit could not be taken reliably (the matrices are
-    /// not the quadratic polynomial in the radius that the closed form says).
-    #[error("the zero-radius limit is not reliable here (departure from a quadratic in the radius: {departure:.3e}, relative to {scale:.3e})")]
-    ZeroRadiusLimit { departure: f64, scale: f64 },
-    #[error("model `{model}` declares no forward speed (no speed parameter and no speed coordinate)")]
-    NoForwardSpeed { model: &'static str },
-    #[error("model `{model}` has {n} independent coordinates or states, more than the linearization supports")]
-    TooManyIndependent { model: &'static str, n: usize },
-    #[error("model `{model}` has extra states (e.g. tyre forces): its linearization is a state-space model, not M, C, K (use state_space_at_speed)")]
-    HasStates { model: &'static str },
-}
 
 /// Evaluate the reduced equations `Ec = Mi q'' - Qi` (thesis `EcMov.m`) at
 /// independent coordinates `q`, rates `dq`, accelerations `ddq`, with the
@@ -236,15 +193,6 @@ pub fn reduced_system<M: MultibodyModel, T: Scalar>(
     Ok(ReducedSystem { ec, mi, p, dp, ec_rest })
 }
 
-/// `M`, `C`, `K` of `M q'' + C q' + K q = 0` (thesis eq. 48-50) about
-/// upright straight running, in the model's independent coordinates.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Linearization {
-    pub mass: DMatrix<f64>,
-    pub damping: DMatrix<f64>,
-    pub stiffness: DMatrix<f64>,
-}
-
 /// Exact linearization (dual numbers) about upright straight running of a
 /// driven-speed model, at `param` (which fixes the speed): `M`, `C`, `K` in
 /// the two independent coordinates (roll, steer).
@@ -255,9 +203,6 @@ pub fn linearize<M: MultibodyModel>(param: &[f64]) -> Result<Linearization, Line
     }
     M::linearize_with_rest_exact(param, &[0.0; 2]).map(|(l, _)| l)
 }
-
-/// A linearization and the stiffness at rest from the same evaluation.
-pub type WithRest = (Linearization, DMatrix<f64>);
 
 /// The exact linearization about upright straight running (independent
 /// rates `dq0`) and, from the same evaluation, the stiffness at rest, with
@@ -631,9 +576,6 @@ pub fn linearize_at_speed<M: MultibodyModel>(param: &[f64], speed: f64) -> Resul
     let (param, dq0) = speed_setup::<M>(param, speed)?;
     M::linearize_with_rest_exact(&param, &dq0).map(|(l, _)| l)
 }
-
-/// A state matrix (re-exported so generated code needs no nalgebra).
-pub type StateMatrix = DMatrix<f64>;
 
 /// A linear state-space model `x' = A x` about upright straight running.
 #[derive(Clone, Debug)]

@@ -11,6 +11,7 @@
 //! acceleration level `Cq p'' + dCqdp + ... = 0`) and the nonholonomic ones
 //! `B p' = 0` (acceleration level `B p'' + dBdp = 0`).
 
+pub use crate::linear_types::MissingRole;
 use crate::scalar::Scalar;
 
 /// A parameter of a generated model.
@@ -136,18 +137,6 @@ impl ParameterRole {
             ParameterRole::FrontWheelRadius => "front wheel radius",
         }
     }
-}
-
-/// A model lacks a meaning (role) that a job needs.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("model `{model}` declares no {kind} with the role `{role}`, which {job} needs (declare it in the model file: `coordinate_role` / `parameter_role`)")]
-pub struct MissingRole {
-    pub model: &'static str,
-    /// `"coordinate"` or `"parameter"`.
-    pub kind: &'static str,
-    pub role: &'static str,
-    /// The job that needs it, e.g. `"simulation output"`.
-    pub job: &'static str,
 }
 
 /// An effect applied to a model, with what identification needs to test it,
@@ -403,13 +392,13 @@ pub trait MultibodyModel: Send + Sync + 'static {
     fn linearize_with_rest_exact(
         param: &[f64],
         dq0: &[f64],
-    ) -> Result<crate::linearize::WithRest, crate::linearize::LinearizeError>;
+    ) -> Result<crate::linear_types::WithRest, crate::linear_types::LinearizeError>;
     /// State matrix over `[q, q', z]` with this model's dual width
     /// (generated: `linearize::state_space_dual::<Self, {2 ni + nz}>`).
     fn state_space_exact(
         param: &[f64],
         dq0: &[f64],
-    ) -> Result<crate::linearize::StateMatrix, crate::linearize::LinearizeError>;
+    ) -> Result<crate::linear_types::StateMatrix, crate::linear_types::LinearizeError>;
     /// Rates of the extra states, `STATES.len()` values.
     fn state_rates<T: Scalar>(param: &[T], t: T, p: &[T], dp: &[T], out: &mut [T]);
 }

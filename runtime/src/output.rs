@@ -1,7 +1,7 @@
 //! Output files: atomic writing, CSV/JSON writers and terminal tables.
 //!
 //! # Atomic writes
-//! Every `save_*` function (and the plots in [`crate::plot`]) writes through
+//! Every `save_*` function (and the plots of the `plot` module) writes through
 //! [`write_atomic`] / [`write_atomic_via_path`]. A symbolic link is followed
 //! (and kept); a FIFO or a device is written through, never replaced
 //! ([`output_target`]). For a regular file or a new path the content goes to a fresh

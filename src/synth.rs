@@ -1,6 +1,6 @@
-//! `bikedyn synth`: synthetic field runs (issue 7, point 6), the physical
+//! Synthetic measured-style run sets (`bikedyn synth`): synthetic field runs (issue 7, point 6), the physical
 //! side. Each run is a hand-held launch, release, saddle kick and free
-//! response of the chosen model ([`trajectory_for_run`]); this command writes
+//! response of the chosen model ([`trajectory_for_run`]); [`synth`] writes
 //! per run the orientation history (`<run>_trajectory.csv`: t, yaw, roll,
 //! pitch, steer, rear_wheel_angle in rad, speed in m/s, thesis conventions)
 //! and a truth file (`<run>_truth.json`: run plan, parameters, state at
@@ -14,50 +14,114 @@
 //! sensor) goes to `truth/`, outside the set, so `bikedyn fit OUT` reads the
 //! set as it would a measured one.
 
-use anyhow::{bail, Context, Result};
-use bikedyn::bicycle::{canonical_of, Bicycle};
-use bikedyn::registry::{with_model, ModelVisitor};
-use bikedyn::runtime::eigen::eigenvalues;
-use bikedyn::runtime::experiment::synth::{rest_trajectory, write_run, RunKind, SensorModel};
-use bikedyn::runtime::linearize::parameter_vector;
-use bikedyn::runtime::model::CoordinateRole;
-use bikedyn::runtime::output::{save_json, write_atomic};
-use bikedyn::runtime::random::SplitMix64;
-use bikedyn::runtime::simulate::trajectory::{trajectory_for_run, RunPlan, Trajectory};
-use bikedyn::runtime::simulate::{SimOptions, Simulation};
-use bikedyn::runtime::MultibodyModel;
-use clap::Args;
+use crate::bicycle::{canonical_of, Bicycle, BicycleError};
+use crate::generated::with_model;
+use bikedyn_runtime::eigen::{eigenvalues, EigenError};
+use bikedyn_runtime::experiment::synth::{rest_trajectory, write_run, RunKind, SensorModel};
+use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
+use bikedyn_runtime::model::CoordinateRole;
+use bikedyn_runtime::output::{save_json, write_atomic, OutputError};
+use bikedyn_runtime::random::SplitMix64;
+use bikedyn_runtime::registry::ModelVisitor;
+use bikedyn_runtime::simulate::trajectory::{trajectory_for_run, RunPlan, Trajectory};
+use bikedyn_runtime::simulate::{SimOptions, SimulateError, Simulation};
+use bikedyn_runtime::MultibodyModel;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use thiserror::Error;
 
-/// Arguments of `bikedyn synth`.
-#[derive(Args)]
-pub struct SynthArgs {
-    /// Built-in bicycle (thesis, benchmark) or parameter file.
-    #[arg(long, default_value = "thesis")]
-    bike: String,
+/// What set to make.
+#[derive(Clone, Debug)]
+pub struct SynthOptions {
+    /// Built-in bicycle (thesis, benchmark) or parameter file (default thesis).
+    pub bike: String,
     /// Generated model (default: the free-speed variant of the smallest
-    /// model with every parameter the bicycle and `--effects` set, so that
+    /// model with every parameter the bicycle and `effects` set, so that
     /// speed evolves physically after the release).
-    #[arg(long)]
-    model: Option<String>,
-    /// Hidden effects: comma-separated `SYMBOL=VALUE` (e.g.
-    /// `c_steer=0.3` or `Crr_rear=0.008,Crr_front=0.008`), on top of the
-    /// bicycle's own effect parameters.
-    #[arg(long, value_delimiter = ',')]
-    effects: Vec<String>,
-    /// Release speeds are drawn uniformly from LO:HI (m/s).
-    #[arg(long, default_value = "3:7")]
-    speeds: String,
-    /// Number of runs.
-    #[arg(long, default_value_t = 3)]
-    runs: usize,
-    /// Seed of the run plans (run k uses seed + k).
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
+    pub model: Option<String>,
+    /// Hidden effects `(symbol, value)` on top of the bicycle's own effect
+    /// parameters (e.g. `("c_steer", 0.3)`, in the parameter's unit).
+    pub effects: Vec<(String, f64)>,
+    /// Release speeds are drawn uniformly from `[LO, HI]` (m/s, 0 < LO <= HI;
+    /// default 3-7).
+    pub speeds: [f64; 2],
+    /// Number of runs, 1 to 1000 (default 3).
+    pub runs: usize,
+    /// Seed of the run plans (run k uses seed + k; default 1).
+    pub seed: u64,
     /// Output folder.
-    #[arg(long)]
-    out: PathBuf,
+    pub out: PathBuf,
+}
+
+impl Default for SynthOptions {
+    fn default() -> Self {
+        Self {
+            bike: "thesis".into(),
+            model: None,
+            effects: Vec::new(),
+            speeds: [3.0, 7.0],
+            runs: 3,
+            seed: 1,
+            out: PathBuf::from("synth"),
+        }
+    }
+}
+
+/// One run written.
+#[derive(Clone, Debug)]
+pub struct SynthRun {
+    /// Run folder name (`run01`, ...).
+    pub name: String,
+    /// The run plan (launch, release speed, kick).
+    pub plan: RunPlan,
+    /// Why the simulation stopped.
+    pub stop: String,
+}
+
+/// Why a synthetic set could not be made.
+#[derive(Debug, Error)]
+pub enum SynthError {
+    /// The number of runs is outside 1 to 1000.
+    #[error("--runs must be between 1 and 1000")]
+    RunCount { runs: usize },
+    /// The bicycle could not be resolved, or an effect value set on it.
+    #[error(transparent)]
+    Bicycle(#[from] BicycleError),
+    /// The model fitting the bicycle has no free-speed variant.
+    #[error("model `{model}` has no free-speed variant; name one with --model")]
+    NoFreeSpeedVariant { model: String },
+    /// The output folder (or `truth/`) could not be created.
+    #[error("creating {}", path.display())]
+    CreateDir {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// The parameter vector of the model could not be formed.
+    #[error(transparent)]
+    Linearize(#[from] LinearizeError),
+    /// A run could not be simulated.
+    #[error(transparent)]
+    Simulate(#[from] SimulateError),
+    /// The frozen-speed eigenvalues of the truth file failed.
+    #[error(transparent)]
+    Eigen(#[from] EigenError),
+    /// The sensor files of a run could not be written.
+    #[error(transparent)]
+    Sensors(#[from] bikedyn_runtime::experiment::synth::SynthError),
+    /// A trajectory or truth file could not be written.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The sensor truth could not be put into JSON.
+    #[error(transparent)]
+    Json(#[from] serde_json::Error),
+}
+
+fn create_dir(dir: &Path) -> Result<(), SynthError> {
+    std::fs::create_dir_all(dir).map_err(|source| SynthError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })
 }
 
 /// A per-run clock offset: the nominal one plus up to +/- 0.3 s, as in
@@ -95,8 +159,8 @@ fn sensor_trajectory(tr: &Trajectory) -> Trajectory {
     }
 }
 
-fn write_physical_run(dir: &Path, name: &str, tr: &Trajectory, truth: &serde_json::Value) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+fn write_physical_run(dir: &Path, name: &str, tr: &Trajectory, truth: &serde_json::Value) -> Result<(), SynthError> {
+    create_dir(dir)?;
     write_atomic(dir.join(format!("{name}_trajectory.csv")), |w: &mut dyn Write| {
         writeln!(w, "t,yaw,roll,pitch,steer,rear_wheel_angle,speed")?;
         for i in 0..tr.t.len() {
@@ -115,7 +179,7 @@ fn write_physical_run(dir: &Path, name: &str, tr: &Trajectory, truth: &serde_jso
 fn one_run<M: MultibodyModel>(
     lookup: &dyn Fn(&str) -> Option<f64>,
     plan: &RunPlan,
-) -> Result<(Trajectory, Simulation, Vec<f64>)> {
+) -> Result<(Trajectory, Simulation, Vec<f64>), SynthError> {
     let param = parameter_vector::<M>(lookup, plan.speed)?;
     let (tr, sim) = trajectory_for_run::<M>(&param, plan, &SimOptions::default())?;
     Ok((tr, sim, param))
@@ -127,52 +191,39 @@ struct OneRun<'a, F: Fn(&str) -> Option<f64>> {
 }
 impl<F: Fn(&str) -> Option<f64>> ModelVisitor for OneRun<'_, F> {
     #[allow(clippy::type_complexity)]
-    type Output = Result<(Trajectory, Simulation, Vec<f64>, &'static [&'static str])>;
+    type Output = Result<(Trajectory, Simulation, Vec<f64>, &'static [&'static str]), SynthError>;
     fn visit<M: MultibodyModel>(self) -> Self::Output {
         let (t, s, pv) = one_run::<M>(self.lookup, self.plan)?;
         Ok((t, s, pv, M::PARAMETERS))
     }
 }
 
-/// Run `bikedyn synth`.
-pub fn run(a: SynthArgs) -> Result<bool> {
+/// Make the set: `on_run` is called after each run is written.
+pub fn synth(a: &SynthOptions, on_run: &mut dyn FnMut(&SynthRun)) -> Result<(), SynthError> {
     if a.runs == 0 || a.runs > 1000 {
-        bail!("--runs must be between 1 and 1000");
+        return Err(SynthError::RunCount { runs: a.runs });
     }
     let mut bike = Bicycle::resolve(&a.bike)?;
-    for e in &a.effects {
-        let (sym, val) = e
-            .split_once('=')
-            .with_context(|| format!("--effects `{e}`: expected SYMBOL=VALUE"))?;
-        let val: f64 = val
-            .trim()
-            .parse()
-            .ok()
-            .filter(|v: &f64| v.is_finite())
-            .with_context(|| format!("--effects `{e}`: `{}` is not a finite number", val.trim()))?;
-        bike = bike.with_parameter(sym.trim(), val)?;
+    for (sym, val) in &a.effects {
+        bike = bike.with_parameter(sym, *val)?;
     }
-    let (lo, hi) = a
-        .speeds
-        .split_once(':')
-        .and_then(|(l, h)| Some((l.trim().parse::<f64>().ok()?, h.trim().parse::<f64>().ok()?)))
-        .filter(|(l, h)| l.is_finite() && h.is_finite() && *l > 0.0 && h >= l)
-        .with_context(|| format!("--speeds `{}`: expected LO:HI with 0 < LO <= HI (m/s)", a.speeds))?;
+    let [lo, hi] = a.speeds;
+    assert!(
+        lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo,
+        "release speeds must be 0 < LO <= HI, found {lo}:{hi}"
+    );
     let p = bike.thesis()?;
     let canonical = canonical_of(&p)?;
     let info = match a.model.as_deref() {
         Some(name) => bike.model(Some(name))?,
         None => {
             let driven = bike.model(None)?;
-            bikedyn::models::free_speed_variant(driven).with_context(|| {
-                format!(
-                    "model `{}` has no free-speed variant; name one with --model",
-                    driven.name
-                )
+            crate::models::free_speed_variant(driven).ok_or_else(|| SynthError::NoFreeSpeedVariant {
+                model: driven.name.to_string(),
             })?
         }
     };
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    create_dir(&a.out)?;
     let lookup = bike.lookup()?;
     // Sensors like the thesis's instrumentation (FORMAT.md), on this
     // bicycle's rear wheel.
@@ -243,29 +294,11 @@ pub fn run(a: SynthArgs) -> Result<bool> {
         let mut truth = truth;
         truth["sensors"] = serde_json::to_value(&sensor_truth)?;
         write_physical_run(&a.out.join("truth"), &name, &tr, &truth)?;
-        println!(
-            "{name}: release at {:.2} s, {:.2} m/s, kick {:+.2} N s at {:.2} s, {}",
-            plan.launch_duration,
-            plan.speed,
-            plan.kick_impulse,
-            plan.launch_duration + plan.kick_delay,
-            sim.stop
-        );
+        on_run(&SynthRun {
+            stop: sim.stop.to_string(),
+            name,
+            plan,
+        });
     }
-    println!("wrote {} runs to {}", a.runs, a.out.display());
-    Ok(true)
-}
-
-/// A synthetic set of the thesis bicycle at 4-6.5 m/s with `effects` hidden
-/// (for the identification bench).
-pub fn thesis_set(out: &Path, runs: usize, seed: u64, effects: &[&str]) -> Result<bool> {
-    run(SynthArgs {
-        bike: "thesis".into(),
-        model: None,
-        effects: effects.iter().map(|s| s.to_string()).collect(),
-        speeds: "4:6.5".into(),
-        runs,
-        seed,
-        out: out.to_path_buf(),
-    })
+    Ok(())
 }

@@ -2,90 +2,16 @@
 //! command line (issue 7). Angles on the command line are in degrees, rates
 //! in deg/s; the CSV uses the model's units (rad, rad/s, m, m/s, J).
 
+use super::args::SimulateArgs;
 use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::Bicycle;
-use bikedyn::registry::{with_model, ModelVisitor};
-use bikedyn::runtime::linearize::parameter_vector;
 use bikedyn::runtime::plot::PlotOptions;
 use bikedyn::runtime::simulate::plot::plot_simulation;
 use bikedyn::runtime::simulate::{
-    simulate, Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, Simulation, TorquePulse,
+    Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, TorquePulse,
 };
-use bikedyn::runtime::MultibodyModel;
-use clap::Args;
-use std::path::PathBuf;
+use bikedyn::simulate;
 use std::time::Instant;
-
-/// Arguments of `bikedyn simulate`.
-#[derive(Args)]
-pub struct SimulateArgs {
-    /// Built-in bicycle (thesis, benchmark) or parameter file.
-    #[arg(long, default_value = "thesis")]
-    bike: String,
-    /// Generated model (default: thesis_whipple, or whipple_offset when the
-    /// fork mass centre is off the steer axis).
-    #[arg(long)]
-    model: Option<String>,
-    /// Free forward speed (no driving constraint): needs a free-speed model.
-    #[arg(long)]
-    free_speed: bool,
-    /// Forward speed of the rear contact point (m/s); imposed by a driven
-    /// model, initial for a free-speed one.
-    #[arg(long)]
-    speed: f64,
-    /// Initial roll (deg, positive leaning right).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    roll: f64,
-    /// Initial steer (deg, positive turning left).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    steer: f64,
-    /// Initial roll rate (deg/s).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    roll_rate: f64,
-    /// Initial steer rate (deg/s).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    steer_rate: f64,
-    /// Initial yaw (deg).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-    yaw: f64,
-    /// Lateral kick TIME:IMPULSE[:AHEAD:HEIGHT] (s, N s positive toward the
-    /// rider's right, point m ahead of the rear contact and m above ground;
-    /// default point: a saddle 0.25 m ahead, 0.95 m high). Repeatable.
-    #[arg(long, allow_hyphen_values = true)]
-    kick: Vec<String>,
-    /// Torque pulse roll|steer:START:DURATION:AMPLITUDE[:rect|halfsine]
-    /// (s, s, N m). Repeatable.
-    #[arg(long, allow_hyphen_values = true)]
-    pulse: Vec<String>,
-    /// Simulated time (s).
-    #[arg(long)]
-    duration: f64,
-    /// Relative tolerance of the integrator.
-    #[arg(long, default_value_t = 1e-8)]
-    rtol: f64,
-    /// Absolute tolerance of the integrator.
-    #[arg(long, default_value_t = 1e-10)]
-    atol: f64,
-    /// Integration method: dop853 (explicit, default) or radau5 (implicit,
-    /// for stiff effects such as very short tyre relaxation lengths).
-    #[arg(long, default_value = "dop853")]
-    method: String,
-    /// Output sample interval (s).
-    #[arg(long, default_value_t = 0.01)]
-    dt: f64,
-    /// Stop when |roll| reaches this angle (deg; 0 disables).
-    #[arg(long, default_value_t = 1.0f64.to_degrees())]
-    roll_limit: f64,
-    /// Stop when |steer| reaches this angle (deg; 0 disables).
-    #[arg(long, default_value_t = 1.4f64.to_degrees())]
-    steer_limit: f64,
-    /// CSV output (columns: t, coordinates, rates, speed, energies, residual).
-    #[arg(long)]
-    out: Option<PathBuf>,
-    /// Plot of roll, steer and speed against time (.svg or .png).
-    #[arg(long)]
-    plot: Option<PathBuf>,
-}
 
 fn numbers(spec: &str, what: &str) -> Result<Vec<f64>> {
     spec.split(':')
@@ -145,31 +71,6 @@ pub fn parse_pulse(spec: &str) -> Result<TorquePulse> {
     })
 }
 
-fn run_model<M: MultibodyModel>(
-    lookup: impl Fn(&str) -> Option<f64>,
-    ic: &InitialConditions,
-    inputs: &Inputs,
-    duration: f64,
-    opts: &SimOptions,
-) -> Result<Simulation> {
-    let param = parameter_vector::<M>(lookup, ic.speed)?;
-    Ok(simulate::<M>(&param, ic, inputs, duration, opts)?)
-}
-
-struct RunSimulation<'a, F: Fn(&str) -> Option<f64>> {
-    lookup: &'a F,
-    ic: &'a InitialConditions,
-    inputs: &'a Inputs,
-    duration: f64,
-    opts: &'a SimOptions,
-}
-impl<F: Fn(&str) -> Option<f64>> ModelVisitor for RunSimulation<'_, F> {
-    type Output = Result<Simulation>;
-    fn visit<M: MultibodyModel>(self) -> Self::Output {
-        run_model::<M>(self.lookup, self.ic, self.inputs, self.duration, self.opts)
-    }
-}
-
 /// Run `bikedyn simulate`.
 pub fn run(a: SimulateArgs) -> Result<bool> {
     if let Some(p) = &a.plot {
@@ -179,11 +80,7 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
     for w in &bike.warnings {
         eprintln!("warning ({}): {w}", bike.name);
     }
-    let mut info = bike.model(a.model.as_deref())?;
-    if a.free_speed {
-        info = bikedyn::models::free_speed_variant(info)
-            .with_context(|| format!("model `{}` has no free-speed variant (see `bikedyn models`)", info.name))?;
-    }
+    let info = simulate::choose_model(&bike, a.model.as_deref(), a.free_speed)?;
     if !(a.speed.is_finite()) {
         bail!("--speed must be a finite number");
     }
@@ -210,19 +107,8 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
             steer_limit: limit(a.steer_limit),
         },
     };
-    let lookup = bike.lookup()?;
     let start = Instant::now();
-    let sim = with_model(
-        info.name,
-        RunSimulation {
-            lookup: &lookup,
-            ic: &ic,
-            inputs: &inputs,
-            duration: a.duration,
-            opts: &opts,
-        },
-    )
-    .expect("registered model")?;
+    let sim = simulate::run(&bike, info, &ic, &inputs, a.duration, &opts)?;
     let wall = start.elapsed().as_secs_f64();
     let simulated = sim.t.last().copied().unwrap_or(0.0);
     println!(

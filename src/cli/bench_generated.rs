@@ -1,13 +1,13 @@
 //! `bikedyn bench`: figures for the generated code and the stability
 //! pipeline (printed, never asserted; timings depend on the machine).
 
-use crate::bicycle::canonical_of;
-use crate::generated::{ThesisWhipple, CODEGEN_REPORT};
-use crate::models::default_parameters;
-use bikedyn_runtime::eigen::eigenvalues;
-use bikedyn_runtime::parameters::ThesisParameters;
-use bikedyn_runtime::scalar::Counted;
-use bikedyn_runtime::MultibodyModel;
+use bikedyn::bicycle::canonical_of;
+use bikedyn::generated::{ThesisWhipple, CODEGEN_REPORT};
+use bikedyn::models::default_parameters;
+use bikedyn::runtime::eigen::eigenvalues;
+use bikedyn::runtime::parameters::ThesisParameters;
+use bikedyn::runtime::scalar::Counted;
+use bikedyn::runtime::MultibodyModel;
 use rayon::prelude::*;
 use std::hint::black_box;
 use std::time::Instant;
@@ -293,7 +293,7 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         el,
         el / (designs * speeds) as f64 * 1e9
     );
-    crate::fit::bench_experiment(quick)?;
-    crate::bench_simulate::run(quick)?;
+    super::bench::experiment(quick)?;
+    super::bench_simulate::run(quick)?;
     Ok(())
 }

@@ -2,12 +2,12 @@
 //! wall-clock second for a 5 s kick response of the thesis model at rtol 1e-8,
 //! and right-hand-side evaluations per second. Printed, never asserted.
 
-use crate::generated::{Extended, ExtendedFree, ThesisWhipple, ThesisWhippleFree};
-use crate::models::default_parameters;
-use bikedyn_runtime::simulate::{
+use bikedyn::generated::{Extended, ExtendedFree, ThesisWhipple, ThesisWhippleFree};
+use bikedyn::models::default_parameters;
+use bikedyn::runtime::simulate::{
     initial_state, simulate, Evaluator, InitialConditions, Inputs, Kick, SimOptions, Simulation,
 };
-use bikedyn_runtime::MultibodyModel;
+use bikedyn::runtime::MultibodyModel;
 use std::time::Instant;
 
 fn time_run<M: MultibodyModel>(param: &[f64], reps: usize, output_interval: f64) -> anyhow::Result<(f64, Simulation)> {

@@ -1,0 +1,371 @@
+//! The command line's arguments (clap). Every command's work is in the
+//! library; these types only say how it is asked for.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(
+    name = "bikedyn",
+    version,
+    about = "Symbolic multibody bicycle models, generated code, linearization and stability"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum Format {
+    Table,
+    Csv,
+    Json,
+}
+
+/// Quantity of a stability map.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MapArg {
+    /// Width of the self-stable speed range (m/s).
+    Width,
+    /// Weave speed (m/s).
+    Weave,
+    /// Capsize speed (m/s).
+    Capsize,
+    /// Real part of the least stable eigenvalue at --at-speed (1/s).
+    LeastStable,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum FormName {
+    Benchmark,
+    Thesis,
+}
+
+/// Which bicycle to analyse, and through which model.
+#[derive(Args)]
+pub struct BikeArg {
+    /// Built-in bicycle (thesis, benchmark) or parameter file.
+    #[arg(long = "bike", default_value = "thesis")]
+    pub spec: String,
+    /// Generated model to run it through (see `bikedyn models`; default: the
+    /// smallest driven-speed model with every parameter the bicycle sets).
+    #[arg(long)]
+    pub model: Option<String>,
+}
+
+/// Table/CSV/JSON output of a command.
+#[derive(Args)]
+pub struct OutputArgs {
+    #[arg(long, value_enum, default_value_t = Format::Table)]
+    pub format: Format,
+    /// Write the table/CSV/JSON to this file instead of standard output.
+    #[arg(long)]
+    pub output: Option<PathBuf>,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Measured weave eigenvalues from raw logs (thesis-style run sets, TU Delft kick logs).
+    Fit(FitArgs),
+    /// Close the loop: from the residual of measured runs to the missing effect, its fitted parameters, and the error before and after
+    Identify(IdentifyArgs),
+    /// The main job on embedded defaults: verify the generated models, print
+    /// the canonical matrices and self-stable speeds of the built-in bicycles,
+    /// and write eigenvalue tables and continuation diagrams to a folder.
+    Report {
+        /// Output folder.
+        #[arg(long, default_value = "bikedyn-report")]
+        out: PathBuf,
+    },
+    /// List the generated models: coordinates, parameters and effects.
+    Models {
+        /// JSON output: a list of {name, doc, base, free_speed, effects, coordinates, parameters}.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Check every generated derivative against finite differences.
+    Verify {
+        /// Model name (default: all models).
+        #[arg(long)]
+        model: Option<String>,
+        /// Number of random states.
+        #[arg(long, default_value_t = 20)]
+        states: usize,
+        /// Seed of the random states.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// JSON output.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Canonical matrices M0, C1, K0, K2 (Meijaard et al. 2007 form).
+    Canonical {
+        #[command(flatten)]
+        bike: BikeArg,
+        /// Speeds START:STOP:STEP (m/s) at which to print the state-space
+        /// matrices A(v), B(v) of a bicycle without canonical form.
+        #[arg(long, default_value = "0:10:2")]
+        speeds: String,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Eigenvalues and modes over forward speed.
+    Eig {
+        #[command(flatten)]
+        bike: BikeArg,
+        /// Speeds START:STOP:STEP (m/s).
+        #[arg(long, default_value = "0:10:0.5")]
+        speeds: String,
+        #[command(flatten)]
+        out: OutputArgs,
+        /// Continuation diagram (.svg or .png).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+    },
+    /// Weave and capsize speeds and the self-stable speed interval(s).
+    Stability {
+        #[command(flatten)]
+        bike: BikeArg,
+        /// Upper end of the searched speed range (m/s).
+        #[arg(long, default_value_t = 10.0)]
+        speed_max: f64,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Stability over one parameter, or over a grid of two (a stability map).
+    Sweep {
+        #[command(flatten)]
+        bike: BikeArg,
+        /// Parameter symbol (thesis: Rt, x4, d4, ...; benchmark: c, lam, w, ...).
+        #[arg(long)]
+        param: String,
+        /// Values START:STOP:STEP.
+        #[arg(long)]
+        values: String,
+        /// Second parameter for a two-parameter stability map.
+        #[arg(long)]
+        param2: Option<String>,
+        /// Values of the second parameter START:STOP:STEP.
+        #[arg(long)]
+        values2: Option<String>,
+        /// Upper end of the searched speed range (m/s).
+        #[arg(long, default_value_t = 10.0)]
+        speed_max: f64,
+        #[command(flatten)]
+        out: OutputArgs,
+        /// Stability map plot (.svg or .png), two-parameter sweeps only.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Quantity mapped by --plot: the self-stable range width, the weave
+        /// or capsize speed, or the real part of the least stable eigenvalue
+        /// at --at-speed. Cells whose stable range reaches --speed-max are
+        /// marked (the range is cut there).
+        #[arg(long, value_enum, default_value_t = MapArg::Width)]
+        map: MapArg,
+        /// Speed (m/s) of --map least-stable; its value is also written to the
+        /// JSON of every cell.
+        #[arg(long)]
+        at_speed: Option<f64>,
+    },
+    /// Parameter sets: show or convert between thesis and benchmark forms.
+    Params {
+        #[command(subcommand)]
+        command: ParamsCommand,
+    },
+    /// Nonlinear simulation (time histories to CSV and a plot).
+    Simulate(SimulateArgs),
+    /// Synthetic field runs: launch, release, kick, free response (trajectories and truth).
+    Synth(SynthArgs),
+    /// Print timing and operation-count figures of the generated code.
+    Bench {
+        /// Fewer repetitions (for a quick look).
+        #[arg(long)]
+        quick: bool,
+        /// Instead: time a full `identify` on a 12-run synthetic set (steer
+        /// damping hidden), made in a temporary folder.
+        #[arg(long)]
+        identify: bool,
+    },
+}
+
+#[derive(Subcommand)]
+pub enum ParamsCommand {
+    /// Convert a parameter file (or built-in bicycle) to the other form (TOML on stdout).
+    Convert {
+        #[arg(long, value_enum)]
+        to: FormName,
+        /// Parameter file or built-in name.
+        file: String,
+        #[arg(long)]
+        output: Option<PathBuf>,
+    },
+    /// Print a bicycle's parameters (TOML: geometry, inertia and the effect
+    /// parameters of its model, each with its unit) and its validation warnings.
+    Show {
+        /// Built-in bicycle or parameter file (also accepted as `--bike`).
+        #[arg(value_name = "FILE", conflicts_with = "bike")]
+        file: Option<String>,
+        #[arg(long, default_value = "thesis")]
+        bike: String,
+        /// Model whose effect parameters are listed (default: the one that fits).
+        #[arg(long)]
+        model: Option<String>,
+    },
+}
+
+/// Arguments of `bikedyn fit`.
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    /// Set folders (all runs), run folders, TU Delft log files, or folders of logs.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Calibration run (default: `calibration/` beside the runs).
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+    /// Bicycle for the prediction and the frame pitch at rest (built-in name
+    /// or parameter file). Without it the thesis bicycle's frame pitch is used
+    /// and no prediction is made.
+    #[arg(long)]
+    pub bike: Option<String>,
+    /// JSON output (one entry per kick).
+    #[arg(long)]
+    pub json: bool,
+    /// Write plots (responses with speed, continuation diagram) to this folder.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Angle method: direct (default) or thesis (eq. 87-93).
+    #[arg(long, default_value = "direct")]
+    pub angles: String,
+    /// Keep the nominal clock offset instead of estimating it.
+    #[arg(long)]
+    pub nominal_clock: bool,
+}
+
+/// Arguments of `bikedyn identify`.
+#[derive(Args, Debug, Clone)]
+pub struct IdentifyArgs {
+    /// Set folders (all runs) or run folders.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
+    /// Calibration run (default: `calibration/` beside the runs).
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+    /// Bicycle (built-in name or parameter file); its effect parameters, if
+    /// any, are part of the model before identification.
+    #[arg(long, default_value = "thesis")]
+    pub bike: String,
+    /// Candidate effects to consider (comma-separated; default: every
+    /// effect of the library that identification supports).
+    #[arg(long, value_delimiter = ',')]
+    pub effects: Vec<String>,
+    /// Report folder (report.md, report.json, plots, fitted parameter file).
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Print the JSON summary instead of the text summary.
+    #[arg(long)]
+    pub json: bool,
+    /// Folds of the cross-validation over runs.
+    #[arg(long, default_value_t = 4)]
+    pub folds: usize,
+}
+
+/// Arguments of `bikedyn simulate`.
+#[derive(Args)]
+pub struct SimulateArgs {
+    /// Built-in bicycle (thesis, benchmark) or parameter file.
+    #[arg(long, default_value = "thesis")]
+    pub bike: String,
+    /// Generated model (default: thesis_whipple, or whipple_offset when the
+    /// fork mass centre is off the steer axis).
+    #[arg(long)]
+    pub model: Option<String>,
+    /// Free forward speed (no driving constraint): needs a free-speed model.
+    #[arg(long)]
+    pub free_speed: bool,
+    /// Forward speed of the rear contact point (m/s); imposed by a driven
+    /// model, initial for a free-speed one.
+    #[arg(long)]
+    pub speed: f64,
+    /// Initial roll (deg, positive leaning right).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub roll: f64,
+    /// Initial steer (deg, positive turning left).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub steer: f64,
+    /// Initial roll rate (deg/s).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub roll_rate: f64,
+    /// Initial steer rate (deg/s).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub steer_rate: f64,
+    /// Initial yaw (deg).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub yaw: f64,
+    /// Lateral kick TIME:IMPULSE[:AHEAD:HEIGHT] (s, N s positive toward the
+    /// rider's right, point m ahead of the rear contact and m above ground;
+    /// default point: a saddle 0.25 m ahead, 0.95 m high). Repeatable.
+    #[arg(long, allow_hyphen_values = true)]
+    pub kick: Vec<String>,
+    /// Torque pulse roll|steer:START:DURATION:AMPLITUDE[:rect|halfsine]
+    /// (s, s, N m). Repeatable.
+    #[arg(long, allow_hyphen_values = true)]
+    pub pulse: Vec<String>,
+    /// Simulated time (s).
+    #[arg(long)]
+    pub duration: f64,
+    /// Relative tolerance of the integrator.
+    #[arg(long, default_value_t = 1e-8)]
+    pub rtol: f64,
+    /// Absolute tolerance of the integrator.
+    #[arg(long, default_value_t = 1e-10)]
+    pub atol: f64,
+    /// Integration method: dop853 (explicit, default) or radau5 (implicit,
+    /// for stiff effects such as very short tyre relaxation lengths).
+    #[arg(long, default_value = "dop853")]
+    pub method: String,
+    /// Output sample interval (s).
+    #[arg(long, default_value_t = 0.01)]
+    pub dt: f64,
+    /// Stop when |roll| reaches this angle (deg; 0 disables).
+    #[arg(long, default_value_t = 1.0f64.to_degrees())]
+    pub roll_limit: f64,
+    /// Stop when |steer| reaches this angle (deg; 0 disables).
+    #[arg(long, default_value_t = 1.4f64.to_degrees())]
+    pub steer_limit: f64,
+    /// CSV output (columns: t, coordinates, rates, speed, energies, residual).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Plot of roll, steer and speed against time (.svg or .png).
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+}
+
+/// Arguments of `bikedyn synth`.
+#[derive(Args)]
+pub struct SynthArgs {
+    /// Built-in bicycle (thesis, benchmark) or parameter file.
+    #[arg(long, default_value = "thesis")]
+    pub bike: String,
+    /// Generated model (default: the free-speed variant of the smallest
+    /// model with every parameter the bicycle and `--effects` set, so that
+    /// speed evolves physically after the release).
+    #[arg(long)]
+    pub model: Option<String>,
+    /// Hidden effects: comma-separated `SYMBOL=VALUE` (e.g.
+    /// `c_steer=0.3` or `Crr_rear=0.008,Crr_front=0.008`), on top of the
+    /// bicycle's own effect parameters.
+    #[arg(long, value_delimiter = ',')]
+    pub effects: Vec<String>,
+    /// Release speeds are drawn uniformly from LO:HI (m/s).
+    #[arg(long, default_value = "3:7")]
+    pub speeds: String,
+    /// Number of runs.
+    #[arg(long, default_value_t = 3)]
+    pub runs: usize,
+    /// Seed of the run plans (run k uses seed + k).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output folder.
+    #[arg(long)]
+    pub out: PathBuf,
+}

@@ -1,0 +1,74 @@
+//! `bikedyn canonical`: the canonical matrices, or the state-space matrices
+//! A(v), B(v) of a bicycle without canonical form.
+
+use super::args::BikeArg;
+use super::text::{canonical_json, canonical_text, state_input_rows, state_space_text};
+use super::{load, parse_range};
+use anyhow::{Context, Result};
+use bikedyn::runtime::eigen::LinearBicycle;
+
+/// Run `bikedyn canonical`.
+pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
+    let BikeArg { spec: bike, model } = bike;
+    let b = load(&bike)?;
+    let lin = b.linear_with(model.as_deref())?;
+    match &lin.canonical {
+        Some(c) => {
+            if json {
+                let mut v = canonical_json(c);
+                v["model"] = serde_json::json!(lin.model);
+                println!("{}", serde_json::to_string_pretty(&v)?);
+            } else {
+                println!("model: {}", lin.model);
+                print!("{}", canonical_text(c));
+            }
+        }
+        None => {
+            // Why there is no canonical form, then A(v), B(v).
+            let why = b
+                .canonical_with(model.as_deref())
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default();
+            let speeds = parse_range(&speeds, "--speeds")?;
+            let mut rows = Vec::new();
+            for &v in &speeds {
+                let m = lin.at_speed(v)?;
+                let a = m
+                    .state_matrix()
+                    .with_context(|| format!("singular mass matrix at {v} m/s"))?;
+                let minv = m.mass.try_inverse().context("singular mass matrix")?;
+                rows.push((v, a, minv));
+            }
+            if json {
+                let v: Vec<_> = rows
+                    .iter()
+                    .map(|(v, a, minv)| {
+                        serde_json::json!({
+                            "speed": v,
+                            "A": (0..4).map(|i| (0..4).map(|j| a[(i, j)]).collect::<Vec<_>>()).collect::<Vec<_>>(),
+                            "B": state_input_rows(minv),
+                        })
+                    })
+                    .collect();
+                let out = serde_json::json!({
+                    "model": lin.model,
+                    "canonical": null,
+                    "why": why,
+                    "state": ["roll", "steer", "roll_rate", "steer_rate"],
+                    "inputs": ["roll_torque", "steer_torque"],
+                    "state_space": v,
+                });
+                println!("{}", serde_json::to_string_pretty(&out)?);
+            } else {
+                println!("model: {}", lin.model);
+                println!("no canonical form: {why}");
+                println!("state-space form x' = A(v) x + B(v) u, x = [roll, steer, roll rate, steer rate] (rad, rad/s), u = [roll torque, steer torque] (N m), benchmark signs:");
+                for (v, a, minv) in &rows {
+                    print!("{}", state_space_text(*v, a, minv));
+                }
+            }
+        }
+    }
+    Ok(true)
+}

@@ -1,0 +1,79 @@
+//! `bikedyn eig`: eigenvalues and modes over forward speed (table, CSV or
+//! JSON, streamed when long) and the continuation diagram.
+
+use super::args::{BikeArg, Format, OutputArgs};
+use super::{emit, load, range_spec, MAX_STREAMED_POINTS, MAX_TABLE_ROWS};
+use anyhow::Result;
+use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, LinearBicycle};
+use bikedyn::runtime::output;
+use bikedyn::runtime::plot::{plot_continuation, ImageFormat, PlotOptions};
+use std::path::PathBuf;
+
+/// Run `bikedyn eig`.
+pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plot: Option<PathBuf>) -> Result<bool> {
+    let BikeArg { spec: bike, model } = bike;
+    let OutputArgs { format, output: out } = out;
+    let b = load(&bike)?;
+    // Every output is checked before any work (issue 10, point 4).
+    if let Some(p) = &out {
+        output::output_target(p)?;
+    }
+    if let Some(p) = &plot {
+        ImageFormat::from_path(p)?;
+        output::output_target(p)?;
+    }
+    let limit = match format {
+        Format::Table => MAX_TABLE_ROWS,
+        Format::Csv | Format::Json => MAX_STREAMED_POINTS,
+    };
+    let (start, step, n) = range_spec(&speeds, "--speeds", limit).map_err(|e| match format {
+        Format::Table => {
+            anyhow::anyhow!(
+                "{e}; a table holds every row, --format csv or json streams up to {MAX_STREAMED_POINTS} points"
+            )
+        }
+        _ => e,
+    })?;
+    let lin = b.linear_with(model.as_deref())?;
+    eprintln!("model: {}", lin.model);
+    let c: &dyn LinearBicycle = &lin;
+    let speed = |k: usize| start + k as f64 * step;
+    let stream = |fmt: output::StreamFormat| -> Result<()> {
+        match &out {
+            Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep(c, n, speed, fmt, w))?,
+            None => {
+                let mut w = std::io::BufWriter::new(std::io::stdout().lock());
+                output::stream_eigen_sweep(c, n, speed, fmt, &mut w).map_err(|e| anyhow::anyhow!(e))?;
+                std::io::Write::flush(&mut w)?;
+            }
+        }
+        Ok(())
+    };
+    match format {
+        Format::Table => {
+            let speeds: Vec<f64> = (0..n).map(speed).collect();
+            emit(&output::format_eigen_table(&eigen_sweep_of(c, &speeds)?), &out)?;
+        }
+        Format::Csv => stream(output::StreamFormat::Csv)?,
+        Format::Json => stream(output::StreamFormat::Json)?,
+    }
+    if let Some(p) = plot {
+        // A diagram needs no more than 20,001 points: longer ranges are
+        // plotted at evenly spaced speeds over the same interval.
+        const PLOT_POINTS: usize = 20_001;
+        let last = speed(n - 1);
+        let speeds: Vec<f64> = if n <= PLOT_POINTS {
+            (0..n).map(speed).collect()
+        } else {
+            (0..PLOT_POINTS)
+                .map(|k| start + (last - start) * k as f64 / (PLOT_POINTS - 1) as f64)
+                .collect()
+        };
+        let sweep = eigen_sweep_of(c, &speeds)?;
+        let vmax = last.max(start + 1e-9);
+        let crit = critical_speeds_of(c, start, vmax).ok();
+        plot_continuation(&p, &sweep, crit.as_ref(), &PlotOptions::default())?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(true)
+}

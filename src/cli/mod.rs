@@ -1,0 +1,151 @@
+//! The commands of the binary: each parses its arguments into the
+//! library's options, calls the library and prints. Shared here: range
+//! parsing with its limits, bicycle loading with warnings, output to a file
+//! or standard output, and the progress display.
+
+pub mod args;
+pub mod bench;
+mod bench_generated;
+mod bench_simulate;
+pub mod canonical;
+pub mod eig;
+pub mod fit;
+pub mod identify;
+pub mod models;
+pub mod params;
+pub mod report;
+pub mod simulate;
+pub mod stability;
+pub mod sweep;
+pub mod synth;
+pub mod text;
+pub mod verify;
+
+use anyhow::{bail, Context, Result};
+use bikedyn::bicycle::Bicycle;
+use bikedyn::progress::Progress;
+use bikedyn::runtime::output;
+use indicatif::{ProgressBar, ProgressDrawTarget};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::OnceLock;
+use std::time::Duration;
+
+/// Most points a `START:STOP:STEP` range may have when all its results are
+/// held in memory (sweeps, tables, plots).
+pub const MAX_POINTS: usize = 10_000_000;
+/// Most rows of a terminal table (`eig --format table`): the table is
+/// aligned, so it is held in memory; CSV and JSON stream instead.
+pub const MAX_TABLE_ROWS: usize = 100_000;
+/// Most cells of a two-parameter stability map (each cell is one
+/// linearization and one critical-speed search, held in memory).
+pub const MAX_MAP_CELLS: usize = 10_000_000;
+/// Most speeds of `eig` with CSV or JSON output, which streams its rows (memory
+/// stays flat; the limit only bounds the run time, about 1 µs per speed).
+pub const MAX_STREAMED_POINTS: usize = 1_000_000_000;
+
+/// `START:STOP:STEP` (or one number) as `(start, step, count)`, with at most
+/// `limit` points.
+pub fn range_spec(s: &str, what: &str, limit: usize) -> Result<(f64, f64, usize)> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let nums: Vec<f64> = parts
+        .iter()
+        .map(|p| {
+            p.trim()
+                .parse::<f64>()
+                .with_context(|| format!("{what}: `{p}` is not a number (expected START:STOP:STEP)"))
+        })
+        .collect::<Result<_>>()?;
+    match nums.as_slice() {
+        [x] if x.is_finite() => Ok((*x, 0.0, 1)),
+        [a, b, h] if a.is_finite() && b.is_finite() && h.is_finite() && *h > 0.0 && b >= a => {
+            // Count in floating point: `as usize` would saturate (and `+ 1`
+            // wrap) for a tiny step such as 1e-300.
+            let intervals = ((b - a) / h + 1e-9).floor();
+            if intervals.is_nan() || intervals >= limit as f64 {
+                bail!(
+                    "{what}: `{s}` gives {} points, more than the limit of {limit} \
+                     (use a larger STEP or a shorter range)",
+                    output::format_significant(intervals + 1.0, 4)
+                );
+            }
+            Ok((*a, *h, intervals as usize + 1))
+        }
+        _ => bail!("{what}: `{s}` must be START:STOP:STEP with STEP > 0 and STOP >= START"),
+    }
+}
+
+pub fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
+    let (a, h, n) = range_spec(s, what, MAX_POINTS)?;
+    Ok((0..n).map(|k| a + k as f64 * h).collect())
+}
+
+pub fn load(bike: &str) -> Result<Bicycle> {
+    let b = Bicycle::resolve(bike)?;
+    for w in &b.warnings {
+        eprintln!("warning ({}): {w}", b.name);
+    }
+    Ok(b)
+}
+
+pub fn emit(text: &str, output: &Option<PathBuf>) -> Result<()> {
+    match output {
+        Some(p) => output::write_string_atomic(p, text)?,
+        None => print!("{text}"),
+    }
+    Ok(())
+}
+
+/// Renders the library's progress reports on standard error: a bar for
+/// counted steps (runs processed; shown when there are more than three) and
+/// a spinner with the last candidate fitted. Nothing is drawn when standard
+/// error is not a terminal, so logs and tests see only the results.
+pub struct ProgressDisplay {
+    bar: OnceLock<ProgressBar>,
+    spinner: OnceLock<ProgressBar>,
+}
+
+impl ProgressDisplay {
+    pub fn new() -> Self {
+        Self {
+            bar: OnceLock::new(),
+            spinner: OnceLock::new(),
+        }
+    }
+
+    /// Show one report (the library's callback).
+    pub fn show(&self, p: Progress<'_>) {
+        let terminal = std::io::stderr().is_terminal();
+        match p.total {
+            Some(total) => {
+                let bar = self.bar.get_or_init(|| {
+                    let bar = ProgressBar::new(total as u64);
+                    if !(terminal && total > 3) {
+                        bar.set_draw_target(ProgressDrawTarget::hidden());
+                    }
+                    bar
+                });
+                bar.set_position(p.done as u64);
+            }
+            None => {
+                let spinner = self.spinner.get_or_init(|| {
+                    let s = ProgressBar::new_spinner();
+                    if !terminal {
+                        s.set_draw_target(ProgressDrawTarget::hidden());
+                    }
+                    s.enable_steady_tick(Duration::from_millis(200));
+                    s
+                });
+                spinner.set_message(format!("identify: fitted {}", p.step));
+            }
+        }
+    }
+}
+
+impl Drop for ProgressDisplay {
+    fn drop(&mut self) {
+        for b in [self.bar.get(), self.spinner.get()].into_iter().flatten() {
+            b.finish_and_clear();
+        }
+    }
+}

@@ -1,0 +1,199 @@
+//! `bikedyn sweep`: stability over one parameter, or a stability map over two.
+
+use super::args::{BikeArg, Format, MapArg, OutputArgs};
+use super::{emit, load, parse_range, MAX_MAP_CELLS};
+use anyhow::{bail, Result};
+use bikedyn::bicycle::Bicycle;
+use bikedyn::runtime::output;
+use bikedyn::runtime::plot::{plot_stability_map, ImageFormat, PlotOptions};
+use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
+use std::path::PathBuf;
+
+/// The sweep as asked on the command line.
+pub struct SweepArgs {
+    pub bike: BikeArg,
+    pub param: String,
+    pub values: String,
+    pub param2: Option<String>,
+    pub values2: Option<String>,
+    pub speed_max: f64,
+    pub out: OutputArgs,
+    pub plot: Option<PathBuf>,
+    pub map: MapArg,
+    pub at_speed: Option<f64>,
+}
+
+/// Run `bikedyn sweep`.
+pub fn run(a: SweepArgs) -> Result<bool> {
+    let SweepArgs {
+        bike: BikeArg { spec: bike, model },
+        param,
+        values,
+        param2,
+        values2,
+        speed_max,
+        out: OutputArgs { format, output: out },
+        plot,
+        map,
+        at_speed,
+    } = a;
+    let b = load(&bike)?;
+    // Every output is checked before any work (issue 10, point 4).
+    if let Some(p) = &out {
+        output::output_target(p)?;
+    }
+    if let Some(p) = &plot {
+        ImageFormat::from_path(p)?;
+        output::output_target(p)?;
+    }
+    let quantity = match map {
+        MapArg::Width => MapQuantity::StableWidth,
+        MapArg::Weave => MapQuantity::WeaveSpeed,
+        MapArg::Capsize => MapQuantity::CapsizeSpeed,
+        MapArg::LeastStable => MapQuantity::LeastStableRealPart,
+    };
+    if matches!(map, MapArg::LeastStable) && at_speed.is_none() {
+        bail!("--map least-stable needs --at-speed V (m/s)");
+    }
+    if let Some(v) = at_speed {
+        if !v.is_finite() {
+            bail!("--at-speed must be a finite speed, found {v:?}");
+        }
+    }
+    let xs = parse_range(&values, "--values")?;
+    // One model for every cell: the one that represents the design
+    // with the swept parameters at their first non-zero values (a
+    // sweep of c_steer from 0 runs wholly through the model with
+    // steer damping), unless the user names it.
+    let model: Option<String> = match model {
+        Some(m) => Some(m),
+        None => {
+            let pick = |b: &Bicycle, name: &str, vals: &[f64]| -> Result<Bicycle> {
+                let v = vals.iter().copied().find(|&v| v != 0.0).unwrap_or(vals[0]);
+                Ok(b.with_parameter(name, v)?)
+            };
+            let mut probe = pick(&b, &param, &xs)?;
+            if let (Some(p2), Some(v2)) = (&param2, &values2) {
+                probe = pick(&probe, p2, &parse_range(v2, "--values2")?)?;
+            }
+            Some(probe.model(None)?.name.to_string())
+        }
+    };
+    eprintln!("model: {}", model.as_deref().unwrap_or_default());
+    let opts = SweepOptions {
+        probe_speed: at_speed,
+        ..SweepOptions::with_speed_range(0.0, speed_max)
+    };
+    let text = match (param2, values2) {
+        (Some(p2), Some(v2)) => {
+            let ys = parse_range(&v2, "--values2")?;
+            let cells = xs.len() as f64 * ys.len() as f64;
+            if cells > MAX_MAP_CELLS as f64 {
+                bail!(
+                    "--values x --values2 gives {} x {} = {} cells, more than the limit of {MAX_MAP_CELLS} \
+                     (use larger steps)",
+                    xs.len(),
+                    ys.len(),
+                    output::format_significant(cells, 4)
+                );
+            }
+            b.with_parameter(&param, xs[0])?.with_parameter(&p2, ys[0])?;
+            let map = stability_map(
+                ParamAxis::new(param.clone(), xs),
+                ParamAxis::new(p2.clone(), ys),
+                |x, y| {
+                    b.with_parameter(&param, x)
+                        .and_then(|b| b.with_parameter(&p2, y))
+                        .and_then(|b| b.linear_with(model.as_deref()))
+                },
+                &opts,
+            )?;
+            refuse_failed_cells(map.cells.iter().enumerate().map(|(k, c)| {
+                let (ny, x, y) = (map.y.values.len(), &map.x.values, &map.y.values);
+                (format!("{param} = {}, {p2} = {}", x[k / ny], y[k % ny]), c)
+            }))?;
+            if let Some(p) = &plot {
+                let opts = PlotOptions {
+                    x_label: Some(axis_label(&param)),
+                    y_label: Some(axis_label(&p2)),
+                    ..PlotOptions::default()
+                };
+                plot_stability_map(p, &map, quantity, &opts)?;
+                eprintln!("wrote {}", p.display());
+            }
+            match format {
+                Format::Table => output::format_stability_map_table(&map),
+                Format::Json => serde_json::to_string_pretty(&output::stability_map_json(&map))? + "\n",
+                Format::Csv => {
+                    let mut buf = Vec::new();
+                    output::write_stability_map_csv(&mut buf, &map)?;
+                    String::from_utf8(buf)?
+                }
+            }
+        }
+        (None, None) => {
+            b.with_parameter(&param, xs[0])?;
+            if plot.is_some() {
+                bail!("--plot draws a two-parameter stability map: give --param2 and --values2");
+            }
+            let s = parameter_sweep(
+                ParamAxis::new(param.clone(), xs),
+                |x| {
+                    b.with_parameter(&param, x)
+                        .and_then(|b| b.linear_with(model.as_deref()))
+                },
+                &opts,
+            )?;
+            refuse_failed_cells(
+                s.points
+                    .iter()
+                    .zip(&s.param.values)
+                    .map(|(c, x)| (format!("{param} = {x}"), c)),
+            )?;
+            match format {
+                Format::Table => output::format_parameter_table(&s),
+                Format::Json => serde_json::to_string_pretty(&output::parameter_sweep_json(&s))? + "\n",
+                Format::Csv => {
+                    let mut buf = Vec::new();
+                    output::write_parameter_sweep_csv(&mut buf, &s)?;
+                    String::from_utf8(buf)?
+                }
+            }
+        }
+        _ => bail!("--param2 and --values2 go together"),
+    };
+    emit(&text, &out)?;
+    Ok(true)
+}
+
+/// "c: trail (m)" from a parameter symbol, for plot axes.
+fn axis_label(symbol: &str) -> String {
+    use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
+    match BenchmarkParameters::describe(symbol).or_else(|| ThesisParameters::describe(symbol)) {
+        Some(d) => format!("{d} [{symbol}]"),
+        None => symbol.to_string(),
+    }
+}
+
+/// A sweep with failed cells is an error listing them (at most ten), never
+/// a table with messages in it.
+fn refuse_failed_cells<'a>(
+    cells: impl Iterator<Item = (String, &'a bikedyn::runtime::sweep::CellResult)>,
+) -> Result<()> {
+    let failed: Vec<String> = cells
+        .filter_map(|(at, c)| c.as_ref().err().map(|e| format!("  {at}: {}", e.message)))
+        .collect();
+    if failed.is_empty() {
+        return Ok(());
+    }
+    let shown = failed.iter().take(10).cloned().collect::<Vec<_>>().join("\n");
+    let more = if failed.len() > 10 {
+        format!("\n  ... and {} more", failed.len() - 10)
+    } else {
+        String::new()
+    };
+    bail!(
+        "{} of the sweep's designs failed, no table written:\n{shown}{more}",
+        failed.len()
+    )
+}

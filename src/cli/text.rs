@@ -1,0 +1,172 @@
+//! Text and JSON of the analysis commands (stability, canonical matrices,
+//! state-space matrices, model listings, parameter files), shared by the
+//! commands that print them and by `report`.
+
+use anyhow::Result;
+use bikedyn::bicycle::Bicycle;
+use bikedyn::runtime::eigen::{CriticalSpeeds, CrossingDirection, CrossingKind};
+use bikedyn::runtime::output;
+use bikedyn::runtime::CanonicalMatrices;
+
+pub fn stability_json(name: &str, c: &CriticalSpeeds) -> serde_json::Value {
+    serde_json::json!({
+        "bike": name,
+        "weave_speed": c.weave_speed,
+        "capsize_speed": c.capsize_speed,
+        "weave_real_pair_merge_speed": c.weave_real_pair_merge,
+        "stable_intervals": c.stable_intervals,
+        "crossings": c.crossings.iter().map(|x| serde_json::json!({
+            "speed": x.speed, "mode": x.mode.name(), "direction": format!("{:?}", x.direction).to_lowercase(),
+            "kind": match x.kind { CrossingKind::RealRoot => "real_root", CrossingKind::ComplexPair => "complex_pair" },
+            "frequency": x.frequency
+        })).collect::<Vec<_>>(),
+    })
+}
+
+pub fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
+    let f = |x: Option<f64>| {
+        x.map(|v| format!("{v:.10} m/s"))
+            .unwrap_or_else(|| "none in range".into())
+    };
+    let mut s = format!("bicycle: {name}\n");
+    s += &format!("  weave speed v_w:   {}\n", f(c.weave_speed));
+    s += &format!("  capsize speed v_c: {}\n", f(c.capsize_speed));
+    s += &format!("  weave real-pair merge v_d: {}\n", f(c.weave_real_pair_merge));
+    if c.stable_intervals.is_empty() {
+        s += "  self-stable: never in the searched range\n";
+    }
+    for [lo, hi] in &c.stable_intervals {
+        s += &format!("  self-stable from {lo:.4} to {hi:.4} m/s\n");
+    }
+    if !c.crossings.is_empty() {
+        s += "  stability crossings (speed, mode, direction):\n";
+    }
+    for x in &c.crossings {
+        let dir = match x.direction {
+            CrossingDirection::Destabilizing => "becomes unstable",
+            CrossingDirection::Stabilizing => "becomes stable",
+        };
+        let kind = match x.kind {
+            CrossingKind::RealRoot => "real root through zero".to_string(),
+            CrossingKind::ComplexPair => format!("oscillation, {:.4} rad/s", x.frequency),
+        };
+        s += &format!("    {:.10} m/s  {:<17}  {dir} ({kind})\n", x.speed, x.mode.name());
+    }
+    s
+}
+
+pub fn models_text(ms: &[bikedyn::registry::ModelInfo]) -> String {
+    let mut s = String::new();
+    for m in ms {
+        s += &format!("{}\n  {}\n", m.name, m.doc);
+        s += &format!(
+            "  base {}, {} speed; effects: {}\n",
+            m.base,
+            if m.free_speed { "free" } else { "driven" },
+            if m.effects.is_empty() {
+                "none".to_string()
+            } else {
+                m.effects.join(", ")
+            }
+        );
+        let coords: Vec<String> = m
+            .coordinates
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                if m.independent.contains(&i) {
+                    format!("{c}*")
+                } else {
+                    c.to_string()
+                }
+            })
+            .collect();
+        s += &format!("  coordinates (* independent): {}\n", coords.join(" "));
+        let params: Vec<&str> = m.parameters.iter().map(|p| p.name).collect();
+        s += &format!("  parameters: {}\n\n", params.join(" "));
+    }
+    s
+}
+
+/// A bicycle's parameters as TOML (its own form), followed by the effect
+/// parameters of its model with their values, defaults and units.
+pub fn params_show_text(b: &Bicycle, model: Option<&str>) -> Result<String> {
+    let info = b.model(model)?;
+    let mut s = b.parameters.to_toml_string();
+    let effects: Vec<_> = info.parameters.iter().filter(|p| p.effect.is_some()).collect();
+    s += &format!("# model: {} ({})\n", info.name, info.doc);
+    if effects.is_empty() {
+        s += "# this model has no effect parameters (see `bikedyn models`)\n";
+    }
+    for p in effects {
+        let v = b.effects.get(p.name).copied().or(p.default).unwrap_or(f64::NAN);
+        let line = format!("{} = {v:?}", p.name);
+        s += &format!("{line:<32} # {} [effect {}]\n", p.doc, p.effect.unwrap_or(""));
+    }
+    Ok(s)
+}
+
+/// Canonical matrices for people: 12 significant digits relative to each
+/// matrix's largest entry, no negative zero (the JSON keeps full precision).
+pub fn canonical_text(c: &CanonicalMatrices) -> String {
+    let m = |name: &str, x: &nalgebra::Matrix2<f64>| {
+        let e = output::format_matrix_entries(&[x[(0, 0)], x[(0, 1)], x[(1, 0)], x[(1, 1)]], 12);
+        let w = e.iter().map(String::len).max().unwrap_or(0);
+        format!(
+            "{name} = [[{:>w$}, {:>w$}],\n      [{:>w$}, {:>w$}]]\n",
+            e[0], e[1], e[2], e[3]
+        )
+    };
+    format!(
+        "{}{}{}{}g = {}\n",
+        m("M0", &c.m0),
+        m("C1", &c.c1),
+        m("K0", &c.k0),
+        m("K2", &c.k2),
+        c.g
+    )
+}
+
+/// Rows of `B = [0; M^-1]` (inputs roll and steer torque).
+pub fn state_input_rows(minv: &nalgebra::Matrix2<f64>) -> Vec<[f64; 2]> {
+    vec![
+        [0.0, 0.0],
+        [0.0, 0.0],
+        [minv[(0, 0)], minv[(0, 1)]],
+        [minv[(1, 0)], minv[(1, 1)]],
+    ]
+}
+
+pub fn state_space_text(v: f64, a: &nalgebra::Matrix4<f64>, minv: &nalgebra::Matrix2<f64>) -> String {
+    let mut s = format!("v = {v} m/s\n");
+    let e: Vec<f64> = (0..4).flat_map(|i| (0..4).map(move |j| a[(i, j)])).collect();
+    let e = output::format_matrix_entries(&e, 10);
+    let w = e.iter().map(String::len).max().unwrap_or(0);
+    for i in 0..4 {
+        let open = if i == 0 { "A = [[" } else { "     [" };
+        let close = if i == 3 { "]]" } else { "]," };
+        s += &format!(
+            "{open}{:>w$}, {:>w$}, {:>w$}, {:>w$}{close}\n",
+            e[4 * i],
+            e[4 * i + 1],
+            e[4 * i + 2],
+            e[4 * i + 3]
+        );
+    }
+    let b: Vec<f64> = state_input_rows(minv).iter().flatten().copied().collect();
+    let b = output::format_matrix_entries(&b, 10);
+    let w = b.iter().map(String::len).max().unwrap_or(0);
+    for i in 0..4 {
+        let open = if i == 0 { "B = [[" } else { "     [" };
+        let close = if i == 3 { "]]" } else { "]," };
+        s += &format!("{open}{:>w$}, {:>w$}{close}\n", b[2 * i], b[2 * i + 1]);
+    }
+    s
+}
+
+pub fn canonical_json(c: &CanonicalMatrices) -> serde_json::Value {
+    serde_json::json!({
+        "M0": CanonicalMatrices::rows(&c.m0), "C1": CanonicalMatrices::rows(&c.c1),
+        "K0": CanonicalMatrices::rows(&c.k0), "K2": CanonicalMatrices::rows(&c.k2), "g": c.g,
+    })
+}

@@ -1,0 +1,151 @@
+//! What identification tests: the models it runs through (chosen by
+//! capability) and the candidate effects, from the declarations in the
+//! effect files.
+
+use super::error::IdentifyError;
+use crate::bicycle::Bicycle;
+use crate::generated::MODELS;
+use bikedyn_runtime::identify::{Candidate, EffectParameter};
+use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification};
+use bikedyn_runtime::registry::ModelInfo;
+
+/// The identification model, its driven twin, and the alternative model
+/// (free speed, with states: the tyre model) if the registry has one. Each is
+/// chosen by capability: it can represent the bicycle (has every parameter
+/// the bicycle sets) and carries the most effects.
+pub fn identification_models(
+    bike: &Bicycle,
+) -> Result<(&'static ModelInfo, &'static ModelInfo, Option<&'static ModelInfo>), IdentifyError> {
+    let nonzero = bike.nonzero_parameters()?;
+    let (free, driven) = identification_model_pair(bike)?;
+    let alt = MODELS
+        .iter()
+        .filter(|m| {
+            m.free_speed
+                && !m.states.is_empty()
+                && crate::models::fits(m, &nonzero)
+                && free.effects.iter().all(|e| m.effects.contains(e))
+        })
+        .max_by_key(|m| m.effects.len());
+    Ok((free, driven, alt))
+}
+
+/// The free-speed model without extra states that can represent the
+/// bicycle and carries the most effects (every candidate of the library on
+/// every geometry), and its driven-speed twin (same effects).
+fn identification_model_pair(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo), IdentifyError> {
+    let nonzero = bike.nonzero_parameters()?;
+    let free = MODELS
+        .iter()
+        .filter(|m| m.free_speed && m.states.is_empty() && crate::models::fits(m, &nonzero))
+        .max_by_key(|m| m.effects.len())
+        .ok_or_else(|| IdentifyError::NoFreeSpeedModel {
+            bicycle: bike.name.clone(),
+        })?;
+    let driven = MODELS
+        .iter()
+        .find(|m| !m.free_speed && m.effects == free.effects && crate::models::fits(m, &nonzero))
+        .ok_or(IdentifyError::NoDrivenTwin { model: free.name })?;
+    Ok((free, driven))
+}
+
+/// The candidates for a model: every effect it carries whose effect file
+/// declares it a candidate (and is in `only` when given), with what its
+/// declaration says: fitted parameters, ties, floors, held companions,
+/// speed decay and the reason. An effect declared "own model" (tyre slip)
+/// comes from the alternative model `alt`.
+pub fn candidates(
+    info: &ModelInfo,
+    alt: Option<&ModelInfo>,
+    bike: &Bicycle,
+    only: &[String],
+) -> Result<Vec<Candidate>, IdentifyError> {
+    let declared = |m: &ModelInfo| -> Vec<(&'static str, CandidateDeclaration)> {
+        m.effect_declarations
+            .iter()
+            .filter_map(|e| match e.identification {
+                Some(EffectIdentification::Candidate(c)) => Some((e.name, c)),
+                _ => None,
+            })
+            .collect()
+    };
+    let mut pool: Vec<(&ModelInfo, &'static str, CandidateDeclaration)> = declared(info)
+        .into_iter()
+        .filter(|(_, c)| !c.own_model)
+        .map(|(n, c)| (info, n, c))
+        .collect();
+    if let Some(a) = alt {
+        pool.extend(
+            declared(a)
+                .into_iter()
+                .filter(|(_, c)| c.own_model)
+                .map(|(n, c)| (a, n, c)),
+        );
+    }
+    for o in only {
+        if !pool.iter().any(|(_, n, _)| n == o) {
+            return Err(IdentifyError::NotACandidate {
+                effect: o.clone(),
+                known: pool.iter().map(|(_, n, _)| *n).collect(),
+            });
+        }
+    }
+    let mut out = Vec::new();
+    for (info, effect, d) in pool {
+        if !(only.is_empty() || only.iter().any(|o| o == effect)) {
+            continue;
+        }
+        let unit = |sym: &str| {
+            info.parameter(sym)
+                .map(|p| {
+                    p.doc
+                        .rsplit_once('(')
+                        .map_or("", |(_, u)| u.trim_end_matches(')'))
+                        .to_string()
+                })
+                .unwrap_or_default()
+        };
+        out.push(Candidate {
+            name: effect.to_string(),
+            effects: vec![effect.to_string()],
+            parameters: d
+                .fitted
+                .iter()
+                .map(|f| EffectParameter {
+                    symbol: f.symbol.to_string(),
+                    tied: f.tied.iter().map(|t| t.to_string()).collect(),
+                    scale: f.scale,
+                    dissipative: f.dissipative,
+                    unit: unit(f.symbol),
+                    initial: f
+                        .start_at_default
+                        .then(|| info.parameter(f.symbol).and_then(|p| p.default))
+                        .flatten(),
+                    lower: f.floor,
+                })
+                .collect(),
+            fixed: d
+                .held
+                .iter()
+                .filter_map(|sym| bike.value(sym).map(|v| (sym.to_string(), v)))
+                .collect(),
+            speed_decay: d.speed_decay,
+            reason: d.reason.to_string(),
+            alternative_model: d.own_model,
+        });
+    }
+    Ok(out)
+}
+
+/// Effects a model carries that identification never tests, with the
+/// reason their files give (or that they declare nothing).
+pub fn not_candidates(info: &ModelInfo) -> Vec<(&'static str, String)> {
+    info.effect_declarations
+        .iter()
+        .filter_map(|e| match e.identification {
+            Some(EffectIdentification::Candidate(_)) => None,
+            Some(EffectIdentification::OptOut(why)) => Some((e.name, why.to_string())),
+            None => Some((e.name, "its effect file declares no identification".to_string())),
+        })
+        .collect()
+}

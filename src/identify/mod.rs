@@ -1,0 +1,373 @@
+//! `bikedyn identify`: close the loop on a measured set (issue 9). The
+//! measured-run pipeline (`fit`) finds the kicks and their windows; the
+//! numerics are `runtime::identify` (time-series residuals against the
+//! nonlinear simulation, stepwise selection by BIC and cross-validation).
+//! This module is the pipeline; [`candidates`] builds the candidates from
+//! the effect library, [`segments`] cuts the measured windows, [`predict`]
+//! gives the linear weave predictions, [`diagnosis`] relates the residual
+//! pattern to effects, and [`report`] writes the summary and the report
+//! folder.
+
+pub mod candidates;
+pub mod diagnosis;
+mod error;
+pub mod predict;
+pub mod report;
+pub mod segments;
+
+pub use error::IdentifyError;
+
+use crate::bicycle::Bicycle;
+use crate::fit::{run_fit, FitOptions};
+use crate::generated::with_model;
+use crate::progress::{OnProgress, Progress};
+use bikedyn_runtime::identify::{
+    identify, Candidate, Factory, Identification, IdentifyOptions as FitSettings, ModelFactory, Segment, Setup,
+};
+use bikedyn_runtime::linearize::parameter_vector;
+use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+use bikedyn_runtime::MultibodyModel;
+use candidates::{candidates, identification_models};
+use diagnosis::{diagnose, Finding};
+use predict::{linear_equivalent, predict};
+use segments::segments;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The committed example set: six runs of the thesis bicycle made by
+/// `bikedyn synth` with steer damping hidden (`examples/data/README.md`).
+pub const EXAMPLE_SET: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/data/hidden_steer_damping");
+
+/// What to identify: the measured runs, the bicycle, the candidates.
+#[derive(Clone, Debug)]
+pub struct IdentifyRequest {
+    /// Set folders (all runs) or run folders.
+    pub inputs: Vec<PathBuf>,
+    /// Calibration run (default: `calibration/` beside the runs).
+    pub calibration: Option<PathBuf>,
+    /// Bicycle (built-in name or parameter file); its effect parameters, if
+    /// any, are part of the model before identification. Default `thesis`.
+    pub bike: String,
+    /// Candidate effects to consider (empty, the default: every effect of
+    /// the library that identification supports).
+    pub effects: Vec<String>,
+    /// Folds of the cross-validation over runs (default 4).
+    pub folds: usize,
+}
+
+impl Default for IdentifyRequest {
+    fn default() -> Self {
+        Self {
+            inputs: Vec::new(),
+            calibration: None,
+            bike: "thesis".into(),
+            effects: Vec::new(),
+            folds: 4,
+        }
+    }
+}
+
+/// The models and candidates of an identification, chosen before any fit.
+pub struct Plan {
+    /// The bicycle, resolved.
+    pub bike: Bicycle,
+    /// The nonlinear free-speed model the fits run through.
+    pub model: &'static ModelInfo,
+    /// Its driven-speed twin (same effects), for the weave predictions.
+    pub driven_model: &'static ModelInfo,
+    /// The model with extra states (the tyre model), if the registry has one
+    /// that can represent the bicycle.
+    pub alternative_model: Option<&'static ModelInfo>,
+    /// The candidate effects.
+    pub candidates: Vec<Candidate>,
+}
+
+/// Everything identification found, and what the report needs.
+pub struct Outcome {
+    /// The stepwise selection: fits before and after, each step's verdicts.
+    pub identification: Identification,
+    /// The measured segments fitted (one per kick).
+    pub segments: Vec<Segment>,
+    /// Runs and kicks left out, with the reason.
+    pub skipped: Vec<String>,
+    /// The candidate effects tried.
+    pub candidates: Vec<Candidate>,
+    /// The residual diagnosis of the base model.
+    pub findings: Vec<Finding>,
+    /// Weave eigenvalue `[re, im]` (1/s) of each segment, base model.
+    pub predicted_before: Vec<Option<[f64; 2]>>,
+    /// The same with the identified effects.
+    pub predicted_after: Vec<Option<[f64; 2]>>,
+    /// The same with the values fitted without the segment's fold.
+    pub predicted_held_out: Vec<Option<[f64; 2]>>,
+    /// Identified effect values by symbol (tied symbols and held companions included).
+    pub values_after: BTreeMap<String, f64>,
+    /// The free-speed model fitted.
+    pub model: &'static str,
+    /// Its driven-speed twin (the weave predictions).
+    pub driven_model: &'static str,
+    /// Wall-clock time of the run (s).
+    pub seconds: f64,
+    /// Mean |steer rate| of each segment in the fitted simulation (rad/s).
+    pub steer_rate: Vec<f64>,
+    run_plot: Option<RunPlot>,
+}
+
+/// Choose the models and candidates for a request: the first half of
+/// [`run`], so a caller can say which model runs before the fits start.
+pub fn plan(request: &IdentifyRequest) -> Result<Plan, IdentifyError> {
+    let bike = Bicycle::resolve(&request.bike)?;
+    let (model, driven_model, alternative_model) = identification_models(&bike)?;
+    let candidates = candidates(model, alternative_model, &bike, &request.effects)?;
+    // A conclusion ("no effect warranted") means something only when
+    // effects were tried.
+    if candidates.is_empty() {
+        return Err(IdentifyError::NoCandidates {
+            bicycle: bike.name.clone(),
+            model: model.name,
+            effects: model.effects.to_vec(),
+        });
+    }
+    Ok(Plan {
+        bike,
+        model,
+        driven_model,
+        alternative_model,
+        candidates,
+    })
+}
+
+/// Run identification on the inputs: [`plan`], then [`run_plan`].
+pub fn run(request: &IdentifyRequest, progress: OnProgress<'_>) -> Result<Outcome, IdentifyError> {
+    run_plan(&plan(request)?, request, progress)
+}
+
+/// Run identification as planned: the measured-run pipeline, the segments,
+/// the stepwise fits, the predictions before and after, the diagnosis.
+/// `progress` gets the measured runs processed (step `"runs"`) and each
+/// candidate fitted (its name as the step).
+pub fn run_plan(plan: &Plan, request: &IdentifyRequest, progress: OnProgress<'_>) -> Result<Outcome, IdentifyError> {
+    let start = std::time::Instant::now();
+    let Plan {
+        bike,
+        model: free,
+        driven_model: driven,
+        alternative_model: alt,
+        candidates: cands,
+    } = plan;
+    let (free, driven, alt) = (*free, *driven, *alt);
+    let fit_options = FitOptions {
+        inputs: request.inputs.clone(),
+        calibration: request.calibration.clone(),
+        bike: Some(request.bike.clone()),
+        ..FitOptions::default()
+    };
+    let out = run_fit(&fit_options, progress)?;
+    let (segs, mut skipped) = segments(&out);
+    skipped.extend(out.errors.iter().cloned());
+    if segs.len() < 2 {
+        return Err(IdentifyError::TooFewKicks {
+            found: segs.len(),
+            skipped,
+        });
+    }
+    let opts = FitSettings {
+        folds: request.folds,
+        ..FitSettings::default()
+    };
+    // The runtime reports each candidate fitted by name, from the fitting threads.
+    let fitted = AtomicUsize::new(0);
+    let on_fit = |name: &str| {
+        progress(Progress {
+            step: name,
+            done: fitted.fetch_add(1, Ordering::Relaxed) + 1,
+            total: None,
+        })
+    };
+    let (id, run_plot) = with_model(
+        free.name,
+        Identify {
+            bike,
+            alt,
+            segments: &segs,
+            candidates: cands,
+            opts: &opts,
+            progress: &on_fit,
+        },
+    )
+    .expect("registered model")?;
+    let speeds: Vec<f64> = segs.iter().map(|s| s.mean_speed).collect();
+    let predicted_before = predict(driven, bike, &BTreeMap::new(), &speeds)?;
+    let values_after = effect_values(&id.after, &id.after.values, cands);
+    // Steer-rate amplitude of each segment, from the fitted simulation.
+    let steer_rate: Vec<f64> = (0..segs.len())
+        .map(|i| {
+            run_plot
+                .as_ref()
+                .and_then(|rp| rp.after[i].as_ref())
+                .map_or(f64::NAN, |sim| mean_abs_rate(&segs[i].t, &sim.steer))
+        })
+        .collect();
+    let mut predicted_after = Vec::with_capacity(segs.len());
+    for (i, &v) in speeds.iter().enumerate() {
+        let vals = linear_equivalent(driven, &values_after, steer_rate[i]);
+        predicted_after.push(predict(driven, bike, &vals, &[v])?[0]);
+    }
+    // Held out: each segment predicted with the values fitted without its fold.
+    let mut predicted_held_out = vec![None; segs.len()];
+    for (f, vals) in id.after.fold_values.iter().enumerate() {
+        let idx: Vec<usize> = (0..segs.len()).filter(|&s| s % id.folds == f).collect();
+        let sp: Vec<f64> = idx.iter().map(|&s| speeds[s]).collect();
+        let fold_vals = effect_values(&id.after, vals, cands);
+        for (k, &s) in idx.iter().enumerate() {
+            predicted_held_out[s] = predict(
+                driven,
+                bike,
+                &linear_equivalent(driven, &fold_vals, steer_rate[s]),
+                &sp[k..=k],
+            )?[0];
+        }
+    }
+    // Steady bias: the base model's roll residual over the second half of
+    // each window.
+    let bias: Vec<f64> = run_plot
+        .as_ref()
+        .map(|rp| {
+            segs.iter()
+                .zip(&rp.before)
+                .filter_map(|(s, sim)| {
+                    let sim = sim.as_ref()?;
+                    let h = s.t.len() / 2;
+                    let n = (s.t.len() - h).max(1) as f64;
+                    Some((h..s.t.len()).map(|k| s.roll[k] - sim.roll[k]).sum::<f64>() / n)
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let models: Vec<&ModelInfo> = std::iter::once(free).chain(alt).collect();
+    let findings = diagnose(&models, &segs, &predicted_before, &id.before.errors, &bias);
+    Ok(Outcome {
+        identification: id,
+        segments: segs,
+        skipped,
+        candidates: cands.clone(),
+        findings,
+        predicted_before,
+        predicted_after,
+        predicted_held_out,
+        values_after,
+        model: free.name,
+        driven_model: driven.name,
+        seconds: start.elapsed().as_secs_f64(),
+        steer_rate,
+        run_plot,
+    })
+}
+
+/// Effect values of a fit, tied symbols and fixed companions included.
+fn effect_values(
+    fit: &bikedyn_runtime::identify::CandidateFit,
+    values: &[f64],
+    cands: &[Candidate],
+) -> BTreeMap<String, f64> {
+    let mut m = BTreeMap::new();
+    for (p, v) in fit.parameters.iter().zip(values) {
+        m.insert(p.symbol.clone(), *v);
+        for t in &p.tied {
+            m.insert(t.clone(), *v);
+        }
+    }
+    for c in cands.iter().filter(|c| fit.effects.contains(&c.name)) {
+        for (s, v) in &c.fixed {
+            m.insert(s.clone(), *v);
+        }
+    }
+    m
+}
+
+/// Mean absolute rate of a sampled angle (rad/s).
+fn mean_abs_rate(t: &[f64], x: &[f64]) -> f64 {
+    let d: Vec<f64> = t
+        .windows(2)
+        .zip(x.windows(2))
+        .filter(|(a, _)| a[1] > a[0])
+        .map(|(a, b)| ((b[1] - b[0]) / (a[1] - a[0])).abs())
+        .collect();
+    d.iter().sum::<f64>() / d.len().max(1) as f64
+}
+
+/// Simulated channels of every segment before and after (plots, bias,
+/// amplitude of the steer rate), and the typical segment.
+struct RunPlot {
+    segment: usize,
+    before: Vec<Option<bikedyn_runtime::identify::Sim>>,
+    after: Vec<Option<bikedyn_runtime::identify::Sim>>,
+}
+
+struct Identify<'a> {
+    bike: &'a Bicycle,
+    alt: Option<&'static ModelInfo>,
+    segments: &'a [Segment],
+    candidates: &'a [Candidate],
+    opts: &'a FitSettings,
+    progress: &'a (dyn Fn(&str) + Sync),
+}
+
+impl ModelVisitor for Identify<'_> {
+    type Output = Result<(Identification, Option<RunPlot>), IdentifyError>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        let lookup = self.bike.lookup()?;
+        let base = parameter_vector::<M>(&lookup, 5.0)?;
+        let alt: Option<Box<dyn ModelFactory>> = match self.alt {
+            Some(a) => Some(with_model(a.name, MakeFactory { lookup: &lookup }).expect("registered model")?),
+            None => None,
+        };
+        let id = identify::<M>(
+            &base,
+            self.segments,
+            self.candidates,
+            alt.as_deref(),
+            self.opts,
+            self.progress,
+        )?;
+        // The typical run: median roll error before.
+        let mut order: Vec<usize> = (0..self.segments.len()).collect();
+        order.sort_by(|&a, &b| id.before.errors[a].roll_rms.total_cmp(&id.before.errors[b].roll_rms));
+        let sel: Vec<&Candidate> = id
+            .selected
+            .iter()
+            .filter_map(|n| self.candidates.iter().find(|c| &c.name == n))
+            .collect();
+        let before = Setup::new::<M>(&base, self.segments, &id.weights, &[])?;
+        let after = match alt.as_deref().filter(|_| sel.iter().any(|c| c.alternative_model)) {
+            Some(f) => f.setup(self.segments, &id.weights, &sel)?,
+            None => Setup::new::<M>(&base, self.segments, &id.weights, &sel)?,
+        };
+        let plot = order.get(order.len() / 2).map(|&s| RunPlot {
+            segment: s,
+            before: (0..self.segments.len())
+                .map(|i| before.simulated(&[], &self.segments[i], &id.before.nuisance[i]).ok())
+                .collect(),
+            after: (0..self.segments.len())
+                .map(|i| {
+                    after
+                        .simulated(&id.after.values, &self.segments[i], &id.after.nuisance[i])
+                        .ok()
+                })
+                .collect(),
+        });
+        Ok((id, plot))
+    }
+}
+
+struct MakeFactory<'a, F: Fn(&str) -> Option<f64>> {
+    lookup: &'a F,
+}
+
+impl<F: Fn(&str) -> Option<f64>> ModelVisitor for MakeFactory<'_, F> {
+    type Output = Result<Box<dyn ModelFactory>, IdentifyError>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        Ok(Box::new(Factory::<M>::new(parameter_vector::<M>(self.lookup, 5.0)?)))
+    }
+}

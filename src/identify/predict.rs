@@ -1,0 +1,166 @@
+//! Linear predictions of the weave eigenvalue (1/s): the driven-speed
+//! model with effect values on top of the bicycle, each effect replaced by
+//! its declared linear equivalent; the tyre model through its state-space
+//! linearization.
+
+use super::candidates::identification_models;
+use super::error::IdentifyError;
+use crate::bicycle::Bicycle;
+use crate::generated::with_model;
+use bikedyn_runtime::linearize::{lateral_block, linearize_at_speed, parameter_vector, state_space_at_speed};
+use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
+use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+use bikedyn_runtime::MultibodyModel;
+use std::collections::BTreeMap;
+
+/// Weave eigenvalue `[re, im]` of a linearization (the complex pair with
+/// the highest frequency), if any.
+fn weave_of(l: &bikedyn_runtime::linearize::Linearization) -> Option<[f64; 2]> {
+    let m = nalgebra::Matrix2::from_fn(|i, j| l.mass[(i, j)]);
+    let c = nalgebra::Matrix2::from_fn(|i, j| l.damping[(i, j)]);
+    let k = nalgebra::Matrix2::from_fn(|i, j| l.stiffness[(i, j)]);
+    let mi = m.try_inverse()?;
+    let (a, b) = (-mi * k, -mi * c);
+    let mut s = nalgebra::Matrix4::zeros();
+    s[(0, 2)] = 1.0;
+    s[(1, 3)] = 1.0;
+    for i in 0..2 {
+        for j in 0..2 {
+            s[(2 + i, j)] = a[(i, j)];
+            s[(2 + i, 2 + j)] = b[(i, j)];
+        }
+    }
+    s.complex_eigenvalues()
+        .iter()
+        .filter(|z| z.im > 1e-9)
+        .max_by(|x, y| x.im.total_cmp(&y.im))
+        .map(|z| [z.re, z.im])
+}
+
+struct WeaveCurve<'a> {
+    lookup: &'a dyn Fn(&str) -> Option<f64>,
+    speeds: &'a [f64],
+}
+
+impl ModelVisitor for WeaveCurve<'_> {
+    type Output = Result<Vec<Option<[f64; 2]>>, IdentifyError>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        let p = parameter_vector::<M>(self.lookup, 1.0)?;
+        Ok(self
+            .speeds
+            .iter()
+            .map(|&v| {
+                linearize_at_speed::<M>(&p, v)
+                    .ok()
+                    .and_then(|l| weave_of(&lateral_block::<M>(&l)))
+            })
+            .collect())
+    }
+}
+
+/// Predicted weave eigenvalues of the driven model with effect values
+/// `values` set on top of the bicycle, at each of `speeds` (m/s).
+pub fn predict(
+    driven: &ModelInfo,
+    bike: &Bicycle,
+    values: &BTreeMap<String, f64>,
+    speeds: &[f64],
+) -> Result<Vec<Option<[f64; 2]>>, IdentifyError> {
+    let base = bike.lookup()?;
+    let lookup = |s: &str| values.get(s).copied().or_else(|| base(s));
+    let guide = with_model(
+        driven.name,
+        WeaveCurve {
+            lookup: &lookup,
+            speeds,
+        },
+    )
+    .expect("registered model")?;
+    // Effects the driven model lacks (the tyre model's) are predicted with
+    // the alternative model's state-space linearization.
+    if let Some(alt) = values
+        .keys()
+        .any(|k| driven.parameter(k).is_none())
+        .then(|| identification_models(bike).ok().and_then(|m| m.2))
+        .flatten()
+    {
+        return with_model(
+            alt.name,
+            StateSpaceWeave {
+                lookup: &lookup,
+                speeds,
+                guide: &guide,
+            },
+        )
+        .expect("registered model");
+    }
+    Ok(guide)
+}
+
+/// Effect values for a linear (eigenvalue) prediction: each effect whose
+/// file declares a linear equivalent is replaced by it. Coulomb steer
+/// friction has no useful linearization about upright (the smoothed law
+/// linearizes to a stiff damper `T / w`), so it declares its
+/// describing-function equivalent viscous damping at the response's steer
+/// rate: for a sinusoid of amplitude `A`, `c_eq = 4 T / (pi A)`, with
+/// `A = (pi / 2) mean|rate|`.
+pub fn linear_equivalent(
+    info: &ModelInfo,
+    values: &BTreeMap<String, f64>,
+    mean_abs_steer_rate: f64,
+) -> BTreeMap<String, f64> {
+    let mut v = values.clone();
+    for e in info.effect_declarations {
+        let Some(EffectIdentification::Candidate(CandidateDeclaration {
+            linear_equivalent: Some(LinearEquivalent::DescribingFunctionDamping { torque, damping }),
+            ..
+        })) = e.identification
+        else {
+            continue;
+        };
+        if let Some(t) = v.get(torque).copied().filter(|t| *t != 0.0) {
+            let amp = std::f64::consts::FRAC_PI_2 * mean_abs_steer_rate;
+            let c_eq = if amp > 0.0 {
+                4.0 * t / (std::f64::consts::PI * amp)
+            } else {
+                0.0
+            };
+            *v.entry(damping.into()).or_insert(0.0) += c_eq;
+            v.insert(torque.into(), 0.0);
+        }
+    }
+    v
+}
+
+/// Weave eigenvalues of a model with extra states (state-space
+/// linearization): the complex eigenvalue nearest each `guide` (the no-slip
+/// model's weave).
+struct StateSpaceWeave<'a> {
+    lookup: &'a dyn Fn(&str) -> Option<f64>,
+    speeds: &'a [f64],
+    guide: &'a [Option<[f64; 2]>],
+}
+
+impl ModelVisitor for StateSpaceWeave<'_> {
+    type Output = Result<Vec<Option<[f64; 2]>>, IdentifyError>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        let p = parameter_vector::<M>(self.lookup, 1.0)?;
+        Ok(self
+            .speeds
+            .iter()
+            .zip(self.guide)
+            .map(|(&v, g)| {
+                let g = (*g)?;
+                let ss = state_space_at_speed::<M>(&p, v).ok()?;
+                ss.a.complex_eigenvalues()
+                    .iter()
+                    .filter(|z| z.im > 1e-9)
+                    .min_by(|x, y| {
+                        let d = |z: &nalgebra::Complex<f64>| (z.re - g[0]).hypot(z.im - g[1]);
+                        d(x).total_cmp(&d(y))
+                    })
+                    .map(|z| [z.re, z.im])
+            })
+            .collect())
+    }
+}

@@ -1,0 +1,533 @@
+//! The identification's outputs: the five-line summary, the JSON summary
+//! (schema in README, "Closing the loop"), and the report folder
+//! (`report.md`, `report.json`, plots, the fitted parameter file).
+
+use super::candidates::{identification_models, not_candidates};
+use super::predict::{linear_equivalent, predict};
+use super::{IdentifyError, IdentifyRequest, Outcome};
+use crate::bicycle::Bicycle;
+use crate::generated::MODELS;
+use bikedyn_runtime::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
+use bikedyn_runtime::identify::{pooled_rms, Candidate, Segment};
+use bikedyn_runtime::output::{save_json, write_string_atomic};
+use serde_json::{json, Value};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// RMS of |measured - predicted| weave eigenvalue (1/s) over segments.
+pub fn eigen_rms(segs: &[Segment], pred: &[Option<[f64; 2]>]) -> f64 {
+    let d: Vec<f64> = segs
+        .iter()
+        .zip(pred)
+        .filter_map(|(s, p)| {
+            let (m, _) = s.weave?;
+            let p = (*p)?;
+            Some((m[0] - p[0]).powi(2) + (m[1] - p[1]).powi(2))
+        })
+        .collect();
+    (d.iter().sum::<f64>() / d.len().max(1) as f64).sqrt()
+}
+
+fn display_name(c: &Candidate) -> String {
+    if c.speed_decay {
+        format!("{} (speed decay)", c.name)
+    } else {
+        c.name.clone()
+    }
+}
+
+fn errors_json(o: &Outcome, after: bool) -> Value {
+    let id = &o.identification;
+    let fit = if after { &id.after } else { &id.before };
+    let pred = if after { &o.predicted_after } else { &o.predicted_before };
+    let held_pred = if after {
+        &o.predicted_held_out
+    } else {
+        &o.predicted_before
+    };
+    json!({
+        "eigen_rms": eigen_rms(&o.segments, pred),
+        "median_run_roll_rms": median(fit.errors.iter().map(|e| e.roll_rms)),
+        "median_run_steer_rms": median(fit.errors.iter().map(|e| e.steer_rms)),
+        "roll_rms": pooled_rms(&fit.errors, 0),
+        "steer_rms": pooled_rms(&fit.errors, 1),
+        "speed_rms": pooled_rms(&fit.errors, 2),
+        "held_out": {
+            "eigen_rms": eigen_rms(&o.segments, held_pred),
+            "roll_rms": pooled_rms(&fit.held_out, 0),
+            "steer_rms": pooled_rms(&fit.held_out, 1),
+            "speed_rms": pooled_rms(&fit.held_out, 2),
+        },
+        "per_run": o.segments.iter().enumerate().map(|(i, s)| json!({
+            "run": s.run,
+            "window_start": s.t0,
+            "roll_rms": fit.errors[i].roll_rms,
+            "steer_rms": fit.errors[i].steer_rms,
+            "speed_rms": fit.errors[i].speed_rms,
+            "held_out_roll_rms": fit.held_out[i].roll_rms,
+            "measured_weave": s.weave.map(|w| w.0),
+            "predicted_weave": pred[i],
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// The JSON summary (schema in README, "Closing the loop").
+pub fn outcome_json(o: &Outcome) -> Value {
+    let id = &o.identification;
+    let sel: Vec<String> = id
+        .selected
+        .iter()
+        .filter_map(|n| o.candidates.iter().find(|c| &c.name == n))
+        .map(display_name)
+        .collect();
+    let mut params = serde_json::Map::new();
+    for (p, (v, se)) in id
+        .after
+        .parameters
+        .iter()
+        .zip(id.after.values.iter().zip(&id.after.stderr))
+    {
+        params.insert(
+            p.symbol.clone(),
+            json!({"value": v, "low": v - 1.96 * se, "high": v + 1.96 * se, "stderr": se, "unit": p.unit, "tied": p.tied}),
+        );
+    }
+    let mut cands = Vec::new();
+    for (k, step) in id.steps.iter().enumerate() {
+        for ((name, f), (_, verdict)) in step.tried.iter().zip(&step.verdicts) {
+            cands.push(json!({
+                "step": k + 1,
+                "name": name,
+                "extends": step.base,
+                "score": f.bic - step.base_bic,
+                "cv": f.cv,
+                "base_cv": step.base_cv,
+                "values": f.values,
+                "selected": step.added.as_deref() == Some(name.as_str()),
+                "verdict": verdict,
+            }));
+        }
+        for (name, why) in &step.failed {
+            cands.push(json!({
+                "step": k + 1,
+                "name": name,
+                "extends": step.base,
+                "score": Value::Null,
+                "cv": Value::Null,
+                "selected": false,
+                "verdict": why,
+            }));
+        }
+    }
+    json!({
+        "selected_effects": sel,
+        "parameters": params,
+        "candidates": cands,
+        "error_before": errors_json(o, false),
+        "error_after": errors_json(o, true),
+        "model": o.model,
+        "driven_model": o.driven_model,
+        "kicks": o.segments.len(),
+        "skipped": o.skipped,
+        "findings": o.findings,
+        "weights": id.weights,
+        "folds": id.folds,
+        "simulations": id.simulations,
+        "seconds": o.seconds,
+    })
+}
+
+fn median(x: impl Iterator<Item = f64>) -> f64 {
+    let mut v: Vec<f64> = x.filter(|a| a.is_finite()).collect();
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+fn fmt_c(z: Option<[f64; 2]>) -> String {
+    z.map_or("-".into(), |z| format!("{:.3}{:+.3}i", z[0], z[1]))
+}
+
+/// Five-line summary.
+pub fn summary(o: &Outcome) -> String {
+    let id = &o.identification;
+    let b = errors_json(o, false);
+    let a = errors_json(o, true);
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "kicks: {} from {} runs ({} skipped); model {}",
+        o.segments.len(),
+        o.segments
+            .iter()
+            .map(|s| &s.run)
+            .collect::<std::collections::BTreeSet<_>>()
+            .len(),
+        o.skipped.len(),
+        o.model
+    );
+    let sel = if id.selected.is_empty() {
+        "no effect warranted".to_string()
+    } else {
+        id.selected.join(" + ")
+    };
+    let _ = writeln!(s, "selected: {sel}");
+    let vals: Vec<String> = id
+        .after
+        .parameters
+        .iter()
+        .zip(id.after.values.iter().zip(&id.after.stderr))
+        .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4} {}", p.symbol, v, 1.96 * se, p.unit))
+        .collect();
+    let _ = writeln!(
+        s,
+        "parameters (95 %): {}",
+        if vals.is_empty() { "-".into() } else { vals.join(", ") }
+    );
+    let _ = writeln!(
+        s,
+        "error before -> after: weave eigenvalue RMS {:.3} -> {:.3} 1/s, roll RMS {:.3} -> {:.3} deg (median run {:.3} -> {:.3}), steer RMS {:.3} -> {:.3} deg",
+        b["eigen_rms"].as_f64().unwrap_or(f64::NAN),
+        a["eigen_rms"].as_f64().unwrap_or(f64::NAN),
+        b["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        a["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        b["median_run_roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        a["median_run_roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        b["steer_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        a["steer_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+    );
+    let _ = write!(
+        s,
+        "held-out runs: weave RMS {:.3} -> {:.3} 1/s, roll RMS {:.3} -> {:.3} deg ({} folds, {} simulations, {:.1} s)",
+        b["held_out"]["eigen_rms"].as_f64().unwrap_or(f64::NAN),
+        a["held_out"]["eigen_rms"].as_f64().unwrap_or(f64::NAN),
+        b["held_out"]["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        a["held_out"]["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        id.folds,
+        id.simulations,
+        o.seconds
+    );
+    s
+}
+
+/// Parameter file of the identified bicycle: the bicycle plus the fitted
+/// effect values.
+fn fitted_toml(bike: &Bicycle, values: &BTreeMap<String, f64>, o: &Outcome) -> String {
+    let mut s = bike.parameters.to_toml_string();
+    let _ = writeln!(
+        s,
+        "\n# Effects identified by `bikedyn identify` (model {}; driven-speed twin {}).",
+        o.model, o.driven_model
+    );
+    for (k, v) in bike.effects.iter().filter(|(k, _)| !values.contains_key(*k)) {
+        let _ = writeln!(s, "{k} = {v:e}");
+    }
+    for (k, v) in values {
+        let _ = writeln!(s, "{k} = {v:.6e}");
+    }
+    s
+}
+
+fn report_markdown(o: &Outcome, a: &IdentifyRequest, dir: &Path) -> String {
+    let id = &o.identification;
+    let mut s = String::new();
+    let inputs: Vec<String> = a.inputs.iter().map(|p| p.display().to_string()).collect();
+    let _ = writeln!(s, "# Identification report\n");
+    let _ = writeln!(
+        s,
+        "Data: {} ({} kicks). Bicycle: `{}`. Model: `{}` (nonlinear, free forward speed, every effect of the library absent unless fitted); weave predictions from its driven-speed twin `{}`.\n",
+        inputs.join(", "),
+        o.segments.len(),
+        a.bike,
+        o.model,
+        o.driven_model
+    );
+    let _ = writeln!(s, "## Summary\n\n```\n{}\n```\n", summary(o));
+    let _ = writeln!(s, "## What was done\n");
+    let _ = writeln!(s, "1. The measured-run pipeline (`bikedyn fit`) found every kick and its free-response window, and estimated mounting misalignments (calibration run) and clock offsets: these sensor effects are nuisances, never reported as mechanics.");
+    let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed; fitted per run as nuisance parameters), and compared with the measured roll, steer and speed.");
+    let _ = writeln!(s, "3. The residual pattern of the model without any added effect was related to the effects of the library (below).");
+    let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all runs (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run), and its dissipative parameters are positive. The search stops when no candidate passes.\n", id.folds);
+    let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| median(id.weights.iter().map(f));
+    let _ = writeln!(s, "Channel scales (each run's RMS residual under the base model, at least the best run's; median over runs): roll {:.3} deg, steer {:.3} deg, speed {:.3} m/s. Each run and channel is weighed by its own scale, so a run that diverges toward a fall cannot outweigh the others.\n", med(&|w| w.roll).to_degrees(), med(&|w| w.steer).to_degrees(), med(&|w| w.speed));
+    let _ = writeln!(s, "## Residual diagnosis (base model)\n");
+    let _ = writeln!(
+        s,
+        "| pattern | evidence | points to | significant (2 sigma) |\n|---|---|---|---|"
+    );
+    for f in &o.findings {
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} |",
+            f.pattern,
+            f.evidence,
+            f.suspects.join(", "),
+            if f.significant { "yes" } else { "no" }
+        );
+    }
+    let _ = writeln!(s, "\nCandidates and why each is suspected:\n");
+    for c in &o.candidates {
+        let p: Vec<String> = c
+            .parameters
+            .iter()
+            .map(|p| format!("`{}` ({})", p.symbol, p.unit))
+            .collect();
+        let _ = writeln!(
+            s,
+            "* `{}`{}: {} Fitted: {}.",
+            c.name,
+            if c.speed_decay { " (speed decay)" } else { "" },
+            c.reason,
+            p.join(", ")
+        );
+    }
+    if let Some(info) = MODELS.iter().find(|m| m.name == o.model) {
+        for (e, why) in not_candidates(info) {
+            let _ = writeln!(s, "* `{e}` is not a candidate: {why}.");
+        }
+    }
+    let _ = writeln!(s, "\n## Ranking of the candidates\n");
+    for (k, step) in id.steps.iter().enumerate() {
+        let base = if step.base.is_empty() {
+            "the base model".to_string()
+        } else {
+            step.base.join(" + ")
+        };
+        let _ = writeln!(
+            s,
+            "Step {}: added to {base} (BIC {:.1}, held-out error {:.4}).\n",
+            k + 1,
+            step.base_bic,
+            step.base_cv
+        );
+        let _ = writeln!(
+            s,
+            "| candidate | fitted values | BIC change | held-out error | verdict |\n|---|---|---|---|---|"
+        );
+        let mut rows: Vec<usize> = (0..step.tried.len()).collect();
+        rows.sort_by(|&x, &y| step.tried[x].1.bic.total_cmp(&step.tried[y].1.bic));
+        for r in rows {
+            let (name, f) = &step.tried[r];
+            let vals: Vec<String> = f
+                .parameters
+                .iter()
+                .zip(f.values.iter().zip(&f.stderr))
+                .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4}", p.symbol, v, se))
+                .collect();
+            let cv = if f.cv.is_finite() {
+                format!("{:.4}", f.cv)
+            } else {
+                "-".into()
+            };
+            let _ = writeln!(
+                s,
+                "| `{name}` | {} | {:+.1} | {cv} | {} |",
+                vals.join(", "),
+                f.bic - step.base_bic,
+                step.verdicts[r].1
+            );
+        }
+        for (name, why) in &step.failed {
+            let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
+        }
+        let _ = writeln!(s);
+    }
+    if id.selected.is_empty() {
+        let _ = writeln!(s, "**No effect warranted.** No candidate lowered both the information criterion and the held-out error with physical parameter values: the residual of the base model is not explained better by any effect of the library than by noise. The model is left as it is.\n");
+    } else {
+        let _ = writeln!(
+            s,
+            "## Identified effects\n\n| parameter | value | 95 % interval | unit |\n|---|---|---|---|"
+        );
+        for (p, (v, se)) in id
+            .after
+            .parameters
+            .iter()
+            .zip(id.after.values.iter().zip(&id.after.stderr))
+        {
+            let _ = writeln!(
+                s,
+                "| `{}`{} | {:.5} | [{:.5}, {:.5}] | {} |",
+                p.symbol,
+                if p.tied.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (= `{}`)", p.tied.join("`, `"))
+                },
+                v,
+                v - 1.96 * se,
+                v + 1.96 * se,
+                p.unit
+            );
+        }
+        let _ = writeln!(s);
+    }
+    let b = errors_json(o, false);
+    let af = errors_json(o, true);
+    let g = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
+    let _ = writeln!(s, "## Error before and after\n\n| | weave eigenvalue RMS (1/s) | roll RMS (deg) | steer RMS (deg) | speed RMS (m/s) |\n|---|---|---|---|---|");
+    for (label, v) in [
+        ("fitted runs, before", &b),
+        ("fitted runs, after", &af),
+        ("held-out runs, before", &b["held_out"]),
+        ("held-out runs, after", &af["held_out"]),
+    ] {
+        let _ = writeln!(
+            s,
+            "| {label} | {:.4} | {:.4} | {:.4} | {:.4} |",
+            g(v, "eigen_rms"),
+            g(v, "roll_rms").to_degrees(),
+            g(v, "steer_rms").to_degrees(),
+            g(v, "speed_rms")
+        );
+    }
+    let _ = writeln!(s, "\nPer run (roll RMS in deg; weave eigenvalues in 1/s):\n\n| run | window start (s) | speed over the eigenvalue fit (m/s) | measured weave | predicted before | predicted after | roll before | roll after | roll after, held out |\n|---|---|---|---|---|---|---|---|---|");
+    for (i, seg) in o.segments.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} | {:.2}-{:.2} | {} | {} | {} | {:.3} | {:.3} | {:.3} |",
+            seg.run,
+            seg.t0,
+            seg.speed_interval[0],
+            seg.speed_interval[1],
+            fmt_c(seg.weave.map(|w| w.0)),
+            fmt_c(o.predicted_before[i]),
+            fmt_c(o.predicted_after[i]),
+            id.before.errors[i].roll_rms.to_degrees(),
+            id.after.errors[i].roll_rms.to_degrees(),
+            id.after.held_out[i].roll_rms.to_degrees()
+        );
+    }
+    let _ = writeln!(s, "\n## Plots\n\n* `continuation.svg`: weave eigenvalue over speed, model before (thin) and after (thick), with each measured eigenvalue on its speed interval.\n* `run_residuals.svg`: measured and simulated roll, steer and speed of a typical run (median error), before and after.\n");
+    if !o.skipped.is_empty() {
+        let _ = writeln!(s, "## Skipped\n");
+        for k in &o.skipped {
+            let _ = writeln!(s, "* {k}");
+        }
+        let _ = writeln!(s);
+    }
+    let fitted = dir.join("fitted.toml");
+    let _ = writeln!(s, "## Reproduce\n\nThe identified bicycle is `{}`: the bicycle's parameters plus the fitted effect values, for the model `{}` (driven speed) or `{}` (free speed). To refit from it, and to simulate it:\n\n```sh\nbikedyn identify {} --bike {}\nbikedyn simulate --bike {} --model {} --speed 5 --kick 0.5:3 --duration 6 --plot kick.svg\n```\n\nThe refit starts from the identified bicycle: the effects found here are part of its model, so the refit should warrant nothing more.", fitted.display(), o.driven_model, o.model, inputs.join(" "), fitted.display(), fitted.display(), o.model);
+    s
+}
+
+/// Write the report folder.
+pub fn write_report(o: &Outcome, a: &IdentifyRequest, dir: &Path) -> Result<(), IdentifyError> {
+    std::fs::create_dir_all(dir).map_err(|source| IdentifyError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let bike = Bicycle::resolve(&a.bike)?;
+    save_json(dir.join("report.json"), &outcome_json(o))?;
+    write_string_atomic(dir.join("fitted.toml"), &fitted_toml(&bike, &o.values_after, o))?;
+    // Continuation diagram before and after.
+    let vmax = o.segments.iter().map(|s| s.speed_interval[1]).fold(7.0, f64::max) + 1.0;
+    let speeds: Vec<f64> = (1..=200).map(|i| vmax * i as f64 / 200.0).collect();
+    let (_, driven, _) = identification_models(&bike)?;
+    let curve = |vals: &BTreeMap<String, f64>| -> Result<Vec<(f64, f64, f64)>, IdentifyError> {
+        let pts: Vec<(f64, f64, f64)> = predict(driven, &bike, vals, &speeds)?
+            .into_iter()
+            .zip(&speeds)
+            .filter_map(|(z, &v)| z.map(|z| (v, z[0], z[1])))
+            .collect();
+        // The weave, followed down from high speed until it stops being
+        // one complex pair (a jump far beyond the typical step means
+        // another pair took over, e.g. capsize-castering at low speed).
+        let steps: Vec<f64> = pts
+            .windows(2)
+            .map(|w| (w[1].1 - w[0].1).hypot(w[1].2 - w[0].2))
+            .collect();
+        let typical = median(steps.iter().copied());
+        let mut start = 0;
+        for k in (0..steps.len()).rev() {
+            if steps[k] > 10.0 * typical.max(1e-9) {
+                start = k + 1;
+                break;
+            }
+        }
+        Ok(pts[start..].to_vec())
+    };
+    let measured: Vec<MeasuredWeave> = o
+        .segments
+        .iter()
+        .filter_map(|s| {
+            let (w, se) = s.weave?;
+            Some(MeasuredWeave {
+                speed_interval: s.speed_interval,
+                mean_speed: s.mean_speed,
+                eigenvalue: w,
+                stderr: se,
+            })
+        })
+        .collect();
+    let label = if o.identification.selected.is_empty() {
+        "no effect warranted".to_string()
+    } else {
+        o.identification.selected.join(" + ")
+    };
+    let mut rates: Vec<f64> = o.steer_rate.iter().copied().filter(|x| x.is_finite()).collect();
+    rates.sort_by(f64::total_cmp);
+    let median_rate = rates.get(rates.len() / 2).copied().unwrap_or(f64::NAN);
+    let driven_info = MODELS
+        .iter()
+        .find(|m| m.name == o.driven_model)
+        .expect("the identification's driven model is registered");
+    for ext in ["svg", "png"] {
+        plot_continuation(
+            &dir.join(format!("continuation.{ext}")),
+            &curve(&BTreeMap::new())?,
+            &curve(&linear_equivalent(driven_info, &o.values_after, median_rate))?,
+            &label,
+            &measured,
+        )?;
+    }
+    if let Some(rp) = &o.run_plot {
+        let s = &o.segments[rp.segment];
+        let deg = |x: &[f64]| x.iter().map(|v| v.to_degrees()).collect::<Vec<f64>>();
+        let (Some(b), Some(a)) = (&rp.before[rp.segment], &rp.after[rp.segment]) else {
+            return Err(IdentifyError::TypicalRunNotSimulated);
+        };
+        let (mr, br, ar) = (deg(&s.roll), deg(&b.roll), deg(&a.roll));
+        let (ms, bs, as_) = (deg(&s.steer), deg(&b.steer), deg(&a.steer));
+        for ext in ["svg", "png"] {
+            plot_run(
+                &dir.join(format!("run_residuals.{ext}")),
+                &format!(
+                    "{} (window from {:.2} s): measured and simulated, before and after",
+                    Path::new(&s.run)
+                        .file_name()
+                        .map_or(s.run.clone(), |n| n.to_string_lossy().into_owned()),
+                    s.t0
+                ),
+                &[
+                    Channel {
+                        name: "roll",
+                        unit: "deg",
+                        t: &s.t,
+                        measured: &mr,
+                        before: &br,
+                        after: &ar,
+                    },
+                    Channel {
+                        name: "steer",
+                        unit: "deg",
+                        t: &s.t,
+                        measured: &ms,
+                        before: &bs,
+                        after: &as_,
+                    },
+                    Channel {
+                        name: "speed",
+                        unit: "m/s",
+                        t: &s.speed_t,
+                        measured: &s.speed,
+                        before: &b.speed,
+                        after: &a.speed,
+                    },
+                ],
+            )?;
+        }
+    }
+    write_string_atomic(dir.join("report.md"), &report_markdown(o, a, dir))?;
+    Ok(())
+}

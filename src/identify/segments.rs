@@ -1,0 +1,95 @@
+//! The measured segments identification fits: every kick of the processed
+//! runs with a free-response window, carried on to the end of the free
+//! motion.
+
+use crate::fit::FitOutcome;
+use bikedyn_runtime::experiment::{kicks::WindowEnd, PipelineOptions};
+use bikedyn_runtime::identify::Segment;
+
+/// The measured segments of a processed set: every kick with a free
+/// response window, roll and steer from the pipeline's angles (IMU clock),
+/// speed from the reed switch moved onto the IMU clock.
+pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
+    let mut segs = Vec::new();
+    let mut skipped = Vec::new();
+    for r in &out.reports {
+        let (Some(ang), Some(sp)) = (&r.angles, &r.speed) else {
+            skipped.push(format!(
+                "{}: no angles or speed record (TU Delft logs are not identified yet)",
+                r.run.display()
+            ));
+            continue;
+        };
+        let offset = r.clock_offset.map_or(0.0, |c| c.value);
+        for k in &r.kicks {
+            let [w0, mut w1] = k.window;
+            // The eigenvalue fit stops where the oscillation has decayed (or
+            // drifts, or the speed has changed much); the nonlinear model
+            // describes what follows too, and slow effects (speed decay, a
+            // steady lean) show mostly there. So the identification window
+            // goes on to the end of the free motion: the record's end, a
+            // gap, or a fall, at most IDENTIFY_WINDOW after the start.
+            if matches!(
+                k.window_end,
+                WindowEnd::Decayed | WindowEnd::Drift | WindowEnd::SpeedChange
+            ) {
+                let fall = PipelineOptions::default().kicks.fall_angle;
+                let dt = (ang.t[ang.t.len() - 1] - ang.t[0]) / (ang.t.len().max(2) - 1) as f64;
+                let i0 = ang.t.partition_point(|&x| x < w0);
+                let mut end = w1;
+                for i in i0..ang.t.len() {
+                    if ang.t[i] > w0 + IDENTIFY_WINDOW
+                        || ang.roll[i].abs() > fall
+                        || (i > i0 && ang.t[i] - ang.t[i - 1] > 3.0 * dt)
+                    {
+                        break;
+                    }
+                    end = ang.t[i];
+                }
+                w1 = end.max(w1);
+            }
+            let idx: Vec<usize> = (0..ang.t.len()).filter(|&i| ang.t[i] >= w0 && ang.t[i] <= w1).collect();
+            let speed_idx: Vec<usize> = (0..sp.t.len())
+                .filter(|&i| sp.t[i] + offset >= w0 && sp.t[i] + offset <= w1 && sp.v[i].is_finite())
+                .collect();
+            let weave = k.chosen_fit().map(|f| (f.eigenvalue, f.eigenvalue_stderr));
+            let seg = Segment::new(
+                r.run.display().to_string(),
+                w0,
+                idx.iter().map(|&i| ang.t[i] - w0).collect(),
+                idx.iter().map(|&i| ang.roll[i]).collect(),
+                idx.iter().map(|&i| ang.steer[i]).collect(),
+                speed_idx.iter().map(|&i| sp.t[i] + offset - w0).collect(),
+                speed_idx.iter().map(|&i| sp.v[i]).collect(),
+                weave,
+            );
+            match seg {
+                Some(mut s) if s.duration() >= 0.5 => {
+                    // The eigenvalue belongs to the fit window: compare and
+                    // draw it at that window's speeds.
+                    if k.mean_speed.is_finite() && k.speed_interval.iter().all(|v| v.is_finite()) {
+                        s.mean_speed = k.mean_speed;
+                        s.speed_interval = k.speed_interval;
+                    }
+                    segs.push(s)
+                }
+                _ => skipped.push(format!(
+                    "{}: kick at {:.2} s has no usable window ({:.2}-{:.2} s)",
+                    r.run.display(),
+                    k.kick_time,
+                    w0,
+                    w1
+                )),
+            }
+        }
+        if r.kicks.is_empty() {
+            skipped.push(format!("{}: no kick found", r.run.display()));
+        }
+    }
+    (segs, skipped)
+}
+
+/// Longest identification window after a kick (s): a few weave periods and
+/// long enough for the speed to fall measurably; longer costs simulation
+/// time for little more information.
+const IDENTIFY_WINDOW: f64 = 4.0;
