@@ -2,8 +2,9 @@
 //! sets and TU Delft kick logs), with the model's prediction when a bicycle
 //! is given.
 
-use crate::bicycle::{Bicycle, BicycleError};
+use crate::bicycle::{Bicycle, BicycleError, Linear};
 use crate::progress::{OnProgress, Progress};
+use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::experiment::{
     self,
     angles::{AngleMethod, Calibration},
@@ -11,7 +12,6 @@ use bikedyn_runtime::experiment::{
 };
 use bikedyn_runtime::parameters::ParameterError;
 use bikedyn_runtime::plot::PlotError;
-use bikedyn_runtime::CanonicalMatrices;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -66,8 +66,9 @@ pub struct FitOutcome {
     pub reports: Vec<RunReport>,
     /// Skipped runs with the reason.
     pub errors: Vec<String>,
-    /// Canonical matrices of the bicycle, when given.
-    pub canonical: Option<CanonicalMatrices>,
+    /// The bicycle's linear equations through its model (any effects), for
+    /// the predicted weave, when a bicycle is given.
+    pub linear: Option<Linear>,
     /// Calibration of each set (folder and estimate).
     pub calibrations: Vec<(PathBuf, Calibration)>,
 }
@@ -76,12 +77,9 @@ pub struct FitOutcome {
 /// log (step `"runs"`, with the total found).
 pub fn run_fit(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome, FitError> {
     let bike = opts.bike.as_deref().map(Bicycle::resolve).transpose()?;
-    // A bicycle with effect parameters has no canonical form (identify
-    // passes such bicycles for the frame pitch): no prediction then.
-    let canonical = match bike.as_ref().map(|b| b.canonical()) {
-        Some(Err(BicycleError::NotCanonical { .. })) | None => None,
-        Some(r) => Some(r?),
-    };
+    // The prediction runs through the bicycle's own model, effects (damping,
+    // an assist controller) included.
+    let linear = bike.as_ref().map(|b| b.linear_with(None)).transpose()?;
     let pitch_bike = match &bike {
         Some(b) => b.clone(),
         None => Bicycle::resolve("thesis")?,
@@ -171,7 +169,7 @@ pub fn run_fit(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome
     Ok(FitOutcome {
         reports,
         errors,
-        canonical,
+        linear,
         calibrations,
     })
 }
@@ -181,7 +179,7 @@ fn pair(x: [f64; 2]) -> Value {
 }
 
 /// JSON entry of one kick (schema in README, "Measured runs").
-pub fn kick_json(k: &KickFit, canonical: Option<&CanonicalMatrices>) -> Value {
+pub fn kick_json(k: &KickFit, linear: Option<&dyn LinearBicycle>) -> Value {
     let mut v = json!({
         "run": k.run.display().to_string(),
         "kick_time": k.kick_time,
@@ -213,7 +211,7 @@ pub fn kick_json(k: &KickFit, canonical: Option<&CanonicalMatrices>) -> Value {
     if let Some(o) = k.clock_offset {
         v["clock_offset"] = json!({"value": o.value, "stderr": o.stderr, "from_data": o.from_data});
     }
-    if let Some(c) = canonical {
+    if let Some(c) = linear {
         let [lo, hi] = k.speed_interval;
         v["predicted_weave"] = match compare::predict(c, k.mean_speed, lo, hi) {
             Some(p) => json!({
@@ -229,7 +227,7 @@ pub fn kick_json(k: &KickFit, canonical: Option<&CanonicalMatrices>) -> Value {
 
 /// Residual rows (measured against predicted at the mean speed).
 pub fn residuals(out: &FitOutcome) -> Vec<compare::Residual> {
-    let Some(c) = &out.canonical else { return Vec::new() };
+    let Some(c) = &out.linear else { return Vec::new() };
     let mut rows = Vec::new();
     for r in &out.reports {
         for k in &r.kicks {
@@ -354,7 +352,7 @@ pub fn plots(out: &FitOutcome, dir: &Path) -> Result<(), FitError> {
         }
     }
     let kicks: Vec<&KickFit> = out.reports.iter().flat_map(|r| r.kicks.iter()).collect();
-    if let Some(c) = &out.canonical {
+    if let Some(c) = &out.linear {
         xplot::plot_measured_continuation(&dir.join("continuation_measured.svg"), c, &kicks)?;
     }
     Ok(())

@@ -76,6 +76,8 @@ pub struct SynthRun {
     pub plan: RunPlan,
     /// Why the simulation stopped.
     pub stop: String,
+    /// The generated model that simulated it.
+    pub model: &'static str,
 }
 
 /// Why a synthetic set could not be made.
@@ -295,6 +297,7 @@ pub fn synth(a: &SynthOptions, on_run: &mut dyn FnMut(&SynthRun)) -> Result<(), 
         truth["sensors"] = serde_json::to_value(&sensor_truth)?;
         write_physical_run(&a.out.join("truth"), &name, &tr, &truth)?;
         on_run(&SynthRun {
+            model: info.name,
             stop: sim.stop.to_string(),
             name,
             plan,

@@ -5,6 +5,7 @@ use super::args::FitArgs;
 use super::ProgressDisplay;
 use anyhow::{bail, Result};
 use bikedyn::fit::{calibration_text, kick_json, kicks_table, plots, residuals, run_fit, FitOptions};
+use bikedyn::runtime::eigen::LinearBicycle;
 use bikedyn::runtime::experiment::angles::AngleMethod;
 use bikedyn::runtime::experiment::compare;
 use serde_json::Value;
@@ -59,7 +60,7 @@ pub fn run(args: &FitArgs) -> Result<bool> {
             .reports
             .iter()
             .flat_map(|r| r.kicks.iter())
-            .map(|k| kick_json(k, out.canonical.as_ref()))
+            .map(|k| kick_json(k, out.linear.as_ref().map(|l| l as &dyn LinearBicycle)))
             .collect();
         println!("{}", serde_json::to_string_pretty(&list)?);
     } else {

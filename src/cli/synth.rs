@@ -33,6 +33,9 @@ fn speeds(s: &str) -> Result<[f64; 2]> {
 
 fn print_run(r: &SynthRun) {
     let plan = &r.plan;
+    if r.name == "run01" {
+        println!("model: {}", r.model);
+    }
     println!(
         "{}: release at {:.2} s, {:.2} m/s, kick {:+.2} N s at {:.2} s, {}",
         r.name,

@@ -1,14 +1,13 @@
 //! Measured against predicted weave eigenvalues (driven-speed linearization:
 //! the canonical matrices at constant forward speed).
 
-use crate::eigen::{eigen_sweep, Mode};
-use crate::CanonicalMatrices;
+use crate::eigen::{eigen_sweep_of, LinearBicycle, Mode};
 use serde::Serialize;
 
 /// The model's weave eigenvalue `[real, imag]` (imag > 0) at speed `v`
 /// (m/s); `None` below the speed where the weave roots become complex.
-pub fn predicted_weave(c: &CanonicalMatrices, v: f64) -> Option<[f64; 2]> {
-    let sweep = eigen_sweep(c, &[v]).ok()?;
+pub fn predicted_weave(c: &dyn LinearBicycle, v: f64) -> Option<[f64; 2]> {
+    let sweep = eigen_sweep_of(c, &[v]).ok()?;
     let p = sweep.points.first()?;
     (0..4)
         .filter(|&k| p.modes[k] == Mode::Weave && p.eigenvalues[k].im > 0.0)
@@ -28,10 +27,10 @@ pub struct Prediction {
 }
 
 /// Prediction at `mean` and over `[lo, hi]` (m/s).
-pub fn predict(c: &CanonicalMatrices, mean: f64, lo: f64, hi: f64) -> Option<Prediction> {
+pub fn predict(c: &dyn LinearBicycle, mean: f64, lo: f64, hi: f64) -> Option<Prediction> {
     let at = predicted_weave(c, mean)?;
     let speeds: Vec<f64> = (0..=10).map(|i| lo + (hi - lo) * i as f64 / 10.0).collect();
-    let sweep = eigen_sweep(c, &speeds).ok()?;
+    let sweep = eigen_sweep_of(c, &speeds).ok()?;
     let mut re = [f64::INFINITY, f64::NEG_INFINITY];
     let mut im = re;
     for p in &sweep.points {

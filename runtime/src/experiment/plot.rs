@@ -5,10 +5,9 @@
 
 use super::fit::FitForm;
 use super::KickFit;
-use crate::eigen::{eigen_sweep, Mode};
+use crate::eigen::{eigen_sweep_of, LinearBicycle, Mode};
 use crate::output::write_string_atomic;
 use crate::plot::{find_font, use_font, PlotError};
-use crate::CanonicalMatrices;
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -145,7 +144,7 @@ pub fn plot_response(path: &Path, k: &KickFit) -> Result<(), PlotError> {
 /// The model's weave eigenvalue (real and imaginary parts) over speed, and
 /// each measured eigenvalue as a segment over its speed interval with error
 /// bars (one standard error) at its mean speed.
-pub fn plot_measured_continuation(path: &Path, c: &CanonicalMatrices, kicks: &[&KickFit]) -> Result<(), PlotError> {
+pub fn plot_measured_continuation(path: &Path, c: &dyn LinearBicycle, kicks: &[&KickFit]) -> Result<(), PlotError> {
     font_ready()?;
     let vmax = kicks
         .iter()
@@ -154,7 +153,7 @@ pub fn plot_measured_continuation(path: &Path, c: &CanonicalMatrices, kicks: &[&
         .fold(8.0f64, f64::max)
         + 1.0;
     let speeds: Vec<f64> = (0..=400).map(|i| vmax * i as f64 / 400.0).collect();
-    let sweep = eigen_sweep(c, &speeds).map_err(|e| drawing(path, e))?;
+    let sweep = eigen_sweep_of(c, &speeds).map_err(|e| drawing(path, e))?;
     let mut re = Vec::new();
     let mut im = Vec::new();
     for p in &sweep.points {

@@ -201,7 +201,7 @@ fn normalise_name(s: &str) -> String {
 pub const MAX_DATA_FILE_BYTES: u64 = 512 << 20;
 
 /// The largest metadata or parameter file read.
-pub const MAX_TEXT_FILE_BYTES: u64 = 4 << 20;
+pub const MAX_TEXT_FILE_BYTES: u64 = 16 << 20;
 
 /// Read at most `limit` bytes of `path`; a longer file (or an endless
 /// device) is an error that says so, before memory grows.
@@ -221,7 +221,7 @@ pub fn read_capped(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
 /// [`read_capped`] as text (invalid UTF-8 is an error).
 pub fn read_text_capped(path: &Path, limit: u64) -> std::io::Result<String> {
     String::from_utf8(read_capped(path, limit)?)
-        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "not UTF-8 text"))
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "stream did not contain valid UTF-8"))
 }
 
 /// Read a comma-separated numeric table. `wanted` lists, per column, the
