@@ -94,16 +94,7 @@ fn direction<S: Spectrum + ?Sized>(cp: &S, s: C64, v: f64) -> Option<CrossingDir
 /// Crossings exactly at `v = 0` (possible only for a bicycle that is oscillatory at
 /// rest) and tangential touches are not reported.
 pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<CriticalSpeeds, EigenError> {
-    if !v_min.is_finite() || !v_max.is_finite() {
-        return Err(EigenError::NonFinite {
-            what: format!("speed range [{v_min}, {v_max}]"),
-        });
-    }
-    if v_min > v_max {
-        return Err(EigenError::InvalidArgument {
-            what: format!("v_min = {v_min} > v_max = {v_max}"),
-        });
-    }
+    check_range(v_min, v_max)?;
     let cp = CharPoly::new(c)?;
     let g = cp.g;
     let in_range = |v: f64| v >= v_min && v <= v_max;
@@ -154,6 +145,21 @@ pub fn critical_speeds(c: &CanonicalMatrices, v_min: f64, v_max: f64) -> Result<
     cands.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
 
     finish(&cp, cands, v_min, v_max)
+}
+
+/// A speed range `[v_min, v_max]` must be finite and ordered.
+pub(crate) fn check_range(v_min: f64, v_max: f64) -> Result<(), EigenError> {
+    if !v_min.is_finite() || !v_max.is_finite() {
+        return Err(EigenError::NonFinite {
+            what: format!("speed range [{v_min}, {v_max}]"),
+        });
+    }
+    if v_min > v_max {
+        return Err(EigenError::InvalidArgument {
+            what: format!("v_min = {v_min} > v_max = {v_max}"),
+        });
+    }
+    Ok(())
 }
 
 /// Labels, directions, the named critical speeds, the stable intervals and

@@ -18,7 +18,7 @@
 //! bisected to rounding; the direction of each crossing uses speed
 //! derivatives of the coefficients by central differences.
 
-use super::critical::finish;
+use super::critical::{check_range, finish};
 use super::*;
 use nalgebra::Matrix4;
 
@@ -195,16 +195,7 @@ pub fn critical_speeds_of(bike: &dyn LinearBicycle, v_min: f64, v_max: f64) -> R
     if let Some(c) = bike.canonical() {
         return critical_speeds(c, v_min, v_max);
     }
-    if !v_min.is_finite() || !v_max.is_finite() {
-        return Err(EigenError::NonFinite {
-            what: format!("speed range [{v_min}, {v_max}]"),
-        });
-    }
-    if v_min > v_max {
-        return Err(EigenError::InvalidArgument {
-            what: format!("v_min = {v_min} > v_max = {v_max}"),
-        });
-    }
+    check_range(v_min, v_max)?;
     let family = General::new(bike)?;
     let hurwitz = |k: &[f64; 5]| k[1] * k[2] * k[3] - k[4] * k[1] * k[1] - k[0] * k[3] * k[3];
     let mut cands: Vec<(f64, CrossingKind, f64)> = Vec::new();
