@@ -325,6 +325,7 @@ fn the_tudelft_assist_model_predicts_the_measured_weave() {
     }
     let bike = data("tudelft_sbw_bicycle.toml");
     let out = bikedyn(&["fit", logs.to_str().unwrap(), "--bike", &bike, "--json"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("prediction model: extended"));
     let kicks: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let median = |mut x: Vec<f64>| {
         x.sort_by(f64::total_cmp);

@@ -56,6 +56,9 @@ pub fn run(args: &FitArgs) -> Result<bool> {
     }
     if args.json {
         eprint!("{}", calibration_text(&out));
+        if let Some(l) = &out.linear {
+            eprintln!("prediction model: {}", l.model);
+        }
         let list: Vec<Value> = out
             .reports
             .iter()
@@ -68,7 +71,8 @@ pub fn run(args: &FitArgs) -> Result<bool> {
         print!("{}", kicks_table(&out));
         let rows = residuals(&out);
         if !rows.is_empty() {
-            println!("\nmeasured against predicted weave eigenvalue (z = difference / standard error)");
+            let model = out.linear.as_ref().map_or("", |l| l.model);
+            println!("\nmeasured against predicted weave eigenvalue (model {model}; z = difference / standard error)");
             print!("{}", compare::format_residuals(&rows));
         }
     }
