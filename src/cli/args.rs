@@ -133,40 +133,7 @@ pub enum Command {
         json: bool,
     },
     /// Stability over one parameter, or over a grid of two (a stability map).
-    Sweep {
-        #[command(flatten)]
-        bike: BikeArg,
-        /// Parameter symbol (thesis: Rt, x4, d4, ...; benchmark: c, lam, w, ...).
-        #[arg(long)]
-        param: String,
-        /// Values START:STOP:STEP.
-        #[arg(long)]
-        values: String,
-        /// Second parameter for a two-parameter stability map.
-        #[arg(long)]
-        param2: Option<String>,
-        /// Values of the second parameter START:STOP:STEP.
-        #[arg(long)]
-        values2: Option<String>,
-        /// Upper end of the searched speed range (m/s).
-        #[arg(long, default_value_t = 10.0)]
-        speed_max: f64,
-        #[command(flatten)]
-        out: OutputArgs,
-        /// Stability map plot (.svg or .png), two-parameter sweeps only.
-        #[arg(long)]
-        plot: Option<PathBuf>,
-        /// Quantity mapped by --plot: the self-stable range width, the weave
-        /// or capsize speed, or the real part of the least stable eigenvalue
-        /// at --at-speed. Cells whose stable range reaches --speed-max are
-        /// marked (the range is cut there).
-        #[arg(long, value_enum, default_value_t = MapArg::Width)]
-        map: MapArg,
-        /// Speed (m/s) of --map least-stable; its value is also written to the
-        /// JSON of every cell.
-        #[arg(long)]
-        at_speed: Option<f64>,
-    },
+    Sweep(SweepArgs),
     /// Parameter sets: show or convert between thesis and benchmark forms.
     Params {
         #[command(subcommand)]
@@ -368,4 +335,41 @@ pub struct SynthArgs {
     /// Output folder.
     #[arg(long)]
     pub out: PathBuf,
+}
+
+/// `bikedyn sweep`: stability over one or two parameters.
+#[derive(Args)]
+pub struct SweepArgs {
+    #[command(flatten)]
+    pub bike: BikeArg,
+    /// Parameter symbol (thesis: Rt, x4, d4, ...; benchmark: c, lam, w, ...).
+    #[arg(long)]
+    pub param: String,
+    /// Values START:STOP:STEP.
+    #[arg(long)]
+    pub values: String,
+    /// Second parameter for a two-parameter stability map.
+    #[arg(long)]
+    pub param2: Option<String>,
+    /// Values of the second parameter START:STOP:STEP.
+    #[arg(long)]
+    pub values2: Option<String>,
+    /// Upper end of the searched speed range (m/s).
+    #[arg(long, default_value_t = 10.0)]
+    pub speed_max: f64,
+    #[command(flatten)]
+    pub out: OutputArgs,
+    /// Stability map plot (.svg or .png), two-parameter sweeps only.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Quantity mapped by --plot: the self-stable range width, the weave
+    /// or capsize speed, or the real part of the least stable eigenvalue
+    /// at --at-speed. Cells whose stable range reaches --speed-max are
+    /// marked (the range is cut there).
+    #[arg(long, value_enum, default_value_t = MapArg::Width)]
+    pub map: MapArg,
+    /// Speed (m/s) of --map least-stable; its value is also written to the
+    /// JSON of every cell.
+    #[arg(long)]
+    pub at_speed: Option<f64>,
 }

@@ -2,7 +2,7 @@
 //! JSON, streamed when long) and the continuation diagram.
 
 use super::args::{BikeArg, Format, OutputArgs};
-use super::{emit, load, range_spec, MAX_STREAMED_POINTS, MAX_TABLE_ROWS};
+use super::{check_outputs, emit, load, range_spec, MAX_STREAMED_POINTS, MAX_TABLE_ROWS};
 use anyhow::Result;
 use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, LinearBicycle};
 use bikedyn::runtime::output;
@@ -14,14 +14,7 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plot: Option<PathBuf>
     let BikeArg { spec: bike, model } = bike;
     let OutputArgs { format, output: out } = out;
     let b = load(&bike)?;
-    // Every output is checked before any work (issue 10, point 4).
-    if let Some(p) = &out {
-        output::output_target(p)?;
-    }
-    if let Some(p) = &plot {
-        ImageFormat::from_path(p)?;
-        output::output_target(p)?;
-    }
+    check_outputs(out.as_deref(), plot.as_deref())?;
     let limit = match format {
         Format::Table => MAX_TABLE_ROWS,
         Format::Csv | Format::Json => MAX_STREAMED_POINTS,

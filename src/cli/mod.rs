@@ -88,6 +88,20 @@ pub fn load(bike: &str) -> Result<Bicycle> {
     Ok(b)
 }
 
+/// Check every output before any work (a data file and, optionally, a
+/// plot whose extension must name a supported image format), so that a bad
+/// path fails at once rather than after the computation.
+pub fn check_outputs(out: Option<&std::path::Path>, plot: Option<&std::path::Path>) -> Result<()> {
+    if let Some(p) = out {
+        output::output_target(p)?;
+    }
+    if let Some(p) = plot {
+        bikedyn::runtime::plot::ImageFormat::from_path(p)?;
+        output::output_target(p)?;
+    }
+    Ok(())
+}
+
 pub fn emit(text: &str, output: &Option<PathBuf>) -> Result<()> {
     match output {
         Some(p) => output::write_string_atomic(p, text)?,

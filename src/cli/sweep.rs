@@ -1,27 +1,13 @@
 //! `bikedyn sweep`: stability over one parameter, or a stability map over two.
 
-use super::args::{BikeArg, Format, MapArg, OutputArgs};
-use super::{emit, load, parse_range, MAX_MAP_CELLS};
+use super::args::{BikeArg, Format, MapArg, OutputArgs, SweepArgs};
+use super::{check_outputs, emit, load, parse_range, MAX_MAP_CELLS};
 use anyhow::{bail, Result};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::runtime::output;
 use bikedyn::runtime::plot::{plot_stability_map, ImageFormat, PlotOptions};
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
 use std::path::PathBuf;
-
-/// The sweep as asked on the command line.
-pub struct SweepArgs {
-    pub bike: BikeArg,
-    pub param: String,
-    pub values: String,
-    pub param2: Option<String>,
-    pub values2: Option<String>,
-    pub speed_max: f64,
-    pub out: OutputArgs,
-    pub plot: Option<PathBuf>,
-    pub map: MapArg,
-    pub at_speed: Option<f64>,
-}
 
 /// Run `bikedyn sweep`.
 pub fn run(a: SweepArgs) -> Result<bool> {
@@ -38,14 +24,7 @@ pub fn run(a: SweepArgs) -> Result<bool> {
         at_speed,
     } = a;
     let b = load(&bike)?;
-    // Every output is checked before any work (issue 10, point 4).
-    if let Some(p) = &out {
-        output::output_target(p)?;
-    }
-    if let Some(p) = &plot {
-        ImageFormat::from_path(p)?;
-        output::output_target(p)?;
-    }
+    check_outputs(out.as_deref(), plot.as_deref())?;
     let quantity = match map {
         MapArg::Width => MapQuantity::StableWidth,
         MapArg::Weave => MapQuantity::WeaveSpeed,

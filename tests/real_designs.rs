@@ -1,7 +1,9 @@
-//! Regression tests of issue 10 (a new user's trial against a closed-form
-//! oracle on all real parameter files and crafted inputs). One test, or
-//! property test, per point; the fixtures in `tests/data` name their source
-//! and licence in `tests/data/SOURCE.txt`.
+//! Linear analysis of real and random designs: every real parameter file
+//! and 10,000 random designs around them against the closed-form oracle of
+//! Meijaard et al. (2007), skate wheels, continuous mode labels, mode shapes
+//! and derived geometry, and the fast linearization against the two-speed
+//! method. The fixtures in `tests/data` name their source and licence in
+//! `tests/data/SOURCE.txt`.
 
 use bikedyn::bicycle::{canonical_of, Bicycle};
 use bikedyn::runtime::benchmark_oracle::meijaard_canonical;
@@ -87,10 +89,10 @@ fn relative_difference(model: &CanonicalMatrices, oracle: &CanonicalMatrices) ->
         .fold(0.0, f64::max)
 }
 
-/// Issue 10, point 1: a front wheel of radius 5 m (and everything from 0.5
+/// A front wheel of radius 5 m (and everything from 0.5
 /// to 5 m) gives Meijaard's closed form, not the matrices of another root.
 #[test]
-fn issue_10_1_large_front_wheel_matches_closed_form() {
+fn large_front_wheel_matches_closed_form() {
     for k in 1..=10 {
         let mut b = BenchmarkParameters::benchmark_bicycle();
         b.front_wheel_radius = 0.5 * k as f64;
@@ -107,10 +109,10 @@ fn issue_10_1_large_front_wheel_matches_closed_form() {
     assert!((model.k2[(0, 1)] - 88.91073055670).abs() < 1e-8);
 }
 
-/// Issue 10, point 1: a thesis file with `z5 = +5` (front wheel centre 5 m
+/// A thesis file with `z5 = +5` (front wheel centre 5 m
 /// along the steer axis) is linearized about its physical root.
 #[test]
-fn issue_10_1_thesis_z5_plus_5_matches_closed_form() {
+fn thesis_z5_plus_5_matches_closed_form() {
     let mut t = ThesisParameters::thesis_bicycle();
     t.front_wheel_z = 5.0;
     let model = canonical_of(&t).unwrap();
@@ -173,12 +175,12 @@ fn random_design(b: &BenchmarkParameters, rng: &mut SplitMix64) -> BenchmarkPara
     d
 }
 
-/// Issue 10, point 1 (property test): 10,000 random designs around the 37
+/// Property test: 10,000 random designs around the 37
 /// real files and the built-in bicycles agree with Meijaard's closed form, or
 /// are refused with an error; none is refused here, because every sampled
 /// design is a valid bicycle.
 #[test]
-fn issue_10_1_random_designs_match_closed_form() {
+fn random_designs_match_closed_form() {
     let bases = bases();
     let mut rng = SplitMix64::new(20261123);
     let cases = 10_000;
@@ -205,11 +207,11 @@ fn issue_10_1_random_designs_match_closed_form() {
     );
 }
 
-/// Issue 10, point 3: the two-mass-skate bicycle (zero wheel radii, Kooijman
+/// The two-mass-skate bicycle (zero wheel radii, Kooijman
 /// et al. 2011) is supported; its weave speed from the closed form is
 /// 2.841008 m/s and it has no capsize speed below 10 m/s.
 #[test]
-fn issue_10_3_two_mass_skate_bicycle() {
+fn two_mass_skate_bicycle() {
     let path = fixture("TmsBenchmark.txt");
     let bike = Bicycle::resolve(path.to_str().unwrap()).unwrap();
     let c = bike.canonical().unwrap();
@@ -223,9 +225,9 @@ fn issue_10_3_two_mass_skate_bicycle() {
     assert!((weave - oracle_weave).abs() < 1e-9);
 }
 
-/// Issue 10, point 3: a skate wheel with spin inertia is refused by name.
+/// A skate wheel with spin inertia is refused by name.
 #[test]
-fn issue_10_3_skate_wheel_with_spin_inertia_is_refused() {
+fn skate_wheel_with_spin_inertia_is_refused() {
     let mut b = BenchmarkParameters::benchmark_bicycle();
     b.front_wheel_radius = 0.0;
     let msg = canonical_of(&b.to_thesis().unwrap()).unwrap_err().to_string();
@@ -336,12 +338,12 @@ fn check_mode_continuity(points: &[EigenPoint]) -> Result<(), String> {
     Ok(())
 }
 
-/// Issue 10, point 7: on the Bluenose recumbent (HumanControl) the labels
+/// On the Bluenose recumbent (HumanControl) the labels
 /// used to swap at 0.33-0.34 m/s (capsize +4.02 -> -0.96) and at 9.68-9.69
 /// m/s; the root that goes unstable at 3.141 m/s was called weave with
 /// frequency 0 and no capsize speed was reported.
 #[test]
-fn issue_10_7_bluenose_labels_are_continuous_and_capsize_is_reported() {
+fn bluenose_labels_are_continuous_and_capsize_is_reported() {
     let bike = Bicycle::resolve(fixture("BluenosePar.txt").to_str().unwrap()).unwrap();
     let c = bike.canonical().unwrap();
     let speeds: Vec<f64> = (0..=1000).map(|k| k as f64 * 0.01).collect();
@@ -364,11 +366,11 @@ fn issue_10_7_bluenose_labels_are_continuous_and_capsize_is_reported() {
     assert_eq!(crit.weave_speed, Some(hopf.speed));
 }
 
-/// Issue 10, point 7: on the thesis bicycle capsize and castering merge into
+/// On the thesis bicycle capsize and castering merge into
 /// a complex pair from 0.19 to 2.55 m/s; the pair is `capsize-castering`
 /// (it used to be two `capsize` roots, and castering vanished).
 #[test]
-fn issue_10_7_capsize_castering_pair_is_named() {
+fn capsize_castering_pair_is_named() {
     let c = Bicycle::resolve("thesis").unwrap().canonical().unwrap();
     let sweep = eigen_sweep(&c, &[0.1, 1.0, 2.5, 2.6]).unwrap();
     let count = |p: &EigenPoint, m: Mode| p.modes.iter().filter(|x| **x == m).count();
@@ -380,11 +382,11 @@ fn issue_10_7_capsize_castering_pair_is_named() {
     assert_eq!(Mode::CapsizeCastering.name(), "capsize-castering");
 }
 
-/// Issue 10, point 7 (property test): over 10,000 random designs around the
+/// Property test: over 10,000 random designs around the
 /// real files, every named mode's trajectory over 0-10 m/s is continuous and
 /// every mode is accounted for at every speed.
 #[test]
-fn issue_10_7_random_designs_have_continuous_mode_labels() {
+fn random_designs_have_continuous_mode_labels() {
     let bases = bases();
     let mut rng = SplitMix64::new(720_261_123);
     let speeds: Vec<f64> = (0..=200).map(|k| k as f64 * 0.05).collect();
@@ -409,17 +411,17 @@ fn issue_10_7_random_designs_have_continuous_mode_labels() {
         }
     }
     eprintln!("{checked} designs checked, {refused} refused by the eigen analysis");
-    // Before issue 10 the anchor search gave up on 57 of these designs (the
+    // Before the anchor ladder was extended, the search gave up on 57 of these designs (the
     // quartic solver at an extreme ladder speed); one remains (mode
     // continuation does not converge for a two-mass-skate variant).
     assert!(checked >= 9_990, "{checked}");
 }
 
-/// Issue 10, point 6: a singular-Jacobian message states the pivot against
+/// A singular-Jacobian message states the pivot against
 /// the matrix scale it was judged by (it used to read "singular ... (pivot
 /// 1.000e0)", which contradicts itself without the scale).
 #[test]
-fn issue_10_6_singular_message_states_its_scale() {
+fn singular_message_states_its_scale() {
     use bikedyn::runtime::constraints::ConstraintError;
     let e = ConstraintError::SingularJacobian {
         what: "holonomic constraints",
@@ -436,11 +438,11 @@ fn issue_10_6_singular_message_states_its_scale() {
     assert!(e.to_string().contains("1e-12 times"), "{e}");
 }
 
-/// Issue 10, point 9: the mode shapes (roll normalised to 1) are eigenvectors:
+/// The mode shapes (roll normalised to 1) are eigenvectors:
 /// `(M0 s^2 + v C1 s + g K0 + v^2 K2) [1, steer] = 0` for every eigenvalue of
 /// the benchmark bicycle from 0 to 10 m/s.
 #[test]
-fn issue_10_9_mode_shapes_solve_the_eigenproblem() {
+fn mode_shapes_solve_the_eigenproblem() {
     use bikedyn::runtime::output::mode_shape;
     let c = Bicycle::resolve("benchmark").unwrap().canonical().unwrap();
     let speeds: Vec<f64> = (0..=100).map(|k| k as f64 * 0.1).collect();
@@ -468,12 +470,12 @@ fn issue_10_9_mode_shapes_solve_the_eigenproblem() {
     }
 }
 
-/// Issue 10, point 9: the derived geometry agrees with the canonical matrices
+/// The derived geometry agrees with the canonical matrices
 /// of the generated model (an independent route): `M0[1][1] = IAll + 2 mu
 /// IAlz + mu^2 ITzz` and `K0[0][0] = -mT hT`, for the built-ins, the
 /// fixtures and every real file.
 #[test]
-fn issue_10_9_derived_geometry_matches_the_model() {
+fn derived_geometry_matches_the_model() {
     use bikedyn::runtime::geometry::DerivedGeometry;
     for (name, b) in bases() {
         let g = DerivedGeometry::of(&b);
@@ -495,12 +497,12 @@ fn issue_10_9_derived_geometry_matches_the_model() {
     assert!((g.steer_axis_tilt_deg - 18.0).abs() < 1e-12);
 }
 
-/// Issue 10, point 10: the faster linearization (one full dual evaluation at
+/// The faster linearization (one full dual evaluation at
 /// V = 1 plus the gravity-only stiffness at rest) gives the same canonical
 /// matrices as the previous two full linearizations, on 500 random designs;
 /// so does the standalone gravity-only stiffness at rest (`g K0`).
 #[test]
-fn issue_10_10_fast_linearization_equals_two_speed_method() {
+fn fast_linearization_equals_two_speed_method() {
     use bikedyn::generated::{ThesisWhipple, WhippleOffset};
     use bikedyn::runtime::linearize::{
         canonical_matrices, canonical_matrices_two_speeds, parameter_vector, static_stiffness,

@@ -1,5 +1,7 @@
-//! Regression tests of issue 10 through the command line (the points whose
-//! defect was in what the user sees).
+//! What a user sees at the command line: bad parameter files refused with
+//! file, line and field, numbers printed with fixed digits, outputs checked
+//! before computing and written through links and devices, streamed and
+//! bounded outputs, stability crossings and stability maps.
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -31,11 +33,11 @@ fn fixture(name: &str) -> String {
     format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
-/// Issue 10, point 2: `lam = 18.0` (degrees typed for radians) is refused
+/// `lam = 18.0` (degrees typed for radians) is refused
 /// with the range and the value in radians, naming file and line; `lam =
 /// pi/2` is refused too (it used to give a degenerate bicycle).
 #[test]
-fn issue_10_2_head_angle_in_degrees_is_refused() {
+fn head_angle_in_degrees_is_refused() {
     let p = benchmark_with("lam = 0.3141592653589793 ", "lam = 18.0 ", "lam18.toml");
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
     assert!(!out.status.success());
@@ -48,10 +50,10 @@ fn issue_10_2_head_angle_in_degrees_is_refused() {
     assert!(text(&out.stderr).contains("`lam`"), "{}", text(&out.stderr));
 }
 
-/// Issue 10, point 2: a wheelbase of 1020 (millimetres) and a frame mass
+/// A wheelbase of 1020 (millimetres) and a frame mass
 /// centre below the ground give warnings that name the field.
 #[test]
-fn issue_10_2_millimetres_and_mass_centre_below_ground_warn() {
+fn millimetres_and_mass_centre_below_ground_warn() {
     let p = benchmark_with("w = 1.02 ", "w = 1020 ", "w1020.toml");
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
     let err = text(&out.stderr);
@@ -69,10 +71,10 @@ fn issue_10_2_millimetres_and_mass_centre_below_ground_warn() {
     assert!(text(&out.stderr).is_empty(), "{}", text(&out.stderr));
 }
 
-/// Issue 10, point 7: `stability` lists every crossing with its mode; for the
+/// `stability` lists every crossing with its mode; for the
 /// Bluenose the first is the capsize root at 3.1413834189 m/s.
 #[test]
-fn issue_10_7_stability_lists_crossings_with_modes() {
+fn stability_lists_crossings_with_modes() {
     let out = bikedyn(&["stability", "--bike", &fixture("BluenosePar.txt")]);
     assert!(out.status.success());
     let s = text(&out.stdout);
@@ -85,11 +87,11 @@ fn issue_10_7_stability_lists_crossings_with_modes() {
     assert!(s.ends_with('\n'), "{s:?}");
 }
 
-/// Issue 10, point 8: matrices print with a fixed number of significant
+/// Matrices print with a fixed number of significant
 /// digits and no negative zero (they used to print `80.81721999999998`,
 /// `-80.94999999999999` and `-0.00000000000000`); JSON keeps full precision.
 #[test]
-fn issue_10_8_printed_numbers() {
+fn matrices_print_fixed_significant_digits_without_negative_zero() {
     let out = bikedyn(&["canonical", "--bike", "benchmark"]);
     let s = text(&out.stdout);
     assert!(s.contains("[[80.8172200000,  2.3194133221]"), "{s}");
@@ -104,10 +106,10 @@ fn issue_10_8_printed_numbers() {
     assert!(s.contains("+0.00000 + 0.83122i") && !s.contains("-0.00000"), "{s}");
 }
 
-/// Issue 10, point 6: each cause is printed once (the UTF-8 error used to
+/// Each cause is printed once (the UTF-8 error used to
 /// read "...UTF-8: stream did not contain valid UTF-8" twice over).
 #[test]
-fn issue_10_6_cause_printed_once() {
+fn a_read_error_states_its_cause_once() {
     let p = tmp("latin1.txt");
     std::fs::write(&p, b"w = 1.02\n\xff\xfe\n").unwrap();
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
@@ -115,9 +117,9 @@ fn issue_10_6_cause_printed_once() {
     assert_eq!(err.matches("valid UTF-8").count(), 1, "{err}");
 }
 
-/// Issue 10, point 6: a 10 MB junk line is not echoed whole.
+/// A 10 MB junk line is not echoed whole.
 #[test]
-fn issue_10_6_junk_line_is_cut() {
+fn junk_line_is_cut() {
     let p = tmp("junk.txt");
     std::fs::write(&p, format!("w = {}\n", "x".repeat(10_000_000))).unwrap();
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
@@ -127,11 +129,11 @@ fn issue_10_6_junk_line_is_cut() {
     assert!(err.contains("junk.txt:1") && err.contains("more characters"), "{err}");
 }
 
-/// Issue 10, point 6: `mB = 1e300` names the file, line and field (it used to
+/// `mB = 1e300` names the file, line and field (it used to
 /// end in "singular mass matrix M0 (det = NaN)"); `1e-300` is printed as
 /// such, not with 300 digits.
 #[test]
-fn issue_10_6_huge_and_tiny_values_name_file_and_field() {
+fn huge_and_tiny_values_name_file_and_field() {
     let p = benchmark_with("mB = 85.0 ", "mB = 1e300 ", "mb_huge.toml");
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
     let err = text(&out.stderr);
@@ -145,9 +147,9 @@ fn issue_10_6_huge_and_tiny_values_name_file_and_field() {
     assert!(err.contains("found -1e-300") && err.len() < 300, "{err}");
 }
 
-/// Issue 10, point 6: a file missing several fields reports all of them.
+/// A file missing several fields reports all of them.
 #[test]
-fn issue_10_6_all_missing_fields_at_once() {
+fn all_missing_fields_at_once() {
     let p = tmp("two_fields.txt");
     std::fs::write(&p, "w = 1.02\nc = 0.08\n").unwrap();
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
@@ -158,23 +160,23 @@ fn issue_10_6_all_missing_fields_at_once() {
     );
 }
 
-/// Issue 10, point 5: a range of 1e300 points states the count and the
+/// A range of 1e300 points states the count and the
 /// limit (it used to say "0 points is too many").
 #[test]
-fn issue_10_5_too_many_points_says_how_many() {
+fn too_many_points_says_how_many() {
     let out = bikedyn(&["eig", "--speeds", "0:1:1e-300"]);
     assert!(!out.status.success());
     let err = text(&out.stderr);
     assert!(err.contains("1.000e300 points") && err.contains("limit of"), "{err}");
 }
 
-/// Issue 10, point 4: `--output` through a symbolic link writes the link's
+/// `--output` through a symbolic link writes the link's
 /// target and keeps the link; a character device (`/dev/null`) and a FIFO
 /// are written through, not replaced by a regular file; a directory is
 /// refused.
 #[cfg(unix)]
 #[test]
-fn issue_10_4_output_keeps_links_devices_and_fifos() {
+fn output_keeps_links_devices_and_fifos() {
     use std::os::unix::fs::FileTypeExt;
     let target = tmp("real.csv");
     let link = tmp("link.csv");
@@ -236,10 +238,10 @@ fn issue_10_4_output_keeps_links_devices_and_fifos() {
     assert!(text(&out.stderr).contains("is a directory"), "{}", text(&out.stderr));
 }
 
-/// Issue 10, point 4: an unsupported plot format is reported before any
+/// An unsupported plot format is reported before any
 /// output (it used to print the whole table and then fail).
 #[test]
-fn issue_10_4_outputs_are_validated_before_computing() {
+fn outputs_are_validated_before_computing() {
     let out = bikedyn(&["eig", "--speeds", "0:1:0.1", "--plot", tmp("x.gif").to_str().unwrap()]);
     assert!(!out.status.success());
     assert!(out.stdout.is_empty(), "{}", text(&out.stdout));
@@ -248,11 +250,11 @@ fn issue_10_4_outputs_are_validated_before_computing() {
     assert!(!out.status.success() && out.stdout.is_empty());
 }
 
-/// Issue 10, points 5 and 9: `eig` streams CSV and JSON (several blocks
+/// `eig` streams CSV and JSON (several blocks
 /// here) with the same labels as one in-memory sweep, and both carry the
 /// mode shapes.
 #[test]
-fn issue_10_5_9_streamed_eig_output_with_mode_shapes() {
+fn streamed_eig_output_with_mode_shapes() {
     let out = bikedyn(&[
         "eig",
         "--bike",
@@ -287,10 +289,10 @@ fn issue_10_5_9_streamed_eig_output_with_mode_shapes() {
     assert!(s.starts_with("v,re_1,im_1,mode_1,roll_amp_1,roll_phase_1,steer_amp_1,steer_phase_1,re_2"));
 }
 
-/// Issue 10, point 9: `params show` prints the derived geometry of a bicycle
+/// `params show` prints the derived geometry of a bicycle
 /// in either form, as comments (the output still loads).
 #[test]
-fn issue_10_9_params_show_prints_derived_geometry() {
+fn params_show_prints_derived_geometry() {
     for bike in ["thesis", "benchmark"] {
         let out = bikedyn(&["params", "show", "--bike", bike]);
         let s = text(&out.stdout);
@@ -306,13 +308,13 @@ fn issue_10_9_params_show_prints_derived_geometry() {
     assert!(s.contains("# mT       =      94.000000 kg"), "{s}");
 }
 
-/// Issue 10, point 9: `sweep --param2` maps a chosen quantity; `--map
+/// `sweep --param2` maps a chosen quantity; `--map
 /// least-stable --at-speed 5` records the real part of the least stable
 /// eigenvalue at 5 m/s (-0.322866429004 for the benchmark bicycle, as `eig`
 /// gives), and cells whose stable range is cut by `--speed-max` are marked
 /// in the plot.
 #[test]
-fn issue_10_9_sweep_maps_a_chosen_quantity() {
+fn sweep_maps_a_chosen_quantity() {
     let svg = tmp("least.svg");
     let out = bikedyn(&[
         "sweep",
@@ -379,11 +381,11 @@ fn issue_10_9_sweep_maps_a_chosen_quantity() {
     assert!(!out.status.success() && text(&out.stderr).contains("--at-speed"));
 }
 
-/// Issue 10, point 5: the in-memory outputs state their limits: a table of
+/// The in-memory outputs state their limits: a table of
 /// more than 100,000 rows points to the streamed formats, and a stability
 /// map of more than 10^7 cells says how many it would have.
 #[test]
-fn issue_10_5_in_memory_limits_are_stated() {
+fn in_memory_limits_are_stated() {
     let out = bikedyn(&["eig", "--speeds", "0:10:1e-5"]);
     let err = text(&out.stderr);
     assert!(
