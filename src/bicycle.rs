@@ -53,8 +53,6 @@ pub enum BicycleError {
     NoModelFits { bike: String, nonzero: String },
     #[error("the canonical form M0, C1, K0, K2 holds for the Whipple bicycle; with {effects} the linear equations depend on speed otherwise")]
     NotCanonical { effects: String },
-    #[error("model `{model}` has extra first-order states ({states}): its linear analysis is not a roll-steer quartic; choose a model without them (`--model`)")]
-    HasStates { model: String, states: String },
 }
 
 /// A resolved bicycle.
@@ -233,7 +231,15 @@ impl Bicycle {
     pub fn linear_with(&self, model: Option<&str>) -> Result<Linear, BicycleError> {
         let nonzero = self.nonzero_parameters()?;
         let info = self.model_for(model, &nonzero)?;
-        match self.canonical_with(model) {
+        // A model with extra states has no canonical form (nor M, C, K).
+        let canonical = if info.states.is_empty() {
+            self.canonical_with(model)
+        } else {
+            Err(BicycleError::NotCanonical {
+                effects: info.states.join(", "),
+            })
+        };
+        match canonical {
             Ok(c) => {
                 return Ok(Linear {
                     model: info.name,
@@ -243,12 +249,6 @@ impl Bicycle {
             }
             Err(BicycleError::NotCanonical { .. }) => {}
             Err(e) => return Err(e),
-        }
-        if !info.states.is_empty() {
-            return Err(BicycleError::HasStates {
-                model: info.name.to_string(),
-                states: info.states.join(", "),
-            });
         }
         let lookup = self.lookup()?;
         let equations = with_model(info.name, MakeLinear(&lookup))
@@ -411,6 +411,9 @@ impl LinearBicycle for Linear {
     }
     fn canonical(&self) -> Option<&CanonicalMatrices> {
         self.canonical.as_ref()
+    }
+    fn first_order(&self) -> Option<&dyn bikedyn_runtime::eigen::StateSpaceBicycle> {
+        self.equations.first_order()
     }
 }
 

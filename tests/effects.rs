@@ -317,3 +317,69 @@ fn non_physical_effect_parameters_are_refused() {
     assert!(err.contains("c_steer") && err.contains("at least 0"), "{err}");
     assert!(b.with_parameter("c_steer", 0.3).is_ok());
 }
+
+/// The linear analysis of a model with extra states (issue 16, point 4):
+/// the tyre model's weave and capsize speeds tend to the rolling-without-slip
+/// bicycle's as the tyres stiffen, its four roll-steer modes are labelled as
+/// every model's, and with the extra modes they make up the whole lateral
+/// spectrum but the neutral heading.
+#[test]
+fn the_tyre_model_has_weave_and_capsize_speeds_that_tend_to_rolling_without_slip() {
+    use bikedyn::generated::{ThesisWhippleFree, TyreFree};
+    use bikedyn_runtime::eigen::{critical_speeds, critical_speeds_of, eigen_sweep_of, Mode, StateSpaceBicycle};
+    use bikedyn_runtime::linearize::LinearModel;
+    let p = ThesisParameters::thesis_bicycle();
+    let c = canonical_matrices::<ThesisWhippleFree>(|s| p.get(s)).unwrap();
+    let no_slip = critical_speeds(&c, 0.0, 10.0).unwrap();
+    let (vw0, vc0) = (no_slip.weave_speed.unwrap(), no_slip.capsize_speed.unwrap());
+    let mut last = f64::INFINITY;
+    for (ca, sigma) in [(14.0, 0.2), (200.0, 0.02), (3000.0, 0.002)] {
+        let m = LinearModel::<TyreFree>::new(|s| match s {
+            "Ca_rear" | "Ca_front" => Some(ca),
+            "sigma_rear" | "sigma_front" => Some(sigma),
+            _ => p.get(s),
+        })
+        .unwrap();
+        let r = critical_speeds_of(&m, 0.0, 10.0).unwrap();
+        let (vw, vc) = (r.weave_speed.unwrap(), r.capsize_speed.unwrap());
+        println!("C_alpha {ca:>6} /rad, sigma {sigma} m: weave speed {vw:.6} (no slip {vw0:.6}), capsize speed {vc:.6} (no slip {vc0:.6})");
+        let err = ((vw - vw0) / vw0).abs().max(((vc - vc0) / vc0).abs());
+        assert!(
+            err < last,
+            "the critical speeds approach rolling without slip as tyres stiffen"
+        );
+        last = err;
+        // Labels and the whole spectrum at a speed between the two.
+        let sweep = eigen_sweep_of(&m, &[5.0]).unwrap();
+        let pt = &sweep.points[0];
+        assert_eq!(pt.modes, [Mode::Weave, Mode::Weave, Mode::Capsize, Mode::Castering]);
+        let ls = m.lateral_states(5.0).unwrap();
+        assert_eq!(ls.neutral, 1, "the heading");
+        let mut all: Vec<_> = ls.a.complex_eigenvalues().iter().copied().collect();
+        let ours: Vec<_> = pt.eigenvalues.iter().chain(&pt.extra_eigenvalues).copied().collect();
+        assert_eq!(ours.len(), all.len() - 1);
+        for z in &ours {
+            let k = (0..all.len())
+                .min_by(|&i, &j| (all[i] - z).norm().total_cmp(&(all[j] - z).norm()))
+                .unwrap();
+            assert!(
+                (all[k] - z).norm() <= 1e-9 * z.norm().max(1.0),
+                "{z} is an eigenvalue of A"
+            );
+            all.remove(k);
+        }
+        // Zero up to the rounding of the Schur form, about 1e-16 max |A_ij|.
+        let rounding = 1e-10 * ls.a.abs().max();
+        assert!(
+            all[0].norm() < rounding,
+            "what is left is the neutral heading, {}",
+            all[0]
+        );
+        // The weave and capsize at 5 m/s: stable, and the castering fast.
+        assert!(pt.is_stable(), "{:?}", pt.eigenvalues);
+    }
+    assert!(
+        last < 1e-3,
+        "stiff tyres: critical speeds within 0.1 % of rolling without slip ({last:.2e})"
+    );
+}

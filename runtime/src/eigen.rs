@@ -61,10 +61,12 @@ use crate::canonical::CanonicalMatrices;
 mod critical;
 mod general;
 mod quartic;
+mod states;
 
 pub use critical::critical_speeds;
 pub use general::{critical_speeds_of, eigen_sweep_of, eigenvalues_of, LinearBicycle, SpeedMatrices};
 use quartic::{quartic_roots, sort_desc, C64};
+pub use states::{LateralStates, StateSpaceBicycle};
 
 /// Errors of the eigen analysis. Functions never panic and never return NaN.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -208,6 +210,10 @@ pub struct EigenPoint {
     /// unit 2-norm, phase fixed so that the largest-modulus component of `[phi, delta]`
     /// is real and positive.
     pub eigenvectors: [[Complex<f64>; 4]; 4],
+    /// Eigenvalues of the modes beyond the four roll-steer modes (a model
+    /// with extra first-order states, e.g. lagged tyre forces: see
+    /// [`StateSpaceBicycle`]), by descending real part; empty otherwise.
+    pub extra_eigenvalues: Vec<Complex<f64>>,
 }
 
 impl EigenPoint {
@@ -221,9 +227,12 @@ impl EigenPoint {
         self.modes.iter().position(|x| *x == m)
     }
 
-    /// Whether all real parts are strictly negative.
+    /// Whether all real parts are strictly negative (extra modes included).
     pub fn is_stable(&self) -> bool {
-        self.eigenvalues.iter().all(|s| s.re < 0.0)
+        self.eigenvalues
+            .iter()
+            .chain(&self.extra_eigenvalues)
+            .all(|s| s.re < 0.0)
     }
 }
 
@@ -860,6 +869,7 @@ pub fn eigen_sweep(c: &CanonicalMatrices, speeds: &[f64]) -> Result<EigenSweep, 
                 eigenvalues: l.roots,
                 modes: l.labels,
                 eigenvectors: vecs,
+                extra_eigenvalues: Vec::new(),
             }
         })
         .collect();

@@ -11,7 +11,7 @@
 
 use crate::canonical::CanonicalMatrices;
 use crate::constraints::{constraint_matrices, dependent_velocities, solve_configuration, NewtonOptions};
-use crate::eigen::{EigenError, LinearBicycle, SpeedMatrices};
+use crate::eigen::{EigenError, LateralStates, LinearBicycle, SpeedMatrices, StateSpaceBicycle};
 use crate::linalg::{lu_factor, lu_solve, lu_solve_dual, lu_solve_dual_narrow, solve_in_place, Scratch};
 use crate::model::{CoordinateRole, MultibodyModel};
 // The types the `MultibodyModel` trait names live below it; their public
@@ -868,12 +868,18 @@ pub fn canonical_matrices_two_speeds<M: MultibodyModel>(
 /// off-diagonal entries change sign). Any effect enters: damping,
 /// friction's describing function, a speed-scheduled controller.
 ///
-/// Models with extra first-order states (tyre forces) have no
-/// second-order roll-steer form and are refused ([`LinearizeError::HasStates`]).
+/// A model with extra first-order states (tyre forces) has no second-order
+/// roll-steer form: it gives its lateral first-order equations instead
+/// ([`StateSpaceBicycle`], from [`state_space_at_speed`]), which the eigen
+/// analyses use themselves.
 pub struct LinearModel<M: MultibodyModel> {
     param: Vec<f64>,
     /// Positions of roll and steer within the independent coordinates.
     roll_steer: [usize; 2],
+    /// For a model with extra states: which states of
+    /// [`state_space_at_speed`] are lateral, and how many eigenvalues are
+    /// neutral (see [`lateral_states_of`]).
+    lateral: Option<(Vec<usize>, usize)>,
     _model: std::marker::PhantomData<M>,
 }
 
@@ -881,9 +887,6 @@ impl<M: MultibodyModel> LinearModel<M> {
     /// The model with its parameters filled from `lookup` (missing ones:
     /// the model's defaults).
     pub fn new(lookup: impl Fn(&str) -> Option<f64>) -> Result<Self, LinearizeError> {
-        if !M::STATES.is_empty() {
-            return Err(LinearizeError::HasStates { model: M::NAME });
-        }
         let param = parameter_vector::<M>(&lookup, 0.0)?;
         let position = |role| -> Result<usize, LinearizeError> {
             let j = M::require_coordinate(role, "the linear roll-steer analysis")?;
@@ -896,16 +899,110 @@ impl<M: MultibodyModel> LinearModel<M> {
                 })
         };
         let roll_steer = [position(CoordinateRole::Roll)?, position(CoordinateRole::Steer)?];
+        let lateral = if M::STATES.is_empty() {
+            None
+        } else {
+            Some(lateral_states_of::<M>(&param, roll_steer)?)
+        };
         Ok(LinearModel {
             param,
             roll_steer,
+            lateral,
             _model: std::marker::PhantomData,
+        })
+    }
+}
+
+/// The lateral states of a model with extra states: every state of
+/// [`state_space_at_speed`] but the speed coordinate and its rate (the
+/// longitudinal motion, uncoupled from the lateral at upright straight
+/// running) and the coordinates nothing depends on (lateral position, yaw,
+/// wheel rotations: their columns of `A` vanish, each adds a zero
+/// eigenvalue, and dropping them leaves the other eigenvalues exact since
+/// `A` is block triangular in them). A column is structurally zero when it
+/// is exactly zero at two unrelated speeds; dropping a state can empty
+/// another's column (yaw feeds only the lateral position), hence the loop.
+///
+/// Also the number of neutral eigenvalues that remain (the heading when the
+/// yaw stays, as with tyre slip: a zero eigenvalue at every speed), counted
+/// as those below `1e-10 max |A_ij|` at both probe speeds (their rounding is
+/// about `1e-16 max |A_ij|`).
+fn lateral_states_of<M: MultibodyModel>(
+    param: &[f64],
+    roll_steer: [usize; 2],
+) -> Result<(Vec<usize>, usize), LinearizeError> {
+    let ni = M::INDEPENDENT.len();
+    let probes = [
+        state_space_at_speed::<M>(param, 1.3)?,
+        state_space_at_speed::<M>(param, 4.7)?,
+    ];
+    let n = probes[0].a.nrows();
+    let mut keep: Vec<usize> = (0..n)
+        .filter(|&i| {
+            let longitudinal =
+                M::SPEED_COORDINATE.is_some_and(|c| M::INDEPENDENT.get(i % ni.max(1)) == Some(&c) && i < 2 * ni);
+            !longitudinal
+        })
+        .collect();
+    let essential = [roll_steer[0], roll_steer[1], ni + roll_steer[0], ni + roll_steer[1]];
+    loop {
+        let before = keep.len();
+        let current = keep.clone();
+        keep.retain(|&j| {
+            essential.contains(&j)
+                || probes
+                    .iter()
+                    .any(|p| current.iter().any(|&i| i != j && p.a[(i, j)] != 0.0) || p.a[(j, j)] != 0.0)
+        });
+        if keep.len() == before {
+            break;
+        }
+    }
+    let neutral = probes
+        .iter()
+        .map(|p| {
+            let a = DMatrix::from_fn(keep.len(), keep.len(), |i, j| p.a[(keep[i], keep[j])]);
+            let tol = 1e-10 * a.abs().max().max(1.0);
+            a.complex_eigenvalues().iter().filter(|z| z.norm() <= tol).count()
+        })
+        .min()
+        .unwrap_or(0);
+    Ok((keep, neutral))
+}
+
+impl<M: MultibodyModel> StateSpaceBicycle for LinearModel<M> {
+    fn lateral_states(&self, v: f64) -> Result<LateralStates, EigenError> {
+        let (keep, neutral) = match &self.lateral {
+            Some((k, n)) => (k.as_slice(), *n),
+            None => (&[][..], 0),
+        };
+        let ss = state_space_at_speed::<M>(&self.param, v).map_err(|e| EigenError::Linearization {
+            speed: v,
+            what: e.to_string(),
+        })?;
+        let ni = M::INDEPENDENT.len();
+        let at = |j: usize| keep.iter().position(|&k| k == j).unwrap_or(usize::MAX);
+        let [r, s] = self.roll_steer;
+        Ok(LateralStates {
+            names: keep.iter().map(|&k| ss.names[k].clone()).collect(),
+            a: DMatrix::from_fn(keep.len(), keep.len(), |i, j| ss.a[(keep[i], keep[j])]),
+            roll_steer: [at(r), at(s), at(ni + r), at(ni + s)],
+            // The generated models use the thesis's axes (see `at_speed`).
+            steer_sign: -1.0,
+            extra: (0..keep.len()).filter(|&i| keep[i] >= 2 * ni).collect(),
+            neutral,
         })
     }
 }
 
 impl<M: MultibodyModel> LinearBicycle for LinearModel<M> {
     fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError> {
+        if self.lateral.is_some() {
+            return Err(EigenError::Linearization {
+                speed: v,
+                what: LinearizeError::HasStates { model: M::NAME }.to_string(),
+            });
+        }
         let lin = linearize_at_speed::<M>(&self.param, v).map_err(|e| EigenError::Linearization {
             speed: v,
             what: e.to_string(),
@@ -917,5 +1014,8 @@ impl<M: MultibodyModel> LinearBicycle for LinearModel<M> {
             damping: pick(&lin.damping),
             stiffness: pick(&lin.stiffness),
         })
+    }
+    fn first_order(&self) -> Option<&dyn StateSpaceBicycle> {
+        self.lateral.is_some().then_some(self as &dyn StateSpaceBicycle)
     }
 }

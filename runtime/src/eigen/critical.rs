@@ -218,27 +218,9 @@ pub(crate) fn finish<S: Spectrum + ?Sized>(
         })
         .map(|x| x.speed);
 
-    // Stable intervals.
-    let mut breaks = vec![v_min];
-    breaks.extend(crossings.iter().map(|x| x.speed).filter(|&v| v > v_min && v < v_max));
-    breaks.push(v_max);
-    breaks.dedup();
-    let stable_at = |v: f64| -> Result<bool, EigenError> { Ok(cp.roots_at(v)?.iter().all(|z| z.re < 0.0)) };
-    let mut stable_intervals: Vec<[f64; 2]> = Vec::new();
-    if breaks.len() == 1 {
-        if stable_at(v_min)? {
-            stable_intervals.push([v_min, v_max]);
-        }
-    } else {
-        for w in breaks.windows(2) {
-            if stable_at(0.5 * (w[0] + w[1]))? {
-                match stable_intervals.last_mut() {
-                    Some(last) if last[1] == w[0] => last[1] = w[1],
-                    _ => stable_intervals.push([w[0], w[1]]),
-                }
-            }
-        }
-    }
+    let stable_intervals = stable_intervals(v_min, v_max, &crossings, |v| {
+        Ok(cp.roots_at(v)?.iter().all(|z| z.re < 0.0))
+    })?;
 
     let (weave_real_pair_merge, weave_merge_eigenvalue) = match weave_merge(cp, v_min.max(0.0), v_max)? {
         Some((v, s)) => (Some(v), Some(s)),
@@ -252,6 +234,37 @@ pub(crate) fn finish<S: Spectrum + ?Sized>(
         crossings,
         stable_intervals,
     })
+}
+
+/// Maximal sub-intervals of `[v_min, v_max]` where `stable_at` holds: the
+/// range is cut at the crossing speeds and each piece is judged at its
+/// midpoint (the spectrum cannot change stability between crossings).
+pub(crate) fn stable_intervals(
+    v_min: f64,
+    v_max: f64,
+    crossings: &[Crossing],
+    stable_at: impl Fn(f64) -> Result<bool, EigenError>,
+) -> Result<Vec<[f64; 2]>, EigenError> {
+    let mut breaks = vec![v_min];
+    breaks.extend(crossings.iter().map(|x| x.speed).filter(|&v| v > v_min && v < v_max));
+    breaks.push(v_max);
+    breaks.dedup();
+    let mut out: Vec<[f64; 2]> = Vec::new();
+    if breaks.len() == 1 {
+        if stable_at(v_min)? {
+            out.push([v_min, v_max]);
+        }
+    } else {
+        for w in breaks.windows(2) {
+            if stable_at(0.5 * (w[0] + w[1]))? {
+                match out.last_mut() {
+                    Some(last) if last[1] == w[0] => last[1] = w[1],
+                    _ => out.push([w[0], w[1]]),
+                }
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Grid intervals used to bracket `v_d`.

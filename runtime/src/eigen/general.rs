@@ -19,6 +19,7 @@
 //! derivatives of the coefficients by central differences.
 
 use super::critical::{check_range, finish};
+use super::states::{self, StateSpaceBicycle};
 use super::*;
 use nalgebra::Matrix4;
 
@@ -54,14 +55,23 @@ impl SpeedMatrices {
     }
 }
 
-/// A bicycle whose linear roll-steer equations are known at every speed:
-/// the canonical matrices of a Whipple bicycle, or any generated model
+/// A bicycle whose linear equations are known at every speed: the
+/// canonical matrices of a Whipple bicycle, or any generated model
 /// linearized at each speed (`bikedyn_runtime::linearize::LinearModel`).
+///
+/// A model with extra first-order states (lagged tyre forces) has no
+/// second-order roll-steer form: it answers [`LinearBicycle::first_order`]
+/// and its `at_speed` fails; the analyses here ([`eigen_sweep_of`],
+/// [`critical_speeds_of`], [`eigenvalues_of`]) take that path themselves.
 pub trait LinearBicycle: Sync {
-    /// The equations at forward speed `v` (m/s).
+    /// The roll-steer equations at forward speed `v` (m/s).
     fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError>;
     /// The canonical form, when the equations have it (the exact path).
     fn canonical(&self) -> Option<&CanonicalMatrices> {
+        None
+    }
+    /// The first-order lateral equations, for a model with extra states.
+    fn first_order(&self) -> Option<&dyn StateSpaceBicycle> {
         None
     }
 }
@@ -86,6 +96,9 @@ impl<T: LinearBicycle + ?Sized> LinearBicycle for Box<T> {
     fn canonical(&self) -> Option<&CanonicalMatrices> {
         (**self).canonical()
     }
+    fn first_order(&self) -> Option<&dyn StateSpaceBicycle> {
+        (**self).first_order()
+    }
 }
 
 impl<T: LinearBicycle + ?Sized> LinearBicycle for &T {
@@ -94,6 +107,9 @@ impl<T: LinearBicycle + ?Sized> LinearBicycle for &T {
     }
     fn canonical(&self) -> Option<&CanonicalMatrices> {
         (**self).canonical()
+    }
+    fn first_order(&self) -> Option<&dyn StateSpaceBicycle> {
+        (**self).first_order()
     }
 }
 
@@ -163,6 +179,9 @@ impl Spectrum for General<'_> {
 /// The four eigenvalues at speed `v` (no labels), sorted by descending real
 /// part, then imaginary part.
 pub fn eigenvalues_of(bike: &dyn LinearBicycle, v: f64) -> Result<[Complex<f64>; 4], EigenError> {
+    if let Some(s) = bike.first_order() {
+        return states::eigenvalues_of_states(s, v);
+    }
     match bike.canonical() {
         Some(c) => eigenvalues(c, v),
         None => General::new(bike)?.roots_at(v),
@@ -172,6 +191,9 @@ pub fn eigenvalues_of(bike: &dyn LinearBicycle, v: f64) -> Result<[Complex<f64>;
 /// [`eigen_sweep`] for any [`LinearBicycle`]: eigenvalues, continuous mode
 /// labels and mode shapes at each speed.
 pub fn eigen_sweep_of(bike: &dyn LinearBicycle, speeds: &[f64]) -> Result<EigenSweep, EigenError> {
+    if let Some(s) = bike.first_order() {
+        return states::eigen_sweep_of_states(s, speeds);
+    }
     if let Some(c) = bike.canonical() {
         return eigen_sweep(c, speeds);
     }
@@ -185,6 +207,7 @@ pub fn eigen_sweep_of(bike: &dyn LinearBicycle, speeds: &[f64]) -> Result<EigenS
             eigenvalues: l.roots,
             modes: l.labels,
             eigenvectors: vectors(&m, &l.roots),
+            extra_eigenvalues: Vec::new(),
         });
     }
     Ok(EigenSweep { points })
@@ -192,27 +215,41 @@ pub fn eigen_sweep_of(bike: &dyn LinearBicycle, speeds: &[f64]) -> Result<EigenS
 
 /// [`critical_speeds`] for any [`LinearBicycle`] over `[v_min, v_max]`.
 pub fn critical_speeds_of(bike: &dyn LinearBicycle, v_min: f64, v_max: f64) -> Result<CriticalSpeeds, EigenError> {
+    if let Some(s) = bike.first_order() {
+        return states::critical_speeds_of_states(s, v_min, v_max);
+    }
     if let Some(c) = bike.canonical() {
         return critical_speeds(c, v_min, v_max);
     }
     check_range(v_min, v_max)?;
     let family = General::new(bike)?;
+    let cands = crossing_candidates(&family, v_min, v_max)?;
+    finish(&family, cands, v_min, v_max)
+}
+
+/// Crossing candidates `(speed, kind, frequency)` of a spectrum without
+/// closed forms, ascending: a real root crosses zero where `k0` changes sign,
+/// a complex pair crosses the imaginary axis where the Hurwitz determinant
+/// changes sign with `w^2 = k1 / k3 > 0`. Bracketed on a grid, bisected.
+pub(crate) fn crossing_candidates<S: Spectrum + ?Sized>(
+    family: &S,
+    v_min: f64,
+    v_max: f64,
+) -> Result<Vec<(f64, CrossingKind, f64)>, EigenError> {
     let hurwitz = |k: &[f64; 5]| k[1] * k[2] * k[3] - k[4] * k[1] * k[1] - k[0] * k[3] * k[3];
     let mut cands: Vec<(f64, CrossingKind, f64)> = Vec::new();
     if v_max > v_min {
-        let grid: Vec<f64> = (0..=CROSSING_GRID)
-            .map(|i| v_min + (v_max - v_min) * (i as f64 / CROSSING_GRID as f64))
-            .collect();
+        let grid = crossing_grid(v_min, v_max);
         let ks: Vec<[f64; 5]> = grid.iter().map(|&v| family.coefficients(v)).collect::<Result<_, _>>()?;
         for i in 0..CROSSING_GRID {
             let (a, b) = (grid[i], grid[i + 1]);
             // A real root through zero: k0 changes sign.
-            if let Some(v) = bisect(&family, a, b, |k| k[0], ks[i][0], ks[i + 1][0])? {
+            if let Some(v) = bisect(family, a, b, |k| k[0], ks[i][0], ks[i + 1][0])? {
                 cands.push((v, CrossingKind::RealRoot, 0.0));
             }
             // A complex pair through the imaginary axis: H changes sign with
             // w^2 = k1 / k3 > 0 there.
-            if let Some(v) = bisect(&family, a, b, hurwitz, hurwitz(&ks[i]), hurwitz(&ks[i + 1]))? {
+            if let Some(v) = bisect(family, a, b, hurwitz, hurwitz(&ks[i]), hurwitz(&ks[i + 1]))? {
                 let k = family.coefficients(v)?;
                 let w2 = k[1] / k[3];
                 if w2 > 0.0 && w2.is_finite() {
@@ -222,19 +259,26 @@ pub fn critical_speeds_of(bike: &dyn LinearBicycle, v_min: f64, v_max: f64) -> R
         }
     }
     cands.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap_or(std::cmp::Ordering::Equal));
-    finish(&family, cands, v_min, v_max)
+    Ok(cands)
+}
+
+/// The grid of [`CROSSING_GRID`] cells over `[v_min, v_max]`.
+pub(crate) fn crossing_grid(v_min: f64, v_max: f64) -> Vec<f64> {
+    (0..=CROSSING_GRID)
+        .map(|i| v_min + (v_max - v_min) * (i as f64 / CROSSING_GRID as f64))
+        .collect()
 }
 
 /// Grid intervals over the speed range that bracket the crossings of a
 /// general model (crossings closer than a cell apart may be missed; a
 /// bicycle's are tenths of m/s apart or more over 0-10 m/s).
-const CROSSING_GRID: usize = 400;
+pub(crate) const CROSSING_GRID: usize = 400;
 
 /// The zero of `f(coefficients(v))` in `[a, b]` when `fa`, `fb` have opposite
 /// signs (bisection to rounding), `None` otherwise. An exact zero at the
 /// lower end counts for the cell below, so a grid point is found once.
-fn bisect(
-    family: &General<'_>,
+fn bisect<S: Spectrum + ?Sized>(
+    family: &S,
     mut a: f64,
     mut b: f64,
     f: impl Fn(&[f64; 5]) -> f64,
