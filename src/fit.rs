@@ -4,6 +4,7 @@
 
 use crate::bicycle::{Bicycle, BicycleError, Linear};
 use crate::progress::{OnProgress, Progress};
+use bikedyn_report::plot::PlotError;
 use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::experiment::{
     self,
@@ -11,7 +12,6 @@ use bikedyn_runtime::experiment::{
     compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
 };
 use bikedyn_runtime::parameters::ParameterError;
-use bikedyn_runtime::plot::PlotError;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -329,13 +329,13 @@ pub fn kicks_table(out: &FitOutcome) -> String {
             ]);
         }
     }
-    bikedyn_runtime::output::format_table(&header, &rows)
+    bikedyn_report::output::format_table(&header, &rows)
 }
 
 /// Response plots (one per kick) and, with a bicycle, the continuation
 /// diagram with the measured eigenvalues, in `dir` (created).
 pub fn plots(out: &FitOutcome, dir: &Path) -> Result<(), FitError> {
-    use bikedyn_runtime::experiment::plot as xplot;
+    use bikedyn_report::experiment::plot as xplot;
     std::fs::create_dir_all(dir).map_err(|source| FitError::CreateDir {
         path: dir.to_path_buf(),
         source,

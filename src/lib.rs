@@ -2,6 +2,7 @@
 //! Rust, and the numerics that use them (linearization, stability sweeps,
 //! verification). See README.md and ARCHITECTURE.md.
 
+pub use bikedyn_report as report;
 pub use bikedyn_runtime as runtime;
 
 #[path = "../generated/mod.rs"]

@@ -7,7 +7,7 @@
 //! release, stop reason, frozen-speed eigenvalues at the mean speed after
 //! release).
 //!
-//! The sensor side is `experiment::synth::write_run`: every run becomes a
+//! The sensor side is `bikedyn_report::experiment::synth::write_run`: every run becomes a
 //! run folder in the measured-run format of `../shared/data/FORMAT.md`
 //! (IMU quaternions, reed switch, run.toml) with sensor effects, beside a
 //! `calibration/` folder (the bicycle at rest). The truth (physical and
@@ -16,11 +16,12 @@
 
 use crate::bicycle::{canonical_of, Bicycle, BicycleError};
 use crate::generated::with_model;
+use bikedyn_report::experiment::synth::{write_run, WriteRunError};
+use bikedyn_report::output::{save_json, write_atomic, OutputError};
 use bikedyn_runtime::eigen::{eigenvalues, EigenError};
-use bikedyn_runtime::experiment::synth::{rest_trajectory, write_run, RunKind, SensorModel};
+use bikedyn_runtime::experiment::synth::{rest_trajectory, RunKind, SensorModel};
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
 use bikedyn_runtime::model::CoordinateRole;
-use bikedyn_runtime::output::{save_json, write_atomic, OutputError};
 use bikedyn_runtime::random::SplitMix64;
 use bikedyn_runtime::registry::ModelVisitor;
 use bikedyn_runtime::simulate::trajectory::{trajectory_for_run, RunPlan, Trajectory};
@@ -110,7 +111,7 @@ pub enum SynthError {
     Eigen(#[from] EigenError),
     /// The sensor files of a run could not be written.
     #[error(transparent)]
-    Sensors(#[from] bikedyn_runtime::experiment::synth::SynthError),
+    Sensors(#[from] WriteRunError),
     /// A trajectory or truth file could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),

@@ -443,7 +443,7 @@ fn singular_message_states_its_scale() {
 /// the benchmark bicycle from 0 to 10 m/s.
 #[test]
 fn mode_shapes_solve_the_eigenproblem() {
-    use bikedyn::runtime::output::mode_shape;
+    use bikedyn::report::output::mode_shape;
     let c = Bicycle::resolve("benchmark").unwrap().canonical().unwrap();
     let speeds: Vec<f64> = (0..=100).map(|k| k as f64 * 0.1).collect();
     for p in eigen_sweep(&c, &speeds).unwrap().points {

@@ -12,18 +12,14 @@
 //!   in the mapping) is recorded as a [`CellError`] in that cell; it never
 //!   aborts the sweep and never produces NaN.
 //!
-//! A progress bar (indicatif) is drawn on stderr only when
-//! [`SweepOptions::progress`] is set, stderr is a terminal, and the run has
-//! lasted longer than [`SweepOptions::progress_delay`] (so short runs, tests and
-//! redirected output stay quiet).
+//! Progress goes through a plain callback ([`OnCellDone`]: cells done, cells
+//! in all), called from the worker threads after each cell; the runtime never
+//! draws on a terminal (the command line turns the callback into a bar).
 
 use std::fmt::Display;
-use std::io::IsTerminal;
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Duration;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -39,11 +35,6 @@ pub struct SweepOptions {
     /// Upper end of the forward-speed range (m/s). Default `10.0` (the range of
     /// Meijaard et al. 2007, Fig. 3).
     pub speed_max: f64,
-    /// Allow a progress bar on stderr. Default `true`; it is still hidden when
-    /// stderr is not a terminal or the run is short.
-    pub progress: bool,
-    /// The bar appears only once the run has taken this long. Default 1 s.
-    pub progress_delay: Duration,
     /// Speed (m/s) at which every cell also records the real part of its
     /// least stable eigenvalue ([`StabilitySummary::least_stable_real_part`],
     /// [`MapQuantity::LeastStableRealPart`]). Default `None`.
@@ -55,8 +46,6 @@ impl Default for SweepOptions {
         Self {
             speed_min: 0.0,
             speed_max: 10.0,
-            progress: true,
-            progress_delay: Duration::from_secs(1),
             probe_speed: None,
         }
     }
@@ -301,29 +290,65 @@ pub fn speed_sweep(c: &CanonicalMatrices, speeds: &[f64]) -> Result<EigenSweep, 
     eigen_sweep(c, speeds)
 }
 
+/// Progress of a sweep: `(cells done, cells in all)`, called once after each
+/// cell from whichever worker thread finished it. Calls from different
+/// threads may arrive out of order, so a display counts the calls (or keeps
+/// the largest `done`); exactly one call has `done == total`.
+pub type OnCellDone<'a> = &'a (dyn Fn(usize, usize) + Sync);
+
+/// A progress callback that ignores every report.
+pub fn no_progress(_done: usize, _total: usize) {}
+
+/// Counts finished cells and reports each to the callback.
+struct CellCounter<'a> {
+    done: AtomicUsize,
+    total: usize,
+    on_cell_done: OnCellDone<'a>,
+}
+
+impl<'a> CellCounter<'a> {
+    fn new(total: usize, on_cell_done: OnCellDone<'a>) -> Self {
+        Self {
+            done: AtomicUsize::new(0),
+            total,
+            on_cell_done,
+        }
+    }
+
+    fn cell_done(&self) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        (self.on_cell_done)(done, self.total);
+    }
+}
+
 /// Critical speeds of the bicycle returned by `map(value)`, for each value, in parallel.
 ///
 /// `map` is where the caller linearizes its model at the parameter value. Its
 /// errors (and panics) are recorded per value, as are eigen-analysis errors.
-/// Fails as a whole only for an invalid speed range.
-pub fn parameter_sweep<F, L, E>(param: ParamAxis, map: F, opts: &SweepOptions) -> Result<ParameterSweep, SweepError>
+/// Fails as a whole only for an invalid speed range. `on_cell_done` hears of
+/// each finished value ([`no_progress`] to ignore it).
+pub fn parameter_sweep<F, L, E>(
+    param: ParamAxis,
+    map: F,
+    opts: &SweepOptions,
+    on_cell_done: OnCellDone<'_>,
+) -> Result<ParameterSweep, SweepError>
 where
     F: Fn(f64) -> Result<L, E> + Sync,
     L: LinearBicycle,
     E: Display,
 {
     opts.validate()?;
-    let progress = Progress::new(param.values.len(), "parameter sweep", opts);
+    let counter = CellCounter::new(param.values.len(), on_cell_done);
     let points = param
         .values
         .par_iter()
         .map(|&p| {
             let r = evaluate_cell(|| map(p), opts);
-            progress.inc();
+            counter.cell_done();
             r
         })
         .collect();
-    progress.finish();
     Ok(ParameterSweep {
         param,
         speed_range: [opts.speed_min, opts.speed_max],
@@ -333,12 +358,13 @@ where
 
 /// Critical speeds over the grid `x.values x y.values` (row-major, `x` outer), in parallel.
 ///
-/// Same error policy as [`parameter_sweep`].
+/// Same error policy and progress as [`parameter_sweep`].
 pub fn stability_map<F, L, E>(
     x: ParamAxis,
     y: ParamAxis,
     map: F,
     opts: &SweepOptions,
+    on_cell_done: OnCellDone<'_>,
 ) -> Result<StabilityMap, SweepError>
 where
     F: Fn(f64, f64) -> Result<L, E> + Sync,
@@ -347,17 +373,16 @@ where
 {
     opts.validate()?;
     let (nx, ny) = (x.values.len(), y.values.len());
-    let progress = Progress::new(nx * ny, "stability map", opts);
+    let counter = CellCounter::new(nx * ny, on_cell_done);
     let cells = (0..nx * ny)
         .into_par_iter()
         .map(|k| {
             let (px, py) = (x.values[k / ny], y.values[k % ny]);
             let r = evaluate_cell(|| map(px, py), opts);
-            progress.inc();
+            counter.cell_done();
             r
         })
         .collect();
-    progress.finish();
     Ok(StabilityMap {
         x,
         y,
@@ -399,48 +424,6 @@ fn evaluate_cell<L: LinearBicycle, E: Display>(map: impl FnOnce() -> Result<L, E
         summary.least_stable_real_part = Some(z.iter().map(|s| s.re).fold(f64::NEG_INFINITY, f64::max));
     }
     Ok(summary)
-}
-
-/// Progress bar that starts hidden and is switched to stderr after the delay
-/// (only if enabled and stderr is a terminal).
-struct Progress {
-    bar: ProgressBar,
-    enabled: bool,
-    shown: AtomicBool,
-    delay: Duration,
-}
-
-impl Progress {
-    fn new(len: usize, what: &'static str, opts: &SweepOptions) -> Self {
-        let enabled = opts.progress && std::io::stderr().is_terminal() && len > 1;
-        let bar = ProgressBar::with_draw_target(Some(len as u64), ProgressDrawTarget::hidden());
-        if let Ok(style) = ProgressStyle::with_template("{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} (eta {eta})")
-        {
-            bar.set_style(style);
-        }
-        bar.set_message(what);
-        Self {
-            bar,
-            enabled,
-            shown: AtomicBool::new(false),
-            delay: opts.progress_delay,
-        }
-    }
-
-    fn inc(&self) {
-        self.bar.inc(1);
-        if self.enabled
-            && !self.shown.load(Ordering::Relaxed)
-            && self.bar.elapsed() >= self.delay
-            && !self.shown.swap(true, Ordering::AcqRel)
-        {
-            self.bar.set_draw_target(ProgressDrawTarget::stderr());
-        }
-    }
-
-    fn finish(&self) {
-        self.bar.finish_and_clear();
-    }
 }
 
 #[cfg(test)]

@@ -46,8 +46,9 @@ fn identify_bench() -> Result<()> {
 /// core. Uses `../shared` when present, else a synthetic run written to a
 /// temporary folder (and no TU Delft figure).
 pub fn experiment(quick: bool) -> Result<()> {
+    use bikedyn::report::experiment::synth::write_run;
     use bikedyn::runtime::experiment::angles::Calibration;
-    use bikedyn::runtime::experiment::synth::{rest_trajectory, write_run, ResponseSpec, SensorModel};
+    use bikedyn::runtime::experiment::synth::{rest_trajectory, ResponseSpec, SensorModel};
     use std::time::Instant;
     let reps = if quick { 5 } else { 30 };
     println!("\n== measured runs (bikedyn fit), median of {reps}, one thread ==");

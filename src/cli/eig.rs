@@ -4,9 +4,9 @@
 use super::args::{BikeArg, Format, OutputArgs};
 use super::{check_outputs, emit, load, range_spec, MAX_STREAMED_POINTS, MAX_TABLE_ROWS};
 use anyhow::Result;
+use bikedyn::report::output;
+use bikedyn::report::plot::{plot_continuation, PlotOptions};
 use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, LinearBicycle};
-use bikedyn::runtime::output;
-use bikedyn::runtime::plot::{plot_continuation, ImageFormat, PlotOptions};
 use std::path::PathBuf;
 
 /// Run `bikedyn eig`.

@@ -5,9 +5,9 @@ use super::args::FitArgs;
 use super::ProgressDisplay;
 use anyhow::{bail, Result};
 use bikedyn::fit::{calibration_text, kick_json, kicks_table, plots, residuals, run_fit, FitOptions};
+use bikedyn::report::experiment::compare;
 use bikedyn::runtime::eigen::LinearBicycle;
 use bikedyn::runtime::experiment::angles::AngleMethod;
-use bikedyn::runtime::experiment::compare;
 use serde_json::Value;
 
 /// The library's options from the command line.

@@ -24,10 +24,11 @@ pub mod verify;
 use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::progress::Progress;
-use bikedyn::runtime::output;
-use indicatif::{ProgressBar, ProgressDrawTarget};
+use bikedyn::report::output;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;
 use std::time::Duration;
 
@@ -96,7 +97,7 @@ pub fn check_outputs(out: Option<&std::path::Path>, plot: Option<&std::path::Pat
         output::output_target(p)?;
     }
     if let Some(p) = plot {
-        bikedyn::runtime::plot::ImageFormat::from_path(p)?;
+        bikedyn::report::plot::ImageFormat::from_path(p)?;
         output::output_target(p)?;
     }
     Ok(())
@@ -161,5 +162,56 @@ impl Drop for ProgressDisplay {
         for b in [self.bar.get(), self.spinner.get()].into_iter().flatten() {
             b.finish_and_clear();
         }
+    }
+}
+
+/// The bar of a sweep, fed by the runtime's cell callback
+/// (`sweep::OnCellDone`). It starts hidden and moves to standard error once
+/// the run has lasted [`CellProgressBar::DELAY`], and only on a terminal and
+/// for more than one cell, so short runs, tests and redirected output stay
+/// quiet.
+pub struct CellProgressBar {
+    bar: ProgressBar,
+    enabled: bool,
+    shown: AtomicBool,
+}
+
+impl CellProgressBar {
+    /// How long a sweep runs before its bar appears.
+    pub const DELAY: Duration = Duration::from_secs(1);
+
+    /// A bar for `cells` cells, labelled `what` ("parameter sweep").
+    pub fn new(cells: usize, what: &'static str) -> Self {
+        let bar = ProgressBar::with_draw_target(Some(cells as u64), ProgressDrawTarget::hidden());
+        if let Ok(style) = ProgressStyle::with_template("{msg} [{elapsed_precise}] {wide_bar} {pos}/{len} (eta {eta})")
+        {
+            bar.set_style(style);
+        }
+        bar.set_message(what);
+        Self {
+            bar,
+            enabled: std::io::stderr().is_terminal() && cells > 1,
+            shown: AtomicBool::new(false),
+        }
+    }
+
+    /// One cell finished (the callback's `(done, total)` counts cells; the
+    /// bar counts its own calls, since reports from the worker threads may
+    /// arrive out of order).
+    pub fn cell_done(&self, _done: usize, _total: usize) {
+        self.bar.inc(1);
+        if self.enabled
+            && !self.shown.load(Ordering::Relaxed)
+            && self.bar.elapsed() >= Self::DELAY
+            && !self.shown.swap(true, Ordering::AcqRel)
+        {
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+        }
+    }
+}
+
+impl Drop for CellProgressBar {
+    fn drop(&mut self) {
+        self.bar.finish_and_clear();
     }
 }

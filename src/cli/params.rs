@@ -4,7 +4,7 @@ use super::args::{FormName, ParamsCommand};
 use super::text::params_show_text;
 use super::{emit, load};
 use anyhow::Result;
-use bikedyn::runtime::output;
+use bikedyn::report::output;
 
 /// Run `bikedyn params ...`.
 pub fn run(command: ParamsCommand) -> Result<bool> {

@@ -7,9 +7,9 @@ use super::{load, parse_range};
 use anyhow::{Context, Result};
 use bikedyn::bicycle::BUILT_IN;
 use bikedyn::identify::{report, IdentifyRequest};
+use bikedyn::report::output;
+use bikedyn::report::plot::{plot_continuation, PlotOptions};
 use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep};
-use bikedyn::runtime::output;
-use bikedyn::runtime::plot::{plot_continuation, PlotOptions};
 use bikedyn::runtime::verify::VerifyOptions;
 use std::path::PathBuf;
 

@@ -5,8 +5,9 @@
 use super::args::SimulateArgs;
 use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::Bicycle;
-use bikedyn::runtime::plot::PlotOptions;
-use bikedyn::runtime::simulate::plot::plot_simulation;
+use bikedyn::report::plot::PlotOptions;
+use bikedyn::report::simulate::plot::plot_simulation;
+use bikedyn::report::simulate::save_simulation_csv;
 use bikedyn::runtime::simulate::{
     Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, TorquePulse,
 };
@@ -74,7 +75,7 @@ pub fn parse_pulse(spec: &str) -> Result<TorquePulse> {
 /// Run `bikedyn simulate`.
 pub fn run(a: SimulateArgs) -> Result<bool> {
     if let Some(p) = &a.plot {
-        bikedyn::runtime::plot::ImageFormat::from_path(p)?;
+        bikedyn::report::plot::ImageFormat::from_path(p)?;
     }
     let bike = Bicycle::resolve(&a.bike)?;
     for w in &bike.warnings {
@@ -134,7 +135,7 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
         sim.relative_energy_drift()
     );
     if let Some(out) = &a.out {
-        sim.save_csv(out)?;
+        save_simulation_csv(out, &sim)?;
         eprintln!("wrote {}", out.display());
     }
     if let Some(plot) = &a.plot {

@@ -1,13 +1,12 @@
 //! `bikedyn sweep`: stability over one parameter, or a stability map over two.
 
 use super::args::{BikeArg, Format, MapArg, OutputArgs, SweepArgs};
-use super::{check_outputs, emit, load, parse_range, MAX_MAP_CELLS};
+use super::{check_outputs, emit, load, parse_range, CellProgressBar, MAX_MAP_CELLS};
 use anyhow::{bail, Result};
 use bikedyn::bicycle::Bicycle;
-use bikedyn::runtime::output;
-use bikedyn::runtime::plot::{plot_stability_map, ImageFormat, PlotOptions};
+use bikedyn::report::output;
+use bikedyn::report::plot::{plot_stability_map, PlotOptions};
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
-use std::path::PathBuf;
 
 /// Run `bikedyn sweep`.
 pub fn run(a: SweepArgs) -> Result<bool> {
@@ -77,6 +76,7 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                 );
             }
             b.with_parameter(&param, xs[0])?.with_parameter(&p2, ys[0])?;
+            let bar = CellProgressBar::new(xs.len() * ys.len(), "stability map");
             let map = stability_map(
                 ParamAxis::new(param.clone(), xs),
                 ParamAxis::new(p2.clone(), ys),
@@ -86,7 +86,9 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                         .and_then(|b| b.linear_with(model.as_deref()))
                 },
                 &opts,
+                &|done, total| bar.cell_done(done, total),
             )?;
+            drop(bar);
             refuse_failed_cells(map.cells.iter().enumerate().map(|(k, c)| {
                 let (ny, x, y) = (map.y.values.len(), &map.x.values, &map.y.values);
                 (format!("{param} = {}, {p2} = {}", x[k / ny], y[k % ny]), c)
@@ -115,6 +117,7 @@ pub fn run(a: SweepArgs) -> Result<bool> {
             if plot.is_some() {
                 bail!("--plot draws a two-parameter stability map: give --param2 and --values2");
             }
+            let bar = CellProgressBar::new(xs.len(), "parameter sweep");
             let s = parameter_sweep(
                 ParamAxis::new(param.clone(), xs),
                 |x| {
@@ -122,7 +125,9 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                         .and_then(|b| b.linear_with(model.as_deref()))
                 },
                 &opts,
+                &|done, total| bar.cell_done(done, total),
             )?;
+            drop(bar);
             refuse_failed_cells(
                 s.points
                     .iter()

@@ -4,8 +4,8 @@
 
 use anyhow::Result;
 use bikedyn::bicycle::Bicycle;
+use bikedyn::report::output;
 use bikedyn::runtime::eigen::{CriticalSpeeds, CrossingDirection, CrossingKind};
-use bikedyn::runtime::output;
 use bikedyn::runtime::CanonicalMatrices;
 
 pub fn stability_json(name: &str, c: &CriticalSpeeds) -> serde_json::Value {

@@ -2,9 +2,9 @@
 
 use crate::bicycle::BicycleError;
 use crate::fit::FitError;
+use bikedyn_report::output::OutputError;
+use bikedyn_report::plot::PlotError;
 use bikedyn_runtime::linearize::LinearizeError;
-use bikedyn_runtime::output::OutputError;
-use bikedyn_runtime::plot::PlotError;
 use std::path::PathBuf;
 use thiserror::Error;
 

@@ -13,7 +13,6 @@ pub mod angles;
 pub mod compare;
 pub mod fit;
 pub mod kicks;
-pub mod plot;
 pub mod read;
 pub mod speed;
 pub mod sync;

@@ -1,6 +1,9 @@
-//! Synthetic measured runs: the sensor writer that turns a sampled motion of
-//! the bicycle into the files of `shared/data/FORMAT.md`, with the sensors'
-//! imperfections, and a simple launch-kick-response motion for tests.
+//! Synthetic measured runs: the sensor model that turns a sampled motion of
+//! the bicycle into the readings of `shared/data/FORMAT.md` (orientations of
+//! the two IMUs and the reed-switch voltage), with the sensors'
+//! imperfections, and a simple launch-kick-response motion for tests. The
+//! report layer writes the readings as a run's files (its
+//! `experiment::synth::write_run`).
 
 pub use super::read::RunKind;
 use crate::random::SplitMix64;
@@ -8,8 +11,6 @@ use crate::simulate::trajectory::Trajectory;
 use crate::CanonicalMatrices;
 use nalgebra::{Rotation3, UnitQuaternion, Vector3};
 use serde::Serialize;
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 /// Sensor imperfections. `Default` = values like `shared/data/dev`.
 #[derive(Clone, Debug, Serialize)]
@@ -99,20 +100,45 @@ pub struct SynthTruth {
     pub weave: Option<[f64; 2]>,
 }
 
-/// Why writing failed.
+/// Why a run cannot be recorded.
 #[derive(Debug, thiserror::Error)]
 pub enum SynthError {
-    /// A file could not be written.
-    #[error("{}: {source}", path.display())]
-    Io {
-        /// Path.
-        path: PathBuf,
-        /// Cause.
-        source: std::io::Error,
-    },
     /// The trajectory is not usable.
     #[error("trajectory: {0}")]
     Trajectory(&'static str),
+}
+
+/// One reading of an IMU: time on the IMU clock (s) and the orientation it
+/// reports.
+#[derive(Clone, Copy, Debug)]
+pub struct ImuSample {
+    /// Time on the IMU clock (s).
+    pub time: f64,
+    /// Orientation, sign-continuous with the previous reading.
+    pub orientation: UnitQuaternion<f64>,
+}
+
+/// One reading of the reed switch: time on the DAQ clock (s) and voltage.
+#[derive(Clone, Copy, Debug)]
+pub struct SwitchSample {
+    /// Time on the DAQ clock (s).
+    pub time: f64,
+    /// Voltage across the switch (V).
+    pub volts: f64,
+}
+
+/// The sensor readings of one synthetic run, with what the pipeline should
+/// recover from them.
+#[derive(Clone, Debug)]
+pub struct SensorRecording {
+    /// Frame IMU at its rate.
+    pub frame: Vec<ImuSample>,
+    /// Handlebar IMU at its rate.
+    pub handlebar: Vec<ImuSample>,
+    /// Reed switch at the DAQ rate.
+    pub speed_switch: Vec<SwitchSample>,
+    /// The truth behind the readings.
+    pub truth: SynthTruth,
 }
 
 /// Stream of a run's sensor errors: the seed mixed with a constant, so it
@@ -132,25 +158,16 @@ fn interp(t: &[f64], x: &[f64], s: f64) -> f64 {
     x[k - 1] + w * (x[k] - x[k - 1])
 }
 
-fn write(path: &Path, text: &str) -> Result<(), SynthError> {
-    std::fs::write(path, text).map_err(|source| SynthError::Io {
-        path: path.to_path_buf(),
-        source,
-    })
-}
-
-/// Write `imu_frame.csv`, `imu_handlebar.csv`, `speed_switch.csv` and
-/// `run.toml` of one run into `dir` (created), following FORMAT.md, from the
+/// The readings of the two IMUs and the reed switch of one run, from the
 /// angles of `traj` (the reed switch follows its wheel rotation; its speed
-/// series is not read).
-pub fn write_run(
-    dir: &Path,
+/// series is not read), with the sensors' imperfections drawn from `seed`.
+pub fn record_run(
     name: &str,
     kind: RunKind,
     traj: &Trajectory,
     sensors: &SensorModel,
     seed: u64,
-) -> Result<SynthTruth, SynthError> {
+) -> Result<SensorRecording, SynthError> {
     let n = traj.t.len();
     if n < 2
         || [&traj.yaw, &traj.roll, &traj.pitch, &traj.steer, &traj.rear_wheel_angle]
@@ -162,10 +179,6 @@ pub fn write_run(
     if traj.t.windows(2).any(|w| !(w[1] > w[0])) {
         return Err(SynthError::Trajectory("t must increase"));
     }
-    std::fs::create_dir_all(dir).map_err(|source| SynthError::Io {
-        path: dir.to_path_buf(),
-        source,
-    })?;
     let mut rng = SplitMix64::new(seed ^ SENSOR_STREAM);
     let e = |a: [f64; 3]| Rotation3::from_euler_angles(a[0], a[1], a[2]);
     let mf = e(sensors.frame_misalignment);
@@ -175,8 +188,8 @@ pub fn write_run(
     // Settling error axes, fixed per run.
     let mut axis = || Vector3::new(rng.normal(), rng.normal(), rng.normal()).normalize();
     let (ax_f, ax_h) = (axis(), axis());
-    let mut frame_csv = String::from("time_s,q0,q1,q2,q3\n");
-    let mut hb_csv = String::from("time_s,q0,q1,q2,q3\n");
+    let mut frame = Vec::new();
+    let mut handlebar = Vec::new();
     let (mut last_f, mut last_h): (Option<UnitQuaternion<f64>>, Option<UnitQuaternion<f64>>) = (None, None);
     let dt_imu = 1.0 / sensors.imu_rate_hz;
     let n_imu = ((t_end - t0) / dt_imu).floor() as usize + 1;
@@ -201,7 +214,7 @@ pub fn write_run(
         };
         let rf = ideal * mf * noise(&ax_f);
         let rh = ideal * Rotation3::from_axis_angle(&Vector3::z_axis(), steer) * mh * noise(&ax_h);
-        for (r, last, csv) in [(rf, &mut last_f, &mut frame_csv), (rh, &mut last_h, &mut hb_csv)] {
+        for (r, last, readings) in [(rf, &mut last_f, &mut frame), (rh, &mut last_h, &mut handlebar)] {
             let mut q = UnitQuaternion::from_rotation_matrix(&r);
             if let Some(l) = last {
                 if q.coords.dot(&l.coords) < 0.0 {
@@ -209,7 +222,10 @@ pub fn write_run(
                 }
             }
             *last = Some(q);
-            let _ = writeln!(csv, "{:.4},{:.7},{:.7},{:.7},{:.7}", ti, q.w, q.i, q.j, q.k);
+            readings.push(ImuSample {
+                time: ti,
+                orientation: q,
+            });
         }
     }
     // Reed switch.
@@ -227,7 +243,7 @@ pub fn write_run(
         })
         .collect();
     let c = sensors.wheel_circumference;
-    let mut sw_csv = String::from("time_s,volts\n");
+    let mut speed_switch = Vec::new();
     let dt_daq = 1.0 / sensors.daq_rate_hz;
     let mut k = 0usize;
     let mut was_closed = false;
@@ -255,34 +271,11 @@ pub fn write_run(
             }
             was_closed = closed;
             let v = if out { sensors.supply_v } else { 0.0 } + sensors.switch_noise_v * rng.normal();
-            let _ = writeln!(sw_csv, "{:.3},{:.3}", td, v);
+            speed_switch.push(SwitchSample { time: td, volts: v });
         }
         k += 1;
     }
-    write(&dir.join("imu_frame.csv"), &frame_csv)?;
-    write(&dir.join("imu_handlebar.csv"), &hb_csv)?;
-    write(&dir.join("speed_switch.csv"), &sw_csv)?;
-    let kind_s = match kind {
-        RunKind::Run => "run",
-        RunKind::Calibration => "calibration",
-    };
-    let toml = format!(
-        "# synthetic run written by bikedyn (see shared/data/FORMAT.md)\n\
-         name = \"{name}\"\nkind = \"{kind_s}\"\n\
-         bicycle = \"synthetic\"\nparameters = \"synthetic\"\n\n\
-         [clocks]\nnominal_offset_s = {:.2}\n\n\
-         [imu]\nrate_hz = {}\nfiles = [\"imu_frame.csv\", \"imu_handlebar.csv\"]\n\n\
-         [speed_switch]\nrate_hz = {}\nfile = \"speed_switch.csv\"\nmagnets = {nm}\nwheel = \"rear\"\n\
-         wheel_circumference_m = {}\nsupply_v = {}\nclosing_distance_mm = {}\nsensor_set = \"synthetic\"\n",
-        sensors.nominal_offset,
-        sensors.imu_rate_hz,
-        sensors.daq_rate_hz,
-        sensors.wheel_circumference,
-        sensors.supply_v,
-        sensors.closing_distance * 1000.0
-    );
-    write(&dir.join("run.toml"), &toml)?;
-    Ok(SynthTruth {
+    let truth = SynthTruth {
         name: name.to_string(),
         kind,
         frame_misalignment: sensors.frame_misalignment,
@@ -292,6 +285,12 @@ pub fn write_run(
         magnet_positions: magnets,
         kick_time: None,
         weave: None,
+    };
+    Ok(SensorRecording {
+        frame,
+        handlebar,
+        speed_switch,
+        truth,
     })
 }
 

@@ -37,8 +37,6 @@
 //!   nuisances (mounting misalignment, clock offset) are estimated per set by
 //!   the measured-run pipeline before, and are never candidates.
 
-pub mod plot;
-
 use crate::model::MultibodyModel;
 use crate::simulate::{simulate, Events, InitialConditions, Inputs, Method, SimOptions};
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};

@@ -321,7 +321,7 @@ pub(crate) fn degrees_hint(value: f64) -> String {
     if value.is_finite() && value.abs() >= 1.0 && value.abs() <= 360.0 {
         format!(
             "; it looks like degrees: {value} deg is {} rad",
-            crate::output::format_significant(value.to_radians(), 6)
+            crate::number_text::format_significant(value.to_radians(), 6)
         )
     } else {
         String::new()
@@ -495,21 +495,21 @@ impl fmt::Display for ParameterWarning {
                 f,
                 "principal moments of the {body} [{}, {}, {}] kg m^2 violate the triangle \
                  inequality by {} kg m^2",
-                crate::output::format_significant(principal[0], 6),
-                crate::output::format_significant(principal[1], 6),
-                crate::output::format_significant(principal[2], 6),
-                crate::output::format_significant(*excess, 6),
+                crate::number_text::format_significant(principal[0], 6),
+                crate::number_text::format_significant(principal[1], 6),
+                crate::number_text::format_significant(principal[2], 6),
+                crate::number_text::format_significant(*excess, 6),
             ),
             ParameterWarning::LooksLikeMillimetres { field, value } => write!(
                 f,
                 "`{field}` = {value:?} m is implausibly long for a bicycle; if it is in millimetres, \
                  write {} (metres)",
-                crate::output::format_significant(value / 1000.0, 6)
+                crate::number_text::format_significant(value / 1000.0, 6)
             ),
             ParameterWarning::MassCentreBelowGround { body, height } => write!(
                 f,
                 "the {body} mass centre is {} m below the ground when upright",
-                crate::output::format_significant(-height, 6)
+                crate::number_text::format_significant(-height, 6)
             ),
             ParameterWarning::Degenerate { body, what } => {
                 write!(f, "the {body} is degenerate: {what}")

@@ -82,14 +82,10 @@ mod inputs;
 mod rhs;
 
 pub mod fit;
-pub mod plot;
 pub mod trajectory;
 
 pub use inputs::{Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, StopReason, TorquePulse};
 pub use rhs::{forward_speed, BicycleCoordinates, Evaluator, StateLayout};
-
-use std::io::Write;
-use std::path::Path;
 
 use differential_equations::prelude::{
     ControlFlag, ImplicitRungeKutta, Interpolation, Matrix as DeMatrix, Solout, Solution, IVP, ODE,
@@ -99,7 +95,6 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::model::MultibodyModel;
-use crate::output::{write_atomic, OutputError};
 
 /// Why a simulation failed.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -327,48 +322,6 @@ impl Simulation {
     pub fn state(&self, name: &str) -> Option<Vec<f64>> {
         let j = self.states.iter().position(|c| *c == name)?;
         Some(self.z.iter().map(|z| z[j]).collect())
-    }
-
-    /// CSV header: `t`, every coordinate, `d` + every coordinate, `speed`,
-    /// `kinetic_energy`, `potential_energy`, `constraint_residual`, then the
-    /// extra states by name (models with states only).
-    pub fn csv_header(&self) -> Vec<String> {
-        let mut h = vec!["t".to_string()];
-        h.extend(self.coordinates.iter().map(|c| c.to_string()));
-        h.extend(self.coordinates.iter().map(|c| format!("d{c}")));
-        for s in ["speed", "kinetic_energy", "potential_energy", "constraint_residual"] {
-            h.push(s.into());
-        }
-        h.extend(self.states.iter().map(|s| s.to_string()));
-        h
-    }
-
-    /// Write the CSV (see [`Simulation::csv_header`]).
-    pub fn write_csv<W: Write>(&self, w: W) -> Result<(), csv::Error> {
-        let mut c = csv::Writer::from_writer(w);
-        c.write_record(self.csv_header())?;
-        for i in 0..self.t.len() {
-            let mut row = vec![format!("{:.6}", self.t[i])];
-            row.extend(self.p[i].iter().map(|x| format!("{x:.12e}")));
-            row.extend(self.dp[i].iter().map(|x| format!("{x:.12e}")));
-            for x in [
-                self.speed[i],
-                self.kinetic_energy[i],
-                self.potential_energy[i],
-                self.constraint_residual[i],
-            ] {
-                row.push(format!("{x:.12e}"));
-            }
-            row.extend(self.z[i].iter().map(|x| format!("{x:.12e}")));
-            c.write_record(&row)?;
-        }
-        c.flush()?;
-        Ok(())
-    }
-
-    /// Write the CSV atomically to `path`.
-    pub fn save_csv(&self, path: impl AsRef<Path>) -> Result<(), OutputError> {
-        write_atomic(path, |w| self.write_csv(w))
     }
 }
 

@@ -1,6 +1,6 @@
 //! The sampled motion of the bicycle ([`Trajectory`]): what a simulated run
-//! gives ([`trajectory_for_run`]) and what the synthetic measured-run writer
-//! takes (`experiment::synth::write_run`, issue 8), with the test motions of
+//! gives ([`trajectory_for_run`]) and what the synthetic sensor model takes
+//! (`experiment::synth::record_run`, issue 8), with the test motions of
 //! `experiment::synth`.
 
 use serde::Serialize;

@@ -7,17 +7,19 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-use bikedyn_runtime::canonical::CanonicalMatrices;
-use bikedyn_runtime::output::{
+use bikedyn_report::output::{
     eigen_sweep_csv_header, eigen_sweep_json, format_eigen_table, format_parameter_table, format_stability_map_table,
     parameter_sweep_json, save_eigen_sweep_csv, save_eigen_sweep_json, save_parameter_sweep_csv,
     save_stability_map_csv, save_stability_map_json, stability_map_json, write_atomic, write_eigen_sweep_csv,
     write_stability_map_csv, OutputError,
 };
-use bikedyn_runtime::plot::{plot_continuation, plot_stability_map, use_font, PlotError, PlotOptions};
+use bikedyn_report::plot::{plot_continuation, plot_stability_map, use_font, PlotError, PlotOptions};
+use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::sweep::{
-    linspace, parameter_sweep, speed_sweep, stability_map, CellStage, MapQuantity, ParamAxis, SweepError, SweepOptions,
+    linspace, no_progress, parameter_sweep, speed_sweep, stability_map, CellStage, MapQuantity, ParamAxis, SweepError,
+    SweepOptions,
 };
 use nalgebra::Matrix2;
 
@@ -101,10 +103,7 @@ fn scaled(a: f64, b: f64) -> Result<CanonicalMatrices, String> {
 }
 
 fn quiet(speed_min: f64, speed_max: f64) -> SweepOptions {
-    SweepOptions {
-        progress: false,
-        ..SweepOptions::with_speed_range(speed_min, speed_max)
-    }
+    SweepOptions::with_speed_range(speed_min, speed_max)
 }
 
 #[test]
@@ -218,12 +217,12 @@ fn sweep_grid_parallel_and_deterministic() {
     let x = ParamAxis::new("K2 scale", linspace(0.5, 1.5, 9));
     let y = ParamAxis::new("C1 scale", linspace(0.5, 1.5, 7));
     let opts = quiet(0.0, 10.0);
-    let a = stability_map(x.clone(), y.clone(), scaled, &opts).unwrap();
+    let a = stability_map(x.clone(), y.clone(), scaled, &opts, &no_progress).unwrap();
     // Same result on a single thread and on several threads.
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
-    let b = one.install(|| stability_map(x.clone(), y.clone(), scaled, &opts).unwrap());
+    let b = one.install(|| stability_map(x.clone(), y.clone(), scaled, &opts, &no_progress).unwrap());
     let four = rayon::ThreadPoolBuilder::new().num_threads(4).build().unwrap();
-    let c = four.install(|| stability_map(x.clone(), y.clone(), scaled, &opts).unwrap());
+    let c = four.install(|| stability_map(x.clone(), y.clone(), scaled, &opts, &no_progress).unwrap());
     assert_eq!(a, b);
     assert_eq!(a, c);
     assert_eq!(a.shape(), (9, 7));
@@ -277,7 +276,7 @@ fn sweep_failed_cells_are_recorded_not_fatal() {
         }
         scaled(a, b)
     };
-    let m = stability_map(x, y, map, &quiet(0.0, 10.0)).unwrap();
+    let m = stability_map(x, y, map, &quiet(0.0, 10.0), &no_progress).unwrap();
     assert!(m.cells[0].is_ok());
     let e = m.cells[1].as_ref().unwrap_err();
     assert_eq!(e.stage, CellStage::Model);
@@ -295,7 +294,13 @@ fn sweep_failed_cells_are_recorded_not_fatal() {
         c.m0 *= s;
         Ok(c)
     };
-    let p = parameter_sweep(ParamAxis::new("mass scale", vec![1.0, 0.0]), sing, &quiet(0.0, 10.0)).unwrap();
+    let p = parameter_sweep(
+        ParamAxis::new("mass scale", vec![1.0, 0.0]),
+        sing,
+        &quiet(0.0, 10.0),
+        &no_progress,
+    )
+    .unwrap();
     assert!(p.points[0].is_ok());
     assert_eq!(p.points[1].as_ref().unwrap_err().stage, CellStage::Eigen);
     let j = parameter_sweep_json(&p);
@@ -303,18 +308,27 @@ fn sweep_failed_cells_are_recorded_not_fatal() {
     assert_eq!(j["points"][1]["error"]["stage"], "eigen");
 
     // Invalid speed range rejects the whole sweep.
-    let err = parameter_sweep(ParamAxis::new("a", vec![1.0]), sing, &quiet(5.0, 1.0)).unwrap_err();
+    let err = parameter_sweep(ParamAxis::new("a", vec![1.0]), sing, &quiet(5.0, 1.0), &no_progress).unwrap_err();
     assert!(matches!(err, SweepError::InvalidSpeedRange { .. }));
 }
 
 #[test]
 fn sweep_parameter_sweep_outputs() {
+    let (cells_done, last_done) = (AtomicUsize::new(0), AtomicUsize::new(0));
     let p = parameter_sweep(
         ParamAxis::new("K2 scale", linspace(0.6, 1.4, 17)),
         |a| scaled(a, 1.0),
         &quiet(0.0, 10.0),
+        &|done, total| {
+            assert_eq!(total, 17);
+            cells_done.fetch_add(1, Ordering::Relaxed);
+            last_done.fetch_max(done, Ordering::Relaxed);
+        },
     )
     .unwrap();
+    // The progress callback hears of every cell, and the count reaches the total.
+    assert_eq!(cells_done.load(Ordering::Relaxed), 17);
+    assert_eq!(last_done.load(Ordering::Relaxed), 17);
     assert_eq!(p.points.len(), 17);
     let s = p.points[8].as_ref().unwrap();
     assert!((s.weave_speed.unwrap() - WEAVE_SPEED).abs() < 1e-6);
@@ -429,7 +443,7 @@ fn plot_continuation_svg_and_png() {
 fn plot_stability_map_svg_and_png() {
     let x = ParamAxis::new("K2 scale", linspace(0.2, 1.8, 25));
     let y = ParamAxis::new("C1 scale", linspace(0.2, 1.8, 21));
-    let m = stability_map(x, y, scaled, &quiet(0.0, 10.0)).unwrap();
+    let m = stability_map(x, y, scaled, &quiet(0.0, 10.0), &no_progress).unwrap();
     let dir = test_dir("map");
     let opts = PlotOptions::default();
     plot_stability_map(dir.join("map.svg"), &m, MapQuantity::StableWidth, &opts).unwrap();

@@ -54,8 +54,12 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use nalgebra::Complex;
 use serde_json::{json, Value};
 
-use crate::eigen::{EigenPoint, EigenSweep, Mode};
-use crate::sweep::{CellResult, ParameterSweep, StabilityMap};
+use bikedyn_runtime::eigen::{EigenPoint, EigenSweep, Mode};
+use bikedyn_runtime::sweep::{CellResult, ParameterSweep, StabilityMap};
+
+// The number formatters live in the runtime (its error messages use them);
+// tables and callers reach them here.
+pub use bikedyn_runtime::number_text::{format_fixed, format_significant};
 
 /// Boxed error of a writer callback.
 pub type BoxError = Box<dyn std::error::Error + Send + Sync + 'static>;
@@ -541,11 +545,11 @@ pub const STREAM_BLOCK: usize = 4096;
 /// Compute and write the eigen sweep of `c` at the `n` speeds `speed(0)`,
 /// ..., `speed(n - 1)` block by block ([`STREAM_BLOCK`] speeds at a time), so
 /// memory stays flat in `n` (issue 10, point 5). Labels are the same as those
-/// of one [`crate::eigen::eigen_sweep`] over all speeds, because every speed
+/// of one [`bikedyn_runtime::eigen::eigen_sweep`] over all speeds, because every speed
 /// is labelled by continuation from the bicycle's anchor speed, independent
 /// of the other requested speeds.
 pub fn stream_eigen_sweep(
-    c: &dyn crate::eigen::LinearBicycle,
+    c: &dyn bikedyn_runtime::eigen::LinearBicycle,
     n: usize,
     speed: impl Fn(usize) -> f64,
     format: StreamFormat,
@@ -553,7 +557,7 @@ pub fn stream_eigen_sweep(
 ) -> Result<(), BoxError> {
     // Fail before writing anything if the bicycle has no eigen analysis.
     if n > 0 {
-        crate::eigen::eigenvalues_of(c, speed(0))?;
+        bikedyn_runtime::eigen::eigenvalues_of(c, speed(0))?;
     }
     let for_each_point = |f: &mut dyn FnMut(usize, &EigenPoint) -> Result<(), BoxError>| -> Result<(), BoxError> {
         let mut speeds = Vec::with_capacity(STREAM_BLOCK.min(n));
@@ -562,7 +566,7 @@ pub fn stream_eigen_sweep(
             let end = (start + STREAM_BLOCK).min(n);
             speeds.clear();
             speeds.extend((start..end).map(&speed));
-            let sweep = crate::eigen::eigen_sweep_of(c, &speeds)?;
+            let sweep = bikedyn_runtime::eigen::eigen_sweep_of(c, &speeds)?;
             for (i, p) in sweep.points.iter().enumerate() {
                 f(start + i, p)?;
             }
@@ -939,63 +943,6 @@ pub fn format_stability_map_table(m: &StabilityMap) -> String {
 // Printed numbers (issue 10, point 8). JSON and CSV keep full precision
 // (shortest round-trip representation); text for people has a fixed number
 // of significant digits and never a negative zero.
-
-/// Remove the sign of a formatted number whose digits are all zero
-/// (`"-0.000"` -> `"0.000"`, `"+0.000"` stays unsigned-zero as `"+0.000"`
-/// only when `plus` formatting was asked for).
-fn drop_negative_zero(s: String) -> String {
-    let digits_zero = s
-        .chars()
-        .take_while(|c| *c != 'e' && *c != 'E')
-        .all(|c| matches!(c, '-' | '+' | '0' | '.'));
-    if digits_zero && s.starts_with('-') {
-        s[1..].to_string()
-    } else {
-        s
-    }
-}
-
-/// `x` with `digits` significant digits: plain decimals for `1e-4 <= |x| <
-/// 1e12`, scientific notation otherwise (so `1e-300` prints as
-/// `1.00000e-300`, not with 300 digits); `0` and `-0` print as `0`.
-///
-/// ```
-/// use bikedyn_runtime::output::format_significant;
-/// assert_eq!(format_significant(80.81721999999998, 6), "80.8172");
-/// assert_eq!(format_significant(-0.0, 6), "0");
-/// assert_eq!(format_significant(1e-300, 3), "1.00e-300");
-/// ```
-pub fn format_significant(x: f64, digits: usize) -> String {
-    let digits = digits.max(1);
-    if x == 0.0 {
-        return "0".to_string();
-    }
-    if !x.is_finite() {
-        return x.to_string();
-    }
-    let e = x.abs().log10().floor() as i32;
-    if !(-4..12).contains(&e) {
-        return drop_negative_zero(format!("{:.*e}", digits - 1, x));
-    }
-    let decimals = (digits as i32 - 1 - e).max(0) as usize;
-    drop_negative_zero(format!("{x:.decimals$}"))
-}
-
-/// `x` with a fixed number of decimals, and a `+` sign when `plus`; a value
-/// that rounds to zero prints without a minus sign.
-pub fn format_fixed(x: f64, decimals: usize, plus: bool) -> String {
-    let s = if plus {
-        format!("{x:+.decimals$}")
-    } else {
-        format!("{x:.decimals$}")
-    };
-    let s = drop_negative_zero(s);
-    if plus && !s.starts_with(['+', '-']) {
-        format!("+{s}")
-    } else {
-        s
-    }
-}
 
 /// The entries of a matrix with `digits` significant digits relative to its
 /// largest entry (all entries get the same number of decimals, so columns

@@ -25,9 +25,9 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
-use crate::eigen::{CriticalSpeeds, EigenSweep, Mode};
 use crate::output::{write_atomic_via_path, write_string_atomic, OutputError};
-use crate::sweep::{MapQuantity, StabilityMap};
+use bikedyn_runtime::eigen::{CriticalSpeeds, EigenSweep, Mode};
+use bikedyn_runtime::sweep::{MapQuantity, StabilityMap};
 
 /// Font family name under which the font is registered and used.
 const FAMILY: &str = "sans-serif";

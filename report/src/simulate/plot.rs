@@ -9,7 +9,7 @@ use plotters::prelude::*;
 
 use crate::plot::{de, padded, render, tick, DrawErr, Figure, PlotError, PlotOptions};
 
-use super::Simulation;
+use bikedyn_runtime::simulate::Simulation;
 
 struct TimeHistory<'a> {
     sim: &'a Simulation,
@@ -23,7 +23,7 @@ struct TimeHistory<'a> {
 pub fn plot_simulation(path: impl AsRef<Path>, sim: &Simulation, opts: &PlotOptions) -> Result<(), PlotError> {
     let path = path.as_ref();
     crate::plot::ImageFormat::from_path(path)?;
-    use crate::model::CoordinateRole as R;
+    use bikedyn_runtime::model::CoordinateRole as R;
     let (roll, steer) = match (sim.coordinate_of(R::Roll), sim.coordinate_of(R::Steer)) {
         (Some(r), Some(s)) if sim.t.len() >= 2 => (r, s),
         _ => {

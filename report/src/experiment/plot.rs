@@ -3,11 +3,11 @@
 //! each measured weave eigenvalue on its speed segment with error bars
 //! (Figures 14-15).
 
-use super::fit::FitForm;
-use super::KickFit;
-use crate::eigen::{eigen_sweep_of, LinearBicycle, Mode};
 use crate::output::write_string_atomic;
 use crate::plot::{find_font, use_font, PlotError};
+use bikedyn_runtime::eigen::{eigen_sweep_of, LinearBicycle, Mode};
+use bikedyn_runtime::experiment::fit::FitForm;
+use bikedyn_runtime::experiment::KickFit;
 use plotters::prelude::*;
 use std::path::Path;
 

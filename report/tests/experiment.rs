@@ -1,11 +1,14 @@
 //! Measured runs (issue 8): the pipeline on synthetic runs with known truth,
 //! on `shared/data/dev`, on the TU Delft kick logs, and on corrupt inputs.
+//! Here rather than in the runtime because the synthetic runs are written
+//! by the report layer's `write_run` and read back by the runtime.
 
+use bikedyn_report::experiment::synth::write_run;
 use bikedyn_runtime::experiment::angles::AngleMethod;
 use bikedyn_runtime::experiment::{
     self,
     read::{self, ReadError, RunKind},
-    synth::{rest_trajectory, write_run, ResponseSpec, SensorModel},
+    synth::{rest_trajectory, ResponseSpec, SensorModel},
     PipelineOptions,
 };
 use nalgebra::Rotation3;

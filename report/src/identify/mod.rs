@@ -1,0 +1,3 @@
+//! Output of an identification: its plots ([`plot`]).
+
+pub mod plot;
