@@ -1,17 +1,18 @@
 //! Bicycles as users name them (built-in names or parameter files), mapped to
 //! the generated model that represents them and to their canonical matrices.
 
-use crate::generated::with_model;
-use crate::models::{effect_parameters, fits, model_names, models};
+use crate::models::{effect_parameters_in, fits, index};
+use crate::registry::BuiltIn;
 use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::linearize::{canonical_matrices, LinearModel, LinearizeError};
 use bikedyn_runtime::parameters::{
     BenchmarkParameters, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
 };
-use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
 use bikedyn_runtime::MultibodyModel;
 use std::collections::BTreeMap;
+use std::marker::PhantomData;
 use std::path::Path;
 use thiserror::Error;
 
@@ -55,9 +56,11 @@ pub enum BicycleError {
     NotCanonical { effects: String },
 }
 
-/// A resolved bicycle.
+/// A resolved bicycle, against the models of registry `R` (the built-in
+/// models by default): its effect parameters are those of `R`'s models, and
+/// its model is chosen among them.
 #[derive(Clone, Debug)]
-pub struct Bicycle {
+pub struct Bicycle<R: ModelRegistry = BuiltIn> {
     /// Built-in name or file path.
     pub name: String,
     /// Parameters as given (thesis or benchmark form).
@@ -67,12 +70,23 @@ pub struct Bicycle {
     /// Effect parameters given in the file, by symbol (absent: the model's
     /// default, at which the effect is absent).
     pub effects: BTreeMap<String, f64>,
+    registry: PhantomData<R>,
 }
 
 impl Bicycle {
     /// Resolve `thesis`, `benchmark` or a parameter file (TOML in either form,
-    /// or the `name = value[+/-std]` text form of bicycleparameters/HumanControl).
+    /// or the `name = value[+/-std]` text form of bicycleparameters/HumanControl)
+    /// against the built-in models.
     pub fn resolve(spec: &str) -> Result<Bicycle, BicycleError> {
+        Self::resolve_in(spec)
+    }
+}
+
+impl<R: ModelRegistry> Bicycle<R> {
+    /// [`Bicycle::resolve`] against the models of registry `R`: a parameter
+    /// file may set the effect parameters of `R`'s models, and the bicycle's
+    /// model is chosen among them.
+    pub fn resolve_in(spec: &str) -> Result<Bicycle<R>, BicycleError> {
         let (parameters, warnings) = match spec {
             "thesis" => {
                 let p = ThesisParameters::thesis_bicycle();
@@ -85,16 +99,17 @@ impl Bicycle {
                 (ParameterSet::Benchmark(p), w)
             }
             path if Path::new(path).exists() => {
-                let extra: Vec<&str> = effect_parameters().iter().map(|p| p.name).collect();
+                let extra: Vec<&str> = effect_parameters_in::<R>().iter().map(|p| p.name).collect();
                 let (set, effects, warnings) = ParameterSet::load_with_extra(path, &extra)?;
                 for (name, &value) in &effects {
-                    check_effect_value(name, value, path)?;
+                    check_effect_value_in::<R>(name, value, path)?;
                 }
                 return Ok(Bicycle {
                     name: spec.to_string(),
                     parameters: set,
                     warnings,
                     effects,
+                    registry: PhantomData,
                 });
             }
             _ => return Err(BicycleError::NotFound { spec: spec.to_string() }),
@@ -104,6 +119,7 @@ impl Bicycle {
             parameters,
             warnings,
             effects: BTreeMap::new(),
+            registry: PhantomData,
         })
     }
 
@@ -115,7 +131,7 @@ impl Bicycle {
             .iter()
             .filter_map(|&s| t.get(s).filter(|&v| v != 0.0).map(|v| (s, v)))
             .collect();
-        for p in effect_parameters() {
+        for p in effect_parameters_in::<R>() {
             if let Some(&v) = self.effects.get(p.name) {
                 if Some(v) != p.default && v != 0.0 {
                     out.push((p.name, v));
@@ -141,12 +157,12 @@ impl Bicycle {
     ) -> Result<&'static ModelInfo, BicycleError> {
         match name {
             Some(n) => {
-                let info = models()
+                let info = R::models()
                     .iter()
                     .find(|m| m.name == n)
                     .ok_or_else(|| BicycleError::UnknownModel {
                         name: n.to_string(),
-                        known: model_names().join(", "),
+                        known: R::models().iter().map(|m| m.name).collect::<Vec<_>>().join(", "),
                     })?;
                 let missing: Vec<String> = nonzero
                     .iter()
@@ -165,7 +181,8 @@ impl Bicycle {
             }
             // Smallest first, so only the models smaller than the one chosen
             // are tested (once per design in a sweep); ties keep registry order.
-            None => models_by_size()
+            None => index::<R>()
+                .driven_by_size
                 .iter()
                 .find(|m| fits(m, nonzero))
                 .copied()
@@ -187,9 +204,9 @@ impl Bicycle {
     pub fn canonical_with(&self, model: Option<&str>) -> Result<CanonicalMatrices, BicycleError> {
         if model.is_none() && self.effects.is_empty() {
             let t = self.thesis()?;
-            if let Some(info) = default_model_of(&t) {
+            if let Some(info) = default_model_of::<R>(&t) {
                 if t.rear_wheel_radius != 0.0 && t.front_wheel_radius != 0.0 {
-                    return with_model(info.name, Canonical(&|s: &str| t.get(s)))
+                    return R::with_model(info.name, Canonical(&|s: &str| t.get(s)))
                         .expect("registered model")
                         .map_err(|source| BicycleError::Linearize {
                             bike: self.name.clone(),
@@ -212,10 +229,12 @@ impl Bicycle {
         }
         let t = self.thesis()?;
         if t.rear_wheel_radius == 0.0 || t.front_wheel_radius == 0.0 {
+            // No effect is active here, so the matrices are the Whipple
+            // bicycle's, which the built-in models give for any registry.
             return canonical_zero_radius(&t);
         }
         let lookup = self.lookup()?;
-        with_model(info.name, Canonical(&lookup))
+        R::with_model(info.name, Canonical(&lookup))
             .expect("registered model")
             .map_err(|source| BicycleError::Linearize {
                 bike: self.name.clone(),
@@ -251,7 +270,7 @@ impl Bicycle {
             Err(e) => return Err(e),
         }
         let lookup = self.lookup()?;
-        let equations = with_model(info.name, MakeLinear(&lookup))
+        let equations = R::with_model(info.name, MakeLinear(&lookup))
             .expect("registered model")
             .map_err(|source| BicycleError::Linearize {
                 bike: self.name.clone(),
@@ -277,9 +296,9 @@ impl Bicycle {
 
     /// The same bicycle with one parameter changed. `symbol` is a thesis
     /// symbol (`Rt`, `x4`, `d4`, ...) or a benchmark symbol (`c`, `lam`, ...).
-    pub fn with_parameter(&self, symbol: &str, value: f64) -> Result<Bicycle, BicycleError> {
-        if effect_parameters().iter().any(|p| p.name == symbol) {
-            check_effect_value(symbol, value, &self.name)?;
+    pub fn with_parameter(&self, symbol: &str, value: f64) -> Result<Bicycle<R>, BicycleError> {
+        if effect_parameters_in::<R>().iter().any(|p| p.name == symbol) {
+            check_effect_value_in::<R>(symbol, value, &self.name)?;
             let mut b = self.clone();
             b.effects.insert(symbol.to_string(), value);
             b.name = format!("{} ({symbol} = {value})", self.name);
@@ -302,6 +321,7 @@ impl Bicycle {
             parameters,
             warnings,
             effects: self.effects.clone(),
+            registry: PhantomData,
         })
     }
 
@@ -313,7 +333,7 @@ impl Bicycle {
             .or_else(|| self.parameters.to_benchmark().ok().and_then(|b| b.get(symbol)))
             .or_else(|| self.effects.get(symbol).copied())
             .or_else(|| {
-                effect_parameters()
+                effect_parameters_in::<R>()
                     .iter()
                     .find(|p| p.name == symbol)
                     .and_then(|p| p.default)
@@ -324,7 +344,12 @@ impl Bicycle {
 /// Refuse a non-physical value of effect parameter `name` (not finite, or
 /// below the lower bound its effect file declares), naming `file`.
 pub fn check_effect_value(name: &str, value: f64, file: &str) -> Result<(), BicycleError> {
-    match effect_parameters()
+    check_effect_value_in::<BuiltIn>(name, value, file)
+}
+
+/// [`check_effect_value`] for the effect parameters of registry `R`.
+pub fn check_effect_value_in<R: ModelRegistry>(name: &str, value: f64, file: &str) -> Result<(), BicycleError> {
+    match effect_parameters_in::<R>()
         .iter()
         .find(|p| p.name == name)
         .and_then(|p| p.refuses(value))
@@ -352,47 +377,21 @@ fn set_field<P: serde::Serialize + serde::de::DeserializeOwned>(
     })
 }
 
-/// The driven-speed models, by increasing number of parameters (stable, so
-/// ties keep registry order).
-fn models_by_size() -> &'static [&'static ModelInfo] {
-    static SORTED: std::sync::OnceLock<Vec<&'static ModelInfo>> = std::sync::OnceLock::new();
-    SORTED.get_or_init(|| {
-        let mut v: Vec<&'static ModelInfo> = models().iter().filter(|m| !m.free_speed).collect();
-        v.sort_by_key(|m| m.parameters.len());
-        v
-    })
-}
-
 /// The default model of a bicycle without effect parameters, as
-/// [`Bicycle::model`] chooses it, by bit masks over the thesis symbols (the
-/// choice is made once per design in a sweep, so it avoids comparing
-/// names). `None` when no model fits or the one chosen has a non-zero
-/// thesis symbol as an effect parameter: the general choice reports why.
-fn default_model_of(t: &ThesisParameters) -> Option<&'static ModelInfo> {
-    // Per model (in `models_by_size` order): the thesis symbols it has, and
-    // those of them that are effect parameters.
-    static MASKS: std::sync::OnceLock<Vec<(u64, u64)>> = std::sync::OnceLock::new();
-    let masks = MASKS.get_or_init(|| {
-        models_by_size()
-            .iter()
-            .map(|m| {
-                ThesisParameters::SYMBOLS
-                    .iter()
-                    .enumerate()
-                    .fold((0u64, 0u64), |(has, effect), (i, s)| match m.parameter(s) {
-                        Some(p) => (has | 1 << i, effect | (p.effect.is_some() as u64) << i),
-                        None => (has, effect),
-                    })
-            })
-            .collect()
-    });
+/// [`Bicycle::model`] chooses it among the models of registry `R`, by bit
+/// masks over the thesis symbols (the choice is made once per design in a
+/// sweep, so it avoids comparing names). `None` when no model fits or the
+/// one chosen has a non-zero thesis symbol as an effect parameter: the
+/// general choice reports why.
+fn default_model_of<R: ModelRegistry>(t: &ThesisParameters) -> Option<&'static ModelInfo> {
+    let index = index::<R>();
     let nonzero = t
         .values()
         .iter()
         .enumerate()
         .fold(0u64, |m, (i, &v)| m | ((v != 0.0) as u64) << i);
-    let k = masks.iter().position(|&(has, _)| nonzero & !has == 0)?;
-    (nonzero & masks[k].1 == 0).then(|| models_by_size()[k])
+    let k = index.thesis_masks.iter().position(|&(has, _)| nonzero & !has == 0)?;
+    (nonzero & index.thesis_masks[k].1 == 0).then(|| index.driven_by_size[k])
 }
 
 /// The linear roll-steer equations of a bicycle through the model chosen.
@@ -452,8 +451,8 @@ pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleEr
     // The default model directly (what `Bicycle::canonical_with` does first),
     // without building a `Bicycle`: this runs once per design in a sweep.
     if p.rear_wheel_radius != 0.0 && p.front_wheel_radius != 0.0 {
-        if let Some(info) = default_model_of(p) {
-            return with_model(info.name, Canonical(&|s: &str| p.get(s)))
+        if let Some(info) = default_model_of::<BuiltIn>(p) {
+            return crate::generated::with_model(info.name, Canonical(&|s: &str| p.get(s)))
                 .expect("registered model")
                 .map_err(|source| BicycleError::Linearize {
                     bike: "parameters".into(),
@@ -461,11 +460,12 @@ pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleEr
                 });
         }
     }
-    Bicycle {
+    Bicycle::<BuiltIn> {
         name: "parameters".into(),
         parameters: ParameterSet::Thesis(*p),
         warnings: Vec::new(),
         effects: BTreeMap::new(),
+        registry: PhantomData,
     }
     .canonical()
 }

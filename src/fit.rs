@@ -5,6 +5,7 @@
 use crate::bicycle::{Bicycle, BicycleError, Linear};
 use crate::progress::{OnProgress, Progress};
 use bikedyn_report::plot::PlotError;
+use crate::registry::BuiltIn;
 use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::experiment::{
     self,
@@ -12,6 +13,7 @@ use bikedyn_runtime::experiment::{
     compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
 };
 use bikedyn_runtime::parameters::ParameterError;
+use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -76,13 +78,19 @@ pub struct FitOutcome {
 /// Run the pipeline on the inputs. `progress` is called after each run or
 /// log (step `"runs"`, with the total found).
 pub fn run_fit(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome, FitError> {
-    let bike = opts.bike.as_deref().map(Bicycle::resolve).transpose()?;
+    run_fit_in::<BuiltIn>(opts, progress)
+}
+
+/// [`run_fit`] with the bicycle resolved against the models of registry `R`
+/// (its prediction runs through one of them).
+pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome, FitError> {
+    let bike = opts.bike.as_deref().map(Bicycle::<R>::resolve_in).transpose()?;
     // The prediction runs through the bicycle's own model, effects (damping,
     // an assist controller) included.
     let linear = bike.as_ref().map(|b| b.linear_with(None)).transpose()?;
     let pitch_bike = match &bike {
         Some(b) => b.clone(),
-        None => Bicycle::resolve("thesis")?,
+        None => Bicycle::<R>::resolve_in("thesis")?,
     };
     let frame_pitch = pitch_bike
         .thesis()?

@@ -10,11 +10,19 @@ pub mod generated;
 
 pub use generated::{ThesisWhipple, WhippleOffset};
 
-/// The registry of generated models: `MODELS`, `SOURCES`, `with_model`, and
-/// the runtime's `ModelInfo` and `ModelVisitor`.
+/// The registry of generated models: `MODELS`, `SOURCES`, `with_model`, the
+/// built-in registry as a type ([`registry::BuiltIn`]), and the runtime's
+/// `ModelInfo`, `ModelVisitor` and `ModelRegistry`.
+///
+/// The pipelines run on the built-in registry by default; their `_in`
+/// forms (`Bicycle::resolve_in`, `synth::synth_in`, `identify::run_in`, ...)
+/// take another one, such as the `Registry` a user's build script generated
+/// with `bikedyn_modeler::codegen::generate` (`examples/steering_spring`).
 pub mod registry {
     pub use crate::generated::{with_model, MODELS, SOURCES};
-    pub use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+    pub use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
+    /// The models bikedyn's own build generates (`bikedyn models`).
+    pub type BuiltIn = crate::generated::Registry;
 }
 
 pub mod bicycle;

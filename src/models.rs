@@ -2,12 +2,15 @@
 //! model is named here): default parameters, verification, listing.
 
 use crate::generated::{with_model, MODELS};
+use crate::registry::BuiltIn;
 use bikedyn_runtime::linearize::parameter_vector;
 use bikedyn_runtime::model::ParameterInfo;
 use bikedyn_runtime::parameters::{BenchmarkParameters, ThesisParameters};
-use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
 use bikedyn_runtime::verify::{verify, with_effects_switched_on, VerifyOptions, VerifyReport};
 use bikedyn_runtime::MultibodyModel;
+use std::any::TypeId;
+use std::sync::{Mutex, OnceLock, PoisonError};
 
 /// The built-in bicycles' parameters (thesis form) by name.
 pub fn built_in_thesis_parameters() -> [(&'static str, ThesisParameters); 2] {
@@ -86,21 +89,82 @@ pub fn model_names() -> Vec<&'static str> {
     MODELS.iter().map(|m| m.name).collect()
 }
 
-/// Every effect parameter of any model, with its description (computed
-/// once: sweeps resolve bicycles in their inner loop).
+/// Every effect parameter of any built-in model, with its description.
 pub fn effect_parameters() -> &'static [&'static ParameterInfo] {
-    static CACHE: std::sync::OnceLock<Vec<&'static ParameterInfo>> = std::sync::OnceLock::new();
-    CACHE.get_or_init(|| {
-        let mut out: Vec<&'static ParameterInfo> = Vec::new();
-        for m in MODELS {
+    effect_parameters_in::<BuiltIn>()
+}
+
+/// Every effect parameter of any model of registry `R`, with its
+/// description.
+pub fn effect_parameters_in<R: ModelRegistry>() -> &'static [&'static ParameterInfo] {
+    &index::<R>().effect_parameters
+}
+
+/// What bicycle resolution and model choice read from a registry, computed
+/// once per registry: sweeps resolve bicycles in their inner loop.
+pub(crate) struct Index {
+    /// Every effect parameter of any model (first declaration of each name).
+    pub effect_parameters: Vec<&'static ParameterInfo>,
+    /// The driven-speed models, by increasing number of parameters (stable,
+    /// so ties keep registry order).
+    pub driven_by_size: Vec<&'static ModelInfo>,
+    /// Per model of `driven_by_size`: the thesis symbols it has, and those
+    /// of them that are effect parameters (bit `i` for
+    /// `ThesisParameters::SYMBOLS[i]`).
+    pub thesis_masks: Vec<(u64, u64)>,
+}
+
+impl Index {
+    fn of(models: &'static [ModelInfo]) -> Index {
+        let mut effect_parameters: Vec<&'static ParameterInfo> = Vec::new();
+        for m in models {
             for p in m.parameters {
-                if p.effect.is_some() && !out.iter().any(|q| q.name == p.name) {
-                    out.push(p);
+                if p.effect.is_some() && !effect_parameters.iter().any(|q| q.name == p.name) {
+                    effect_parameters.push(p);
                 }
             }
         }
-        out
-    })
+        let mut driven_by_size: Vec<&'static ModelInfo> = models.iter().filter(|m| !m.free_speed).collect();
+        driven_by_size.sort_by_key(|m| m.parameters.len());
+        let thesis_masks = driven_by_size
+            .iter()
+            .map(|m| {
+                ThesisParameters::SYMBOLS
+                    .iter()
+                    .enumerate()
+                    .fold((0u64, 0u64), |(has, effect), (i, s)| match m.parameter(s) {
+                        Some(p) => (has | 1 << i, effect | (p.effect.is_some() as u64) << i),
+                        None => (has, effect),
+                    })
+            })
+            .collect();
+        Index {
+            effect_parameters,
+            driven_by_size,
+            thesis_masks,
+        }
+    }
+}
+
+/// The [`Index`] of registry `R`. The built-in registry's is a plain
+/// `OnceLock` (no lock on the sweeps' path); other registries' are kept,
+/// one per registry type, behind a mutex taken once per lookup.
+pub(crate) fn index<R: ModelRegistry>() -> &'static Index {
+    static BUILT_IN: OnceLock<Index> = OnceLock::new();
+    static OTHERS: Mutex<Vec<(TypeId, &'static Index)>> = Mutex::new(Vec::new());
+    if TypeId::of::<R>() == TypeId::of::<BuiltIn>() {
+        return BUILT_IN.get_or_init(|| Index::of(R::models()));
+    }
+    // The list only grows and each entry is complete when pushed, so a
+    // poisoned lock still holds a valid list.
+    let mut others = OTHERS.lock().unwrap_or_else(PoisonError::into_inner);
+    if let Some(&(_, i)) = others.iter().find(|(t, _)| *t == TypeId::of::<R>()) {
+        return i;
+    }
+    // One per registry type for the life of the process.
+    let i: &'static Index = Box::leak(Box::new(Index::of(R::models())));
+    others.push((TypeId::of::<R>(), i));
+    i
 }
 
 /// JSON record of a model, as `bikedyn models --json` prints it.
@@ -125,10 +189,15 @@ pub fn model_json(m: &ModelInfo) -> serde_json::Value {
 /// The free-speed variant of a model: same base and effects, free speed
 /// (itself if it already has free speed).
 pub fn free_speed_variant(info: &'static ModelInfo) -> Option<&'static ModelInfo> {
+    free_speed_variant_in::<BuiltIn>(info)
+}
+
+/// [`free_speed_variant`] among the models of registry `R`.
+pub fn free_speed_variant_in<R: ModelRegistry>(info: &'static ModelInfo) -> Option<&'static ModelInfo> {
     if info.free_speed {
         return Some(info);
     }
-    MODELS
+    R::models()
         .iter()
         .find(|m| m.free_speed && m.base == info.base && m.effects == info.effects)
 }

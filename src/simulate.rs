@@ -4,9 +4,8 @@
 //! runtime's plain structs.
 
 use crate::bicycle::{Bicycle, BicycleError};
-use crate::generated::with_model;
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
-use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
 use bikedyn_runtime::simulate::{simulate, InitialConditions, Inputs, SimOptions, SimulateError, Simulation};
 use bikedyn_runtime::MultibodyModel;
 use thiserror::Error;
@@ -29,9 +28,10 @@ pub enum SimulationError {
 }
 
 /// The model a bicycle is simulated with: `model` by name, or the one that
-/// fits the bicycle; its free-speed variant when `free_speed`.
-pub fn choose_model(
-    bike: &Bicycle,
+/// fits the bicycle; its free-speed variant when `free_speed` (among the
+/// models of the bicycle's registry).
+pub fn choose_model<R: ModelRegistry>(
+    bike: &Bicycle<R>,
     model: Option<&str>,
     free_speed: bool,
 ) -> Result<&'static ModelInfo, SimulationError> {
@@ -39,13 +39,13 @@ pub fn choose_model(
     if !free_speed {
         return Ok(info);
     }
-    crate::models::free_speed_variant(info).ok_or(SimulationError::NoFreeSpeedVariant { model: info.name })
+    crate::models::free_speed_variant_in::<R>(info).ok_or(SimulationError::NoFreeSpeedVariant { model: info.name })
 }
 
 /// Simulate `bike` through `model` from `initial` with `inputs` for
 /// `duration` (s).
-pub fn run(
-    bike: &Bicycle,
+pub fn run<R: ModelRegistry>(
+    bike: &Bicycle<R>,
     model: &ModelInfo,
     initial: &InitialConditions,
     inputs: &Inputs,
@@ -53,7 +53,7 @@ pub fn run(
     options: &SimOptions,
 ) -> Result<Simulation, SimulationError> {
     let lookup = bike.lookup()?;
-    with_model(
+    R::with_model(
         model.name,
         RunSimulation {
             lookup: &lookup,

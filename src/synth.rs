@@ -15,7 +15,7 @@
 //! set as it would a measured one.
 
 use crate::bicycle::{canonical_of, Bicycle, BicycleError};
-use crate::generated::with_model;
+use crate::registry::BuiltIn;
 use bikedyn_report::experiment::synth::{write_run, WriteRunError};
 use bikedyn_report::output::{save_json, write_atomic, OutputError};
 use bikedyn_runtime::eigen::{eigenvalues, EigenError};
@@ -23,7 +23,7 @@ use bikedyn_runtime::experiment::synth::{rest_trajectory, RunKind, SensorModel};
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
 use bikedyn_runtime::model::CoordinateRole;
 use bikedyn_runtime::random::SplitMix64;
-use bikedyn_runtime::registry::ModelVisitor;
+use bikedyn_runtime::registry::{ModelRegistry, ModelVisitor};
 use bikedyn_runtime::simulate::trajectory::{trajectory_for_run, RunPlan, Trajectory};
 use bikedyn_runtime::simulate::{SimOptions, SimulateError, Simulation};
 use bikedyn_runtime::MultibodyModel;
@@ -201,12 +201,20 @@ impl<F: Fn(&str) -> Option<f64>> ModelVisitor for OneRun<'_, F> {
     }
 }
 
-/// Make the set: `on_run` is called after each run is written.
+/// Make the set with the built-in models: `on_run` is called after each
+/// run is written.
 pub fn synth(a: &SynthOptions, on_run: &mut dyn FnMut(&SynthRun)) -> Result<(), SynthError> {
+    synth_in::<BuiltIn>(a, on_run)
+}
+
+/// [`synth`] with the models of registry `R`: the bicycle, the hidden
+/// effects and the model are resolved among them (e.g. an effect declared
+/// in a user's own build script).
+pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&SynthRun)) -> Result<(), SynthError> {
     if a.runs == 0 || a.runs > 1000 {
         return Err(SynthError::RunCount { runs: a.runs });
     }
-    let mut bike = Bicycle::resolve(&a.bike)?;
+    let mut bike = Bicycle::<R>::resolve_in(&a.bike)?;
     for (sym, val) in &a.effects {
         bike = bike.with_parameter(sym, *val)?;
     }
@@ -221,7 +229,7 @@ pub fn synth(a: &SynthOptions, on_run: &mut dyn FnMut(&SynthRun)) -> Result<(), 
         Some(name) => bike.model(Some(name))?,
         None => {
             let driven = bike.model(None)?;
-            crate::models::free_speed_variant(driven).ok_or_else(|| SynthError::NoFreeSpeedVariant {
+            crate::models::free_speed_variant_in::<R>(driven).ok_or_else(|| SynthError::NoFreeSpeedVariant {
                 model: driven.name.to_string(),
             })?
         }
@@ -238,7 +246,7 @@ pub fn synth(a: &SynthOptions, on_run: &mut dyn FnMut(&SynthRun)) -> Result<(), 
         let mut plan = RunPlan::random(a.seed.wrapping_add(k as u64));
         // RunPlan::random draws 3-7 m/s; map that draw onto LO:HI.
         plan.speed = lo + (hi - lo) * (plan.speed - 3.0) / 4.0;
-        let (tr, sim, param, names) = with_model(
+        let (tr, sim, param, names) = R::with_model(
             info.name,
             OneRun {
                 lookup: &lookup,

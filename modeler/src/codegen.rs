@@ -18,7 +18,9 @@
 //!
 //! [`generate`] writes, into the output folder, one `<model>.rs` per model
 //! (its functions and its `MultibodyModel` implementation), `models.rs` (the
-//! registry: a module per model, `MODELS`, `SOURCES`, `with_model`) and
+//! registry: a module per model, `MODELS`, `SOURCES`, `with_model` and the
+//! unit struct `Registry`, which implements
+//! `bikedyn_runtime::registry::ModelRegistry` for them) and
 //! `codegen_report.json` (derivation time and operation counts).
 
 use crate::derive::derive;

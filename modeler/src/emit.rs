@@ -482,7 +482,9 @@ pub struct Emitted {
 /// emitted file pulled in from `OUT_DIR` with `include!`), the list of
 /// [`ModelInfo`](../../runtime) records, the emitted sources, and
 /// `with_model`, which runs generic code on a model chosen by name at run
-/// time. This is the only place that lists model names in Rust.
+/// time, and the unit struct `Registry` implementing the runtime's
+/// `ModelRegistry` with them. This is the only place that lists model names
+/// in Rust.
 pub fn emit_registry(models: &[crate::model::Model]) -> Result<String, EmitError> {
     let mods = models.iter().map(|m| {
         let md = format_ident!("{}", m.name);
@@ -526,6 +528,20 @@ pub fn emit_registry(models: &[crate::model::Model]) -> Result<String, EmitError
             match name {
                 #(#names => Some(visitor.visit::<#tys>()),)*
                 _ => None,
+            }
+        }
+
+        /// This registry as a type, for code generic over a set of models
+        /// (the application's pipelines take it as their registry).
+        #[derive(Clone, Copy, Debug, Default)]
+        pub struct Registry;
+
+        impl bikedyn_runtime::registry::ModelRegistry for Registry {
+            fn models() -> &'static [bikedyn_runtime::registry::ModelInfo] {
+                MODELS
+            }
+            fn with_model<V: bikedyn_runtime::registry::ModelVisitor>(name: &str, visitor: V) -> Option<V::Output> {
+                with_model(name, visitor)
             }
         }
     };

@@ -66,3 +66,17 @@ pub trait ModelVisitor {
     type Output;
     fn visit<M: MultibodyModel>(self) -> Self::Output;
 }
+
+/// A set of generated models, as one code generation wrote them: its
+/// models and the dispatch from a name to a model type. Every generated
+/// registry (`models.rs` of `bikedyn_modeler::codegen::generate`) defines a
+/// unit struct `Registry` implementing it, so the application's pipelines
+/// (bicycle resolution, synthetic sets, identification) run on the models
+/// of bikedyn's build or of a user's own build script alike.
+pub trait ModelRegistry: Copy + Default + std::fmt::Debug + Send + Sync + 'static {
+    /// Every model of the registry, in declaration order.
+    fn models() -> &'static [ModelInfo];
+    /// Run `visitor` on the model called `name`; `None` when the registry
+    /// has no model of that name.
+    fn with_model<V: ModelVisitor>(name: &str, visitor: V) -> Option<V::Output>;
+}

@@ -4,21 +4,21 @@
 
 use super::error::IdentifyError;
 use crate::bicycle::Bicycle;
-use crate::generated::MODELS;
 use bikedyn_runtime::identify::{Candidate, EffectParameter};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification};
-use bikedyn_runtime::registry::ModelInfo;
+use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 
 /// The identification model, its driven twin, and the alternative model
 /// (free speed, with states: the tyre model) if the registry has one. Each is
-/// chosen by capability: it can represent the bicycle (has every parameter
-/// the bicycle sets) and carries the most effects.
-pub fn identification_models(
-    bike: &Bicycle,
+/// chosen by capability among the models of the bicycle's registry: it can
+/// represent the bicycle (has every parameter the bicycle sets) and carries
+/// the most effects.
+pub fn identification_models<R: ModelRegistry>(
+    bike: &Bicycle<R>,
 ) -> Result<(&'static ModelInfo, &'static ModelInfo, Option<&'static ModelInfo>), IdentifyError> {
     let nonzero = bike.nonzero_parameters()?;
     let (free, driven) = identification_model_pair(bike)?;
-    let alt = MODELS
+    let alt = R::models()
         .iter()
         .filter(|m| {
             m.free_speed
@@ -33,16 +33,18 @@ pub fn identification_models(
 /// The free-speed model without extra states that can represent the
 /// bicycle and carries the most effects (every candidate of the library on
 /// every geometry), and its driven-speed twin (same effects).
-fn identification_model_pair(bike: &Bicycle) -> Result<(&'static ModelInfo, &'static ModelInfo), IdentifyError> {
+fn identification_model_pair<R: ModelRegistry>(
+    bike: &Bicycle<R>,
+) -> Result<(&'static ModelInfo, &'static ModelInfo), IdentifyError> {
     let nonzero = bike.nonzero_parameters()?;
-    let free = MODELS
+    let free = R::models()
         .iter()
         .filter(|m| m.free_speed && m.states.is_empty() && crate::models::fits(m, &nonzero))
         .max_by_key(|m| m.effects.len())
         .ok_or_else(|| IdentifyError::NoFreeSpeedModel {
             bicycle: bike.name.clone(),
         })?;
-    let driven = MODELS
+    let driven = R::models()
         .iter()
         .find(|m| !m.free_speed && m.effects == free.effects && crate::models::fits(m, &nonzero))
         .ok_or(IdentifyError::NoDrivenTwin { model: free.name })?;
@@ -54,10 +56,10 @@ fn identification_model_pair(bike: &Bicycle) -> Result<(&'static ModelInfo, &'st
 /// declaration says: fitted parameters, ties, floors, held companions,
 /// speed decay and the reason. An effect declared "own model" (tyre slip)
 /// comes from the alternative model `alt`.
-pub fn candidates(
+pub fn candidates<R: ModelRegistry>(
     info: &ModelInfo,
     alt: Option<&ModelInfo>,
-    bike: &Bicycle,
+    bike: &Bicycle<R>,
     only: &[String],
 ) -> Result<Vec<Candidate>, IdentifyError> {
     let declared = |m: &ModelInfo| -> Vec<(&'static str, CandidateDeclaration)> {

@@ -18,20 +18,21 @@ pub mod segments;
 pub use error::IdentifyError;
 
 use crate::bicycle::Bicycle;
-use crate::fit::{run_fit, FitOptions};
-use crate::generated::with_model;
+use crate::fit::{run_fit_in, FitOptions};
 use crate::progress::{OnProgress, Progress};
+use crate::registry::BuiltIn;
 use bikedyn_runtime::identify::{
     identify, Candidate, Factory, Identification, IdentifyOptions as FitSettings, ModelFactory, Segment, Setup,
 };
 use bikedyn_runtime::linearize::parameter_vector;
-use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
 use bikedyn_runtime::MultibodyModel;
 use candidates::{candidates, identification_models};
 use diagnosis::{diagnose, Finding};
 use predict::{linear_equivalent, predict};
 use segments::segments;
 use std::collections::BTreeMap;
+use std::marker::PhantomData;
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -68,10 +69,11 @@ impl Default for IdentifyRequest {
     }
 }
 
-/// The models and candidates of an identification, chosen before any fit.
-pub struct Plan {
+/// The models and candidates of an identification, chosen before any fit
+/// among the models of registry `R` (the built-in models by default).
+pub struct Plan<R: ModelRegistry = BuiltIn> {
     /// The bicycle, resolved.
-    pub bike: Bicycle,
+    pub bike: Bicycle<R>,
     /// The nonlinear free-speed model the fits run through.
     pub model: &'static ModelInfo,
     /// Its driven-speed twin (same effects), for the weave predictions.
@@ -83,8 +85,9 @@ pub struct Plan {
     pub candidates: Vec<Candidate>,
 }
 
-/// Everything identification found, and what the report needs.
-pub struct Outcome {
+/// Everything identification found, and what the report needs; its models
+/// are those of registry `R`.
+pub struct Outcome<R: ModelRegistry = BuiltIn> {
     /// The stepwise selection: fits before and after, each step's verdicts.
     pub identification: Identification,
     /// The measured segments fitted (one per kick).
@@ -112,12 +115,20 @@ pub struct Outcome {
     /// Mean |steer rate| of each segment in the fitted simulation (rad/s).
     pub steer_rate: Vec<f64>,
     run_plot: Option<RunPlot>,
+    registry: PhantomData<R>,
 }
 
 /// Choose the models and candidates for a request: the first half of
 /// [`run`], so a caller can say which model runs before the fits start.
 pub fn plan(request: &IdentifyRequest) -> Result<Plan, IdentifyError> {
-    let bike = Bicycle::resolve(&request.bike)?;
+    plan_in::<BuiltIn>(request)
+}
+
+/// [`plan`] among the models of registry `R`: the bicycle is resolved
+/// against them, and the candidates are the effects their files declare
+/// (e.g. an effect of a user's own build script).
+pub fn plan_in<R: ModelRegistry>(request: &IdentifyRequest) -> Result<Plan<R>, IdentifyError> {
+    let bike = Bicycle::<R>::resolve_in(&request.bike)?;
     let (model, driven_model, alternative_model) = identification_models(&bike)?;
     let candidates = candidates(model, alternative_model, &bike, &request.effects)?;
     // A conclusion ("no effect warranted") means something only when
@@ -140,14 +151,26 @@ pub fn plan(request: &IdentifyRequest) -> Result<Plan, IdentifyError> {
 
 /// Run identification on the inputs: [`plan`], then [`run_plan`].
 pub fn run(request: &IdentifyRequest, progress: OnProgress<'_>) -> Result<Outcome, IdentifyError> {
-    run_plan(&plan(request)?, request, progress)
+    run_in::<BuiltIn>(request, progress)
+}
+
+/// [`run`] among the models of registry `R`: [`plan_in`], then [`run_plan`].
+pub fn run_in<R: ModelRegistry>(
+    request: &IdentifyRequest,
+    progress: OnProgress<'_>,
+) -> Result<Outcome<R>, IdentifyError> {
+    run_plan(&plan_in::<R>(request)?, request, progress)
 }
 
 /// Run identification as planned: the measured-run pipeline, the segments,
 /// the stepwise fits, the predictions before and after, the diagnosis.
 /// `progress` gets the measured runs processed (step `"runs"`) and each
 /// candidate fitted (its name as the step).
-pub fn run_plan(plan: &Plan, request: &IdentifyRequest, progress: OnProgress<'_>) -> Result<Outcome, IdentifyError> {
+pub fn run_plan<R: ModelRegistry>(
+    plan: &Plan<R>,
+    request: &IdentifyRequest,
+    progress: OnProgress<'_>,
+) -> Result<Outcome<R>, IdentifyError> {
     let start = std::time::Instant::now();
     let Plan {
         bike,
@@ -163,7 +186,7 @@ pub fn run_plan(plan: &Plan, request: &IdentifyRequest, progress: OnProgress<'_>
         bike: Some(request.bike.clone()),
         ..FitOptions::default()
     };
-    let out = run_fit(&fit_options, progress)?;
+    let out = run_fit_in::<R>(&fit_options, progress)?;
     let (segs, mut skipped) = segments(&out);
     skipped.extend(out.errors.iter().cloned());
     if segs.len() < 2 {
@@ -185,7 +208,7 @@ pub fn run_plan(plan: &Plan, request: &IdentifyRequest, progress: OnProgress<'_>
             total: None,
         })
     };
-    let (id, run_plot) = with_model(
+    let (id, run_plot) = R::with_model(
         free.name,
         Identify {
             bike,
@@ -262,6 +285,7 @@ pub fn run_plan(plan: &Plan, request: &IdentifyRequest, progress: OnProgress<'_>
         seconds: start.elapsed().as_secs_f64(),
         steer_rate,
         run_plot,
+        registry: PhantomData,
     })
 }
 
@@ -305,8 +329,8 @@ struct RunPlot {
     after: Vec<Option<bikedyn_runtime::identify::Sim>>,
 }
 
-struct Identify<'a> {
-    bike: &'a Bicycle,
+struct Identify<'a, R: ModelRegistry> {
+    bike: &'a Bicycle<R>,
     alt: Option<&'static ModelInfo>,
     segments: &'a [Segment],
     candidates: &'a [Candidate],
@@ -314,13 +338,13 @@ struct Identify<'a> {
     progress: &'a (dyn Fn(&str) + Sync),
 }
 
-impl ModelVisitor for Identify<'_> {
+impl<R: ModelRegistry> ModelVisitor for Identify<'_, R> {
     type Output = Result<(Identification, Option<RunPlot>), IdentifyError>;
     fn visit<M: MultibodyModel>(self) -> Self::Output {
         let lookup = self.bike.lookup()?;
         let base = parameter_vector::<M>(&lookup, 5.0)?;
         let alt: Option<Box<dyn ModelFactory>> = match self.alt {
-            Some(a) => Some(with_model(a.name, MakeFactory { lookup: &lookup }).expect("registered model")?),
+            Some(a) => Some(R::with_model(a.name, MakeFactory { lookup: &lookup }).expect("registered model")?),
             None => None,
         };
         let id = identify::<M>(

@@ -6,10 +6,9 @@
 use super::candidates::identification_models;
 use super::error::IdentifyError;
 use crate::bicycle::Bicycle;
-use crate::generated::with_model;
 use bikedyn_runtime::linearize::{lateral_block, linearize_at_speed, parameter_vector, state_space_at_speed};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
-use bikedyn_runtime::registry::{ModelInfo, ModelVisitor};
+use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
 use bikedyn_runtime::MultibodyModel;
 use std::collections::BTreeMap;
 
@@ -59,16 +58,17 @@ impl ModelVisitor for WeaveCurve<'_> {
 }
 
 /// Predicted weave eigenvalues of the driven model with effect values
-/// `values` set on top of the bicycle, at each of `speeds` (m/s).
-pub fn predict(
+/// `values` set on top of the bicycle, at each of `speeds` (m/s); `driven`
+/// is a model of the bicycle's registry.
+pub fn predict<R: ModelRegistry>(
     driven: &ModelInfo,
-    bike: &Bicycle,
+    bike: &Bicycle<R>,
     values: &BTreeMap<String, f64>,
     speeds: &[f64],
 ) -> Result<Vec<Option<[f64; 2]>>, IdentifyError> {
     let base = bike.lookup()?;
     let lookup = |s: &str| values.get(s).copied().or_else(|| base(s));
-    let guide = with_model(
+    let guide = R::with_model(
         driven.name,
         WeaveCurve {
             lookup: &lookup,
@@ -84,7 +84,7 @@ pub fn predict(
         .then(|| identification_models(bike).ok().and_then(|m| m.2))
         .flatten()
     {
-        return with_model(
+        return R::with_model(
             alt.name,
             StateSpaceWeave {
                 lookup: &lookup,

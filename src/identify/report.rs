@@ -6,10 +6,10 @@ use super::candidates::{identification_models, not_candidates};
 use super::predict::{linear_equivalent, predict};
 use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
-use crate::generated::MODELS;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic};
 use bikedyn_runtime::identify::{pooled_rms, Candidate, Segment};
+use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -37,7 +37,7 @@ fn display_name(c: &Candidate) -> String {
     }
 }
 
-fn errors_json(o: &Outcome, after: bool) -> Value {
+fn errors_json<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Value {
     let id = &o.identification;
     let fit = if after { &id.after } else { &id.before };
     let pred = if after { &o.predicted_after } else { &o.predicted_before };
@@ -73,7 +73,7 @@ fn errors_json(o: &Outcome, after: bool) -> Value {
 }
 
 /// The JSON summary (schema in README, "Closing the loop").
-pub fn outcome_json(o: &Outcome) -> Value {
+pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
     let id = &o.identification;
     let sel: Vec<String> = id
         .selected
@@ -149,7 +149,7 @@ fn fmt_c(z: Option<[f64; 2]>) -> String {
 }
 
 /// Five-line summary.
-pub fn summary(o: &Outcome) -> String {
+pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     let id = &o.identification;
     let b = errors_json(o, false);
     let a = errors_json(o, true);
@@ -212,7 +212,7 @@ pub fn summary(o: &Outcome) -> String {
 
 /// Parameter file of the identified bicycle: the bicycle plus the fitted
 /// effect values.
-fn fitted_toml(bike: &Bicycle, values: &BTreeMap<String, f64>, o: &Outcome) -> String {
+fn fitted_toml<R: ModelRegistry>(bike: &Bicycle<R>, values: &BTreeMap<String, f64>, o: &Outcome<R>) -> String {
     let mut s = bike.parameters.to_toml_string();
     let _ = writeln!(
         s,
@@ -228,7 +228,7 @@ fn fitted_toml(bike: &Bicycle, values: &BTreeMap<String, f64>, o: &Outcome) -> S
     s
 }
 
-fn report_markdown(o: &Outcome, a: &IdentifyRequest, dir: &Path) -> String {
+fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: &Path) -> String {
     let id = &o.identification;
     let mut s = String::new();
     let inputs: Vec<String> = a.inputs.iter().map(|p| p.display().to_string()).collect();
@@ -281,7 +281,7 @@ fn report_markdown(o: &Outcome, a: &IdentifyRequest, dir: &Path) -> String {
             p.join(", ")
         );
     }
-    if let Some(info) = MODELS.iter().find(|m| m.name == o.model) {
+    if let Some(info) = R::models().iter().find(|m| m.name == o.model) {
         for (e, why) in not_candidates(info) {
             let _ = writeln!(s, "* `{e}` is not a candidate: {why}.");
         }
@@ -411,13 +411,14 @@ fn report_markdown(o: &Outcome, a: &IdentifyRequest, dir: &Path) -> String {
     s
 }
 
-/// Write the report folder.
-pub fn write_report(o: &Outcome, a: &IdentifyRequest, dir: &Path) -> Result<(), IdentifyError> {
+/// Write the report folder; the bicycle of `a` is resolved against the
+/// registry the identification ran on.
+pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: &Path) -> Result<(), IdentifyError> {
     std::fs::create_dir_all(dir).map_err(|source| IdentifyError::CreateDir {
         path: dir.to_path_buf(),
         source,
     })?;
-    let bike = Bicycle::resolve(&a.bike)?;
+    let bike = Bicycle::<R>::resolve_in(&a.bike)?;
     save_json(dir.join("report.json"), &outcome_json(o))?;
     write_string_atomic(dir.join("fitted.toml"), &fitted_toml(&bike, &o.values_after, o))?;
     // Continuation diagram before and after.
@@ -468,7 +469,7 @@ pub fn write_report(o: &Outcome, a: &IdentifyRequest, dir: &Path) -> Result<(), 
     let mut rates: Vec<f64> = o.steer_rate.iter().copied().filter(|x| x.is_finite()).collect();
     rates.sort_by(f64::total_cmp);
     let median_rate = rates.get(rates.len() / 2).copied().unwrap_or(f64::NAN);
-    let driven_info = MODELS
+    let driven_info = R::models()
         .iter()
         .find(|m| m.name == o.driven_model)
         .expect("the identification's driven model is registered");
