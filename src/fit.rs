@@ -4,8 +4,8 @@
 
 use crate::bicycle::{Bicycle, BicycleError, Linear};
 use crate::progress::{OnProgress, Progress};
-use bikedyn_report::plot::PlotError;
 use crate::registry::BuiltIn;
+use bikedyn_report::plot::PlotError;
 use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::experiment::{
     self,

@@ -207,6 +207,64 @@ fn the_tudelft_bicycle_with_its_assist_runs_through_the_linear_commands() {
     assert_eq!(v["state_space"][0]["A"].as_array().unwrap().len(), 4);
 }
 
+/// The tyre model (extra first-order states) runs through every linear
+/// command: its four roll-steer modes, its extra modes, its crossings, a
+/// sweep over an effect parameter, and its first-order A(v) when asked for
+/// the canonical form.
+#[test]
+fn the_tyre_model_runs_through_the_linear_commands() {
+    let out = bikedyn(&["stability", "--model", "tyre_free", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["model"], "tyre_free");
+    let (vw, vc) = (v["weave_speed"].as_f64().unwrap(), v["capsize_speed"].as_f64().unwrap());
+    // Default city-bike tyres move the thesis bicycle's 3.41 and 6.16 m/s
+    // a little (stiff tyres recover them: tests/effects.rs).
+    assert!((vw - 3.41).abs() < 0.1 && (vc - 6.16).abs() < 0.2, "{vw} {vc}");
+
+    let out = bikedyn(&["eig", "--model", "tyre_free", "--speeds", "1:5:2", "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let points: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let points = points.as_array().unwrap();
+    assert_eq!(points.len(), 3);
+    for p in points {
+        assert_eq!(p["eigenvalues"].as_array().unwrap().len(), 4);
+        // Two tyre-force lags and the lateral slip and yaw they free; the
+        // neutral heading left out.
+        assert_eq!(p["extra_eigenvalues"].as_array().unwrap().len(), 4, "{p}");
+    }
+    let out = bikedyn(&["eig", "--model", "tyre_free", "--speeds", "1:5:2"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("extra 4"));
+
+    let out = bikedyn(&[
+        "sweep",
+        "--model",
+        "tyre_free",
+        "--param",
+        "c_steer",
+        "--values",
+        "0:0.5:0.25",
+        "--format",
+        "json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let rows = v["points"].as_array().or_else(|| v.as_array()).unwrap().clone();
+    let vw: Vec<f64> = rows.iter().map(|r| r["weave_speed"].as_f64().unwrap()).collect();
+    assert!(
+        vw[0] < vw[1] && vw[1] < vw[2],
+        "steer damping raises the weave speed: {vw:?}"
+    );
+    assert!(rows.iter().all(|r| r["capsize_speed"].as_f64().is_some()), "{rows:?}");
+
+    let out = bikedyn(&["canonical", "--model", "tyre_free", "--speeds", "5:5:1", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["why"].as_str().unwrap().contains("Fy_rear"));
+    let n = v["state"].as_array().unwrap().len();
+    assert_eq!(v["state_space"][0]["A"].as_array().unwrap().len(), n);
+}
+
 #[test]
 fn a_sweep_over_an_effect_parameter_uses_one_model_and_fails_loudly() {
     let out = bikedyn(&[

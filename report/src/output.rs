@@ -476,17 +476,23 @@ pub fn mode_shape(x: &[Complex<f64>; 4]) -> ModeShape {
 /// "mode_shapes"}` (see [`eigen_sweep_json`]).
 pub fn eigen_point_json(p: &EigenPoint) -> Value {
     let idx = ordered_indices(p);
-    json!({
+    let mut v = json!({
         "v": p.v,
         "eigenvalues": idx.iter().map(|&k| [p.eigenvalues[k].re, p.eigenvalues[k].im]).collect::<Vec<_>>(),
         "modes": idx.iter().map(|&k| p.modes[k].name()).collect::<Vec<_>>(),
         "mode_shapes": idx.iter().map(|&k| mode_shape(&p.eigenvectors[k])).collect::<Vec<_>>(),
-    })
+    });
+    // A model with extra states (tyre forces) adds its other modes.
+    if !p.extra_eigenvalues.is_empty() {
+        v["extra_eigenvalues"] = json!(p.extra_eigenvalues.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>());
+    }
+    v
 }
 
 /// JSON value of an eigen sweep: `[{"v": .., "eigenvalues": [[re, im], ..],
 /// "modes": ["weave", ..], "mode_shapes": [{"roll_amplitude", "roll_phase",
-/// "steer_amplitude", "steer_phase"}, ..]}, ..]` (see [`ModeShape`]).
+/// "steer_amplitude", "steer_phase"}, ..]}, ..]` (see [`ModeShape`]), and
+/// `"extra_eigenvalues": [[re, im], ..]` for a model with extra states.
 pub fn eigen_sweep_json(sweep: &EigenSweep) -> Value {
     Value::Array(sweep.points.iter().map(eigen_point_json).collect())
 }
@@ -494,11 +500,21 @@ pub fn eigen_sweep_json(sweep: &EigenSweep) -> Value {
 /// Header of the eigen-sweep CSV: `v`, then per eigenvalue `k`: `re_k, im_k,
 /// mode_k, roll_amp_k, roll_phase_k, steer_amp_k, steer_phase_k`.
 pub fn eigen_sweep_csv_header() -> Vec<String> {
+    eigen_sweep_csv_header_with(0)
+}
+
+/// [`eigen_sweep_csv_header`] with `extra` more eigenvalues (a model with
+/// extra states): `re_extra_k, im_extra_k` each.
+pub fn eigen_sweep_csv_header_with(extra: usize) -> Vec<String> {
     let mut h = vec!["v".to_string()];
     for k in 1..=4 {
         for c in ["re", "im", "mode", "roll_amp", "roll_phase", "steer_amp", "steer_phase"] {
             h.push(format!("{c}_{k}"));
         }
+    }
+    for k in 1..=extra {
+        h.push(format!("re_extra_{k}"));
+        h.push(format!("im_extra_{k}"));
     }
     h
 }
@@ -516,13 +532,18 @@ pub fn eigen_point_csv_row(p: &EigenPoint) -> Vec<String> {
         row.push(num(shape.steer_amplitude));
         row.push(num(shape.steer_phase));
     }
+    for z in &p.extra_eigenvalues {
+        row.push(num(z.re));
+        row.push(num(z.im));
+    }
     row
 }
 
 /// Write an eigen sweep as CSV (see the module docs for the columns).
 pub fn write_eigen_sweep_csv<W: Write>(w: W, sweep: &EigenSweep) -> Result<(), csv::Error> {
     let mut wr = csv::Writer::from_writer(w);
-    wr.write_record(eigen_sweep_csv_header())?;
+    let extra = sweep.points.first().map_or(0, |p| p.extra_eigenvalues.len());
+    wr.write_record(eigen_sweep_csv_header_with(extra))?;
     for p in &sweep.points {
         wr.write_record(eigen_point_csv_row(p))?;
     }
@@ -555,10 +576,15 @@ pub fn stream_eigen_sweep(
     format: StreamFormat,
     w: &mut dyn Write,
 ) -> Result<(), BoxError> {
-    // Fail before writing anything if the bicycle has no eigen analysis.
-    if n > 0 {
-        bikedyn_runtime::eigen::eigenvalues_of(c, speed(0))?;
-    }
+    // Fail before writing anything if the bicycle has no eigen analysis;
+    // the first point also says how many extra eigenvalues each row has.
+    let extra = if n > 0 {
+        bikedyn_runtime::eigen::eigen_sweep_of(c, &[speed(0)])?.points[0]
+            .extra_eigenvalues
+            .len()
+    } else {
+        0
+    };
     let for_each_point = |f: &mut dyn FnMut(usize, &EigenPoint) -> Result<(), BoxError>| -> Result<(), BoxError> {
         let mut speeds = Vec::with_capacity(STREAM_BLOCK.min(n));
         let mut start = 0;
@@ -577,7 +603,7 @@ pub fn stream_eigen_sweep(
     match format {
         StreamFormat::Csv => {
             let mut wr = csv::Writer::from_writer(w);
-            wr.write_record(eigen_sweep_csv_header())?;
+            wr.write_record(eigen_sweep_csv_header_with(extra))?;
             for_each_point(&mut |_, p| Ok(wr.write_record(eigen_point_csv_row(p))?))?;
             wr.flush()?;
         }
@@ -626,6 +652,22 @@ pub fn format_eigen_table(sweep: &EigenSweep) -> String {
             _ => format!("lambda_{} (1/s)", k + 1),
         });
     }
+    // A model with extra states: its other modes after the bicycle's.
+    let extra = sweep
+        .points
+        .iter()
+        .map(|p| p.extra_eigenvalues.len())
+        .max()
+        .unwrap_or(0);
+    header.extend((1..=extra).map(|k| format!("extra {k}")));
+    let complex = |s: &Complex<f64>| {
+        format!(
+            "{} {} {}i",
+            format_fixed(s.re, 5, true),
+            if s.im < 0.0 { '-' } else { '+' },
+            format_fixed(s.im.abs(), 5, false)
+        )
+    };
     let body = sweep
         .points
         .iter()
@@ -633,14 +675,10 @@ pub fn format_eigen_table(sweep: &EigenSweep) -> String {
         .map(|(p, r)| {
             let mut row = vec![format!("{:.3}", p.v)];
             for (s, m) in r {
-                let z = format!(
-                    "{} {} {}i",
-                    format_fixed(s.re, 5, true),
-                    if s.im < 0.0 { '-' } else { '+' },
-                    format_fixed(s.im.abs(), 5, false)
-                );
+                let z = complex(s);
                 row.push(if uniform { z } else { format!("{z} {}", m.name()) });
             }
+            row.extend(p.extra_eigenvalues.iter().map(complex));
             row
         })
         .collect::<Vec<_>>();

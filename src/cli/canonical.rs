@@ -5,7 +5,7 @@ use super::args::BikeArg;
 use super::text::{canonical_json, canonical_text, state_input_rows, state_space_text};
 use super::{load, parse_range};
 use anyhow::{Context, Result};
-use bikedyn::runtime::eigen::LinearBicycle;
+use bikedyn::runtime::eigen::{LinearBicycle, StateSpaceBicycle};
 
 /// Run `bikedyn canonical`.
 pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
@@ -31,6 +31,9 @@ pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
                 .map(|e| e.to_string())
                 .unwrap_or_default();
             let speeds = parse_range(&speeds, "--speeds")?;
+            if let Some(first) = lin.first_order() {
+                return first_order(lin.model, first, &speeds, json);
+            }
             let mut rows = Vec::new();
             for &v in &speeds {
                 let m = lin.at_speed(v)?;
@@ -67,6 +70,65 @@ pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
                 for (v, a, minv) in &rows {
                     print!("{}", state_space_text(*v, a, minv));
                 }
+            }
+        }
+    }
+    Ok(true)
+}
+
+/// A model with extra states: its lateral first-order equations `x' = A(v) x`
+/// with the state named (no roll-steer form, so no `M`, `C`, `K`; the
+/// torque inputs are not formed for these models).
+fn first_order(model: &str, eq: &dyn StateSpaceBicycle, speeds: &[f64], json: bool) -> Result<bool> {
+    let mut rows = Vec::new();
+    for &v in speeds {
+        rows.push((v, eq.lateral_states(v)?));
+    }
+    let names = rows.first().map(|(_, l)| l.names.clone()).unwrap_or_default();
+    let extra: Vec<&str> = rows
+        .first()
+        .map(|(_, l)| l.extra.iter().map(|&i| l.names[i].as_str()).collect())
+        .unwrap_or_default();
+    let why = &format!(
+        "model `{model}` has extra first-order states ({}): its lateral equations have no second-order roll-steer form",
+        extra.join(", ")
+    );
+    if json {
+        let v: Vec<_> = rows
+            .iter()
+            .map(|(v, l)| {
+                serde_json::json!({
+                    "speed": v,
+                    "A": (0..l.a.nrows()).map(|i| (0..l.a.ncols()).map(|j| l.a[(i, j)]).collect::<Vec<_>>()).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        let out = serde_json::json!({
+            "model": model,
+            "canonical": null,
+            "why": why,
+            "state": names,
+            "state_space": v,
+        });
+        println!("{}", serde_json::to_string_pretty(&out)?);
+    } else {
+        println!("model: {model}");
+        println!("no canonical form: {why}");
+        println!(
+            "first-order lateral equations x' = A(v) x, x = [{}] (the model's own coordinates and signs; rates are d + coordinate, then the extra states):",
+            names.join(", ")
+        );
+        for (v, l) in &rows {
+            println!("v = {v} m/s");
+            let n = l.a.ncols();
+            let e: Vec<f64> = l.a.transpose().iter().copied().collect();
+            let e = bikedyn::report::output::format_matrix_entries(&e, 10);
+            let w = e.iter().map(String::len).max().unwrap_or(0);
+            for i in 0..l.a.nrows() {
+                let open = if i == 0 { "A = [[" } else { "     [" };
+                let close = if i + 1 == l.a.nrows() { "]]" } else { "]," };
+                let cells: Vec<String> = e[n * i..n * (i + 1)].iter().map(|c| format!("{c:>w$}")).collect();
+                println!("{open}{}{close}", cells.join(", "));
             }
         }
     }

@@ -199,6 +199,31 @@ pub(crate) fn finish<S: Spectrum + ?Sized>(
     // stabilizes (the weave pair, or a weave root merged with capsize or
     // castering); the capsize speed is where the capsize mode (alone or merged
     // with castering) destabilizes.
+    let (weave_speed, capsize_speed) = named_speeds(&crossings);
+
+    let stable_intervals = stable_intervals(v_min, v_max, &crossings, |v| {
+        Ok(cp.roots_at(v)?.iter().all(|z| z.re < 0.0))
+    })?;
+
+    let (weave_real_pair_merge, weave_merge_eigenvalue) = match weave_merge(cp, v_min.max(0.0), v_max)? {
+        Some((v, s)) => (Some(v), Some(s)),
+        None => (None, None),
+    };
+    Ok(CriticalSpeeds {
+        weave_real_pair_merge,
+        weave_merge_eigenvalue,
+        weave_speed,
+        capsize_speed,
+        crossings,
+        stable_intervals,
+    })
+}
+
+/// The weave speed (the first stabilizing complex-pair crossing of a mode
+/// containing the weave, at `v >= 0`) and the capsize speed (the first
+/// destabilizing crossing of the capsize mode, alone or merged with
+/// castering) among `crossings` (ascending).
+pub(crate) fn named_speeds(crossings: &[Crossing]) -> (Option<f64>, Option<f64>) {
     let weave_speed = crossings
         .iter()
         .find(|x| {
@@ -217,23 +242,7 @@ pub(crate) fn finish<S: Spectrum + ?Sized>(
                 && x.direction == CrossingDirection::Destabilizing
         })
         .map(|x| x.speed);
-
-    let stable_intervals = stable_intervals(v_min, v_max, &crossings, |v| {
-        Ok(cp.roots_at(v)?.iter().all(|z| z.re < 0.0))
-    })?;
-
-    let (weave_real_pair_merge, weave_merge_eigenvalue) = match weave_merge(cp, v_min.max(0.0), v_max)? {
-        Some((v, s)) => (Some(v), Some(s)),
-        None => (None, None),
-    };
-    Ok(CriticalSpeeds {
-        weave_real_pair_merge,
-        weave_merge_eigenvalue,
-        weave_speed,
-        capsize_speed,
-        crossings,
-        stable_intervals,
-    })
+    (weave_speed, capsize_speed)
 }
 
 /// Maximal sub-intervals of `[v_min, v_max]` where `stable_at` holds: the

@@ -20,7 +20,7 @@
 //! an extra mode is found on the full spectrum (the count of eigenvalues
 //! with positive real part changes) and reported as `Other(EXTRA)`.
 
-use super::critical::{check_range, finish, stable_intervals};
+use super::critical::{check_range, finish, named_speeds, stable_intervals};
 use super::general::{crossing_candidates, crossing_grid, CROSSING_GRID};
 use super::*;
 use nalgebra::DMatrix;
@@ -369,9 +369,16 @@ pub(crate) fn eigen_sweep_of_states(bike: &dyn StateSpaceBicycle, speeds: &[f64]
     Ok(EigenSweep { points })
 }
 
-/// Critical speeds of a first-order model: those of the bicycle modes (as
-/// for every model), plus each crossing of an extra mode, and stable
-/// intervals judged on the whole spectrum.
+/// Critical speeds of a first-order model. The crossing speeds are those
+/// where the count of eigenvalues with positive real part changes (the
+/// whole spectrum, bracketed on a grid and bisected to rounding): a robust
+/// test even where the capsize root passes through zero beside the neutral
+/// heading (a double zero: each of the two is then known only to about
+/// `sqrt(eps |A|)`, 1e-6 1/s, so the crossing speed to about 1e-4 m/s). Each
+/// crossing is labelled by the root whose real part changes sign beside it
+/// (a bicycle mode's label, or `Other(EXTRA)`). The weave merge comes from
+/// the bicycle modes' quartic. Stable intervals are judged on the whole
+/// spectrum.
 pub(crate) fn critical_speeds_of_states(
     bike: &dyn StateSpaceBicycle,
     v_min: f64,
@@ -385,6 +392,7 @@ pub(crate) fn critical_speeds_of_states(
         let s = family.split(v)?;
         Ok(s.bicycle.iter().chain(&s.extra).filter(|z| z.re > 0.0).count())
     };
+    let mut crossings = Vec::new();
     if v_max > v_min {
         let grid = crossing_grid(v_min, v_max);
         let counts: Vec<usize> = grid.iter().map(|&v| unstable(v)).collect::<Result<_, _>>()?;
@@ -392,7 +400,6 @@ pub(crate) fn critical_speeds_of_states(
             if counts[i] == counts[i + 1] {
                 continue;
             }
-            // Bisect on the count to the speed where it changes.
             let (mut a, mut b) = (grid[i], grid[i + 1]);
             for _ in 0..200 {
                 let m = 0.5 * (a + b);
@@ -406,17 +413,39 @@ pub(crate) fn critical_speeds_of_states(
                 }
             }
             let v = 0.5 * (a + b);
-            let tol = 1e-6 * v.abs().max(1.0);
-            if out.crossings.iter().any(|c| (c.speed - v).abs() <= tol.max(b - a)) {
-                continue; // a bicycle mode's crossing, already labelled
-            }
-            let s = family.split(v)?;
-            let Some(z) = s.extra.iter().min_by(|x, y| x.re.abs().total_cmp(&y.re.abs())) else {
-                continue;
+            // Which root crossed: the one whose real part has changed sign
+            // between speeds a little below and above (1e-3 m/s: beyond the
+            // rounding of a root near the neutral double zero, about 1e-6
+            // 1/s, yet within the grid cell).
+            let h = (1e-3 * v.abs().max(1.0)).min(0.25 * (grid[i + 1] - grid[i]));
+            let sides = eigen_sweep_of_states(bike, &[v - h, v + h])?;
+            let (lo, hi) = (&sides.points[0], &sides.points[1]);
+            let flipped = (0..4).find(|&k| (lo.eigenvalues[k].re > 0.0) != (hi.eigenvalues[k].re > 0.0));
+            let (mode, z) = match flipped {
+                Some(k) => (hi.modes[k], hi.eigenvalues[k]),
+                None => {
+                    let z = hi
+                        .extra_eigenvalues
+                        .iter()
+                        .zip(&lo.extra_eigenvalues)
+                        .find(|(a, b)| (a.re > 0.0) != (b.re > 0.0))
+                        .map(|(a, _)| *a)
+                        .unwrap_or_default();
+                    (Mode::Other(EXTRA), z)
+                }
             };
-            out.crossings.push(Crossing {
+            // Its frequency at the crossing itself.
+            let at = family.split(v)?;
+            let z = at
+                .bicycle
+                .iter()
+                .chain(&at.extra)
+                .copied()
+                .min_by(|a, b| (a - z).norm().total_cmp(&(b - z).norm()))
+                .unwrap_or(z);
+            crossings.push(Crossing {
                 speed: v,
-                mode: Mode::Other(EXTRA),
+                mode,
                 direction: if counts[i + 1] > counts[i] {
                     CrossingDirection::Destabilizing
                 } else {
@@ -431,8 +460,10 @@ pub(crate) fn critical_speeds_of_states(
             });
         }
     }
-    out.crossings
-        .sort_by(|a, b| a.speed.partial_cmp(&b.speed).unwrap_or(std::cmp::Ordering::Equal));
-    out.stable_intervals = stable_intervals(v_min, v_max, &out.crossings, |v| Ok(unstable(v)? == 0))?;
+    crossings.sort_by(|a, b| a.speed.partial_cmp(&b.speed).unwrap_or(std::cmp::Ordering::Equal));
+    crossings.dedup_by(|a, b| a.speed == b.speed && a.mode == b.mode);
+    (out.weave_speed, out.capsize_speed) = named_speeds(&crossings);
+    out.stable_intervals = stable_intervals(v_min, v_max, &crossings, |v| Ok(unstable(v)? == 0))?;
+    out.crossings = crossings;
     Ok(out)
 }
