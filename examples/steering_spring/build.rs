@@ -86,5 +86,11 @@ fn main() {
     .into_iter()
     .collect::<Result<Vec<Model>, ModelError>>()
     .unwrap_or_else(|e| panic!("{e}"));
+    // The coordinate roles bikedyn's jobs (linear analysis, simulation,
+    // identification) look up: a missing one stops the build here.
+    for m in &models {
+        m.check_roles(bikedyn_modeler::model::BICYCLE_JOBS)
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
     bikedyn_modeler::codegen::generate(&models, &out).unwrap_or_else(|e| panic!("{e}"));
 }

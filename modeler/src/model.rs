@@ -361,12 +361,46 @@ pub enum Diagnostic {
         body: String,
     },
     NoIndependentCoordinates,
+    /// A job of the runtime needs a coordinate with this role.
+    MissingRole {
+        role: &'static str,
+        job: &'static str,
+    },
 }
+
+/// The jobs of bikedyn's runtime and the coordinate roles each needs (the
+/// runtime looks coordinates up by these roles; see
+/// `bikedyn_runtime::model::MultibodyModel::require_coordinate`). A bicycle
+/// model is checked against them when it is generated
+/// ([`Model::check_roles`]), so a missing role stops the build, not a run.
+pub const BICYCLE_JOBS: &[(&str, &[CoordinateRole])] = &[
+    (
+        "the linear roll-steer analysis",
+        &[CoordinateRole::Roll, CoordinateRole::Steer],
+    ),
+    (
+        "the nonlinear simulation and the run's trajectory",
+        &[
+            CoordinateRole::Yaw,
+            CoordinateRole::Roll,
+            CoordinateRole::Pitch,
+            CoordinateRole::Steer,
+            CoordinateRole::RearWheelRotation,
+        ],
+    ),
+    (
+        "identification residuals",
+        &[CoordinateRole::Roll, CoordinateRole::Steer],
+    ),
+];
 
 impl fmt::Display for Diagnostic {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Diagnostic::Duplicate { kind, name } => write!(f, "{kind} `{name}` is declared twice"),
+            Diagnostic::MissingRole { role, job } => {
+                write!(f, "no coordinate has the role `{role}`, which {job} needs (declare it with `coordinate_role`)")
+            }
             Diagnostic::Undeclared { kind, name, used_in } => {
                 write!(f, "{kind} `{name}` is used in {used_in} but not declared")
             }
@@ -427,6 +461,31 @@ pub struct ModelBuilder {
 }
 
 impl Model {
+    /// Check that the model declares every coordinate role the `jobs` need
+    /// (e.g. [`BICYCLE_JOBS`]); the error lists each missing role with its
+    /// job.
+    pub fn check_roles(&self, jobs: &[(&'static str, &[CoordinateRole])]) -> Result<(), ModelError> {
+        let mut problems = Vec::new();
+        for &(job, roles) in jobs {
+            for role in roles {
+                if !self.coordinates.iter().any(|c| c.meaning == Some(*role)) {
+                    problems.push(Diagnostic::MissingRole {
+                        role: role.variant(),
+                        job,
+                    });
+                }
+            }
+        }
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(ModelError::Invalid {
+                model: self.name.clone(),
+                problems,
+            })
+        }
+    }
+
     /// Start declaring a model.
     pub fn builder(name: &str) -> ModelBuilder {
         ModelBuilder {
@@ -1002,5 +1061,28 @@ mod tests {
         assert_eq!(names, ["xc", "yc", "phi", "theta", "psi", "beta", "gamma", "eps", "xi"]);
         let offset = models.iter().find(|m| m.name == "whipple_offset").unwrap();
         assert!(offset.parameters.iter().any(|p| p.name == "d4"));
+    }
+
+    /// A bicycle model without a role a job needs is refused when it is
+    /// generated, naming the role and the job (issue 16, point 1).
+    #[test]
+    fn a_model_without_the_roles_the_jobs_need_is_refused_at_generation() {
+        let models = crate::models::all().unwrap();
+        for m in &models {
+            m.check_roles(BICYCLE_JOBS).unwrap();
+        }
+        let mut m = models.iter().find(|m| m.name == "whipple_offset").unwrap().clone();
+        for c in m.coordinates.iter_mut() {
+            if c.meaning == Some(CoordinateRole::Steer) {
+                c.meaning = None;
+            }
+        }
+        let err = m.check_roles(BICYCLE_JOBS).unwrap_err().to_string();
+        assert!(
+            err.contains("`Steer`") && err.contains("the linear roll-steer analysis"),
+            "{err}"
+        );
+        assert!(err.contains("identification residuals"), "{err}");
+        assert!(!err.contains("`Roll`"), "{err}");
     }
 }

@@ -10,8 +10,14 @@ macro_rules! models {
     ($($name:ident),* $(,)?) => {
         $(pub mod $name;)*
         /// Every model that `build.rs` generates code for, in registry order.
+        /// Each is checked for the coordinate roles the runtime's jobs need
+        /// ([`crate::model::BICYCLE_JOBS`]).
         pub fn all() -> Result<Vec<Model>, ModelError> {
-            Ok(vec![$($name::model()?),*])
+            let models = vec![$($name::model()?),*];
+            for m in &models {
+                m.check_roles(crate::model::BICYCLE_JOBS)?;
+            }
+            Ok(models)
         }
     };
 }
