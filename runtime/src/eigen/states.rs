@@ -16,14 +16,15 @@
 //! steer in it than the weave at higher speeds, but it lives on the tyre
 //! forces.) The bicycle's modes are labelled and tracked as in
 //! [`crate::eigen`] (through their characteristic quartic) and give the weave
-//! and capsize speeds. Every other eigenvalue is an extra mode. A crossing of
-//! an extra mode is found on the full spectrum (the count of eigenvalues
-//! with positive real part changes) and reported as `Other(EXTRA)`.
+//! and capsize speeds. Every other eigenvalue is an extra mode. Crossings
+//! are found on the whole spectrum (where the count of eigenvalues with
+//! positive real part changes) and labelled by the root that crosses; an
+//! extra mode's is `Other(EXTRA)`.
 
 use super::critical::{check_range, finish, named_speeds, stable_intervals};
 use super::general::{crossing_candidates, crossing_grid, CROSSING_GRID};
 use super::*;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 
 /// The label of a crossing of an extra (non roll-steer) mode.
 pub const EXTRA: u8 = 4;
@@ -215,7 +216,6 @@ fn choose(
     }
 }
 
-use nalgebra::DVector;
 
 /// A right (or, `left`, left) eigenvector of eigenvalue `s` by two steps of
 /// inverse iteration with a shift just off `s` (the solve of `A - s I`
