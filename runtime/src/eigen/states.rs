@@ -216,7 +216,6 @@ fn choose(
     }
 }
 
-
 /// A right (or, `left`, left) eigenvector of eigenvalue `s` by two steps of
 /// inverse iteration with a shift just off `s` (the solve of `A - s I`
 /// itself would be singular).
