@@ -132,15 +132,9 @@ impl OutputError {
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// Reserve a fresh temporary file next to `path`; returns (file, temp path).
-fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
-    let name = match path.file_name() {
-        Some(n) => n.to_string_lossy().into_owned(),
-        None => {
-            return Err(OutputError::InvalidPath {
-                path: path.to_path_buf(),
-            })
-        }
-    };
+/// The directory a file `path` goes in (`.` for a bare name), which must
+/// exist.
+fn existing_dir_of(path: &Path) -> Result<PathBuf, OutputError> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
@@ -151,6 +145,19 @@ fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
             dir,
         });
     }
+    Ok(dir)
+}
+
+fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
+    let name = match path.file_name() {
+        Some(n) => n.to_string_lossy().into_owned(),
+        None => {
+            return Err(OutputError::InvalidPath {
+                path: path.to_path_buf(),
+            })
+        }
+    };
+    let dir = existing_dir_of(path)?;
     // Keep the extension last: some encoders choose the format from it.
     let stem = path
         .file_stem()
@@ -243,16 +250,7 @@ pub fn output_target(path: impl AsRef<Path>) -> Result<OutputTarget, OutputError
                     path: path.to_path_buf(),
                 });
             }
-            let dir = match path.parent() {
-                Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-                _ => PathBuf::from("."),
-            };
-            if !dir.is_dir() {
-                return Err(OutputError::NoSuchDirectory {
-                    path: path.to_path_buf(),
-                    dir,
-                });
-            }
+            existing_dir_of(path)?;
             Ok(OutputTarget::Atomic(path.to_path_buf()))
         }
         Ok(m) if m.file_type().is_symlink() => match fs::canonicalize(path) {

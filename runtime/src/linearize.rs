@@ -937,12 +937,10 @@ fn lateral_states_of<M: MultibodyModel>(
         state_space_at_speed::<M>(param, 4.7)?,
     ];
     let n = probes[0].a.nrows();
+    // The speed coordinate's position and rate (states k and ni + k).
+    let speed = M::SPEED_COORDINATE.and_then(|c| M::INDEPENDENT.iter().position(|&j| j == c));
     let mut keep: Vec<usize> = (0..n)
-        .filter(|&i| {
-            let longitudinal =
-                M::SPEED_COORDINATE.is_some_and(|c| M::INDEPENDENT.get(i % ni.max(1)) == Some(&c) && i < 2 * ni);
-            !longitudinal
-        })
+        .filter(|&i| speed.is_none_or(|k| i != k && i != ni + k))
         .collect();
     let essential = [roll_steer[0], roll_steer[1], ni + roll_steer[0], ni + roll_steer[1]];
     loop {

@@ -2,7 +2,7 @@
 //! A(v), B(v) of a bicycle without canonical form.
 
 use super::args::BikeArg;
-use super::text::{canonical_json, canonical_text, state_input_rows, state_space_text};
+use super::text::{canonical_json, canonical_text, matrix_text, state_input_rows, state_space_text};
 use super::{load, parse_range};
 use anyhow::{Context, Result};
 use bikedyn::runtime::eigen::{LinearBicycle, StateSpaceBicycle};
@@ -120,16 +120,8 @@ fn first_order(model: &str, eq: &dyn StateSpaceBicycle, speeds: &[f64], json: bo
         );
         for (v, l) in &rows {
             println!("v = {v} m/s");
-            let n = l.a.ncols();
             let e: Vec<f64> = l.a.transpose().iter().copied().collect();
-            let e = bikedyn::report::output::format_matrix_entries(&e, 10);
-            let w = e.iter().map(String::len).max().unwrap_or(0);
-            for i in 0..l.a.nrows() {
-                let open = if i == 0 { "A = [[" } else { "     [" };
-                let close = if i + 1 == l.a.nrows() { "]]" } else { "]," };
-                let cells: Vec<String> = e[n * i..n * (i + 1)].iter().map(|c| format!("{c:>w$}")).collect();
-                println!("{open}{}{close}", cells.join(", "));
-            }
+            print!("{}", matrix_text("A", l.a.ncols(), &e));
         }
     }
     Ok(true)

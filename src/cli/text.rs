@@ -140,26 +140,28 @@ pub fn state_input_rows(minv: &nalgebra::Matrix2<f64>) -> Vec<[f64; 2]> {
 pub fn state_space_text(v: f64, a: &nalgebra::Matrix4<f64>, minv: &nalgebra::Matrix2<f64>) -> String {
     let mut s = format!("v = {v} m/s\n");
     let e: Vec<f64> = (0..4).flat_map(|i| (0..4).map(move |j| a[(i, j)])).collect();
-    let e = output::format_matrix_entries(&e, 10);
-    let w = e.iter().map(String::len).max().unwrap_or(0);
-    for i in 0..4 {
-        let open = if i == 0 { "A = [[" } else { "     [" };
-        let close = if i == 3 { "]]" } else { "]," };
-        s += &format!(
-            "{open}{:>w$}, {:>w$}, {:>w$}, {:>w$}{close}\n",
-            e[4 * i],
-            e[4 * i + 1],
-            e[4 * i + 2],
-            e[4 * i + 3]
-        );
-    }
+    s += &matrix_text("A", 4, &e);
     let b: Vec<f64> = state_input_rows(minv).iter().flatten().copied().collect();
-    let b = output::format_matrix_entries(&b, 10);
-    let w = b.iter().map(String::len).max().unwrap_or(0);
-    for i in 0..4 {
-        let open = if i == 0 { "B = [[" } else { "     [" };
-        let close = if i == 3 { "]]" } else { "]," };
-        s += &format!("{open}{:>w$}, {:>w$}{close}\n", b[2 * i], b[2 * i + 1]);
+    s += &matrix_text("B", 2, &b);
+    s
+}
+
+/// `NAME = [[a, b],\n       [c, d]]`: a matrix given row by row
+/// (`entries`, `cols` per row), 10 significant digits, columns aligned.
+pub fn matrix_text(name: &str, cols: usize, entries: &[f64]) -> String {
+    let e = output::format_matrix_entries(entries, 10);
+    let w = e.iter().map(String::len).max().unwrap_or(0);
+    let rows = entries.len() / cols.max(1);
+    let mut s = String::new();
+    for i in 0..rows {
+        let open = if i == 0 {
+            format!("{name} = [[")
+        } else {
+            format!("{}[", " ".repeat(name.len() + 4))
+        };
+        let close = if i + 1 == rows { "]]" } else { "]," };
+        let cells: Vec<String> = e[cols * i..cols * (i + 1)].iter().map(|c| format!("{c:>w$}")).collect();
+        s += &format!("{open}{}{close}\n", cells.join(", "));
     }
     s
 }

@@ -231,7 +231,7 @@ pub fn critical_speeds_of(bike: &dyn LinearBicycle, v_min: f64, v_max: f64) -> R
 /// closed forms, ascending: a real root crosses zero where `k0` changes sign,
 /// a complex pair crosses the imaginary axis where the Hurwitz determinant
 /// changes sign with `w^2 = k1 / k3 > 0`. Bracketed on a grid, bisected.
-pub(crate) fn crossing_candidates<S: Spectrum + ?Sized>(
+fn crossing_candidates<S: Spectrum + ?Sized>(
     family: &S,
     v_min: f64,
     v_max: f64,

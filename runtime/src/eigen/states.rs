@@ -22,7 +22,7 @@
 //! extra mode's is `Other(EXTRA)`.
 
 use super::critical::{check_range, finish, named_speeds, stable_intervals};
-use super::general::{crossing_candidates, crossing_grid, CROSSING_GRID};
+use super::general::{crossing_grid, CROSSING_GRID};
 use super::*;
 use nalgebra::{DMatrix, DVector};
 
@@ -385,8 +385,9 @@ pub(crate) fn critical_speeds_of_states(
 ) -> Result<CriticalSpeeds, EigenError> {
     check_range(v_min, v_max)?;
     let family = Lateral::new(bike)?;
-    let cands = crossing_candidates(&family, v_min, v_max)?;
-    let mut out = finish(&family, cands, v_min, v_max)?;
+    // The quartic's crossings are not needed (see above): `finish` without
+    // candidates gives the weave merge.
+    let mut out = finish(&family, Vec::new(), v_min, v_max)?;
     let unstable = |v: f64| -> Result<usize, EigenError> {
         let s = family.split(v)?;
         Ok(s.bicycle.iter().chain(&s.extra).filter(|z| z.re > 0.0).count())
