@@ -11,6 +11,7 @@
 pub mod candidates;
 pub mod diagnosis;
 mod error;
+mod markdown;
 pub mod predict;
 pub mod report;
 pub mod segments;

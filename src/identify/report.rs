@@ -2,7 +2,8 @@
 //! (schema in README, "Closing the loop"), and the report folder
 //! (`report.md`, `report.json`, plots, the fitted parameter file).
 
-use super::candidates::{identification_models, not_candidates};
+use super::candidates::identification_models;
+use super::markdown::report_markdown;
 use super::predict::{linear_equivalent, predict};
 use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
@@ -37,7 +38,7 @@ fn display_name(c: &Candidate) -> String {
     }
 }
 
-fn errors_json<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Value {
+pub(super) fn errors_json<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Value {
     let id = &o.identification;
     let fit = if after { &id.after } else { &id.before };
     let pred = if after { &o.predicted_after } else { &o.predicted_before };
@@ -138,13 +139,13 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
     })
 }
 
-fn median(x: impl Iterator<Item = f64>) -> f64 {
+pub(super) fn median(x: impl Iterator<Item = f64>) -> f64 {
     let mut v: Vec<f64> = x.filter(|a| a.is_finite()).collect();
     v.sort_by(f64::total_cmp);
     v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
-fn fmt_c(z: Option<[f64; 2]>) -> String {
+pub(super) fn fmt_c(z: Option<[f64; 2]>) -> String {
     z.map_or("-".into(), |z| format!("{:.3}{:+.3}i", z[0], z[1]))
 }
 
@@ -225,189 +226,6 @@ fn fitted_toml<R: ModelRegistry>(bike: &Bicycle<R>, values: &BTreeMap<String, f6
     for (k, v) in values {
         let _ = writeln!(s, "{k} = {v:.6e}");
     }
-    s
-}
-
-fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: &Path) -> String {
-    let id = &o.identification;
-    let mut s = String::new();
-    let inputs: Vec<String> = a.inputs.iter().map(|p| p.display().to_string()).collect();
-    let _ = writeln!(s, "# Identification report\n");
-    let _ = writeln!(
-        s,
-        "Data: {} ({} kicks). Bicycle: `{}`. Model: `{}` (nonlinear, free forward speed, every effect of the library absent unless fitted); weave predictions from its driven-speed twin `{}`.\n",
-        inputs.join(", "),
-        o.segments.len(),
-        a.bike,
-        o.model,
-        o.driven_model
-    );
-    let _ = writeln!(s, "## Summary\n\n```\n{}\n```\n", summary(o));
-    let _ = writeln!(s, "## What was done\n");
-    let _ = writeln!(s, "1. The measured-run pipeline (`bikedyn fit`) found every kick and its free-response window, and estimated mounting misalignments (calibration run) and clock offsets: these sensor effects are nuisances, never reported as mechanics.");
-    let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed; fitted per run as nuisance parameters), and compared with the measured roll, steer and speed.");
-    let _ = writeln!(s, "3. The residual pattern of the model without any added effect was related to the effects of the library (below).");
-    let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all runs (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run), and its dissipative parameters are positive. The search stops when no candidate passes.\n", id.folds);
-    let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| median(id.weights.iter().map(f));
-    let _ = writeln!(s, "Channel scales (each run's RMS residual under the base model, at least the best run's; median over runs): roll {:.3} deg, steer {:.3} deg, speed {:.3} m/s. Each run and channel is weighed by its own scale, so a run that diverges toward a fall cannot outweigh the others.\n", med(&|w| w.roll).to_degrees(), med(&|w| w.steer).to_degrees(), med(&|w| w.speed));
-    let _ = writeln!(s, "## Residual diagnosis (base model)\n");
-    let _ = writeln!(
-        s,
-        "| pattern | evidence | points to | significant (2 sigma) |\n|---|---|---|---|"
-    );
-    for f in &o.findings {
-        let _ = writeln!(
-            s,
-            "| {} | {} | {} | {} |",
-            f.pattern,
-            f.evidence,
-            f.suspects.join(", "),
-            if f.significant { "yes" } else { "no" }
-        );
-    }
-    let _ = writeln!(s, "\nCandidates and why each is suspected:\n");
-    for c in &o.candidates {
-        let p: Vec<String> = c
-            .parameters
-            .iter()
-            .map(|p| format!("`{}` ({})", p.symbol, p.unit))
-            .collect();
-        let _ = writeln!(
-            s,
-            "* `{}`{}: {} Fitted: {}.",
-            c.name,
-            if c.speed_decay { " (speed decay)" } else { "" },
-            c.reason,
-            p.join(", ")
-        );
-    }
-    if let Some(info) = R::models().iter().find(|m| m.name == o.model) {
-        for (e, why) in not_candidates(info) {
-            let _ = writeln!(s, "* `{e}` is not a candidate: {why}.");
-        }
-    }
-    let _ = writeln!(s, "\n## Ranking of the candidates\n");
-    for (k, step) in id.steps.iter().enumerate() {
-        let base = if step.base.is_empty() {
-            "the base model".to_string()
-        } else {
-            step.base.join(" + ")
-        };
-        let _ = writeln!(
-            s,
-            "Step {}: added to {base} (BIC {:.1}, held-out error {:.4}).\n",
-            k + 1,
-            step.base_bic,
-            step.base_cv
-        );
-        let _ = writeln!(
-            s,
-            "| candidate | fitted values | BIC change | held-out error | verdict |\n|---|---|---|---|---|"
-        );
-        let mut rows: Vec<usize> = (0..step.tried.len()).collect();
-        rows.sort_by(|&x, &y| step.tried[x].1.bic.total_cmp(&step.tried[y].1.bic));
-        for r in rows {
-            let (name, f) = &step.tried[r];
-            let vals: Vec<String> = f
-                .parameters
-                .iter()
-                .zip(f.values.iter().zip(&f.stderr))
-                .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4}", p.symbol, v, se))
-                .collect();
-            let cv = if f.cv.is_finite() {
-                format!("{:.4}", f.cv)
-            } else {
-                "-".into()
-            };
-            let _ = writeln!(
-                s,
-                "| `{name}` | {} | {:+.1} | {cv} | {} |",
-                vals.join(", "),
-                f.bic - step.base_bic,
-                step.verdicts[r].1
-            );
-        }
-        for (name, why) in &step.failed {
-            let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
-        }
-        let _ = writeln!(s);
-    }
-    if id.selected.is_empty() {
-        let _ = writeln!(s, "**No effect warranted.** No candidate lowered both the information criterion and the held-out error with physical parameter values: the residual of the base model is not explained better by any effect of the library than by noise. The model is left as it is.\n");
-    } else {
-        let _ = writeln!(
-            s,
-            "## Identified effects\n\n| parameter | value | 95 % interval | unit |\n|---|---|---|---|"
-        );
-        for (p, (v, se)) in id
-            .after
-            .parameters
-            .iter()
-            .zip(id.after.values.iter().zip(&id.after.stderr))
-        {
-            let _ = writeln!(
-                s,
-                "| `{}`{} | {:.5} | [{:.5}, {:.5}] | {} |",
-                p.symbol,
-                if p.tied.is_empty() {
-                    String::new()
-                } else {
-                    format!(" (= `{}`)", p.tied.join("`, `"))
-                },
-                v,
-                v - 1.96 * se,
-                v + 1.96 * se,
-                p.unit
-            );
-        }
-        let _ = writeln!(s);
-    }
-    let b = errors_json(o, false);
-    let af = errors_json(o, true);
-    let g = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
-    let _ = writeln!(s, "## Error before and after\n\n| | weave eigenvalue RMS (1/s) | roll RMS (deg) | steer RMS (deg) | speed RMS (m/s) |\n|---|---|---|---|---|");
-    for (label, v) in [
-        ("fitted runs, before", &b),
-        ("fitted runs, after", &af),
-        ("held-out runs, before", &b["held_out"]),
-        ("held-out runs, after", &af["held_out"]),
-    ] {
-        let _ = writeln!(
-            s,
-            "| {label} | {:.4} | {:.4} | {:.4} | {:.4} |",
-            g(v, "eigen_rms"),
-            g(v, "roll_rms").to_degrees(),
-            g(v, "steer_rms").to_degrees(),
-            g(v, "speed_rms")
-        );
-    }
-    let _ = writeln!(s, "\nPer run (roll RMS in deg; weave eigenvalues in 1/s):\n\n| run | window start (s) | speed over the eigenvalue fit (m/s) | measured weave | predicted before | predicted after | roll before | roll after | roll after, held out |\n|---|---|---|---|---|---|---|---|---|");
-    for (i, seg) in o.segments.iter().enumerate() {
-        let _ = writeln!(
-            s,
-            "| {} | {:.2} | {:.2}-{:.2} | {} | {} | {} | {:.3} | {:.3} | {:.3} |",
-            seg.run,
-            seg.t0,
-            seg.speed_interval[0],
-            seg.speed_interval[1],
-            fmt_c(seg.weave.map(|w| w.0)),
-            fmt_c(o.predicted_before[i]),
-            fmt_c(o.predicted_after[i]),
-            id.before.errors[i].roll_rms.to_degrees(),
-            id.after.errors[i].roll_rms.to_degrees(),
-            id.after.held_out[i].roll_rms.to_degrees()
-        );
-    }
-    let _ = writeln!(s, "\n## Plots\n\n* `continuation.svg`: weave eigenvalue over speed, model before (thin) and after (thick), with each measured eigenvalue on its speed interval.\n* `run_residuals.svg`: measured and simulated roll, steer and speed of a typical run (median error), before and after.\n");
-    if !o.skipped.is_empty() {
-        let _ = writeln!(s, "## Skipped\n");
-        for k in &o.skipped {
-            let _ = writeln!(s, "* {k}");
-        }
-        let _ = writeln!(s);
-    }
-    let fitted = dir.join("fitted.toml");
-    let _ = writeln!(s, "## Reproduce\n\nThe identified bicycle is `{}`: the bicycle's parameters plus the fitted effect values, for the model `{}` (driven speed) or `{}` (free speed). To refit from it, and to simulate it:\n\n```sh\nbikedyn identify {} --bike {}\nbikedyn simulate --bike {} --model {} --speed 5 --kick 0.5:3 --duration 6 --plot kick.svg\n```\n\nThe refit starts from the identified bicycle: the effects found here are part of its model, so the refit should warrant nothing more.", fitted.display(), o.driven_model, o.model, inputs.join(" "), fitted.display(), fitted.display(), o.model);
     s
 }
 
