@@ -1,8 +1,8 @@
 //! Generated model code. `build.rs` writes every model and the registry into
 //! OUT_DIR; this module pulls the registry in (it lists the models, so no
 //! model name is written by hand here). `generated/snapshots/` holds
-//! committed, formatted copies, kept fresh by `tests/codegen_snapshots.rs`
-//! (refresh with `UPDATE_SNAPSHOTS=1 cargo test --test codegen_snapshots`).
+//! committed, formatted copies, kept fresh by `tests/generated_code/snapshots.rs`
+//! (refresh with `UPDATE_SNAPSHOTS=1 cargo test --test behaviour snapshots`).
 
 include!(concat!(env!("OUT_DIR"), "/models.rs"));
 

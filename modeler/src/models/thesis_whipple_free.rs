@@ -1,7 +1,7 @@
 //! The thesis model with free forward speed: no driving constraint; the rear
 //! wheel rotation is a degree of freedom, so speed can change (coasting,
 //! rolling resistance, drag). Its linearization at a speed reproduces the
-//! driven model's canonical matrices (`tests/free_speed.rs`).
+//! driven model's canonical matrices (`tests/linear_analysis/free_speed.rs`).
 
 use super::thesis_whipple::{declare, Speed};
 use crate::model::{Model, ModelError};

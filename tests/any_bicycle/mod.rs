@@ -6,6 +6,7 @@
 //! one where both apply, and with independent eigenvalue computations where
 //! only it does.
 
+use crate::common::*;
 use bikedyn::bicycle::Bicycle;
 use bikedyn::generated::Extended;
 use bikedyn_runtime::eigen::{
@@ -14,29 +15,16 @@ use bikedyn_runtime::eigen::{
 use bikedyn_runtime::linearize::LinearModel;
 use bikedyn_runtime::MultibodyModel;
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn bikedyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
-}
-
-fn data(name: &str) -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
 
 /// The balance-assist Gazelle of `tests/data` with the assist law of Moore's
 /// lab, `k (v_s - v)` on the roll rate below `v_s = 4.7 m/s` (benchmark
 /// signs: steer torque `k (v_s - v) phi'`), written in a copy of its
 /// bicycleparameters file. Thesis signs flip the steer torque.
 fn balance_assist_file(k: f64) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bikedyn-any-bicycle-{}", std::process::id()));
+    let dir = scratch("any-bicycle");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("Balanceassistv1_k{k}.txt"));
-    let mut text = std::fs::read_to_string(data("Balanceassistv1Benchmark.txt")).unwrap();
+    let mut text = std::fs::read_to_string(fixture_arg("Balanceassistv1Benchmark.txt")).unwrap();
     text += &format!("Kc_roll_rate = {}\nKc_roll_rate_v = {}\nKc_v_max = 4.7\n", -k * 4.7, k);
     std::fs::write(&path, text).unwrap();
     path
@@ -162,7 +150,7 @@ fn general_eigenvalues_are_those_of_the_state_matrix() {
 #[test]
 fn the_balance_assist_stabilizes_the_weave_below_its_switch_speed() {
     let assisted = Bicycle::resolve(balance_assist_file(10.0).to_str().unwrap()).unwrap();
-    let bare = Bicycle::resolve(&data("Balanceassistv1Benchmark.txt")).unwrap();
+    let bare = Bicycle::resolve(&fixture_arg("Balanceassistv1Benchmark.txt")).unwrap();
     let (la, lb) = (assisted.linear_with(None).unwrap(), bare.linear_with(None).unwrap());
     let weave_re = |l: &dyn LinearBicycle, v: f64| {
         let p = &eigen_sweep_of(l, &[v]).unwrap().points[0];
@@ -184,7 +172,7 @@ fn the_balance_assist_stabilizes_the_weave_below_its_switch_speed() {
 
 #[test]
 fn the_tudelft_bicycle_with_its_assist_runs_through_the_linear_commands() {
-    let bike = data("tudelft_sbw_bicycle.toml");
+    let bike = fixture_arg("tudelft_sbw_bicycle.toml");
     let out = bikedyn(&["stability", "--bike", &bike, "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -219,7 +207,7 @@ fn the_tyre_model_runs_through_the_linear_commands() {
     assert_eq!(v["model"], "tyre_free");
     let (vw, vc) = (v["weave_speed"].as_f64().unwrap(), v["capsize_speed"].as_f64().unwrap());
     // Default city-bike tyres move the thesis bicycle's 3.41 and 6.16 m/s
-    // a little (stiff tyres recover them: tests/effects.rs).
+    // a little (stiff tyres recover them: tests/effects/mod.rs).
     assert!((vw - 3.41).abs() < 0.1 && (vc - 6.16).abs() < 0.2, "{vw} {vc}");
 
     let out = bikedyn(&["eig", "--model", "tyre_free", "--speeds", "1:5:2", "--format", "json"]);
@@ -376,12 +364,10 @@ fn no_job_names_a_thesis_symbol() {
 /// bicycle and law, quoted in the project's issue on real bicycles).
 #[test]
 fn the_tudelft_assist_model_predicts_the_measured_weave() {
-    let logs = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/tudelft_sbw_kicks/logs");
-    if !logs.exists() {
-        eprintln!("skipped: {} not found", logs.display());
+    let Some(logs) = shared("realdata/tudelft_sbw_kicks/logs") else {
         return;
-    }
-    let bike = data("tudelft_sbw_bicycle.toml");
+    };
+    let bike = fixture_arg("tudelft_sbw_bicycle.toml");
     let out = bikedyn(&["fit", logs.to_str().unwrap(), "--bike", &bike, "--json"]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("prediction model: extended"));
     let kicks: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();

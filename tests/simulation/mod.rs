@@ -1,6 +1,7 @@
-//! Nonlinear simulation (issue 7): constraint residuals, energy, small-amplitude
+//! Nonlinear simulation: constraint residuals, energy, small-amplitude
 //! agreement with the linearized equations, events, kicks and pulses.
 
+use crate::common::*;
 use bikedyn::ThesisWhipple;
 use bikedyn_runtime::linearize::linearize;
 use bikedyn_runtime::linearize::parameter_vector;
@@ -262,21 +263,14 @@ fn bad_inputs_are_errors() {
     assert!(e.is_err(), "{e:?}");
 }
 
-fn cli(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_bikedyn"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
 /// `bikedyn simulate` writes the documented CSV columns and a plot.
 #[test]
 fn cli_simulate_writes_csv_and_plot() {
-    let dir = std::env::temp_dir().join(format!("bikedyn-sim-{}", std::process::id()));
+    let dir = scratch("simulate");
     std::fs::create_dir_all(&dir).unwrap();
     let csv = dir.join("run.csv");
     let svg = dir.join("run.svg");
-    let out = cli(&[
+    let out = bikedyn(&[
         "simulate",
         "--speed",
         "4.5",
@@ -317,7 +311,7 @@ fn cli_simulate_writes_csv_and_plot() {
     assert!(svg_text.contains("<svg") && svg_text.contains("roll"));
 
     // A fall is reported; bad arguments are clear errors.
-    let out = cli(&["simulate", "--speed", "1", "--roll", "5", "--duration", "20"]);
+    let out = bikedyn(&["simulate", "--speed", "1", "--roll", "5", "--duration", "20"]);
     assert!(out.status.success());
     assert!(String::from_utf8_lossy(&out.stdout).contains("fell: roll reached 57.30 deg"));
     for bad in [
@@ -327,7 +321,7 @@ fn cli_simulate_writes_csv_and_plot() {
         vec!["simulate", "--speed", "4", "--duration", "1", "--model", "nope"],
         vec!["simulate", "--speed", "4", "--duration", "1", "--plot", "x.gif"],
     ] {
-        let out = cli(&bad);
+        let out = bikedyn(&bad);
         assert_eq!(out.status.code(), Some(2), "{bad:?}");
         assert!(String::from_utf8_lossy(&out.stderr).contains("error:"));
     }
@@ -678,10 +672,10 @@ fn tyre_relaxation_never_increases_the_energy() {
 /// tyre forces as extra CSV columns.
 #[test]
 fn cli_simulates_the_tyre_model() {
-    let dir = std::env::temp_dir().join(format!("bikedyn-sim-tyre-{}", std::process::id()));
+    let dir = scratch("simulate").join("tyre");
     std::fs::create_dir_all(&dir).unwrap();
     let csv = dir.join("tyre.csv");
-    let out = cli(&[
+    let out = bikedyn(&[
         "simulate",
         "--model",
         "tyre_free",
@@ -788,7 +782,7 @@ fn stiff_tyres_need_far_fewer_evaluations_with_radau5() {
     );
 
     // The CLI selects the method.
-    let out = cli(&[
+    let out = bikedyn(&[
         "simulate",
         "--model",
         "tyre_free",
@@ -805,7 +799,7 @@ fn stiff_tyres_need_far_fewer_evaluations_with_radau5() {
     let stdout = String::from_utf8_lossy(&out.stdout);
     println!("{stdout}");
     assert!(stdout.contains("radau5: simulated 1.000 s"), "{stdout}");
-    let out = cli(&["simulate", "--speed", "4.5", "--duration", "1", "--method", "euler"]);
+    let out = bikedyn(&["simulate", "--speed", "4.5", "--duration", "1", "--method", "euler"]);
     assert_eq!(out.status.code(), Some(2));
 }
 

@@ -5,6 +5,7 @@
 //! method. The fixtures in `tests/data` name their source and licence in
 //! `tests/data/SOURCE.txt`.
 
+use crate::common::*;
 use bikedyn::bicycle::{canonical_of, Bicycle};
 use bikedyn::runtime::benchmark_oracle::meijaard_canonical;
 use bikedyn::runtime::eigen::critical_speeds;
@@ -12,20 +13,14 @@ use bikedyn::runtime::parameters::{BenchmarkParameters, ParameterSet, ThesisPara
 use bikedyn::runtime::random::SplitMix64;
 use bikedyn::runtime::CanonicalMatrices;
 use nalgebra::Matrix2;
-use std::path::{Path, PathBuf};
-
-fn fixture(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
-}
+use std::path::PathBuf;
 
 /// The real parameter files (HumanControl and BicycleParameters benchmark
 /// sets), or an empty list with a skip message when `../shared` is absent.
 fn real_files() -> Vec<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/parameter_sets");
-    if !root.exists() {
-        eprintln!("SKIP: {} not found; using the fixtures only", root.display());
+    let Some(root) = shared("realdata/parameter_sets") else {
         return Vec::new();
-    }
+    };
     let mut files = Vec::new();
     for entry in std::fs::read_dir(root.join("HumanControl_Par")).unwrap() {
         let p = entry.unwrap().path();
@@ -104,7 +99,7 @@ fn large_front_wheel_matches_closed_form() {
     let mut b = BenchmarkParameters::benchmark_bicycle();
     b.front_wheel_radius = 5.0;
     let model = canonical_of(&b.to_thesis().unwrap()).unwrap();
-    // The figures the issue quotes from the closed form.
+    // The closed-form figures.
     assert!((model.m0[(0, 0)] - 155.44972).abs() < 1e-9);
     assert!((model.k2[(0, 1)] - 88.91073055670).abs() < 1e-8);
 }

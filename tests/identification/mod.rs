@@ -1,4 +1,4 @@
-//! Closing the loop (issue 9, point 6): for every effect identification
+//! Closing the loop: for every effect identification
 //! supports, a set made by `bikedyn synth` with that effect hidden; the
 //! effect must be selected, its parameter recovered within 20 %, and the
 //! error it drives must fall by at least half. A control set with no hidden
@@ -7,20 +7,16 @@
 //! with the default sensor effects (misalignment, noise, drift, clock
 //! offset, magnet spacing errors, switch bounce).
 
+use crate::common::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn bikedyn(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
-}
 
 fn synth(name: &str, effects: &str, seed: u64) -> PathBuf {
     synth_with(name, None, effects, seed)
 }
 
 fn synth_with(name: &str, model: Option<&str>, effects: &str, seed: u64) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bikedyn-identify-{name}-{}", std::process::id()));
+    let dir = scratch("identify").join(name);
     let _ = std::fs::remove_dir_all(&dir);
     let seed = seed.to_string();
     let mut args = vec![
@@ -204,9 +200,9 @@ fn control_set_gets_no_effect() {
 
 #[test]
 fn example_set_report_folder() {
-    let dir = std::env::temp_dir().join(format!("bikedyn-identify-report-{}", std::process::id()));
+    let dir = scratch("identify").join("report");
     let _ = std::fs::remove_dir_all(&dir);
-    let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping");
+    let set = example_set();
     let j = identify(&set, Some(&dir));
     assert_eq!(j["selected_effects"][0], "steer_damping");
     for f in [
@@ -234,7 +230,7 @@ fn bad_inputs_are_clear_errors() {
     assert!(!out.status.success());
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("/nonexistent/set"), "{e}");
-    let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping");
+    let set = example_set();
     let out = bikedyn(&["identify", set.to_str().unwrap(), "--effects", "flux_capacitor"]);
     assert!(!out.status.success());
     let e = String::from_utf8_lossy(&out.stderr);

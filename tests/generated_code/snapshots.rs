@@ -1,6 +1,6 @@
 //! The committed copies in `generated/snapshots/` must equal what build.rs
 //! emits, so that a model change shows up as a readable diff in review.
-//! Refresh them with `UPDATE_SNAPSHOTS=1 cargo test --test codegen_snapshots`.
+//! Refresh them with `UPDATE_SNAPSHOTS=1 cargo test --test behaviour snapshots`.
 
 use std::path::Path;
 
@@ -48,7 +48,7 @@ fn generated_snapshots_are_fresh() {
     }
     assert!(
         stale.is_empty(),
-        "stale generated snapshots:\n  {}\nrun `UPDATE_SNAPSHOTS=1 cargo test --test codegen_snapshots` and review the diff",
+        "stale generated snapshots:\n  {}\nrun `UPDATE_SNAPSHOTS=1 cargo test --test behaviour snapshots` and review the diff",
         stale.join("\n  ")
     );
 }

@@ -1,8 +1,8 @@
 //! Generated derivatives against finite differences of generated primal
-//! quantities (issue: verified generated code), through the library and the CLI.
+//! quantities, through the library and the CLI.
 
+use crate::common::*;
 use bikedyn::runtime::verify::VerifyOptions;
-use std::process::Command;
 
 #[test]
 fn every_generated_derivative_of_every_model_matches_finite_differences() {
@@ -32,19 +32,16 @@ fn every_generated_derivative_of_every_model_matches_finite_differences() {
 
 #[test]
 fn cli_verify_json_reports_every_quantity() {
-    let out = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
-        .args([
-            "verify",
-            "--model",
-            "thesis_whipple",
-            "--states",
-            "5",
-            "--seed",
-            "3",
-            "--json",
-        ])
-        .output()
-        .unwrap();
+    let out = bikedyn(&[
+        "verify",
+        "--model",
+        "thesis_whipple",
+        "--states",
+        "5",
+        "--seed",
+        "3",
+        "--json",
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["passed"], true);
@@ -69,10 +66,7 @@ fn cli_verify_json_reports_every_quantity() {
 
 #[test]
 fn cli_verify_rejects_an_unknown_model() {
-    let out = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
-        .args(["verify", "--model", "tricycle"])
-        .output()
-        .unwrap();
+    let out = bikedyn(&["verify", "--model", "tricycle"]);
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("unknown model `tricycle`"));
 }

@@ -1,4 +1,4 @@
-//! Free forward speed (issue 6, point 3): the free-speed variant of each base
+//! Free forward speed: the free-speed variant of each base
 //! model, linearized about upright straight running at a speed, reproduces
 //! the driven model's canonical matrices, and the forward-speed equation
 //! decouples from roll and steer at first order.

@@ -1,22 +1,18 @@
-//! The effect library through parameters, models and the CLI (issue 6,
-//! points 4, 6, 7): effect parameters in parameter files, model selection,
+//! The effect library through parameters, models and the CLI: effect
+//! parameters in parameter files, model selection,
 //! `bikedyn models`, `bikedyn params show`, and the physics of an effect in
 //! the linearization.
 
+use crate::common::*;
 use bikedyn::bicycle::{Bicycle, BicycleError};
 use bikedyn::generated::{Extended, ThesisWhipple, WhippleOffset};
 use bikedyn::models::{default_bicycle, model_names};
 use bikedyn::registry::ModelInfo;
 use bikedyn_runtime::linearize::{canonical_matrices, lateral_block, linearize_at_speed, parameter_vector};
 use bikedyn_runtime::parameters::ThesisParameters;
-use std::process::{Command, Output};
-
-fn bikedyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
-}
 
 fn thesis_file_with(extra: &str, name: &str) -> std::path::PathBuf {
-    let dir = std::env::temp_dir().join(format!("bikedyn-effects-{}", std::process::id()));
+    let dir = scratch("effects");
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
     let text = format!("{}{extra}", ThesisParameters::thesis_bicycle().to_toml_string());
@@ -242,7 +238,7 @@ fn stiff_tyres_recover_the_rolling_without_slip_weave() {
     );
 }
 
-/// Each effect file declares what identification needs (issue 16, point 2):
+/// Each effect file declares what identification needs:
 /// an effect without a declaration is never silently skipped, and what a
 /// declaration names exists in the models that carry the effect.
 #[test]
@@ -318,7 +314,7 @@ fn non_physical_effect_parameters_are_refused() {
     assert!(b.with_parameter("c_steer", 0.3).is_ok());
 }
 
-/// The linear analysis of a model with extra states (issue 16, point 4):
+/// The linear analysis of a model with extra states:
 /// the tyre model's weave and capsize speeds tend to the rolling-without-slip
 /// bicycle's as the tyres stiffen, its four roll-steer modes are labelled as
 /// every model's, and with the extra modes they make up the whole lateral

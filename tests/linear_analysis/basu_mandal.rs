@@ -22,6 +22,7 @@
 //! the thesis's psi to the roll frame, so psi' = -(u6 + u5). The front wheel
 //! angles are both relative to the fork: eps' = -u8.
 
+use crate::common::*;
 use bikedyn::WhippleOffset;
 use bikedyn_runtime::constraints::{solve_configuration, NewtonOptions};
 use bikedyn_runtime::linearize::parameter_vector;
@@ -30,8 +31,7 @@ use bikedyn_runtime::MultibodyModel;
 use std::collections::BTreeMap;
 
 fn data() -> toml::Table {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/basu_mandal2007.toml")).unwrap();
+    let text = std::fs::read_to_string(fixture("basu_mandal2007.toml")).unwrap();
     text.parse().unwrap()
 }
 

@@ -3,34 +3,21 @@
 //! before computing and written through links and devices, streamed and
 //! bounded outputs, stability crossings and stability maps.
 
+use crate::common::*;
 use std::path::PathBuf;
-use std::process::{Command, Output};
-
-fn bikedyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
+use std::process::Command;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bikedyn-cli10-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
+    scratch("inputs-and-outputs").join(name)
 }
 
 /// The embedded benchmark TOML with one line replaced.
 fn benchmark_with(replace: &str, with: &str, name: &str) -> PathBuf {
-    let src = include_str!("../runtime/data/benchmark_bicycle.toml");
+    let src = include_str!("../../runtime/data/benchmark_bicycle.toml");
     assert!(src.contains(replace), "{replace}");
     let p = tmp(name);
     std::fs::write(&p, src.replacen(replace, with, 1)).unwrap();
     p
-}
-
-fn fixture(name: &str) -> String {
-    format!("{}/tests/data/{name}", env!("CARGO_MANIFEST_DIR"))
 }
 
 /// `lam = 18.0` (degrees typed for radians) is refused
@@ -75,7 +62,7 @@ fn millimetres_and_mass_centre_below_ground_warn() {
 /// Bluenose the first is the capsize root at 3.1413834189 m/s.
 #[test]
 fn stability_lists_crossings_with_modes() {
-    let out = bikedyn(&["stability", "--bike", &fixture("BluenosePar.txt")]);
+    let out = bikedyn(&["stability", "--bike", &fixture_arg("BluenosePar.txt")]);
     assert!(out.status.success());
     let s = text(&out.stdout);
     assert!(s.contains("capsize speed v_c: 3.1413834189 m/s"), "{s}");
@@ -101,7 +88,13 @@ fn matrices_print_fixed_significant_digits_without_negative_zero() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["M0"][0][0].as_f64().unwrap(), 80.81722000000002);
     // Eigenvalue tables: no "-0.00000" (the Bluenose has a purely imaginary pair at rest).
-    let out = bikedyn(&["eig", "--bike", &fixture("BluenosePar.txt"), "--speeds", "0:0.1:0.1"]);
+    let out = bikedyn(&[
+        "eig",
+        "--bike",
+        &fixture_arg("BluenosePar.txt"),
+        "--speeds",
+        "0:0.1:0.1",
+    ]);
     let s = text(&out.stdout);
     assert!(s.contains("+0.00000 + 0.83122i") && !s.contains("-0.00000"), "{s}");
 }

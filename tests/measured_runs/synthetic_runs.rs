@@ -6,14 +6,15 @@
 //! within +-0.3 s of the nominal one, reed-switch bounce and magnet spacing
 //! errors). Its `truth/` folder holds what the pipeline must recover.
 
+use crate::common::*;
 use bikedyn::bicycle::Bicycle;
 use bikedyn::runtime::experiment::{self, PipelineOptions};
 use nalgebra::Rotation3;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 fn set() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping")
+    example_set()
 }
 
 fn truth(run: &str) -> serde_json::Value {

@@ -1,27 +1,6 @@
-//! `bikedyn fit` end to end (issue 8).
+//! `bikedyn fit` end to end.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bikedyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
-}
-
-/// `../shared/<sub>` from the repository root, or `None` (with a skip
-/// message) when the shared data is not checked out.
-fn shared(sub: &str) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared").join(sub);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!("skipped: {} not found", p.display());
-        None
-    }
-}
-
-fn json(out: &Output) -> serde_json::Value {
-    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stderr)))
-}
+use crate::common::*;
 
 fn pair(v: &serde_json::Value) -> [f64; 2] {
     [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()]
@@ -31,13 +10,13 @@ fn pair(v: &serde_json::Value) -> [f64; 2] {
 /// and every reliable fit (r^2 > 0.95) is within 20 % of the model's
 /// frozen-speed weave eigenvalue over the window's speed interval. The dev runs
 /// contain physics the rigid model lacks, so they are not expected to match
-/// it exactly; 20 % is the issue's bound.
+/// it exactly; 20 % is the bound asked of the fit.
 #[test]
 fn dev_set_fits_every_run_near_the_model() {
     let Some(dev) = shared("data/dev") else { return };
     let out = bikedyn(&["fit", dev.to_str().unwrap(), "--bike", "thesis", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let v = json(&out);
+    let v = stdout_json(&out);
     let list = v.as_array().unwrap();
     assert_eq!(list.len(), 12, "one kick per run");
     let mut reliable = 0;
@@ -90,7 +69,7 @@ fn dev_set_fits_every_run_near_the_model() {
 #[test]
 fn plots_are_written() {
     let Some(run) = shared("data/dev/run03") else { return };
-    let d = std::env::temp_dir().join(format!("bikedyn-fitplot-{}", std::process::id()));
+    let d = scratch("fit").join("plots");
     let _ = std::fs::remove_dir_all(&d);
     let out = bikedyn(&[
         "fit",
@@ -115,7 +94,7 @@ fn tudelft_log_json() {
     };
     let out = bikedyn(&["fit", log.to_str().unwrap(), "--json"]);
     assert!(out.status.success());
-    let v = json(&out);
+    let v = stdout_json(&out);
     let list = v.as_array().unwrap();
     assert!(list.len() > 20);
     for e in list {
@@ -132,7 +111,7 @@ fn tudelft_log_json() {
 #[test]
 fn corrupt_and_missing_inputs_are_reported() {
     let Some(dev) = shared("data/dev") else { return };
-    let d = std::env::temp_dir().join(format!("bikedyn-fitcli-{}", std::process::id()));
+    let d = scratch("fit").join("inputs");
     let _ = std::fs::remove_dir_all(&d);
     for r in ["calibration", "run02", "run03"] {
         std::fs::create_dir_all(d.join(r)).unwrap();
@@ -149,7 +128,7 @@ fn corrupt_and_missing_inputs_are_reported() {
     assert_eq!(out.status.code(), Some(1));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("speed_switch.csv:100:"), "{err}");
-    assert_eq!(json(&out).as_array().unwrap().len(), 1);
+    assert_eq!(stdout_json(&out).as_array().unwrap().len(), 1);
     std::fs::remove_dir_all(d.join("calibration")).unwrap();
     let out = bikedyn(&["fit", d.join("run02").to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));

@@ -67,7 +67,7 @@ fn a_front_wheel_that_cannot_reach_the_ground_is_a_typed_error_not_nan() {
     t.front_wheel_radius = 3.0; // far larger than the wheelbase allows
     let err = canonical_matrices::<W>(|s| t.get(s)).unwrap_err();
     // Detected from the model's closed-form upright configuration before
-    // Newton runs (issue 10, point 1): the frame pitch has no real value.
+    // Newton runs: the frame pitch has no real value.
     match err {
         LinearizeError::Constraint(ConstraintError::NoUprightConfiguration { coordinate }) => {
             assert_eq!(coordinate, "beta");

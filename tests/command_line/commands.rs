@@ -1,26 +1,10 @@
 //! The `bikedyn` command line, end to end.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bikedyn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
-}
-
-fn ok_json(args: &[&str]) -> serde_json::Value {
-    let out = bikedyn(args);
-    assert!(
-        out.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
+use crate::common::*;
+use std::path::PathBuf;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bikedyn-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d.join(name)
+    scratch("commands").join(name)
 }
 
 #[test]
@@ -181,14 +165,9 @@ fn bad_input_gives_clear_errors() {
 
 #[test]
 fn every_real_parameter_set_gives_its_stability_interval() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/realdata/parameter_sets/HumanControl_Par");
-    if !dir.exists() {
-        println!(
-            "skipped: {} is absent (real parameter sets are only in the development checkout)",
-            dir.display()
-        );
+    let Some(dir) = shared("realdata/parameter_sets/HumanControl_Par") else {
         return;
-    }
+    };
     let mut stable = 0;
     for e in std::fs::read_dir(&dir).unwrap() {
         let p = e.unwrap().path();

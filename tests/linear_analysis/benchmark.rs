@@ -3,6 +3,7 @@
 //! Reference figures: runtime/tests/data/meijaard2007.toml (copied from the
 //! paper: Proc. R. Soc. A 463:1955-1982, doi 10.1098/rspa.2007.1857).
 
+use crate::common::*;
 use bikedyn::bicycle::{canonical_of, Bicycle};
 use bikedyn::generated::{ThesisWhipple, WhippleOffset};
 use bikedyn::runtime::eigen::{critical_speeds, eigenvalues};
@@ -10,7 +11,6 @@ use bikedyn::runtime::linearize::{canonical_matrices, linearize, linearize_finit
 use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
 use bikedyn::runtime::CanonicalMatrices;
 use nalgebra::Matrix2;
-use std::process::Command;
 
 fn reference() -> toml::Table {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/runtime/tests/data/meijaard2007.toml");
@@ -158,10 +158,7 @@ fn thesis_model_and_offset_model_agree_when_the_offset_is_zero() {
 
 #[test]
 fn cli_stability_of_the_benchmark_prints_the_published_speeds() {
-    let out = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
-        .args(["stability", "--bike", "benchmark", "--json"])
-        .output()
-        .unwrap();
+    let out = bikedyn(&["stability", "--bike", "benchmark", "--json"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!((v["weave_speed"].as_f64().unwrap() - 4.29238253634111).abs() < 1e-10);

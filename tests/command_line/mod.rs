@@ -1,0 +1,4 @@
+//! The command line: every command's output formats and its errors.
+
+mod commands;
+mod inputs_and_outputs;

@@ -1,0 +1,68 @@
+//! Helpers every group of tests shares: running the `bikedyn` binary,
+//! reading its output, scratch folders, the fixtures in `tests/data`, and the
+//! development data in `../shared` (absent on a user's clone: tests that
+//! need it print that they skipped).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the `bikedyn` binary of this build with `args`.
+pub fn bikedyn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
+}
+
+/// Bytes of a command's output as text (lossy).
+pub fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// Standard output parsed as JSON; on failure the panic shows standard error.
+pub fn stdout_json(out: &Output) -> serde_json::Value {
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| panic!("{e}: {}", text(&out.stderr)))
+}
+
+/// Runs `bikedyn args`, asserts success and parses its JSON output.
+pub fn ok_json(args: &[&str]) -> serde_json::Value {
+    let out = bikedyn(args);
+    assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
+    stdout_json(&out)
+}
+
+/// A scratch folder for one group of tests, unique to this test process so
+/// that concurrent runs never share files.
+pub fn scratch(group: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("bikedyn-{group}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A fixture of `tests/data`.
+pub fn fixture(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+}
+
+/// `fixture` as a string, for command lines.
+pub fn fixture_arg(name: &str) -> String {
+    fixture(name).to_string_lossy().into_owned()
+}
+
+/// `../shared/<sub>` from the repository root, or `None` with a skip
+/// message when the development data is not checked out.
+pub fn shared(sub: &str) -> Option<PathBuf> {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared").join(sub);
+    if p.exists() {
+        Some(p)
+    } else {
+        eprintln!(
+            "skipped: {} not found (development data, absent on a user's clone)",
+            p.display()
+        );
+        None
+    }
+}
+
+/// The example measured set shipped with bikedyn (six synthetic runs of the
+/// thesis bicycle with steer damping hidden, and their truth files).
+pub fn example_set() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping")
+}

@@ -1,0 +1,9 @@
+//! The linearized equations and their stability: published figures, closed
+//! forms, constraint solving and the fast upright path.
+
+mod basu_mandal;
+mod benchmark;
+mod constraints;
+mod fast_path;
+mod free_speed;
+mod real_designs;

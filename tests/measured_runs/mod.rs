@@ -1,0 +1,4 @@
+//! Measured runs: `fit` on measured-style, synthetic and TU Delft runs.
+
+mod fit_command;
+mod synthetic_runs;
