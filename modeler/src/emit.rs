@@ -687,7 +687,18 @@ pub fn emit(d: &Derived) -> Result<Emitted, EmitError> {
             }
             None => quote!(None),
         };
-        quote!(bikedyn_runtime::model::ParameterInfo { name: #n, doc: #pd, default: #default, effect: #effect, lower: #lower })
+        let uncertainty = match p.uncertainty {
+            Some(crate::model::Uncertainty::Relative(r)) => {
+                let l = proc_macro2::Literal::f64_suffixed(r);
+                quote!(Some(bikedyn_runtime::model::Uncertainty::Relative(#l)))
+            }
+            Some(crate::model::Uncertainty::Absolute(a)) => {
+                let l = proc_macro2::Literal::f64_suffixed(a);
+                quote!(Some(bikedyn_runtime::model::Uncertainty::Absolute(#l)))
+            }
+            None => quote!(None),
+        };
+        quote!(bikedyn_runtime::model::ParameterInfo { name: #n, doc: #pd, default: #default, effect: #effect, lower: #lower, uncertainty: #uncertainty })
     });
     let force_info = m.forces.iter().map(|f| {
         let n = f.name();

@@ -155,6 +155,35 @@ pub struct Parameter {
     /// Physical lower bound, if any: `(bound, strict)`; a value below it (or
     /// at it, when strict) is refused when a bicycle is read.
     pub lower: Option<(f64, bool)>,
+    /// Measurement uncertainty of a measured parameter (one standard
+    /// deviation): what identification may correct, and how far.
+    pub uncertainty: Option<Uncertainty>,
+}
+
+/// One standard deviation of a measured parameter; mirrors
+/// `bikedyn_runtime::model::Uncertainty`. The constants are the defaults
+/// bikedyn's models state per kind of measurement, for bicycle files that
+/// give no `+/-`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Uncertainty {
+    /// A fraction of the value.
+    Relative(f64),
+    /// In the parameter's unit.
+    Absolute(f64),
+}
+
+impl Uncertainty {
+    /// Moments of inertia from pendulum or torsion measurements: 10 %.
+    pub const INERTIA: Uncertainty = Uncertainty::Relative(0.10);
+    /// Masses from weighing: 2 %.
+    pub const MASS: Uncertainty = Uncertainty::Relative(0.02);
+    /// Mass-centre coordinates from hanging or balancing: 2 cm.
+    pub const MASS_CENTRE: Uncertainty = Uncertainty::Absolute(0.02);
+    /// Frame geometry from a tape and an inclinometer (axle and head-tube
+    /// points; trail and steer tilt follow from them): 5 mm.
+    pub const GEOMETRY: Uncertainty = Uncertainty::Absolute(0.005);
+    /// Wheel radii from a roll-out: 2 mm.
+    pub const WHEEL_RADIUS: Uncertainty = Uncertainty::Absolute(0.002);
 }
 
 /// An extra first-order state (beyond the coordinates and their rates),
@@ -583,6 +612,7 @@ impl ModelBuilder {
             effect: self.effect.clone(),
             meaning: None,
             lower: None,
+            uncertainty: None,
         });
         Expr::Param(name.into())
     }
@@ -596,6 +626,7 @@ impl ModelBuilder {
             effect: self.effect.clone(),
             meaning: None,
             lower: None,
+            uncertainty: None,
         });
         Expr::Param(name.into())
     }
@@ -613,6 +644,13 @@ impl ModelBuilder {
         match self.m.parameters.iter_mut().find(|c| c.name == parameter) {
             Some(p) => p.lower = Some((bound, strict)),
             None => self.unresolved_roles.push((parameter.to_string(), "lower bound")),
+        }
+    }
+    /// Declare how well a measured parameter is known (see [`Uncertainty`]).
+    pub fn uncertainty(&mut self, parameter: &str, uncertainty: Uncertainty) {
+        match self.m.parameters.iter_mut().find(|c| c.name == parameter) {
+            Some(p) => p.uncertainty = Some(uncertainty),
+            None => self.unresolved_roles.push((parameter.to_string(), "uncertainty")),
         }
     }
     /// Declare what coordinate `coordinate` means (see [`CoordinateRole`]).

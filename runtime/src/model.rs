@@ -27,6 +27,29 @@ pub struct ParameterInfo {
     pub effect: Option<&'static str>,
     /// Physical lower bound `(bound, strict)`, if declared.
     pub lower: Option<(f64, bool)>,
+    /// How well the parameter is known when a bicycle file states no
+    /// uncertainty (measured parameters only): identification may correct
+    /// it, within this standard deviation as a Gaussian prior.
+    pub uncertainty: Option<Uncertainty>,
+}
+
+/// A parameter's measurement uncertainty, one standard deviation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Uncertainty {
+    /// A fraction of the value (inertias: 0.10).
+    Relative(f64),
+    /// In the parameter's unit (mass-centre coordinates: 0.02 m).
+    Absolute(f64),
+}
+
+impl Uncertainty {
+    /// The standard deviation for a parameter of value `value`.
+    pub fn sigma(self, value: f64) -> f64 {
+        match self {
+            Uncertainty::Relative(r) => r * value.abs(),
+            Uncertainty::Absolute(a) => a,
+        }
+    }
 }
 
 impl ParameterInfo {

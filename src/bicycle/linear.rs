@@ -175,6 +175,7 @@ pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleEr
         parameters: ParameterSet::Thesis(*p),
         warnings: Vec::new(),
         effects: BTreeMap::new(),
+        uncertainties: BTreeMap::new(),
         registry: PhantomData,
     }
     .canonical()

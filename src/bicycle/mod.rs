@@ -70,6 +70,9 @@ pub struct Bicycle<R: ModelRegistry = BuiltIn> {
     /// Effect parameters given in the file, by symbol (absent: the model's
     /// default, at which the effect is absent).
     pub effects: BTreeMap<String, f64>,
+    /// Standard deviations the file gives (`value+/-std`), by the file's
+    /// symbols; empty when it gives none.
+    pub uncertainties: BTreeMap<String, f64>,
     registry: PhantomData<R>,
 }
 
@@ -100,15 +103,16 @@ impl<R: ModelRegistry> Bicycle<R> {
             }
             path if Path::new(path).exists() => {
                 let extra: Vec<&str> = effect_parameters_in::<R>().iter().map(|p| p.name).collect();
-                let (set, effects, warnings) = ParameterSet::load_with_extra(path, &extra)?;
-                for (name, &value) in &effects {
+                let loaded = ParameterSet::load_with_extra(path, &extra)?;
+                for (name, &value) in &loaded.effects {
                     check_effect_value_in::<R>(name, value, path)?;
                 }
                 return Ok(Bicycle {
                     name: spec.to_string(),
-                    parameters: set,
-                    warnings,
-                    effects,
+                    parameters: loaded.set,
+                    warnings: loaded.warnings,
+                    effects: loaded.effects,
+                    uncertainties: loaded.uncertainties,
                     registry: PhantomData,
                 });
             }
@@ -119,8 +123,37 @@ impl<R: ModelRegistry> Bicycle<R> {
             parameters,
             warnings,
             effects: BTreeMap::new(),
+            uncertainties: BTreeMap::new(),
             registry: PhantomData,
         })
+    }
+
+    /// Standard deviation of parameter `symbol` (a thesis or benchmark
+    /// symbol) from the uncertainties the file gives: the file's own value
+    /// for one of its symbols, else first-order propagation through the
+    /// conversion between forms, taking the file's uncertainties as
+    /// independent. `None` when the file gives none that reach `symbol`.
+    pub fn file_uncertainty(&self, symbol: &str) -> Option<f64> {
+        if let Some(&sd) = self.uncertainties.get(symbol) {
+            return Some(sd);
+        }
+        let value = self.value(symbol)?;
+        let mut var = 0.0;
+        for (given, &sd) in &self.uncertainties {
+            let Some(v0) = self.value(given) else { continue };
+            if !(sd > 0.0) {
+                continue;
+            }
+            // One step of a standard deviation each way, whichever is a
+            // valid bicycle (a step may break the triangle inequality).
+            let moved = [sd, -sd]
+                .into_iter()
+                .find_map(|h| self.with_parameter(given, v0 + h).ok()?.value(symbol));
+            if let Some(m) = moved {
+                var += (m - value) * (m - value);
+            }
+        }
+        (var > 0.0).then(|| var.sqrt())
     }
 
     /// Parameters this bicycle sets to a non-zero value: thesis symbols and
@@ -232,6 +265,7 @@ impl<R: ModelRegistry> Bicycle<R> {
             parameters,
             warnings,
             effects: self.effects.clone(),
+            uncertainties: self.uncertainties.clone(),
             registry: PhantomData,
         })
     }

@@ -234,6 +234,11 @@ pub struct IdentifyArgs {
     /// Folds of the cross-validation over runs.
     #[arg(long, default_value_t = 4)]
     pub folds: usize,
+    /// Largest number of parameter corrections (of the parameters whose
+    /// model declares an uncertainty) tried beside the effects; 0 (the
+    /// default): none.
+    #[arg(long, default_value_t = 0)]
+    pub corrections: usize,
 }
 
 /// Arguments of `bikedyn simulate`.

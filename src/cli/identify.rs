@@ -14,6 +14,7 @@ pub fn request(a: &IdentifyArgs) -> IdentifyRequest {
         bike: a.bike.clone(),
         effects: a.effects.clone(),
         folds: a.folds,
+        corrections: a.corrections,
     }
 }
 

@@ -124,6 +124,7 @@ pub fn candidates<R: ModelRegistry>(
                         .then(|| info.parameter(f.symbol).and_then(|p| p.default))
                         .flatten(),
                     lower: f.floor,
+                    prior: None,
                 })
                 .collect(),
             fixed: d

@@ -9,6 +9,7 @@
 //! folder.
 
 pub mod candidates;
+pub mod corrections;
 pub mod diagnosis;
 mod error;
 mod markdown;
@@ -56,6 +57,10 @@ pub struct IdentifyRequest {
     pub effects: Vec<String>,
     /// Folds of the cross-validation over runs (default 4).
     pub folds: usize,
+    /// Largest number of parameter corrections tried beside the effects
+    /// (default 0: effects only, until corrections stop being selected
+    /// beside a found effect on sets that have none; see [`corrections`]).
+    pub corrections: usize,
 }
 
 impl Default for IdentifyRequest {
@@ -66,6 +71,7 @@ impl Default for IdentifyRequest {
             bike: "thesis".into(),
             effects: Vec::new(),
             folds: 4,
+            corrections: 0,
         }
     }
 }
@@ -196,6 +202,15 @@ pub fn run_plan<R: ModelRegistry>(
             skipped,
         });
     }
+    // Parameter corrections that could explain the measured weave misfit
+    // join the effects as candidates.
+    let speeds: Vec<f64> = segs.iter().map(|s| s.mean_speed).collect();
+    let predicted_before = predict(driven, bike, &BTreeMap::new(), &speeds)?;
+    let mut cands = cands.clone();
+    for c in corrections::screen(free, driven, bike, &segs, &predicted_before, request.corrections)? {
+        cands.push(corrections::candidate(free, &c));
+    }
+    let cands = &cands;
     let opts = FitSettings {
         folds: request.folds,
         ..FitSettings::default()
@@ -221,8 +236,6 @@ pub fn run_plan<R: ModelRegistry>(
         },
     )
     .expect("registered model")?;
-    let speeds: Vec<f64> = segs.iter().map(|s| s.mean_speed).collect();
-    let predicted_before = predict(driven, bike, &BTreeMap::new(), &speeds)?;
     let values_after = effect_values(&id.after, &id.after.values, cands);
     // Steer-rate amplitude of each segment, from the fitted simulation.
     let steer_rate: Vec<f64> = (0..segs.len())

@@ -211,22 +211,38 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     s
 }
 
-/// Parameter file of the identified bicycle: the bicycle plus the fitted
-/// effect values.
-fn fitted_toml<R: ModelRegistry>(bike: &Bicycle<R>, values: &BTreeMap<String, f64>, o: &Outcome<R>) -> String {
-    let mut s = bike.parameters.to_toml_string();
+/// Parameter file of the identified bicycle: the bicycle with its
+/// corrected parameters, plus the fitted effect values.
+fn fitted_toml<R: ModelRegistry>(
+    bike: &Bicycle<R>,
+    values: &BTreeMap<String, f64>,
+    o: &Outcome<R>,
+) -> Result<String, IdentifyError> {
+    let mut fitted = bike.clone();
+    let mut corrected = Vec::new();
+    for (k, v) in values {
+        if !bike.effects.contains_key(k) && !crate::models::effect_parameters_in::<R>().iter().any(|p| p.name == k) {
+            corrected.push(format!("{k} {:.6e} -> {v:.6e}", bike.value(k).unwrap_or(f64::NAN)));
+        }
+        fitted = fitted.with_parameter(k, *v)?;
+    }
+    let mut s = fitted.parameters.to_toml_string();
+    if !corrected.is_empty() {
+        let _ = writeln!(
+            s,
+            "\n# Parameters corrected by `bikedyn identify`: {}.",
+            corrected.join(", ")
+        );
+    }
     let _ = writeln!(
         s,
         "\n# Effects identified by `bikedyn identify` (model {}; driven-speed twin {}).",
         o.model, o.driven_model
     );
-    for (k, v) in bike.effects.iter().filter(|(k, _)| !values.contains_key(*k)) {
+    for (k, v) in &fitted.effects {
         let _ = writeln!(s, "{k} = {v:e}");
     }
-    for (k, v) in values {
-        let _ = writeln!(s, "{k} = {v:.6e}");
-    }
-    s
+    Ok(s)
 }
 
 /// Write the report folder; the bicycle of `a` is resolved against the
@@ -238,7 +254,7 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
     })?;
     let bike = Bicycle::<R>::resolve_in(&a.bike)?;
     save_json(dir.join("report.json"), &outcome_json(o))?;
-    write_string_atomic(dir.join("fitted.toml"), &fitted_toml(&bike, &o.values_after, o))?;
+    write_string_atomic(dir.join("fitted.toml"), &fitted_toml(&bike, &o.values_after, o)?)?;
     // Continuation diagram before and after.
     let vmax = o.segments.iter().map(|s| s.speed_interval[1]).fold(7.0, f64::max) + 1.0;
     let speeds: Vec<f64> = (1..=200).map(|i| vmax * i as f64 / 200.0).collect();

@@ -409,3 +409,22 @@ fn the_tudelft_assist_model_predicts_the_measured_weave() {
         );
     }
 }
+
+/// The `+/-` of a bicycleparameters file are kept when it is read and reach
+/// the model's parameters (first-order propagation through the conversion
+/// to the thesis form): the frame's inertia about its own x axis is known
+/// about as well as the file's `IBxx` (1.120 +/- 0.018, with `IBxz` and
+/// `IBzz` mixed in by the frame's pitch), the rear wheel radius exactly as
+/// the file's `rR`; a built-in bicycle gives none.
+#[test]
+fn a_bicycle_files_uncertainties_reach_the_model_parameters() {
+    let b = Bicycle::resolve(&fixture_arg("Balanceassistv1Benchmark.txt")).unwrap();
+    assert_eq!(b.uncertainties.get("IBxx"), Some(&0.018));
+    let rr = b.file_uncertainty("rR").unwrap();
+    assert_eq!(rr, *b.uncertainties.get("rR").unwrap());
+    let rt = b.file_uncertainty("Rt").unwrap();
+    assert!((rt - rr).abs() < 1e-9 * rr.max(1.0), "Rt +/- {rt}, rR +/- {rr}");
+    let i3x = b.file_uncertainty("I3x").unwrap();
+    assert!(i3x > 0.01 && i3x < 0.06, "I3x +/- {i3x}");
+    assert!(Bicycle::resolve("thesis").unwrap().file_uncertainty("I3x").is_none());
+}

@@ -7,7 +7,7 @@
 use super::thesis_whipple::{self, Speed};
 use crate::effects::BicycleParts;
 use crate::expr::{num, vec3};
-use crate::model::{Model, ModelBuilder, ModelError};
+use crate::model::{Model, ModelBuilder, ModelError, Uncertainty};
 
 const SOURCE: &str = "modeler/src/models/whipple_offset.rs";
 
@@ -23,6 +23,7 @@ pub fn declare(name: &str, source: &str, speed: Speed) -> (ModelBuilder, Bicycle
         Speed::Free => "Whipple bicycle with the handlebar/fork mass centre a distance d4 ahead of the steer axis (benchmark-compatible), free forward speed",
     });
     let d4 = m.parameter("d4", "handlebar/fork mass centre ahead of the steer axis, fork x (m)");
+    m.uncertainty("d4", Uncertainty::MASS_CENTRE);
     let g4 = m.point(
         "G4_offset",
         Some(parts.steer_point),

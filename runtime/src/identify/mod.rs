@@ -165,6 +165,10 @@ pub struct EffectParameter {
     /// there): for parameters the model is undefined or singular without,
     /// such as a relaxation length.
     pub lower: Option<f64>,
+    /// Gaussian prior `(mean, standard deviation)`: a measured parameter
+    /// corrected by identification moves only as far as the data demand
+    /// (the fit adds `((value - mean) / sd)^2` to its weighted sum).
+    pub prior: Option<(f64, f64)>,
 }
 
 /// A candidate effect (or a combination): the parameters fitted when it is
@@ -476,6 +480,28 @@ impl Problem<'_, '_> {
             }
         }
     }
+    /// The parameters with a prior while they are free: `(column, sd)`.
+    fn prior_rows(&self) -> Vec<(usize, f64)> {
+        if self.free == Free::Nuisance {
+            return Vec::new();
+        }
+        self.setup
+            .parameters
+            .iter()
+            .enumerate()
+            .filter_map(|(j, p)| p.prior.map(|(_, sd)| (j, sd)))
+            .collect()
+    }
+    /// Residuals of the priors (after the data's).
+    fn prior_residuals(&self) -> Vec<f64> {
+        self.prior_rows()
+            .into_iter()
+            .map(|(j, sd)| {
+                let mean = self.setup.parameters[j].prior.map_or(0.0, |(m, _)| m);
+                (self.g[j] - mean) / sd
+            })
+            .collect()
+    }
     fn all_residuals(&self) -> Option<Vec<Vec<f64>>> {
         let x = self.pack();
         if let Some((cx, r)) = self.cache.lock().ok()?.as_ref() {
@@ -506,9 +532,10 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
     }
     fn residuals(&self) -> Option<DVector<f64>> {
         let r = self.all_residuals()?;
+        let prior = self.prior_residuals();
         Some(DVector::from_iterator(
-            r.iter().map(Vec::len).sum(),
-            r.into_iter().flatten(),
+            r.iter().map(Vec::len).sum::<usize>() + prior.len(),
+            r.into_iter().flatten().chain(prior),
         ))
     }
     fn jacobian(&self) -> Option<DMatrix<f64>> {
@@ -560,11 +587,16 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
                 Some((p, col, r.iter().zip(&base[p]).map(|(a, b)| (a - b) / h).collect()))
             })
             .collect();
-        let mut jac = DMatrix::zeros(rows.iter().sum(), self.n_free());
+        let data_rows: usize = rows.iter().sum();
+        let priors = self.prior_rows();
+        let mut jac = DMatrix::zeros(data_rows + priors.len(), self.n_free());
         for (p, col, d) in cols? {
             for (i, v) in d.into_iter().enumerate() {
                 jac[(offsets[p] + i, col)] = v;
             }
+        }
+        for (row, (col, sd)) in priors.into_iter().enumerate() {
+            jac[(data_rows + row, col)] = 1.0 / sd;
         }
         Some(jac)
     }
@@ -825,6 +857,32 @@ pub fn fit_candidate(
     Ok(fit)
 }
 
+/// The candidates with their priors put on the scale of the weighted data.
+/// The weighted sum of squares counts every sample as independent with
+/// variance one, but the residuals of a smooth response are strongly
+/// autocorrelated and their level is not the weight: the information the
+/// data carry is that sum divided by `s2 = chi2 / n (1 + rho) / (1 - rho)`
+/// (the inflation the standard errors use). A prior `sd` is therefore
+/// applied as `sd / sqrt(s2)`, measured on the base model's fit, never
+/// weaker than as stated; without this a correction would move several
+/// prior deviations for a small gain in a sum that overstates the data.
+fn with_priors_on_the_data_scale(candidates: &[Candidate], base: &CandidateFit) -> Vec<Candidate> {
+    let n: usize = base.errors.iter().flat_map(|e| e.channel_n).sum();
+    let rho = base.errors.iter().map(|e| e.rho).sum::<f64>() / base.errors.len().max(1) as f64;
+    let s2 = base.chi2 / n.max(1) as f64 * (1.0 + rho) / (1.0 - rho);
+    let scale = if s2.is_finite() { s2.max(1.0).sqrt() } else { 1.0 };
+    candidates
+        .iter()
+        .map(|c| {
+            let mut c = c.clone();
+            for p in &mut c.parameters {
+                p.prior = p.prior.map(|(mean, sd)| (mean, sd / scale));
+            }
+            c
+        })
+        .collect()
+}
+
 /// Bayesian information criterion of `fit` with the effective sample size
 /// of each channel taken from `reference` (the model being extended): the
 /// profile likelihood of Gaussian residuals with one unknown variance per
@@ -941,6 +999,7 @@ pub fn identify<M: MultibodyModel>(
     before.bic = bic(&before, &before);
     progress("base model");
     let mut simulations = first.simulations + before.simulations;
+    let candidates = &with_priors_on_the_data_scale(candidates, &before);
 
     let mut current = before.clone();
     let mut selected: Vec<&Candidate> = Vec::new();

@@ -77,6 +77,17 @@ pub enum ParameterSet {
     Benchmark(BenchmarkParameters),
 }
 
+/// A parameter file as read by [`ParameterSet::load_with_extra`].
+#[derive(Clone, Debug)]
+pub struct LoadedSet {
+    pub set: ParameterSet,
+    /// Effect parameters given, by symbol.
+    pub effects: BTreeMap<String, f64>,
+    /// Standard deviations given as `value+/-std`, by symbol.
+    pub uncertainties: BTreeMap<String, f64>,
+    pub warnings: Vec<ParameterWarning>,
+}
+
 impl ParameterSet {
     /// Read and validate a parameter file. Files ending in `.toml` are read as
     /// TOML ([`from_toml_str`](Self::from_toml_str)), all others as benchmark
@@ -154,19 +165,25 @@ impl ParameterSet {
     /// Read and validate a parameter file, accepting the `extra` symbols
     /// (effect parameters) in TOML and text files alike (see
     /// [`from_toml_str_with_extra`](Self::from_toml_str_with_extra),
-    /// [`MeasuredBenchmark::from_text_str_with_extra`]).
-    #[allow(clippy::type_complexity)]
-    pub fn load_with_extra(
-        path: impl AsRef<Path>,
-        extra: &[&str],
-    ) -> Result<(ParameterSet, BTreeMap<String, f64>, Vec<ParameterWarning>), ParameterError> {
+    /// [`MeasuredBenchmark::from_text_str_with_extra`]). The `+/-`
+    /// uncertainties of a text file are kept (by symbol).
+    pub fn load_with_extra(path: impl AsRef<Path>, extra: &[&str]) -> Result<LoadedSet, ParameterError> {
         let path = path.as_ref();
         let text = read(path)?;
         if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
-            Self::from_toml_str_with_extra(&text, path, extra)
+            Self::from_toml_str_with_extra(&text, path, extra).map(|(set, effects, warnings)| LoadedSet {
+                set,
+                effects,
+                uncertainties: BTreeMap::new(),
+                warnings,
+            })
         } else {
-            MeasuredBenchmark::from_text_str_with_extra(&text, path, extra)
-                .map(|(m, effects, w)| (ParameterSet::Benchmark(m.parameters), effects, w))
+            MeasuredBenchmark::from_text_str_with_extra(&text, path, extra).map(|(m, effects, warnings)| LoadedSet {
+                set: ParameterSet::Benchmark(m.parameters),
+                effects,
+                uncertainties: m.uncertainties,
+                warnings,
+            })
         }
     }
 

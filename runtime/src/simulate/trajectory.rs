@@ -48,7 +48,7 @@ impl Trajectory {
         );
         let mut r = Trajectory::default();
         for i in 0..sim.t.len() {
-            if i > 0 && sim.t[i] <= sim.t[i - 1] {
+            if r.t.last().is_some_and(|&last| sim.t[i] <= last) {
                 continue;
             }
             r.t.push(sim.t[i]);
