@@ -189,21 +189,30 @@ fn canonical_zero_radius(p: &ThesisParameters) -> Result<CanonicalMatrices, Bicy
         source,
     };
     use bikedyn_runtime::parameters::body;
-    if p.rear_wheel_radius == 0.0 && p.rear_wheel_i_axial != 0.0 {
-        return Err(lin(LinearizeError::SkateWithSpinInertia {
-            wheel: body::REAR_WHEEL,
-            radius_symbol: "Rt (rR)",
-            inertia_symbol: "I2y (IRyy)",
-            inertia: p.rear_wheel_i_axial,
-        }));
-    }
-    if p.front_wheel_radius == 0.0 && p.front_wheel_i_axial != 0.0 {
-        return Err(lin(LinearizeError::SkateWithSpinInertia {
-            wheel: body::FRONT_WHEEL,
-            radius_symbol: "Rd (rF)",
-            inertia_symbol: "I5y (IFyy)",
-            inertia: p.front_wheel_i_axial,
-        }));
+    for (radius, inertia, wheel, radius_symbol, inertia_symbol) in [
+        (
+            p.rear_wheel_radius,
+            p.rear_wheel_i_axial,
+            body::REAR_WHEEL,
+            "Rt (rR)",
+            "I2y (IRyy)",
+        ),
+        (
+            p.front_wheel_radius,
+            p.front_wheel_i_axial,
+            body::FRONT_WHEEL,
+            "Rd (rF)",
+            "I5y (IFyy)",
+        ),
+    ] {
+        if radius == 0.0 && inertia != 0.0 {
+            return Err(lin(LinearizeError::SkateWithSpinInertia {
+                wheel,
+                radius_symbol,
+                inertia_symbol,
+                inertia,
+            }));
+        }
     }
     let bench = p.to_benchmark()?;
     // Step: a tenth of the wheelbase keeps every sample a plain bicycle.

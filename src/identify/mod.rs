@@ -4,7 +4,8 @@
 //! nonlinear simulation, stepwise selection by BIC and cross-validation).
 //! This module is the pipeline; [`candidates`] builds the candidates from
 //! the effect library, [`segments`] cuts the measured windows, [`predict`]
-//! gives the linear weave predictions, [`diagnosis`] relates the residual
+//! gives the linear weave predictions, [`corrections`] screens parameter
+//! corrections, `fits` runs the nonlinear fits, [`diagnosis`] relates the residual
 //! pattern to effects, and [`report`] writes the summary and the report
 //! folder.
 
@@ -12,6 +13,7 @@ pub mod candidates;
 pub mod corrections;
 pub mod diagnosis;
 mod error;
+mod fits;
 mod markdown;
 pub mod predict;
 pub mod report;
@@ -23,14 +25,11 @@ use crate::bicycle::Bicycle;
 use crate::fit::{run_fit_in, FitOptions};
 use crate::progress::{OnProgress, Progress};
 use crate::registry::BuiltIn;
-use bikedyn_runtime::identify::{
-    identify, Candidate, Factory, Identification, IdentifyOptions as FitSettings, ModelFactory, Segment, Setup,
-};
-use bikedyn_runtime::linearize::parameter_vector;
-use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
-use bikedyn_runtime::MultibodyModel;
+use bikedyn_runtime::identify::{Candidate, Identification, IdentifyOptions as FitSettings, Segment};
+use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 use candidates::{candidates, identification_models};
 use diagnosis::{diagnose, Finding};
+use fits::{Identify, RunPlot};
 use predict::{linear_equivalent, predict};
 use segments::segments;
 use std::collections::BTreeMap;
@@ -333,79 +332,4 @@ fn mean_abs_rate(t: &[f64], x: &[f64]) -> f64 {
         .map(|(a, b)| ((b[1] - b[0]) / (a[1] - a[0])).abs())
         .collect();
     d.iter().sum::<f64>() / d.len().max(1) as f64
-}
-
-/// Simulated channels of every segment before and after (plots, bias,
-/// amplitude of the steer rate), and the typical segment.
-struct RunPlot {
-    segment: usize,
-    before: Vec<Option<bikedyn_runtime::identify::Sim>>,
-    after: Vec<Option<bikedyn_runtime::identify::Sim>>,
-}
-
-struct Identify<'a, R: ModelRegistry> {
-    bike: &'a Bicycle<R>,
-    alt: Option<&'static ModelInfo>,
-    segments: &'a [Segment],
-    candidates: &'a [Candidate],
-    opts: &'a FitSettings,
-    progress: &'a (dyn Fn(&str) + Sync),
-}
-
-impl<R: ModelRegistry> ModelVisitor for Identify<'_, R> {
-    type Output = Result<(Identification, Option<RunPlot>), IdentifyError>;
-    fn visit<M: MultibodyModel>(self) -> Self::Output {
-        let lookup = self.bike.lookup()?;
-        let base = parameter_vector::<M>(&lookup, 5.0)?;
-        let alt: Option<Box<dyn ModelFactory>> = match self.alt {
-            Some(a) => Some(R::with_model(a.name, MakeFactory { lookup: &lookup }).expect("registered model")?),
-            None => None,
-        };
-        let id = identify::<M>(
-            &base,
-            self.segments,
-            self.candidates,
-            alt.as_deref(),
-            self.opts,
-            self.progress,
-        )?;
-        // The typical run: median roll error before.
-        let mut order: Vec<usize> = (0..self.segments.len()).collect();
-        order.sort_by(|&a, &b| id.before.errors[a].roll_rms.total_cmp(&id.before.errors[b].roll_rms));
-        let sel: Vec<&Candidate> = id
-            .selected
-            .iter()
-            .filter_map(|n| self.candidates.iter().find(|c| &c.name == n))
-            .collect();
-        let before = Setup::new::<M>(&base, self.segments, &id.weights, &[])?;
-        let after = match alt.as_deref().filter(|_| sel.iter().any(|c| c.alternative_model)) {
-            Some(f) => f.setup(self.segments, &id.weights, &sel)?,
-            None => Setup::new::<M>(&base, self.segments, &id.weights, &sel)?,
-        };
-        let plot = order.get(order.len() / 2).map(|&s| RunPlot {
-            segment: s,
-            before: (0..self.segments.len())
-                .map(|i| before.simulated(&[], &self.segments[i], &id.before.nuisance[i]).ok())
-                .collect(),
-            after: (0..self.segments.len())
-                .map(|i| {
-                    after
-                        .simulated(&id.after.values, &self.segments[i], &id.after.nuisance[i])
-                        .ok()
-                })
-                .collect(),
-        });
-        Ok((id, plot))
-    }
-}
-
-struct MakeFactory<'a, F: Fn(&str) -> Option<f64>> {
-    lookup: &'a F,
-}
-
-impl<F: Fn(&str) -> Option<f64>> ModelVisitor for MakeFactory<'_, F> {
-    type Output = Result<Box<dyn ModelFactory>, IdentifyError>;
-    fn visit<M: MultibodyModel>(self) -> Self::Output {
-        Ok(Box::new(Factory::<M>::new(parameter_vector::<M>(self.lookup, 5.0)?)))
-    }
 }
