@@ -13,21 +13,27 @@ use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 /// chosen by capability among the models of the bicycle's registry: it can
 /// represent the bicycle (has every parameter the bicycle sets) and carries
 /// the most effects.
+///
+/// With `speed_imposed` (logs of a bicycle whose hub motor holds the speed)
+/// the fits run through the driven twin, and the alternative model is the
+/// driven one with states.
 pub fn identification_models<R: ModelRegistry>(
     bike: &Bicycle<R>,
+    speed_imposed: bool,
 ) -> Result<(&'static ModelInfo, &'static ModelInfo, Option<&'static ModelInfo>), IdentifyError> {
     let nonzero = bike.nonzero_parameters()?;
     let (free, driven) = identification_model_pair(bike)?;
+    let fitted = if speed_imposed { driven } else { free };
     let alt = R::models()
         .iter()
         .filter(|m| {
-            m.free_speed
+            m.free_speed == !speed_imposed
                 && !m.states.is_empty()
                 && crate::models::fits(m, &nonzero)
                 && free.effects.iter().all(|e| m.effects.contains(e))
         })
         .max_by_key(|m| m.effects.len());
-    Ok((free, driven, alt))
+    Ok((fitted, driven, alt))
 }
 
 /// The free-speed model without extra states that can represent the
@@ -56,11 +62,17 @@ fn identification_model_pair<R: ModelRegistry>(
 /// declaration says: fitted parameters, ties, floors, held companions,
 /// speed decay and the reason. An effect declared "own model" (tyre slip)
 /// comes from the alternative model `alt`.
+///
+/// Not candidates: an effect whose fitted parameters the bicycle file sets
+/// (a controller declared with its gains is a known input of the
+/// experiment, not something to find), and, with `speed_imposed`, the
+/// speed-decay effects (the motor replaces what they would dissipate).
 pub fn candidates<R: ModelRegistry>(
     info: &ModelInfo,
     alt: Option<&ModelInfo>,
     bike: &Bicycle<R>,
     only: &[String],
+    speed_imposed: bool,
 ) -> Result<Vec<Candidate>, IdentifyError> {
     let declared = |m: &ModelInfo| -> Vec<(&'static str, CandidateDeclaration)> {
         m.effect_declarations
@@ -95,6 +107,13 @@ pub fn candidates<R: ModelRegistry>(
     let mut out = Vec::new();
     for (info, effect, d) in pool {
         if !(only.is_empty() || only.iter().any(|o| o == effect)) {
+            continue;
+        }
+        let declared_by_bike = d
+            .fitted
+            .iter()
+            .any(|f| bike.effects.get(f.symbol).is_some_and(|&v| v != 0.0));
+        if declared_by_bike || (speed_imposed && d.speed_decay) {
             continue;
         }
         let unit = |sym: &str| {

@@ -2,7 +2,7 @@
 //! eigenvalue offsets, amplitude dependence, steady lean, speed trends) and
 //! the effects whose files declare that pattern.
 
-use bikedyn_runtime::identify::{pooled_rms, Segment, SegmentError};
+use bikedyn_runtime::identify::{pooled_rms, RollChannel, Segment, SegmentError};
 use bikedyn_runtime::model::{EffectIdentification, Signature};
 use bikedyn_runtime::registry::ModelInfo;
 
@@ -51,7 +51,9 @@ pub fn diagnose(
     predicted: &[Option<[f64; 2]>],
     before: &[SegmentError],
     sims_mean_roll: &[f64],
+    speed_imposed: bool,
 ) -> Vec<Finding> {
+    let channel = segs.first().map_or(RollChannel::Angle, |s| s.roll_channel);
     // The effects whose files declare a pattern, in the models' order.
     let suspects = |sig: Signature| -> Vec<String> {
         let mut out: Vec<String> = Vec::new();
@@ -97,22 +99,26 @@ pub fn diagnose(
     f.push(Finding {
         pattern: "damping that depends on amplitude".into(),
         evidence: format!(
-            "slope of the real-part residual against ln(peak roll): {b:+.3} +- {sb:.3} 1/s (positive: more damping at small amplitude)"
+            "slope of the real-part residual against ln(peak {}): {b:+.3} +- {sb:.3} 1/s (positive: more damping at small amplitude)",
+            channel.describe()
         ),
         suspects: suspects(Signature::AmplitudeDependentDamping),
         significant: b > 2.0 * sb,
     });
+    // A steady lean shows in the roll angle; a roll-rate channel has none.
     let (mb, sbias) = mean_se(sims_mean_roll);
-    f.push(Finding {
-        pattern: "steady lean after the kick".into(),
-        evidence: format!(
-            "mean roll residual over the second half of each window: {:+.3} +- {:.3} deg",
-            mb.to_degrees(),
-            sbias.to_degrees()
-        ),
-        suspects: suspects(Signature::SteadyLean),
-        significant: mb.abs() > 2.0 * sbias,
-    });
+    if channel == RollChannel::Angle {
+        f.push(Finding {
+            pattern: "steady lean after the kick".into(),
+            evidence: format!(
+                "mean roll residual over the second half of each window: {:+.3} +- {:.3} deg",
+                mb.to_degrees(),
+                sbias.to_degrees()
+            ),
+            suspects: suspects(Signature::SteadyLean),
+            significant: mb.abs() > 2.0 * sbias,
+        });
+    }
     let sp: Vec<f64> = pairs.iter().map(|p| segs[p.0].mean_speed).collect();
     let (bs, sbs) = slope(&sp, &dim);
     f.push(Finding {
@@ -125,6 +131,10 @@ pub fn diagnose(
             .collect(),
         significant: bs.abs() > 2.0 * sbs,
     });
+    // With the speed imposed (a motor held it) a speed decay is no model error.
+    if speed_imposed {
+        return f;
+    }
     let decel: Vec<f64> = segs
         .iter()
         .filter(|s| s.speed.len() >= 3)

@@ -33,6 +33,13 @@ pub enum IdentifyError {
         model: &'static str,
         effects: Vec<&'static str>,
     },
+    /// Thesis-style runs and TU Delft logs in one identification: their
+    /// channels differ (roll angle or roll rate; free or imposed speed).
+    #[error("identify: {} mixes thesis-style runs and TU Delft logs; identify them separately", inputs.join(", "))]
+    MixedInputs { inputs: Vec<String> },
+    /// An input path is neither a run, a set nor a log.
+    #[error(transparent)]
+    Input(#[from] bikedyn_runtime::experiment::RunError),
     /// Fewer than two kicks with a free-response window.
     #[error(
         "identification needs at least two kicks with a free-response window; found {found}{}",

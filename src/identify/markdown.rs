@@ -14,9 +14,15 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     let mut s = String::new();
     let inputs: Vec<String> = a.inputs.iter().map(|p| p.display().to_string()).collect();
     let _ = writeln!(s, "# Identification report\n");
+    let (roll, unit) = (o.roll_channel().describe(), o.roll_channel().unit_deg());
+    let speed = if o.speed_imposed {
+        "forward speed imposed (the measured speed over each window: a motor held it)"
+    } else {
+        "free forward speed"
+    };
     let _ = writeln!(
         s,
-        "Data: {} ({} kicks). Bicycle: `{}`. Model: `{}` (nonlinear, free forward speed, every effect of the library absent unless fitted); weave predictions from its driven-speed twin `{}`.\n",
+        "Data: {} ({} kicks). Bicycle: `{}`. Model: `{}` (nonlinear, {speed}, every effect of the library absent unless fitted); weave predictions from its driven-speed twin `{}`.\n",
         inputs.join(", "),
         o.segments.len(),
         a.bike,
@@ -25,12 +31,16 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     );
     let _ = writeln!(s, "## Summary\n\n```\n{}\n```\n", summary(o));
     let _ = writeln!(s, "## What was done\n");
-    let _ = writeln!(s, "1. The measured-run pipeline (`bikedyn fit`) found every kick and its free-response window, and estimated mounting misalignments (calibration run) and clock offsets: these sensor effects are nuisances, never reported as mechanics.");
-    let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed; fitted per run as nuisance parameters), and compared with the measured roll, steer and speed.");
+    if o.speed_imposed {
+        let _ = writeln!(s, "1. The measured-run pipeline (`bikedyn fit`) found every kick of the logs and its free-response window (from the gyro's roll rate; the next kick or the decay into noise ends it).");
+    } else {
+        let _ = writeln!(s, "1. The measured-run pipeline (`bikedyn fit`) found every kick and its free-response window, and estimated mounting misalignments (calibration run) and clock offsets: these sensor effects are nuisances, never reported as mechanics.");
+    }
+    let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed; fitted per kick as nuisance parameters), and compared with the measured {roll}, steer and speed.");
     let _ = writeln!(s, "3. The residual pattern of the model without any added effect was related to the effects of the library (below).");
-    let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all runs (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run), and its dissipative parameters are positive. The search stops when no candidate passes.\n", id.folds);
+    let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all kicks (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run: each run's or log's kicks are predicted with the values fitted to the others), and its dissipative parameters are positive. The search stops when no candidate passes.\n", id.folds);
     let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| median(id.weights.iter().map(f));
-    let _ = writeln!(s, "Channel scales (each run's RMS residual under the base model, at least the best run's; median over runs): roll {:.3} deg, steer {:.3} deg, speed {:.3} m/s. Each run and channel is weighed by its own scale, so a run that diverges toward a fall cannot outweigh the others.\n", med(&|w| w.roll).to_degrees(), med(&|w| w.steer).to_degrees(), med(&|w| w.speed));
+    let _ = writeln!(s, "Channel scales (each kick's RMS residual under the base model, at least the best kick's; median over kicks): {roll} {:.3} {unit}, steer {:.3} deg, speed {:.3} m/s. Each kick and channel is weighed by its own scale, so a run that diverges toward a fall cannot outweigh the others.\n", med(&|w| w.roll).to_degrees(), med(&|w| w.steer).to_degrees(), med(&|w| w.speed));
     let _ = writeln!(s, "## Residual diagnosis (base model)\n");
     let _ = writeln!(
         s,
@@ -146,7 +156,8 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     let b = errors_json(o, false);
     let af = errors_json(o, true);
     let g = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
-    let _ = writeln!(s, "## Error before and after\n\n| | weave eigenvalue RMS (1/s) | roll RMS (deg) | steer RMS (deg) | speed RMS (m/s) |\n|---|---|---|---|---|");
+    let counted = o.weave_kicks.iter().filter(|&&k| k).count();
+    let _ = writeln!(s, "## Error before and after\n\nThe weave eigenvalue figures are over the {counted} of {} kicks whose measured eigenvalue is a weave (the others are listed below with the reason; their time series are fitted all the same); the weighted figure weighs each kick by the inverse variance of its measured eigenvalue.\n\n| | weave eigenvalue RMS (1/s) | weighted (1/s) | {roll} RMS ({unit}) | steer RMS (deg) | speed RMS (m/s) |\n|---|---|---|---|---|---|", o.segments.len());
     for (label, v) in [
         ("fitted runs, before", &b),
         ("fitted runs, after", &af),
@@ -155,14 +166,15 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     ] {
         let _ = writeln!(
             s,
-            "| {label} | {:.4} | {:.4} | {:.4} | {:.4} |",
+            "| {label} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
             g(v, "eigen_rms"),
+            g(v, "eigen_weighted_rms"),
             g(v, "roll_rms").to_degrees(),
             g(v, "steer_rms").to_degrees(),
             g(v, "speed_rms")
         );
     }
-    let _ = writeln!(s, "\nPer run (roll RMS in deg; weave eigenvalues in 1/s):\n\n| run | window start (s) | speed over the eigenvalue fit (m/s) | measured weave | predicted before | predicted after | roll before | roll after | roll after, held out |\n|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "\nPer kick ({roll} RMS in {unit}; weave eigenvalues in 1/s):\n\n| run | window start (s) | speed over the eigenvalue fit (m/s) | measured weave | predicted before | predicted after | {roll} before | {roll} after | {roll} after, held out |\n|---|---|---|---|---|---|---|---|---|");
     for (i, seg) in o.segments.iter().enumerate() {
         let _ = writeln!(
             s,
@@ -179,7 +191,42 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
             id.after.held_out[i].roll_rms.to_degrees()
         );
     }
-    let _ = writeln!(s, "\n## Plots\n\n* `continuation.svg`: weave eigenvalue over speed, model before (thin) and after (thick), with each measured eigenvalue on its speed interval.\n* `run_residuals.svg`: measured and simulated roll, steer and speed of a typical run (median error), before and after.\n");
+    // Each run (log) held out: its kicks predicted with the values fitted
+    // to the other runs.
+    let mut runs: Vec<&str> = Vec::new();
+    for seg in &o.segments {
+        if !runs.contains(&seg.run.as_str()) {
+            runs.push(&seg.run);
+        }
+    }
+    let pooled = |errs: &[bikedyn_runtime::identify::SegmentError], run: &str| {
+        let (mut ss, mut n) = (0.0, 0usize);
+        for (e, seg) in errs.iter().zip(&o.segments) {
+            if seg.run == run {
+                ss += e.roll_rms * e.roll_rms * e.channel_n[0] as f64;
+                n += e.channel_n[0];
+            }
+        }
+        (ss / n.max(1) as f64).sqrt()
+    };
+    let _ = writeln!(s, "\nEach run held out ({roll} RMS in {unit}; `after, held out`: the run's kicks with the effect values fitted to the other runs, only their initial states fitted to it):\n\n| run | kicks | before | after | after, held out |\n|---|---|---|---|---|");
+    for run in &runs {
+        let _ = writeln!(
+            s,
+            "| {run} | {} | {:.3} | {:.3} | {:.3} |",
+            o.segments.iter().filter(|x| x.run == *run).count(),
+            pooled(&id.before.errors, run).to_degrees(),
+            pooled(&id.after.errors, run).to_degrees(),
+            pooled(&id.after.held_out, run).to_degrees()
+        );
+    }
+    if !o.eigen_excluded.is_empty() {
+        let _ = writeln!(s, "\nKicks kept out of the eigenvalue figures:\n");
+        for e in &o.eigen_excluded {
+            let _ = writeln!(s, "* {} at {:.2} s: {}", e.run, e.window_start, e.reason);
+        }
+    }
+    let _ = writeln!(s, "\n## Plots\n\n* `continuation.svg`: weave eigenvalue over speed, model before (thin) and after (thick), with each measured eigenvalue on its speed interval.\n* `run_residuals.svg`: measured and simulated {roll}, steer and speed of a typical kick (median error), before and after.\n");
     if !o.skipped.is_empty() {
         let _ = writeln!(s, "## Skipped\n");
         for k in &o.skipped {

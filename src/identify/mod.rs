@@ -18,6 +18,7 @@ mod markdown;
 pub mod predict;
 pub mod report;
 pub mod segments;
+pub mod weave_errors;
 
 pub use error::IdentifyError;
 
@@ -25,7 +26,7 @@ use crate::bicycle::Bicycle;
 use crate::fit::{run_fit_in, FitOptions};
 use crate::progress::{OnProgress, Progress};
 use crate::registry::BuiltIn;
-use bikedyn_runtime::identify::{Candidate, Identification, IdentifyOptions as FitSettings, Segment};
+use bikedyn_runtime::identify::{Candidate, Identification, IdentifyOptions as FitSettings, RollChannel, Segment};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 use candidates::{candidates, identification_models};
 use diagnosis::{diagnose, Finding};
@@ -80,7 +81,8 @@ impl Default for IdentifyRequest {
 pub struct Plan<R: ModelRegistry = BuiltIn> {
     /// The bicycle, resolved.
     pub bike: Bicycle<R>,
-    /// The nonlinear free-speed model the fits run through.
+    /// The nonlinear model the fits run through: free speed for
+    /// thesis-style runs, the driven twin for logs with the speed imposed.
     pub model: &'static ModelInfo,
     /// Its driven-speed twin (same effects), for the weave predictions.
     pub driven_model: &'static ModelInfo,
@@ -89,6 +91,9 @@ pub struct Plan<R: ModelRegistry = BuiltIn> {
     pub alternative_model: Option<&'static ModelInfo>,
     /// The candidate effects.
     pub candidates: Vec<Candidate>,
+    /// The inputs are logs whose speed a motor held: the model's speed is
+    /// imposed (the measured speed over each window), not free.
+    pub speed_imposed: bool,
 }
 
 /// Everything identification found, and what the report needs; its models
@@ -120,8 +125,22 @@ pub struct Outcome<R: ModelRegistry = BuiltIn> {
     pub seconds: f64,
     /// Mean |steer rate| of each segment in the fitted simulation (rad/s).
     pub steer_rate: Vec<f64>,
+    /// Whether each segment's measured eigenvalue counts as a weave in the
+    /// eigenvalue figures ([`weave_errors`]).
+    pub weave_kicks: Vec<bool>,
+    /// The kicks kept out of the eigenvalue figures, with the reason.
+    pub eigen_excluded: Vec<weave_errors::Excluded>,
+    /// The model's speed was imposed (logs of a motor-held speed).
+    pub speed_imposed: bool,
     run_plot: Option<RunPlot>,
     registry: PhantomData<R>,
+}
+
+impl<R: ModelRegistry> Outcome<R> {
+    /// What the segments' roll channel measures (angle or rate).
+    pub fn roll_channel(&self) -> RollChannel {
+        self.segments.first().map_or(RollChannel::Angle, |s| s.roll_channel)
+    }
 }
 
 /// Choose the models and candidates for a request: the first half of
@@ -135,8 +154,9 @@ pub fn plan(request: &IdentifyRequest) -> Result<Plan, IdentifyError> {
 /// (e.g. an effect of a user's own build script).
 pub fn plan_in<R: ModelRegistry>(request: &IdentifyRequest) -> Result<Plan<R>, IdentifyError> {
     let bike = Bicycle::<R>::resolve_in(&request.bike)?;
-    let (model, driven_model, alternative_model) = identification_models(&bike)?;
-    let candidates = candidates(model, alternative_model, &bike, &request.effects)?;
+    let speed_imposed = speed_imposed(&request.inputs)?;
+    let (model, driven_model, alternative_model) = identification_models(&bike, speed_imposed)?;
+    let candidates = candidates(model, alternative_model, &bike, &request.effects, speed_imposed)?;
     // A conclusion ("no effect warranted") means something only when
     // effects were tried.
     if candidates.is_empty() {
@@ -152,7 +172,30 @@ pub fn plan_in<R: ModelRegistry>(request: &IdentifyRequest) -> Result<Plan<R>, I
         driven_model,
         alternative_model,
         candidates,
+        speed_imposed,
     })
+}
+
+/// Whether the inputs are TU Delft logs (the hub motor holds the speed, so
+/// it is imposed on the model) rather than thesis-style runs (free speed
+/// after the release). Both in one request is an error.
+fn speed_imposed(inputs: &[PathBuf]) -> Result<bool, IdentifyError> {
+    use bikedyn_runtime::experiment::{classify, Input};
+    let (mut logs, mut runs) = (Vec::new(), Vec::new());
+    for path in inputs {
+        for input in classify(path)? {
+            match input {
+                Input::Log(p) => logs.push(p),
+                Input::Set { .. } => runs.push(path.clone()),
+            }
+        }
+    }
+    if !logs.is_empty() && !runs.is_empty() {
+        return Err(IdentifyError::MixedInputs {
+            inputs: runs.iter().chain(&logs).map(|p| p.display().to_string()).collect(),
+        });
+    }
+    Ok(!logs.is_empty())
 }
 
 /// Run identification on the inputs: [`plan`], then [`run_plan`].
@@ -184,6 +227,7 @@ pub fn run_plan<R: ModelRegistry>(
         driven_model: driven,
         alternative_model: alt,
         candidates: cands,
+        ..
     } = plan;
     let (free, driven, alt) = (*free, *driven, *alt);
     let fit_options = FitOptions {
@@ -205,8 +249,16 @@ pub fn run_plan<R: ModelRegistry>(
     // join the effects as candidates.
     let speeds: Vec<f64> = segs.iter().map(|s| s.mean_speed).collect();
     let predicted_before = predict(driven, bike, &BTreeMap::new(), &speeds)?;
+    // Only the kicks whose measured eigenvalue is a weave count in the
+    // eigenvalue figures and the screening of corrections.
+    let (weave_kicks, eigen_excluded) = weave_errors::weave_kicks(&segs, &predicted_before);
+    let weave_predictions: Vec<Option<[f64; 2]>> = predicted_before
+        .iter()
+        .zip(&weave_kicks)
+        .map(|(p, &k)| if k { *p } else { None })
+        .collect();
     let mut cands = cands.clone();
-    for c in corrections::screen(free, driven, bike, &segs, &predicted_before, request.corrections)? {
+    for c in corrections::screen(free, driven, bike, &segs, &weave_predictions, request.corrections)? {
         cands.push(corrections::candidate(free, &c));
     }
     let cands = &cands;
@@ -253,7 +305,7 @@ pub fn run_plan<R: ModelRegistry>(
     // Held out: each segment predicted with the values fitted without its fold.
     let mut predicted_held_out = vec![None; segs.len()];
     for (f, vals) in id.after.fold_values.iter().enumerate() {
-        let idx: Vec<usize> = (0..segs.len()).filter(|&s| s % id.folds == f).collect();
+        let idx: Vec<usize> = (0..segs.len()).filter(|&s| id.fold_of[s] == f).collect();
         let sp: Vec<f64> = idx.iter().map(|&s| speeds[s]).collect();
         let fold_vals = effect_values(&id.after, vals, cands);
         for (k, &s) in idx.iter().enumerate() {
@@ -282,7 +334,19 @@ pub fn run_plan<R: ModelRegistry>(
         })
         .unwrap_or_default();
     let models: Vec<&ModelInfo> = std::iter::once(free).chain(alt).collect();
-    let findings = diagnose(&models, &segs, &predicted_before, &id.before.errors, &bias);
+    let bias = if segs.iter().all(|s| s.roll_channel == RollChannel::Angle) {
+        bias
+    } else {
+        Vec::new()
+    };
+    let findings = diagnose(
+        &models,
+        &segs,
+        &predicted_before,
+        &id.before.errors,
+        &bias,
+        plan.speed_imposed,
+    );
     Ok(Outcome {
         identification: id,
         segments: segs,
@@ -297,6 +361,9 @@ pub fn run_plan<R: ModelRegistry>(
         driven_model: driven.name,
         seconds: start.elapsed().as_secs_f64(),
         steer_rate,
+        weave_kicks,
+        eigen_excluded,
+        speed_imposed: plan.speed_imposed,
         run_plot,
         registry: PhantomData,
     })

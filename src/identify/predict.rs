@@ -81,7 +81,7 @@ pub fn predict<R: ModelRegistry>(
     if let Some(alt) = values
         .keys()
         .any(|k| driven.parameter(k).is_none())
-        .then(|| identification_models(bike).ok().and_then(|m| m.2))
+        .then(|| identification_models(bike, false).ok().and_then(|m| m.2))
         .flatten()
     {
         return R::with_model(

@@ -5,30 +5,17 @@
 use super::candidates::identification_models;
 use super::markdown::report_markdown;
 use super::predict::{linear_equivalent, predict};
+use super::weave_errors::{eigen_rms, eigen_weighted_rms};
 use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic};
-use bikedyn_runtime::identify::{pooled_rms, Candidate, Segment};
+use bikedyn_runtime::identify::{pooled_rms, Candidate};
 use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
-
-/// RMS of |measured - predicted| weave eigenvalue (1/s) over segments.
-pub fn eigen_rms(segs: &[Segment], pred: &[Option<[f64; 2]>]) -> f64 {
-    let d: Vec<f64> = segs
-        .iter()
-        .zip(pred)
-        .filter_map(|(s, p)| {
-            let (m, _) = s.weave?;
-            let p = (*p)?;
-            Some((m[0] - p[0]).powi(2) + (m[1] - p[1]).powi(2))
-        })
-        .collect();
-    (d.iter().sum::<f64>() / d.len().max(1) as f64).sqrt()
-}
 
 fn display_name(c: &Candidate) -> String {
     if c.speed_decay {
@@ -48,14 +35,16 @@ pub(super) fn errors_json<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Valu
         &o.predicted_before
     };
     json!({
-        "eigen_rms": eigen_rms(&o.segments, pred),
+        "eigen_rms": eigen_rms(&o.segments, pred, &o.weave_kicks),
+        "eigen_weighted_rms": eigen_weighted_rms(&o.segments, pred, &o.weave_kicks),
         "median_run_roll_rms": median(fit.errors.iter().map(|e| e.roll_rms)),
         "median_run_steer_rms": median(fit.errors.iter().map(|e| e.steer_rms)),
         "roll_rms": pooled_rms(&fit.errors, 0),
         "steer_rms": pooled_rms(&fit.errors, 1),
         "speed_rms": pooled_rms(&fit.errors, 2),
         "held_out": {
-            "eigen_rms": eigen_rms(&o.segments, held_pred),
+            "eigen_rms": eigen_rms(&o.segments, held_pred, &o.weave_kicks),
+            "eigen_weighted_rms": eigen_weighted_rms(&o.segments, held_pred, &o.weave_kicks),
             "roll_rms": pooled_rms(&fit.held_out, 0),
             "steer_rms": pooled_rms(&fit.held_out, 1),
             "speed_rms": pooled_rms(&fit.held_out, 2),
@@ -68,6 +57,7 @@ pub(super) fn errors_json<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Valu
             "speed_rms": fit.errors[i].speed_rms,
             "held_out_roll_rms": fit.held_out[i].roll_rms,
             "measured_weave": s.weave.map(|w| w.0),
+            "weave_counted": o.weave_kicks[i],
             "predicted_weave": pred[i],
         })).collect::<Vec<_>>(),
     })
@@ -129,8 +119,11 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
         "error_after": errors_json(o, true),
         "model": o.model,
         "driven_model": o.driven_model,
+        "roll_channel": o.roll_channel(),
+        "speed_imposed": o.speed_imposed,
         "kicks": o.segments.len(),
         "skipped": o.skipped,
+        "eigen_excluded": o.eigen_excluded,
         "findings": o.findings,
         "weights": id.weights,
         "folds": id.folds,
@@ -155,9 +148,10 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     let b = errors_json(o, false);
     let a = errors_json(o, true);
     let mut s = String::new();
+    let (roll, unit) = (o.roll_channel().describe(), o.roll_channel().unit_deg());
     let _ = writeln!(
         s,
-        "kicks: {} from {} runs ({} skipped); model {}",
+        "kicks: {} from {} runs ({} skipped); model {}{}",
         o.segments.len(),
         o.segments
             .iter()
@@ -165,8 +159,20 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
             .collect::<std::collections::BTreeSet<_>>()
             .len(),
         o.skipped.len(),
-        o.model
+        o.model,
+        if o.speed_imposed { " (speed imposed)" } else { "" }
     );
+    // Why any run or kick was left out, in the summary itself.
+    for why in &o.skipped {
+        let _ = writeln!(s, "skipped: {why}");
+    }
+    for e in &o.eigen_excluded {
+        let _ = writeln!(
+            s,
+            "not a weave (kept out of the eigenvalue figures): {} at {:.2} s: {}",
+            e.run, e.window_start, e.reason
+        );
+    }
     let sel = if id.selected.is_empty() {
         "no effect warranted".to_string()
     } else {
@@ -187,9 +193,13 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     );
     let _ = writeln!(
         s,
-        "error before -> after: weave eigenvalue RMS {:.3} -> {:.3} 1/s, roll RMS {:.3} -> {:.3} deg (median run {:.3} -> {:.3}), steer RMS {:.3} -> {:.3} deg",
+        "error before -> after: weave eigenvalue RMS {:.3} -> {:.3} 1/s (weighted {:.3} -> {:.3}; {} of {} kicks a weave), {roll} RMS {:.3} -> {:.3} {unit} (median run {:.3} -> {:.3}), steer RMS {:.3} -> {:.3} deg",
         b["eigen_rms"].as_f64().unwrap_or(f64::NAN),
         a["eigen_rms"].as_f64().unwrap_or(f64::NAN),
+        b["eigen_weighted_rms"].as_f64().unwrap_or(f64::NAN),
+        a["eigen_weighted_rms"].as_f64().unwrap_or(f64::NAN),
+        o.weave_kicks.iter().filter(|&&k| k).count(),
+        o.segments.len(),
         b["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
         a["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
         b["median_run_roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
@@ -199,7 +209,7 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     );
     let _ = write!(
         s,
-        "held-out runs: weave RMS {:.3} -> {:.3} 1/s, roll RMS {:.3} -> {:.3} deg ({} folds, {} simulations, {:.1} s)",
+        "held-out runs: weave RMS {:.3} -> {:.3} 1/s, {roll} RMS {:.3} -> {:.3} {unit} ({} folds, {} simulations, {:.1} s)",
         b["held_out"]["eigen_rms"].as_f64().unwrap_or(f64::NAN),
         a["held_out"]["eigen_rms"].as_f64().unwrap_or(f64::NAN),
         b["held_out"]["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
@@ -258,7 +268,7 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
     // Continuation diagram before and after.
     let vmax = o.segments.iter().map(|s| s.speed_interval[1]).fold(7.0, f64::max) + 1.0;
     let speeds: Vec<f64> = (1..=200).map(|i| vmax * i as f64 / 200.0).collect();
-    let (_, driven, _) = identification_models(&bike)?;
+    let (_, driven, _) = identification_models(&bike, false)?;
     let curve = |vals: &BTreeMap<String, f64>| -> Result<Vec<(f64, f64, f64)>, IdentifyError> {
         let pts: Vec<(f64, f64, f64)> = predict(driven, &bike, vals, &speeds)?
             .into_iter()
@@ -336,8 +346,8 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
                 ),
                 &[
                     Channel {
-                        name: "roll",
-                        unit: "deg",
+                        name: s.roll_channel.describe(),
+                        unit: s.roll_channel.unit_deg(),
                         t: &s.t,
                         measured: &mr,
                         before: &br,

@@ -13,11 +13,12 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
     let mut segs = Vec::new();
     let mut skipped = Vec::new();
     for r in &out.reports {
+        if let Some(log) = &r.log {
+            log_segments(r, log, &mut segs, &mut skipped);
+            continue;
+        }
         let (Some(ang), Some(sp)) = (&r.angles, &r.speed) else {
-            skipped.push(format!(
-                "{}: no angles or speed record (TU Delft logs are not identified yet)",
-                r.run.display()
-            ));
+            skipped.push(format!("{}: no angle and speed record", r.run.display()));
             continue;
         };
         let offset = r.clock_offset.map_or(0.0, |c| c.value);
@@ -71,6 +72,7 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
                         s.mean_speed = k.mean_speed;
                         s.speed_interval = k.speed_interval;
                     }
+                    s.weave_r2 = k.chosen_fit().map(|f| f.r2);
                     segs.push(s)
                 }
                 _ => skipped.push(format!(
@@ -88,6 +90,71 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
     }
     (segs, skipped)
 }
+
+/// The segments of a TU Delft log: each kick's free-response window as the
+/// measured-run pipeline found it (the next kick, or the decay into noise,
+/// ends it; after the decay the person running beside the riderless
+/// bicycle may already hold it). The roll channel is the gyro's roll rate
+/// (the log's lean angle is a filter's estimate, distorted by the lateral
+/// acceleration of the kick); steer is the fork angle, the angle the
+/// model's steer is; speed is the log's, held by the hub motor, so these
+/// segments are simulated with the speed imposed.
+///
+/// Signs: the logs have roll and fork angle of the same sign when the
+/// bicycle steers into the lean (benchmark convention, steer positive to
+/// the right), bikedyn's models have steer positive to the left: the fork
+/// angle is negated. (A mirror image of both would be the same motion for
+/// the symmetric models; only a lateral mass offset would flip.)
+fn log_segments(
+    r: &bikedyn_runtime::experiment::RunReport,
+    log: &bikedyn_runtime::experiment::read::TudelftLog,
+    segs: &mut Vec<Segment>,
+    skipped: &mut Vec<String>,
+) {
+    for k in &r.kicks {
+        let [w0, w1] = k.window;
+        let idx: Vec<usize> = (0..log.t.len()).filter(|&i| log.t[i] >= w0 && log.t[i] <= w1).collect();
+        let pick = |x: &[f64]| idx.iter().map(|&i| x[i]).collect::<Vec<f64>>();
+        let t: Vec<f64> = idx.iter().map(|&i| log.t[i] - w0).collect();
+        let steer: Vec<f64> = idx.iter().map(|&i| -log.fork[i]).collect();
+        let weave = k.chosen_fit().map(|f| (f.eigenvalue, f.eigenvalue_stderr));
+        let seg = Segment::with_roll_rate(
+            r.run.display().to_string(),
+            w0,
+            t.clone(),
+            pick(&log.roll),
+            pick(&log.roll_rate),
+            steer,
+            t,
+            pick(&log.speed),
+            weave,
+        );
+        match seg {
+            Some(mut s) if s.duration() >= MIN_LOG_WINDOW => {
+                if k.mean_speed.is_finite() && k.speed_interval.iter().all(|v| v.is_finite()) {
+                    s.mean_speed = k.mean_speed;
+                    s.speed_interval = k.speed_interval;
+                }
+                s.weave_r2 = k.chosen_fit().map(|f| f.r2);
+                segs.push(s)
+            }
+            _ => skipped.push(format!(
+                "{}: kick at {:.2} s has no usable window ({:.2}-{:.2} s)",
+                r.run.display(),
+                k.kick_time,
+                w0,
+                w1
+            )),
+        }
+    }
+    if r.kicks.is_empty() {
+        skipped.push(format!("{}: no kick found", r.run.display()));
+    }
+}
+
+/// Shortest window of a log's kick (s): about a weave period of a heavily
+/// damped response (the assisted bicycle's decays within one or two).
+const MIN_LOG_WINDOW: f64 = 0.4;
 
 /// Longest identification window after a kick (s): a few weave periods and
 /// long enough for the speed to fall measurably; longer costs simulation

@@ -127,6 +127,9 @@ pub struct RunReport {
     /// Speed profile (DAQ clock), for plots.
     #[serde(skip)]
     pub speed: Option<SpeedProfile>,
+    /// The series of a TU Delft log (one clock), for identification.
+    #[serde(skip)]
+    pub log: Option<TudelftLog>,
 }
 
 /// Why a run could not be processed.
@@ -357,6 +360,7 @@ pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOpti
         notes,
         angles: Some(ang),
         speed: Some(sp),
+        log: None,
     }
 }
 
@@ -410,6 +414,7 @@ pub fn process_tudelft(log: &TudelftLog, opt: &PipelineOptions) -> RunReport {
         notes,
         angles: None,
         speed: None,
+        log: Some(log.clone()),
     }
 }
 

@@ -16,12 +16,22 @@
 //!   its noise scale ([`Weights`]).
 //! * **Fitting.** Effect parameters are shared by all segments; the initial
 //!   states are per-segment nuisance parameters. Both are fitted together by
-//!   Levenberg-Marquardt (`levenberg-marquardt` crate). Sensitivities are
+//!   Levenberg-Marquardt on the block-arrow structure of the problem (a
+//!   segment depends only on the shared parameters and its own initial
+//!   state): the normal equations are reduced to the shared parameters by
+//!   eliminating each segment's 5x5 block, so an iteration costs linearly in
+//!   the number of kicks (a dense solver's QR grows with their cube, and a
+//!   hundred kicks of the TU Delft logs took minutes per iteration; the
+//!   `levenberg-marquardt` crate has no sparse path). Sensitivities are
 //!   forward differences of whole simulations at tight tolerance (rtol
 //!   1e-8), with a difference step (1e-3 of the parameter's scale) far
-//!   above the integration error. The Jacobian is block-sparse: a segment
-//!   depends only on the shared parameters and its own initial state, so a
-//!   column costs one simulation of one segment. Segments run in parallel.
+//!   above the integration error; a column costs one simulation of one
+//!   segment. Segments run in parallel.
+//! * **Roll channel and speed.** Thesis-style runs measure the roll angle
+//!   and leave the speed free after the release; a log of a gyro-equipped
+//!   bicycle whose motor holds the speed (the TU Delft logs) measures the
+//!   roll rate ([`RollChannel`]), and its segments are simulated with the
+//!   driven-speed model, the speed nuisance pinned by the measured speed.
 //! * **Uncertainty.** Standard errors come from `(J^T J)^-1 s^2`, with `s^2`
 //!   the residual variance, inflated by `(1 + rho) / (1 - rho)` for the lag-1
 //!   autocorrelation `rho` of the residuals: 120 Hz samples of a smooth
@@ -31,7 +41,7 @@
 //!   Bayesian information criterion computed with the effective sample size
 //!   (`n (1 - rho) / (1 + rho)` per channel, from the current model's
 //!   residuals) *and* lowers the cross-validated error over held-out runs
-//!   (k-fold by run, the effect fitted on the other runs and only the
+//!   (k-fold by run or log, the effect fitted on the other runs and only the
 //!   held-out run's initial state fitted to it), *and* its dissipative
 //!   parameters are positive (a negative damper is not physics). Sensor
 //!   nuisances (mounting misalignment, clock offset) are estimated per set by
@@ -39,8 +49,7 @@
 
 use crate::model::MultibodyModel;
 use crate::simulate::{simulate, Events, InitialConditions, Inputs, Method, SimOptions};
-use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
-use nalgebra::{DMatrix, DVector, Dyn, Owned};
+use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::sync::Mutex;
@@ -51,6 +60,35 @@ pub const NUISANCE: usize = 5;
 /// Scales of the nuisance parameters (difference steps and LM scaling).
 const NUISANCE_SCALE: [f64; NUISANCE] = [0.01, 0.01, 0.1, 0.1, 0.1];
 
+/// What the roll channel of a segment measures: the roll angle (the
+/// thesis's IMU orientation) or the roll rate (a gyro, as on the TU Delft
+/// steer-by-wire bicycle, whose roll angle is a filter's estimate).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RollChannel {
+    /// Roll angle (rad).
+    Angle,
+    /// Roll rate (rad/s).
+    Rate,
+}
+
+impl RollChannel {
+    /// Name of the channel in reports.
+    pub fn describe(self) -> &'static str {
+        match self {
+            RollChannel::Angle => "roll",
+            RollChannel::Rate => "roll rate",
+        }
+    }
+    /// Unit of the channel in reports (degrees).
+    pub fn unit_deg(self) -> &'static str {
+        match self {
+            RollChannel::Angle => "deg",
+            RollChannel::Rate => "deg/s",
+        }
+    }
+}
+
 /// One measured free response.
 #[derive(Clone, Debug, Serialize)]
 pub struct Segment {
@@ -60,8 +98,11 @@ pub struct Segment {
     pub t0: f64,
     /// Sample times from the window start (s).
     pub t: Vec<f64>,
-    /// Measured roll (rad, positive leaning right).
+    /// Measured roll channel, positive leaning right: the roll angle (rad)
+    /// or, for [`RollChannel::Rate`], the roll rate (rad/s).
     pub roll: Vec<f64>,
+    /// What `roll` measures.
+    pub roll_channel: RollChannel,
     /// Measured steer (rad, positive turning left).
     pub steer: Vec<f64>,
     /// Speed sample times from the window start (s).
@@ -76,6 +117,8 @@ pub struct Segment {
     pub speed_interval: [f64; 2],
     /// Measured weave eigenvalue and its standard error (1/s), when fitted.
     pub weave: Option<([f64; 2], [f64; 2])>,
+    /// Coefficient of determination of that eigenvalue fit.
+    pub weave_r2: Option<f64>,
 }
 
 impl Segment {
@@ -121,6 +164,7 @@ impl Segment {
             t0,
             t,
             roll,
+            roll_channel: RollChannel::Angle,
             steer,
             speed_t,
             speed,
@@ -128,7 +172,35 @@ impl Segment {
             mean_speed,
             speed_interval: [lo, hi],
             weave,
+            weave_r2: None,
         })
+    }
+
+    /// A segment whose roll channel is a gyro's roll rate (rad/s): the
+    /// initial roll comes from `roll_angle` (a filter's estimate, used only
+    /// as the starting value of that nuisance), the initial roll rate from
+    /// the rate itself.
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_roll_rate(
+        run: String,
+        t0: f64,
+        t: Vec<f64>,
+        roll_angle: Vec<f64>,
+        roll_rate: Vec<f64>,
+        steer: Vec<f64>,
+        speed_t: Vec<f64>,
+        speed: Vec<f64>,
+        weave: Option<([f64; 2], [f64; 2])>,
+    ) -> Option<Segment> {
+        let mut s = Segment::new(run, t0, t, roll_angle, steer, speed_t, speed, weave)?;
+        if roll_rate.len() != s.t.len() || roll_rate.iter().any(|x| !x.is_finite()) {
+            return None;
+        }
+        let k = s.t.iter().take_while(|&&x| x <= 0.06).count().clamp(1, s.t.len());
+        s.initial[2] = roll_rate[..k].iter().sum::<f64>() / k as f64;
+        s.roll = roll_rate;
+        s.roll_channel = RollChannel::Rate;
+        Some(s)
     }
 
     /// Window length (s).
@@ -317,9 +389,16 @@ fn simulate_segment<M: MultibodyModel>(
         })
         .map_err(|e| e.to_string())?;
     use crate::model::CoordinateRole as R;
-    let roll = sim
-        .require_coordinate(R::Roll, "identification residuals")
-        .map_err(|e| e.to_string())?;
+    let roll = match seg.roll_channel {
+        RollChannel::Angle => sim.require_coordinate(R::Roll, "identification residuals"),
+        RollChannel::Rate => sim.rate_of(R::Roll).ok_or(crate::model::MissingRole {
+            model: sim.model,
+            kind: "coordinate",
+            role: R::Roll.describe(),
+            job: "identification residuals",
+        }),
+    }
+    .map_err(|e| e.to_string())?;
     let steer = sim
         .require_coordinate(R::Steer, "identification residuals")
         .map_err(|e| e.to_string())?;
@@ -520,85 +599,168 @@ impl Problem<'_, '_> {
     }
 }
 
-impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
-    type ResidualStorage = Owned<f64, Dyn>;
-    type JacobianStorage = Owned<f64, Dyn, Dyn>;
-    type ParameterStorage = Owned<f64, Dyn>;
-    fn set_params(&mut self, x: &DVector<f64>) {
-        self.unpack(x.as_slice());
-    }
-    fn params(&self) -> DVector<f64> {
-        DVector::from_vec(self.pack())
-    }
-    fn residuals(&self) -> Option<DVector<f64>> {
-        let r = self.all_residuals()?;
-        let prior = self.prior_residuals();
-        Some(DVector::from_iterator(
-            r.iter().map(Vec::len).sum::<usize>() + prior.len(),
-            r.into_iter().flatten().chain(prior),
-        ))
-    }
-    fn jacobian(&self) -> Option<DMatrix<f64>> {
+/// The Jacobian of one segment: the columns of the free shared (effect)
+/// parameters `a` (rows x k, or no column) and of its own free initial
+/// state `b` (rows x NUISANCE, or no column). A segment depends on nothing
+/// else, so the whole Jacobian is these blocks and zeros.
+struct SegmentJacobian {
+    a: DMatrix<f64>,
+    b: DMatrix<f64>,
+}
+
+impl Problem<'_, '_> {
+    /// Forward-difference Jacobian blocks at the current point, one per
+    /// segment taking part; a column costs one simulation of one segment.
+    fn jacobian_blocks(&self) -> Option<Vec<SegmentJacobian>> {
         let base = self.all_residuals()?;
-        let rows: Vec<usize> = base.iter().map(Vec::len).collect();
-        let offsets: Vec<usize> = rows
-            .iter()
-            .scan(0, |o, &n| {
-                let r = *o;
-                *o += n;
-                Some(r)
-            })
-            .collect();
-        let k = self.setup.k();
-        // Columns: (segment position, free-parameter column, which parameter).
+        let k = if self.free == Free::Nuisance { 0 } else { self.setup.k() };
+        let nn = if self.free == Free::Shared { 0 } else { NUISANCE };
+        // Columns: (segment position, shared parameter or nuisance j).
         let mut tasks = Vec::new();
-        for (p, _) in self.segs.iter().enumerate() {
-            if self.free != Free::Nuisance {
-                for j in 0..k {
-                    tasks.push((p, j, None));
-                }
-            }
-            if self.free != Free::Shared {
-                let c0 = if self.free == Free::All { k } else { 0 };
-                for j in 0..NUISANCE {
-                    tasks.push((p, c0 + NUISANCE * p + j, Some(j)));
-                }
-            }
+        for p in 0..self.segs.len() {
+            tasks.extend((0..k).map(|j| (p, false, j)));
+            tasks.extend((0..nn).map(|j| (p, true, j)));
         }
-        let cols: Option<Vec<(usize, usize, Vec<f64>)>> = tasks
+        let cols: Option<Vec<(usize, bool, usize, Vec<f64>)>> = tasks
             .par_iter()
-            .map(|&(p, col, nj)| {
+            .map(|&(p, nuisance, j)| {
                 let s = self.segs[p];
                 let mut g = self.g.clone();
                 let mut x0 = self.x0[s];
-                let h = match nj {
-                    None => {
-                        let h = 1e-3 * self.setup.parameters[col].scale.max(g[col].abs());
-                        g[col] += h;
-                        h
-                    }
-                    Some(j) => {
-                        let h = 1e-3 * NUISANCE_SCALE[j].max(x0[j].abs());
-                        x0[j] += h;
-                        h
-                    }
+                let h = if nuisance {
+                    let h = 1e-3 * NUISANCE_SCALE[j].max(x0[j].abs());
+                    x0[j] += h;
+                    h
+                } else {
+                    let h = 1e-3 * self.setup.parameters[j].scale.max(g[j].abs());
+                    g[j] += h;
+                    h
                 };
                 let r = self.setup.residuals(&g, s, &x0).ok()?;
-                Some((p, col, r.iter().zip(&base[p]).map(|(a, b)| (a - b) / h).collect()))
+                Some((
+                    p,
+                    nuisance,
+                    j,
+                    r.iter().zip(&base[p]).map(|(a, b)| (a - b) / h).collect(),
+                ))
             })
             .collect();
-        let data_rows: usize = rows.iter().sum();
-        let priors = self.prior_rows();
-        let mut jac = DMatrix::zeros(data_rows + priors.len(), self.n_free());
-        for (p, col, d) in cols? {
-            for (i, v) in d.into_iter().enumerate() {
-                jac[(offsets[p] + i, col)] = v;
+        let mut blocks: Vec<SegmentJacobian> = base
+            .iter()
+            .map(|r| SegmentJacobian {
+                a: DMatrix::zeros(r.len(), k),
+                b: DMatrix::zeros(r.len(), nn),
+            })
+            .collect();
+        for (p, nuisance, j, d) in cols? {
+            let m = if nuisance { &mut blocks[p].b } else { &mut blocks[p].a };
+            m.column_mut(j).copy_from_slice(&d);
+        }
+        Some(blocks)
+    }
+
+    /// Scale of each free parameter in packed order (steps are measured
+    /// against it).
+    fn scales(&self) -> Vec<f64> {
+        let mut x = Vec::with_capacity(self.n_free());
+        if self.free != Free::Nuisance {
+            x.extend(self.setup.parameters.iter().map(|p| p.scale));
+        }
+        if self.free != Free::Shared {
+            for _ in &self.segs {
+                x.extend(NUISANCE_SCALE);
             }
         }
-        for (row, (col, sd)) in priors.into_iter().enumerate() {
-            jac[(data_rows + row, col)] = 1.0 / sd;
+        x
+    }
+}
+
+/// The normal equations of the block-arrow least-squares problem, reduced
+/// to the shared parameters. With `J = [A_i B_i]` per segment, `J^T J` has a
+/// shared block `sum A_i^T A_i` (plus the priors), a 5x5 block `B_i^T B_i`
+/// per segment, and couplings `A_i^T B_i`; eliminating each segment's block
+/// (Schur complement) leaves a k x k system. Its cost grows linearly with
+/// the number of kicks, where a dense QR of `J` grows with their cube (a
+/// hundred kicks of the TU Delft logs: 600 columns, minutes per iteration).
+struct Normal {
+    /// Reduced shared matrix `S` and right-hand side.
+    s: DMatrix<f64>,
+    rhs: DVector<f64>,
+    /// Per segment: the damped `C_i^-1`, `E_i = A_i^T B_i` and `-B_i^T r_i`.
+    segs: Vec<(DMatrix<f64>, DMatrix<f64>, DVector<f64>)>,
+}
+
+impl Normal {
+    /// Build for damping `lambda` (Marquardt: the diagonal scaled by
+    /// `1 + lambda`). `prior` holds `(column, sd, residual)` of the priors.
+    fn new(
+        blocks: &[SegmentJacobian],
+        res: &[Vec<f64>],
+        prior: &[(usize, f64, f64)],
+        k: usize,
+        lambda: f64,
+    ) -> Option<Normal> {
+        let mut hgg = DMatrix::<f64>::zeros(k, k);
+        let mut bg = DVector::<f64>::zeros(k);
+        for (blk, r) in blocks.iter().zip(res) {
+            let r = DVector::from_column_slice(r);
+            if k > 0 {
+                hgg += blk.a.tr_mul(&blk.a);
+                bg -= blk.a.tr_mul(&r);
+            }
         }
-        Some(jac)
+        for &(j, sd, pr) in prior {
+            hgg[(j, j)] += 1.0 / (sd * sd);
+            bg[j] -= pr / sd;
+        }
+        let damp = |m: &mut DMatrix<f64>| {
+            for j in 0..m.nrows() {
+                let d = m[(j, j)];
+                m[(j, j)] = d + lambda * d.max(1e-12);
+            }
+        };
+        damp(&mut hgg);
+        let mut s = hgg;
+        let mut rhs = bg;
+        let mut segs = Vec::with_capacity(blocks.len());
+        for (blk, r) in blocks.iter().zip(res) {
+            let r = DVector::from_column_slice(r);
+            let mut c = blk.b.tr_mul(&blk.b);
+            damp(&mut c);
+            let c_inv = if c.nrows() == 0 { c } else { c.try_inverse()? };
+            let e = blk.a.tr_mul(&blk.b);
+            let bi = -blk.b.tr_mul(&r);
+            if k > 0 && c_inv.nrows() > 0 {
+                let ec = &e * &c_inv;
+                s -= &ec * e.transpose();
+                rhs -= &ec * &bi;
+            }
+            segs.push((c_inv, e, bi));
+        }
+        Some(Normal { s, rhs, segs })
+    }
+
+    /// The step in packed order (shared parameters, then each segment's
+    /// initial state).
+    fn step(&self) -> Option<Vec<f64>> {
+        let dg = if self.s.nrows() > 0 {
+            self.s.clone().lu().solve(&self.rhs)?
+        } else {
+            DVector::zeros(0)
+        };
+        let mut out: Vec<f64> = dg.iter().copied().collect();
+        for (c_inv, e, bi) in &self.segs {
+            if c_inv.nrows() == 0 {
+                continue;
+            }
+            let di = if dg.nrows() > 0 {
+                c_inv * (bi - e.tr_mul(&dg))
+            } else {
+                c_inv * bi
+            };
+            out.extend(di.iter());
+        }
+        Some(out)
     }
 }
 
@@ -683,7 +845,7 @@ pub struct CandidateFit {
 /// Options of identification.
 #[derive(Clone, Debug)]
 pub struct IdentifyOptions {
-    /// Folds of the cross-validation (by segment; at most one per segment).
+    /// Folds of the cross-validation (by run, see [`folds_by_run`]).
     pub folds: usize,
     /// Largest number of effects added.
     pub max_effects: usize,
@@ -701,15 +863,75 @@ impl Default for IdentifyOptions {
     }
 }
 
-fn lm_fit<'s, 'a>(p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
-    // Relative tolerances of 1e-6 on the cost and the step: the simulations
-    // are accurate to about 1e-8, and the parameters' uncertainty is far
-    // larger than what further iterations would change.
-    let (p, _report) = LevenbergMarquardt::new()
-        .with_patience(patience)
-        .with_ftol(1e-6)
-        .with_xtol(1e-6)
-        .minimize(p);
+/// Levenberg-Marquardt on the block-arrow problem (see [`Normal`]):
+/// Marquardt's damping of the normal equations, the damping lowered after
+/// a step that lowers the cost and raised until one does. It stops when an
+/// accepted step changes the cost or the parameters (on their scales) by
+/// less than 1e-6 relative (the simulations are accurate to about 1e-8, and
+/// the parameters' uncertainty is far larger than what further iterations
+/// would change), or after `patience` times the parameters of one segment
+/// (plus one) residual evaluations.
+fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
+    const TOL: f64 = 1e-6;
+    let k = if p.free == Free::Nuisance { 0 } else { p.setup.k() };
+    if p.n_free() == 0 {
+        return p;
+    }
+    let cost = |p: &Problem<'_, '_>| -> Option<f64> {
+        let r = p.all_residuals()?;
+        let pr = p.prior_residuals();
+        Some(r.iter().flatten().chain(&pr).map(|x| x * x).sum::<f64>())
+    };
+    let Some(mut c) = cost(&p) else { return p };
+    let scales = p.scales();
+    let budget = patience.max(1) * (k + NUISANCE + 1) * 4;
+    let mut evals = 1;
+    let mut lambda = 1e-3;
+    'outer: while evals < budget {
+        let (Some(blocks), Some(res)) = (p.jacobian_blocks(), p.all_residuals()) else {
+            break;
+        };
+        let prior: Vec<(usize, f64, f64)> = p
+            .prior_rows()
+            .into_iter()
+            .zip(p.prior_residuals())
+            .map(|((j, sd), r)| (j, sd, r))
+            .collect();
+        let x = p.pack();
+        loop {
+            let step = Normal::new(&blocks, &res, &prior, k, lambda).and_then(|n| n.step());
+            let Some(dx) = step.filter(|d| d.iter().all(|v| v.is_finite())) else {
+                lambda *= 10.0;
+                if lambda > 1e12 {
+                    break 'outer;
+                }
+                continue;
+            };
+            let trial: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
+            p.unpack(&trial);
+            evals += 1;
+            match cost(&p) {
+                Some(ct) if ct < c => {
+                    let df = (c - ct) / c.max(f64::MIN_POSITIVE);
+                    let dn = dx.iter().zip(&scales).map(|(d, s)| (d / s).powi(2)).sum::<f64>().sqrt();
+                    let xn = x.iter().zip(&scales).map(|(v, s)| (v / s).powi(2)).sum::<f64>().sqrt();
+                    c = ct;
+                    lambda = (lambda / 3.0).max(1e-12);
+                    if df <= TOL || dn <= TOL * (xn + TOL) {
+                        break 'outer;
+                    }
+                    break;
+                }
+                _ => {
+                    p.unpack(&x);
+                    lambda *= 4.0;
+                    if lambda > 1e12 || evals >= budget {
+                        break 'outer;
+                    }
+                }
+            }
+        }
+    }
     p
 }
 
@@ -772,15 +994,18 @@ pub fn fit_candidate(
         .collect();
     let nuisance = full.x0.clone();
 
-    // Standard errors of the effect parameters from the Jacobian at the fit.
+    // Standard errors of the effect parameters from the Jacobian at the
+    // fit: the shared block of (J^T J)^-1 is the inverse of the reduced
+    // matrix of the normal equations without damping.
     let mut stderr = vec![f64::NAN; setup.k()];
     if setup.k() > 0 {
-        if let Some(j) = full.jacobian() {
-            let n = j.nrows() as f64;
-            let p = j.ncols() as f64;
+        if let (Some(blocks), Some(res)) = (full.jacobian_blocks(), full.all_residuals()) {
+            let n: usize = res.iter().map(Vec::len).sum::<usize>() + full.prior_rows().len();
+            let p = full.n_free() as f64;
             let rho = errors.iter().map(|e| e.rho).sum::<f64>() / errors.len() as f64;
-            let s2 = chi2 / (n - p).max(1.0) * (1.0 + rho) / (1.0 - rho);
-            if let Some(inv) = (j.transpose() * &j).try_inverse() {
+            let s2 = chi2 / (n as f64 - p).max(1.0) * (1.0 + rho) / (1.0 - rho);
+            let prior: Vec<(usize, f64, f64)> = full.prior_rows().into_iter().map(|(j, sd)| (j, sd, 0.0)).collect();
+            if let Some(inv) = Normal::new(&blocks, &res, &prior, setup.k(), 0.0).and_then(|nm| nm.s.try_inverse()) {
                 for (i, s) in stderr.iter_mut().enumerate() {
                     *s = (inv[(i, i)] * s2).sqrt();
                 }
@@ -939,8 +1164,33 @@ pub struct Identification {
     pub steps: Vec<Step>,
     /// Folds of the cross-validation.
     pub folds: usize,
+    /// Fold of each segment (all kicks of a run in one fold).
+    pub fold_of: Vec<usize>,
     /// Simulations run in all.
     pub simulations: usize,
+}
+
+/// The folds of the cross-validation: by run, so that a held-out error is
+/// that of runs (or logs, with many kicks each) the fit never saw; runs are
+/// dealt to `folds` folds in their order. With a single run the folds are
+/// by kick.
+pub fn folds_by_run(segments: &[Segment], folds: usize) -> (usize, Vec<usize>) {
+    let mut runs: Vec<&str> = Vec::new();
+    for s in segments {
+        if !runs.contains(&s.run.as_str()) {
+            runs.push(&s.run);
+        }
+    }
+    if runs.len() < 2 {
+        let folds = folds.clamp(2, segments.len().max(2));
+        return (folds, (0..segments.len()).map(|s| s % folds).collect());
+    }
+    let folds = folds.clamp(2, runs.len());
+    let fold_of = segments
+        .iter()
+        .map(|s| runs.iter().position(|r| *r == s.run).unwrap_or(0) % folds)
+        .collect();
+    (folds, fold_of)
 }
 
 /// Identify which of `candidates` the data warrant, for the free-speed
@@ -957,8 +1207,7 @@ pub fn identify<M: MultibodyModel>(
     if segments.is_empty() {
         return Err(IdentifyError::NoData);
     }
-    let folds = opts.folds.clamp(2, segments.len().max(2));
-    let fold_of: Vec<usize> = (0..segments.len()).map(|s| s % folds).collect();
+    let (folds, fold_of) = folds_by_run(segments, opts.folds);
     let x0: Vec<[f64; NUISANCE]> = segments.iter().map(|s| s.initial).collect();
     // Channel scales: first a sensor-level guess, then each segment's own
     // residual level per channel under the base model (at least the best
@@ -966,12 +1215,16 @@ pub fn identify<M: MultibodyModel>(
     // channel weighs by how well the base model describes it: roll and
     // steer (rad) and speed (m/s) are otherwise incommensurable, and a run
     // that diverges toward a fall would otherwise dominate the fit.
-    let guess = Weights {
-        roll: 0.005,
+    let guess = |s: &Segment| Weights {
+        roll: match s.roll_channel {
+            RollChannel::Angle => 0.005,
+            RollChannel::Rate => 0.05,
+        },
         steer: 0.01,
         speed: 0.05,
     };
-    let setup0 = Setup::new::<M>(base, segments, &vec![guess; segments.len()], &[])?;
+    let guesses: Vec<Weights> = segments.iter().map(guess).collect();
+    let setup0 = Setup::new::<M>(base, segments, &guesses, &[])?;
     // (No folds: this fit only sets the channel scales.)
     let first = fit_candidate(&setup0, vec![], &[], &x0, &[], opts, None)?;
     let rms = |e: &SegmentError, c: usize| (e.channel_ss[c] / e.channel_n[c].max(1) as f64).sqrt();
@@ -1103,6 +1356,7 @@ pub fn identify<M: MultibodyModel>(
         selected: selected.iter().map(|c| c.name.clone()).collect(),
         steps,
         folds,
+        fold_of,
         simulations,
     })
 }

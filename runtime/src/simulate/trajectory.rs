@@ -34,8 +34,14 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
+    /// Samples closer in time than this (s) are one sample: far below any
+    /// sample interval, far above the rounding of a time near 10 s.
+    pub const MIN_STEP: f64 = 1e-9;
+
     /// The angles and speed of a simulation. Duplicate samples at kick times
     /// (before and after the velocity jump) are merged: angles are continuous.
+    /// So are samples within [`Trajectory::MIN_STEP`] of the one before (an
+    /// event a rounding error from an output time).
     pub fn from_simulation(sim: &Simulation) -> Result<Self, SimulateError> {
         use crate::model::CoordinateRole as R;
         let col = |role| sim.require_coordinate(role, "the run's trajectory");
@@ -48,7 +54,7 @@ impl Trajectory {
         );
         let mut r = Trajectory::default();
         for i in 0..sim.t.len() {
-            if r.t.last().is_some_and(|&last| sim.t[i] <= last) {
+            if r.t.last().is_some_and(|&last| sim.t[i] <= last + Self::MIN_STEP) {
                 continue;
             }
             r.t.push(sim.t[i]);
@@ -69,7 +75,7 @@ impl Trajectory {
         for i in 0..other.t.len() {
             let t = other.t[i] + offset;
             if let Some(&last) = self.t.last() {
-                if t <= last {
+                if t <= last + Self::MIN_STEP {
                     continue;
                 }
             }
