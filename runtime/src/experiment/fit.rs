@@ -377,21 +377,27 @@ fn exp_basis(tau: &[f64], s: f64, w: f64) -> impl Iterator<Item = (f64, f64)> + 
     })
 }
 
-/// Linear least squares of `y ~ c + e^(s tau) (p cos w tau + q sin w tau)`
-/// for fixed `s`, `w`: returns `(ssr, [c, p, q])`.
-fn linear_part(tau: &[f64], y: &[f64], s: f64, w: f64) -> Option<(f64, [f64; 3])> {
-    let mut a = nalgebra::Matrix3::zeros();
-    let mut b = nalgebra::Vector3::zeros();
-    let mut yy = 0.0;
-    for ((ec, es), &yk) in exp_basis(tau, s, w).zip(y) {
-        let x = nalgebra::Vector3::new(1.0, ec, es);
-        a += x * x.transpose();
-        b += x * yk;
-        yy += yk * yk;
+/// Residual sum of squares of `y ~ c + e^(s tau) (p cos w tau + q sin w tau)`,
+/// linear in `c, p, q`, on one cell of the start grid,
+/// from the decay `e^(s tau)` and the row's `cos w tau`, `sin w tau`
+/// (`yy`, `b0`: the sums of `y^2` and `y`). No recurrence inside, so the
+/// sums vectorize.
+fn grid_ssr(decay: &[f64], cs: &[f64], sn: &[f64], y: &[f64], yy: f64, b0: f64) -> Option<f64> {
+    let (mut s1, mut s2, mut s11, mut s12, mut s22, mut b1, mut b2) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for k in 0..y.len().min(decay.len()).min(cs.len()).min(sn.len()) {
+        let (ec, es) = (decay[k] * cs[k], decay[k] * sn[k]);
+        s1 += ec;
+        s2 += es;
+        s11 += ec * ec;
+        s12 += ec * es;
+        s22 += es * es;
+        b1 += ec * y[k];
+        b2 += es * y[k];
     }
+    let a = nalgebra::Matrix3::new(y.len() as f64, s1, s2, s1, s11, s12, s2, s12, s22);
+    let b = nalgebra::Vector3::new(b0, b1, b2);
     let sol = a.cholesky()?.solve(&b);
-    let ssr = yy - sol.dot(&b);
-    Some((ssr, [sol[0], sol[1], sol[2]]))
+    Some(yy - sol.dot(&b))
 }
 
 /// Dominant angular frequency from the mean spacing of zero crossings of the
@@ -490,9 +496,31 @@ pub fn prepare(t: &[f64], y: &[f64]) -> Result<Prepared, FitError> {
     let mut grid = [[f64::INFINITY; NS]; NW];
     let grid_w = |i: usize| w_hat * (0.6 + 0.05 * i as f64);
     let grid_s = |j: usize| w_hat * (-1.2 + 0.075 * j as f64);
+    // The oscillation of a grid row is shared by its cells: cos and sin
+    // once per row, the decay per cell (this grid is most of the time of a
+    // log's many short kicks).
+    let yy: f64 = y_g.iter().map(|v| v * v).sum();
+    let b0: f64 = y_g.iter().sum();
+    let uniform_g = uniform(&tau_g);
+    let mut decay: Vec<f64> = Vec::with_capacity(tau_g.len());
     for (i, row) in grid.iter_mut().enumerate() {
+        let w = grid_w(i);
+        let (sn, cs): (Vec<f64>, Vec<f64>) = tau_g.iter().map(|&t| (w * t).sin_cos()).unzip();
         for (j, cell) in row.iter_mut().enumerate() {
-            if let Some((ssr, _)) = linear_part(&tau_g, &y_g, grid_s(j), grid_w(i)) {
+            let s = grid_s(j);
+            decay.clear();
+            if uniform_g {
+                let r = (s * (tau_g[1] - tau_g[0])).exp();
+                let mut e = (s * tau_g[0]).exp();
+                decay.extend(tau_g.iter().map(|_| {
+                    let out = e;
+                    e *= r;
+                    out
+                }));
+            } else {
+                decay.extend(tau_g.iter().map(|&t| (s * t).exp()));
+            }
+            if let Some(ssr) = grid_ssr(&decay, &cs, &sn, &y_g, yy, b0) {
                 *cell = ssr;
             }
         }

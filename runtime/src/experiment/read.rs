@@ -240,13 +240,16 @@ fn read_table(path: &Path, wanted: &[&[&'static str]]) -> Result<Table, ReadErro
     let mut header: Option<(usize, Vec<usize>, usize)> = None; // (line, indices, n_fields)
     let mut cols: Vec<Vec<f64>> = vec![Vec::new(); wanted.len()];
     let mut lines = Vec::new();
+    // One buffer of fields for every line (a log has 10^4 lines).
+    let mut fields: Vec<&str> = Vec::new();
     for (i, raw) in all.iter().enumerate() {
         let line_no = i + 1;
         let l = raw.trim_end_matches('\r').trim();
         if l.is_empty() || l.starts_with('#') {
             continue;
         }
-        let fields: Vec<&str> = l.split(',').map(|f| f.trim()).collect();
+        fields.clear();
+        fields.extend(l.split(',').map(|f| f.trim()));
         let Some((_, idx, n_fields)) = &header else {
             let names: Vec<String> = fields.iter().map(|f| normalise_name(f)).collect();
             let mut idx = Vec::new();
