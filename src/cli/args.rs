@@ -211,9 +211,15 @@ pub struct FitArgs {
 /// Arguments of `bikedyn identify`.
 #[derive(Args, Debug, Clone)]
 pub struct IdentifyArgs {
-    /// Set folders (all runs) or run folders.
-    #[arg(required = true)]
+    /// Set folders (all runs), run folders, or TU Delft logs (files or a
+    /// folder of them).
+    #[arg(required_unless_present = "eigenvalues")]
     pub inputs: Vec<PathBuf>,
+    /// Instead of runs: a table of measured weave eigenvalues (CSV; columns
+    /// speed m/s, real 1/s, imaginary rad/s, optionally their two standard
+    /// errors; a header row in any words).
+    #[arg(long, conflicts_with = "inputs")]
+    pub eigenvalues: Option<PathBuf>,
     /// Calibration run (default: `calibration/` beside the runs).
     #[arg(long)]
     pub calibration: Option<PathBuf>,

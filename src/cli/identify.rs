@@ -4,7 +4,7 @@
 use super::args::IdentifyArgs;
 use super::ProgressDisplay;
 use anyhow::Result;
-use bikedyn::identify::{plan, report, run_plan, IdentifyRequest, Outcome};
+use bikedyn::identify::{eigen_table, plan, report, run_plan, IdentifyRequest, Outcome};
 
 /// The library's request from the command line.
 pub fn request(a: &IdentifyArgs) -> IdentifyRequest {
@@ -31,6 +31,23 @@ pub fn run_with_progress(request: &IdentifyRequest) -> Result<Outcome> {
 
 /// Run `bikedyn identify`.
 pub fn run(a: &IdentifyArgs) -> Result<bool> {
+    if let Some(table) = &a.eigenvalues {
+        let o = eigen_table::identify_table(&eigen_table::TableRequest {
+            path: table.clone(),
+            bike: a.bike.clone(),
+            effects: a.effects.clone(),
+            corrections: a.corrections,
+        })?;
+        if let Some(dir) = &a.report {
+            eigen_table::write_table_report(&o, dir)?;
+        }
+        if a.json {
+            println!("{}", serde_json::to_string_pretty(&o)?);
+        } else {
+            println!("{}", eigen_table::table_summary(&o));
+        }
+        return Ok(true);
+    }
     let request = request(a);
     let o = run_with_progress(&request)?;
     if let Some(dir) = &a.report {

@@ -65,14 +65,37 @@ pub fn screen<R: ModelRegistry>(
     if max == 0 {
         return Ok(Vec::new());
     }
-    // Measured eigenvalues with their standard errors, where both the fit
-    // and the prediction exist.
-    let used: Vec<(usize, [f64; 2], [f64; 2], [f64; 2])> = segments
+    let rows: Vec<(f64, [f64; 2], [f64; 2], Option<[f64; 2]>)> = segments
         .iter()
         .enumerate()
         .filter_map(|(i, s)| {
             let (m, se) = s.weave?;
-            let p = before.get(i).copied().flatten()?;
+            Some((s.mean_speed, m, se, before.get(i).copied().flatten()))
+        })
+        .collect();
+    screen_points(free, driven, bike, &rows, max)
+}
+
+/// [`screen`] on measured weave eigenvalues given as rows `(speed, measured
+/// [re, im], standard errors, predicted)` (a table of published eigenvalues,
+/// or the kicks of a set).
+pub fn screen_points<R: ModelRegistry>(
+    free: &ModelInfo,
+    driven: &ModelInfo,
+    bike: &Bicycle<R>,
+    rows: &[(f64, [f64; 2], [f64; 2], Option<[f64; 2]>)],
+    max: usize,
+) -> Result<Vec<Screened>, IdentifyError> {
+    if max == 0 {
+        return Ok(Vec::new());
+    }
+    // Measured eigenvalues with their standard errors, where both the fit
+    // and the prediction exist.
+    let used: Vec<(usize, [f64; 2], [f64; 2], [f64; 2])> = rows
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &(_, m, se, p))| {
+            let p = p?;
             let ok = se.iter().all(|e| e.is_finite() && *e > 0.0);
             ok.then_some((i, m, se, p))
         })
@@ -80,7 +103,7 @@ pub fn screen<R: ModelRegistry>(
     if used.is_empty() {
         return Ok(Vec::new());
     }
-    let speeds: Vec<f64> = used.iter().map(|&(i, ..)| segments[i].mean_speed).collect();
+    let speeds: Vec<f64> = used.iter().map(|&(i, ..)| rows[i].0).collect();
     let r: Vec<f64> = used
         .iter()
         .flat_map(|&(_, m, se, p)| [(m[0] - p[0]) / se[0], (m[1] - p[1]) / se[1]])

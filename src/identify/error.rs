@@ -40,6 +40,13 @@ pub enum IdentifyError {
     /// An input path is neither a run, a set nor a log.
     #[error(transparent)]
     Input(#[from] bikedyn_runtime::experiment::RunError),
+    /// A measured eigenvalue table could not be read.
+    #[error("{}{}: {message}", path.display(), if *line > 0 { format!(":{line}") } else { String::new() })]
+    EigenTable {
+        path: PathBuf,
+        line: usize,
+        message: String,
+    },
     /// Fewer than two kicks with a free-response window.
     #[error(
         "identification needs at least two kicks with a free-response window; found {found}{}",

@@ -12,6 +12,7 @@
 pub mod candidates;
 pub mod corrections;
 pub mod diagnosis;
+pub mod eigen_table;
 mod error;
 mod fits;
 mod markdown;

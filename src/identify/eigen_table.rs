@@ -1,0 +1,564 @@
+//! `identify --eigenvalues FILE.csv`: effects and parameter corrections
+//! fitted to a table of measured weave eigenvalues, where no time series
+//! exists (published tables, a colleague's fits).
+//!
+//! The table: one row per speed, columns by position: speed (m/s), real
+//! part (1/s), imaginary part (rad/s), and optionally the standard errors
+//! of the real and imaginary parts. A first row that is not numbers is a
+//! header in whatever words its authors chose; commas, semicolons, tabs or
+//! spaces separate the fields; `#` starts a comment line.
+//!
+//! The residual of a row is measured minus predicted (the driven-speed
+//! model's weave at the row's speed), divided by its standard errors (one
+//! when the table gives none). Candidates are the effects with a
+//! linearization (Coulomb friction needs the response's amplitude, which a
+//! table does not give; speed decay has no weave) and the corrections of
+//! the declared-uncertain parameters that could explain most of the misfit
+//! (Gaussian priors as in the time-series fits). Selection is forward
+//! stepwise as there: a candidate is kept if it lowers the BIC (unknown
+//! residual scale: `n ln(chi2 / n) + k ln n`) and the leave-one-speed-out
+//! error (each row predicted with the values fitted to the others).
+
+use super::candidates::{candidates, identification_models};
+use super::corrections;
+use super::predict::predict;
+use super::IdentifyError;
+use crate::bicycle::Bicycle;
+use bikedyn_runtime::identify::Candidate;
+use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
+use bikedyn_runtime::registry::ModelInfo;
+use nalgebra::{DMatrix, DVector};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// One row of a measured eigenvalue table.
+#[derive(Clone, Debug, Serialize)]
+pub struct EigenPoint {
+    /// Line of the file.
+    pub line: usize,
+    /// Forward speed (m/s).
+    pub speed: f64,
+    /// Measured weave eigenvalue `[re, im]` (1/s).
+    pub eigenvalue: [f64; 2],
+    /// Its standard errors, if the table gives them.
+    pub stderr: Option<[f64; 2]>,
+}
+
+/// Read a measured eigenvalue table (see the module doc).
+pub fn read_eigen_table(path: &Path) -> Result<Vec<EigenPoint>, IdentifyError> {
+    let bad = |line: usize, message: String| IdentifyError::EigenTable {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| bad(0, e.to_string()))?;
+    let mut points = Vec::new();
+    let mut seen_row = false;
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let l = raw.trim().trim_start_matches('\u{feff}');
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = l
+            .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+            .filter(|f| !f.is_empty())
+            .collect();
+        let numbers: Vec<Option<f64>> = fields.iter().map(|f| f.parse::<f64>().ok()).collect();
+        if !seen_row && numbers.iter().any(|x| x.is_none()) {
+            // The header, in the authors' words.
+            seen_row = true;
+            continue;
+        }
+        seen_row = true;
+        let Some(v) = numbers.iter().copied().collect::<Option<Vec<f64>>>() else {
+            return Err(bad(
+                line,
+                format!("`{l}`: every field after the header must be a number"),
+            ));
+        };
+        if v.len() != 3 && v.len() != 5 {
+            return Err(bad(
+                line,
+                format!(
+                    "{} fields; expected 3 (speed m/s, real 1/s, imaginary rad/s) or 5 (and their two standard errors)",
+                    v.len()
+                ),
+            ));
+        }
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err(bad(line, format!("`{l}`: not a finite number")));
+        }
+        if !(v[0] > 0.0) {
+            return Err(bad(line, format!("speed {} m/s: must be positive", v[0])));
+        }
+        if !(v[2] > 0.0) {
+            return Err(bad(
+                line,
+                format!("imaginary part {}: a weave eigenvalue is oscillatory (give the one with a positive imaginary part)", v[2]),
+            ));
+        }
+        let stderr = (v.len() == 5).then(|| [v[3], v[4]]);
+        if stderr.is_some_and(|s| !(s[0] > 0.0 && s[1] > 0.0)) {
+            return Err(bad(line, "standard errors must be positive".into()));
+        }
+        points.push(EigenPoint {
+            line,
+            speed: v[0],
+            eigenvalue: [v[1], v[2]],
+            stderr,
+        });
+    }
+    if points.len() < 3 {
+        return Err(bad(0, format!("{} rows; at least 3 speeds are needed", points.len())));
+    }
+    Ok(points)
+}
+
+/// What to identify from a table.
+#[derive(Clone, Debug)]
+pub struct TableRequest {
+    /// The table.
+    pub path: PathBuf,
+    /// Bicycle (built-in name or parameter file).
+    pub bike: String,
+    /// Candidate effects (empty: every one with a linearization).
+    pub effects: Vec<String>,
+    /// Largest number of parameter corrections tried beside the effects.
+    pub corrections: usize,
+}
+
+/// One candidate tried at one step.
+#[derive(Clone, Debug, Serialize)]
+pub struct TableTrial {
+    pub step: usize,
+    pub name: String,
+    /// Fitted values by symbol, with standard errors.
+    pub values: BTreeMap<String, (f64, f64)>,
+    pub bic_change: f64,
+    /// Leave-one-speed-out error (mean squared weighted residual).
+    pub cv: f64,
+    pub base_cv: f64,
+    pub verdict: String,
+}
+
+/// What identification from a table found.
+#[derive(Clone, Debug, Serialize)]
+pub struct TableOutcome {
+    pub table: PathBuf,
+    pub driven_model: &'static str,
+    pub points: Vec<EigenPoint>,
+    pub selected: Vec<String>,
+    /// Fitted values by symbol: `(value, stderr)`.
+    pub parameters: BTreeMap<String, (f64, f64)>,
+    pub trials: Vec<TableTrial>,
+    /// Candidates not tried, with the reason.
+    pub not_tried: Vec<(String, String)>,
+    /// Weave eigenvalue per row, before and after (1/s).
+    pub predicted_before: Vec<Option<[f64; 2]>>,
+    pub predicted_after: Vec<Option<[f64; 2]>>,
+    /// RMS |measured - predicted| (1/s), before and after; after held out
+    /// (each row with the values fitted to the others).
+    pub eigen_rms_before: f64,
+    pub eigen_rms_after: f64,
+    pub eigen_rms_held_out: f64,
+}
+
+struct Fit {
+    values: Vec<f64>,
+    stderr: Vec<f64>,
+    chi2: f64,
+}
+
+/// Identify effects and corrections from a measured eigenvalue table.
+pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError> {
+    let points = read_eigen_table(&req.path)?;
+    let bike = Bicycle::resolve(&req.bike)?;
+    let (_, driven, _) = identification_models(&bike, false)?;
+    let mut not_tried = Vec::new();
+    let mut cands: Vec<Candidate> = Vec::new();
+    for c in candidates(driven, None, &bike, &req.effects, true)? {
+        if needs_amplitude(driven, &c.name) {
+            not_tried.push((
+                c.name.clone(),
+                "its linear equivalent depends on the response's amplitude, which a table does not give".into(),
+            ));
+        } else {
+            cands.push(c);
+        }
+    }
+    let speeds: Vec<f64> = points.iter().map(|p| p.speed).collect();
+    let before = predict(driven, &bike, &BTreeMap::new(), &speeds)?;
+    // Corrections: the same screen as for time series, on the rows.
+    let se = |p: &EigenPoint| p.stderr.unwrap_or([1.0, 1.0]);
+    let rows: Vec<(f64, [f64; 2], [f64; 2], Option<[f64; 2]>)> = points
+        .iter()
+        .zip(&before)
+        .map(|(p, b)| (p.speed, p.eigenvalue, se(p), *b))
+        .collect();
+    for s in corrections::screen_points(driven, driven, &bike, &rows, req.corrections)? {
+        cands.push(corrections::candidate(driven, &s));
+    }
+    let residuals = |vals: &BTreeMap<String, f64>, idx: &[usize]| -> Result<Vec<f64>, IdentifyError> {
+        let sp: Vec<f64> = idx.iter().map(|&i| speeds[i]).collect();
+        let pred = predict(driven, &bike, vals, &sp)?;
+        let mut r = Vec::with_capacity(2 * idx.len());
+        for (&i, p) in idx.iter().zip(pred) {
+            let (m, s) = (points[i].eigenvalue, se(&points[i]));
+            // No weave predicted: as far off as the measured eigenvalue's size.
+            let p = p.unwrap_or([m[0] + m[1].abs(), 0.0]);
+            r.extend([(m[0] - p[0]) / s[0], (m[1] - p[1]) / s[1]]);
+        }
+        Ok(r)
+    };
+    let all: Vec<usize> = (0..points.len()).collect();
+    let n = 2.0 * points.len() as f64;
+    let bic = |chi2: f64, k: usize| n * (chi2 / n).max(1e-300).ln() + k as f64 * n.ln();
+    let chi2_of = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
+    // Leave one speed out: each row predicted with the values fitted to the others.
+    let held_out = |set: &[&Candidate]| -> Result<(f64, Vec<f64>), IdentifyError> {
+        let mut ss = Vec::new();
+        let mut d2 = Vec::new();
+        for i in 0..points.len() {
+            let train: Vec<usize> = all.iter().copied().filter(|&j| j != i).collect();
+            let vals = if set.is_empty() {
+                BTreeMap::new()
+            } else {
+                values_map(set, &fit(set, &|v| residuals(v, &train))?.values)
+            };
+            let r = residuals(&vals, &[i])?;
+            ss.push(chi2_of(&r) / 2.0);
+            let p = predict(driven, &bike, &vals, &[speeds[i]])?[0];
+            let m = points[i].eigenvalue;
+            d2.push(p.map_or(f64::NAN, |p| (m[0] - p[0]).powi(2) + (m[1] - p[1]).powi(2)));
+        }
+        Ok((ss.iter().sum::<f64>() / ss.len() as f64, d2))
+    };
+    let mut selected: Vec<&Candidate> = Vec::new();
+    let mut current_chi2 = chi2_of(&residuals(&BTreeMap::new(), &all)?);
+    let mut current_bic = bic(current_chi2, 0);
+    let (mut current_cv, mut held_d2) = held_out(&[])?;
+    let mut current_fit = Fit {
+        values: vec![],
+        stderr: vec![],
+        chi2: current_chi2,
+    };
+    let mut trials = Vec::new();
+    for step in 1..=3 {
+        let mut best: Option<(usize, Fit, f64, f64, Vec<f64>)> = None;
+        for (ci, c) in cands.iter().enumerate() {
+            if selected.iter().any(|s| s.name == c.name) {
+                continue;
+            }
+            let set: Vec<&Candidate> = selected.iter().copied().chain([c]).collect();
+            let f = fit(&set, &|v| residuals(v, &all))?;
+            let k: usize = set.iter().map(|c| c.parameters.len()).sum();
+            let db = bic(f.chi2, k) - current_bic;
+            let physical = set
+                .iter()
+                .flat_map(|c| &c.parameters)
+                .zip(&f.values)
+                .all(|(p, v)| !p.dissipative || *v > p.lower.unwrap_or(0.0));
+            let (cv, d2) = if physical && db < 0.0 {
+                held_out(&set)?
+            } else {
+                (f64::NAN, vec![])
+            };
+            let verdict = if !physical {
+                "rejected: a dissipative parameter fitted at or below zero (not physics)".to_string()
+            } else if db >= 0.0 {
+                format!("rejected: BIC {db:+.1} (no gain beyond its added parameters)")
+            } else if !(cv < current_cv) {
+                format!("rejected: leave-one-speed-out error {cv:.4} not below {current_cv:.4}")
+            } else {
+                format!("passes: BIC {db:+.1}, leave-one-speed-out error {cv:.4} (was {current_cv:.4})")
+            };
+            let names = set.iter().flat_map(|c| c.parameters.iter().map(|p| p.symbol.clone()));
+            trials.push(TableTrial {
+                step,
+                name: c.name.clone(),
+                values: names
+                    .zip(f.values.iter().zip(&f.stderr).map(|(v, s)| (*v, *s)))
+                    .collect(),
+                bic_change: db,
+                cv,
+                base_cv: current_cv,
+                verdict,
+            });
+            let passes = physical && db < 0.0 && cv < current_cv;
+            if passes && best.as_ref().is_none_or(|b| db < b.2) {
+                best = Some((ci, f, db, cv, d2));
+            }
+        }
+        let Some((ci, f, db, cv, d2)) = best else { break };
+        selected.push(&cands[ci]);
+        current_bic += db;
+        current_cv = cv;
+        current_chi2 = f.chi2;
+        held_d2 = d2;
+        current_fit = f;
+        if let Some(t) = trials
+            .iter_mut()
+            .rev()
+            .find(|t| t.step == step && t.name == cands[ci].name)
+        {
+            t.verdict = t.verdict.replacen("passes", "selected", 1);
+        }
+    }
+    let _ = current_chi2;
+    let vals = values_map(&selected, &current_fit.values);
+    let after = predict(driven, &bike, &vals, &speeds)?;
+    let rms = |pred: &[Option<[f64; 2]>]| {
+        let d: Vec<f64> = points
+            .iter()
+            .zip(pred)
+            .filter_map(|(p, q)| q.map(|q| (p.eigenvalue[0] - q[0]).powi(2) + (p.eigenvalue[1] - q[1]).powi(2)))
+            .collect();
+        (d.iter().sum::<f64>() / d.len().max(1) as f64).sqrt()
+    };
+    let held = {
+        let d: Vec<f64> = held_d2.iter().copied().filter(|x| x.is_finite()).collect();
+        (d.iter().sum::<f64>() / d.len().max(1) as f64).sqrt()
+    };
+    let names = selected
+        .iter()
+        .flat_map(|c| c.parameters.iter().map(|p| p.symbol.clone()));
+    Ok(TableOutcome {
+        table: req.path.clone(),
+        driven_model: driven.name,
+        selected: selected.iter().map(|c| c.name.clone()).collect(),
+        parameters: names
+            .zip(
+                current_fit
+                    .values
+                    .iter()
+                    .zip(&current_fit.stderr)
+                    .map(|(v, s)| (*v, *s)),
+            )
+            .collect(),
+        trials,
+        not_tried,
+        eigen_rms_before: rms(&before),
+        eigen_rms_after: rms(&after),
+        eigen_rms_held_out: if selected.is_empty() { rms(&before) } else { held },
+        predicted_before: before,
+        predicted_after: after,
+        points,
+    })
+}
+
+/// Whether an effect's linear equivalent needs the response's amplitude.
+fn needs_amplitude(info: &ModelInfo, effect: &str) -> bool {
+    info.effect_declarations.iter().any(|e| {
+        e.name == effect
+            && matches!(
+                e.identification,
+                Some(EffectIdentification::Candidate(CandidateDeclaration {
+                    linear_equivalent: Some(LinearEquivalent::DescribingFunctionDamping { .. }),
+                    ..
+                }))
+            )
+    })
+}
+
+/// The values of a candidate set's parameters (tied symbols and held
+/// companions included) by symbol.
+fn values_map(set: &[&Candidate], values: &[f64]) -> BTreeMap<String, f64> {
+    let mut m = BTreeMap::new();
+    let mut it = values.iter();
+    for c in set {
+        for (s, v) in &c.fixed {
+            m.insert(s.clone(), *v);
+        }
+        for p in &c.parameters {
+            let v = *it.next().unwrap_or(&0.0);
+            let v = p.lower.map_or(v, |lo| v.max(lo));
+            m.insert(p.symbol.clone(), v);
+            for t in &p.tied {
+                m.insert(t.clone(), v);
+            }
+        }
+    }
+    m
+}
+
+/// Levenberg-Marquardt over the parameters of `set` (a few), with their
+/// priors as extra residual rows; forward-difference Jacobian (a
+/// prediction costs microseconds). Standard errors from `(J^T J)^-1 s^2`.
+fn fit(
+    set: &[&Candidate],
+    residuals: &dyn Fn(&BTreeMap<String, f64>) -> Result<Vec<f64>, IdentifyError>,
+) -> Result<Fit, IdentifyError> {
+    let params: Vec<_> = set.iter().flat_map(|c| c.parameters.iter()).collect();
+    let k = params.len();
+    let eval = |x: &[f64]| -> Result<Vec<f64>, IdentifyError> {
+        let mut r = residuals(&values_map(set, x))?;
+        for (p, v) in params.iter().zip(x) {
+            if let Some((m, sd)) = p.prior {
+                r.push((v - m) / sd);
+            }
+        }
+        Ok(r)
+    };
+    let mut x: Vec<f64> = params
+        .iter()
+        .map(|p| p.prior.map(|(m, _)| m).or(p.initial).unwrap_or(0.1 * p.scale))
+        .collect();
+    let mut r = eval(&x)?;
+    let cost = |r: &[f64]| r.iter().map(|a| a * a).sum::<f64>();
+    let mut c = cost(&r);
+    let mut lambda = 1e-3;
+    let jac = |x: &[f64], r: &[f64]| -> Result<DMatrix<f64>, IdentifyError> {
+        let mut j = DMatrix::zeros(r.len(), k);
+        for (col, p) in params.iter().enumerate() {
+            let h = 1e-6 * p.scale.max(x[col].abs());
+            let mut xh = x.to_vec();
+            xh[col] += h;
+            let rh = eval(&xh)?;
+            for (i, (a, b)) in rh.iter().zip(r).enumerate() {
+                j[(i, col)] = (a - b) / h;
+            }
+        }
+        Ok(j)
+    };
+    for _ in 0..100 {
+        let j = jac(&x, &r)?;
+        let h = j.tr_mul(&j);
+        let g = j.tr_mul(&DVector::from_column_slice(&r));
+        let mut improved = false;
+        while lambda < 1e12 {
+            let mut a = h.clone();
+            for d in 0..k {
+                a[(d, d)] += lambda * h[(d, d)].max(1e-12);
+            }
+            let Some(dx) = a.lu().solve(&(-&g)) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let xt: Vec<f64> = x.iter().zip(dx.iter()).map(|(a, b)| a + b).collect();
+            let rt = eval(&xt)?;
+            let ct = cost(&rt);
+            if ct < c {
+                let done = (c - ct) <= 1e-10 * c;
+                x = xt;
+                r = rt;
+                c = ct;
+                lambda = (lambda / 3.0).max(1e-12);
+                improved = !done;
+                break;
+            }
+            lambda *= 4.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    let j = jac(&x, &r)?;
+    let n_data = residuals(&values_map(set, &x))?.len();
+    let chi2 = cost(&residuals(&values_map(set, &x))?);
+    let s2 = chi2 / (n_data as f64 - k as f64).max(1.0);
+    let stderr = match j.tr_mul(&j).try_inverse() {
+        Some(inv) => (0..k).map(|i| (inv[(i, i)] * s2).sqrt()).collect(),
+        None => vec![f64::NAN; k],
+    };
+    let values = params
+        .iter()
+        .zip(&x)
+        .map(|(p, &v)| p.lower.map_or(v, |lo| v.max(lo)))
+        .collect();
+    Ok(Fit { values, stderr, chi2 })
+}
+
+/// The summary printed by `identify --eigenvalues`.
+pub fn table_summary(o: &TableOutcome) -> String {
+    let mut s = format!(
+        "eigenvalue table: {} speeds from {}; model {}\n",
+        o.points.len(),
+        o.table.display(),
+        o.driven_model
+    );
+    s += &format!(
+        "selected: {}\n",
+        if o.selected.is_empty() {
+            "no effect warranted".to_string()
+        } else {
+            o.selected.join(" + ")
+        }
+    );
+    let vals: Vec<String> = o
+        .parameters
+        .iter()
+        .map(|(k, (v, se))| format!("{k} = {v:.4} +- {:.4}", 1.96 * se))
+        .collect();
+    s += &format!(
+        "parameters (95 %): {}\n",
+        if vals.is_empty() { "-".into() } else { vals.join(", ") }
+    );
+    s += &format!(
+        "weave eigenvalue RMS {:.3} -> {:.3} 1/s (leave one speed out: {:.3})",
+        o.eigen_rms_before, o.eigen_rms_after, o.eigen_rms_held_out
+    );
+    for (name, why) in &o.not_tried {
+        s += &format!("\nnot tried: {name}: {why}");
+    }
+    s
+}
+
+/// Write `report.json` (the outcome) and `report.md` (summary, candidates
+/// at every step, per-speed table) into `dir`.
+pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyError> {
+    use bikedyn_report::output::{save_json, write_string_atomic};
+    use std::fmt::Write as _;
+    std::fs::create_dir_all(dir).map_err(|source| IdentifyError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    save_json(
+        dir.join("report.json"),
+        &serde_json::to_value(o).map_err(|e| IdentifyError::EigenTable {
+            path: o.table.clone(),
+            line: 0,
+            message: e.to_string(),
+        })?,
+    )?;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# Identification from a measured eigenvalue table\n\n```\n{}\n```\n",
+        table_summary(o)
+    );
+    let _ = writeln!(s, "## Candidates\n\n| step | candidate | fitted values (+- standard error) | BIC change | leave-one-speed-out error | verdict |\n|---|---|---|---|---|---|");
+    for t in &o.trials {
+        let vals: Vec<String> = t
+            .values
+            .iter()
+            .map(|(k, (v, se))| format!("{k} = {v:.4} +- {se:.4}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "| {} | `{}` | {} | {:+.1} | {:.4} | {} |",
+            t.step,
+            t.name,
+            vals.join(", "),
+            t.bic_change,
+            t.cv,
+            t.verdict
+        );
+    }
+    let _ = writeln!(s, "\n## Per speed\n\n| line | speed (m/s) | measured | predicted before | predicted after |\n|---|---|---|---|---|");
+    let c = |z: Option<[f64; 2]>| z.map_or("-".to_string(), |z| format!("{:.3}{:+.3}i", z[0], z[1]));
+    for (i, p) in o.points.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} | {} | {} | {} |",
+            p.line,
+            p.speed,
+            c(Some(p.eigenvalue)),
+            c(o.predicted_before[i]),
+            c(o.predicted_after[i])
+        );
+    }
+    write_string_atomic(dir.join("report.md"), &s)?;
+    Ok(())
+}
