@@ -22,9 +22,10 @@ pub const MIN_R2: f64 = 0.5;
 /// imaginary part, is not the same kind of point.
 pub const OUTLIER_SIGMAS: f64 = 4.0;
 
-/// Fewest weave kicks for the outlier test (a median and a spread of fewer
-/// points say little).
-const MIN_FOR_OUTLIERS: usize = 5;
+/// Fewest weave kicks for the outlier test: the spread of fewer points is
+/// itself uncertain by a third or more, so "4 standard deviations" of it
+/// would not be four.
+const MIN_FOR_OUTLIERS: usize = 8;
 
 /// A kick kept out of the pooled eigenvalue figures.
 #[derive(Clone, Debug, Serialize)]
@@ -90,7 +91,17 @@ pub fn weave_kicks(segs: &[Segment], predicted: &[Option<[f64; 2]>]) -> (Vec<boo
         };
         let (re, im) = (centre_spread(0), centre_spread(1));
         for (k, &i) in idx.iter().enumerate() {
-            let z = |c: usize, (m, s): (f64, f64)| if s > 0.0 { (d[k][c] - m).abs() / s } else { 0.0 };
+            // The kick's own standard error widens its tolerance: a short,
+            // noisy fit may miss by more without being another kind of point.
+            let se = segs[i].weave.map_or([0.0; 2], |w| w.1);
+            let z = |c: usize, (m, s): (f64, f64)| {
+                let scale = (s * s + se[c] * se[c]).sqrt();
+                if scale > 0.0 {
+                    (d[k][c] - m).abs() / scale
+                } else {
+                    0.0
+                }
+            };
             let worst = z(0, re).max(z(1, im));
             if worst > OUTLIER_SIGMAS {
                 keep[i] = false;
@@ -98,7 +109,7 @@ pub fn weave_kicks(segs: &[Segment], predicted: &[Option<[f64; 2]>]) -> (Vec<boo
                 exclude(
                     i,
                     format!(
-                        "measured {:.2}{:+.2}i misses the model by {worst:.1} robust standard deviations of the other kicks' misfits (beyond {OUTLIER_SIGMAS})",
+                        "measured {:.2}{:+.2}i misses the model by {worst:.1} robust standard deviations of the other kicks' misfits (its own standard error included; beyond {OUTLIER_SIGMAS})",
                         m[0], m[1]
                     ),
                 );
