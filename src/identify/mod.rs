@@ -155,7 +155,7 @@ pub fn plan(request: &IdentifyRequest) -> Result<Plan, IdentifyError> {
 /// (e.g. an effect of a user's own build script).
 pub fn plan_in<R: ModelRegistry>(request: &IdentifyRequest) -> Result<Plan<R>, IdentifyError> {
     let bike = Bicycle::<R>::resolve_in(&request.bike)?;
-    let speed_imposed = speed_imposed(&request.inputs)?;
+    let speed_imposed = segments::speed_imposed(&request.inputs)?;
     let (model, driven_model, alternative_model) = identification_models(&bike, speed_imposed)?;
     let candidates = candidates(model, alternative_model, &bike, &request.effects, speed_imposed)?;
     // A conclusion ("no effect warranted") means something only when
@@ -175,28 +175,6 @@ pub fn plan_in<R: ModelRegistry>(request: &IdentifyRequest) -> Result<Plan<R>, I
         candidates,
         speed_imposed,
     })
-}
-
-/// Whether the inputs are TU Delft logs (the hub motor holds the speed, so
-/// it is imposed on the model) rather than thesis-style runs (free speed
-/// after the release). Both in one request is an error.
-fn speed_imposed(inputs: &[PathBuf]) -> Result<bool, IdentifyError> {
-    use bikedyn_runtime::experiment::{classify, Input};
-    let (mut logs, mut runs) = (Vec::new(), Vec::new());
-    for path in inputs {
-        for input in classify(path)? {
-            match input {
-                Input::Log(p) => logs.push(p),
-                Input::Set { .. } => runs.push(path.clone()),
-            }
-        }
-    }
-    if !logs.is_empty() && !runs.is_empty() {
-        return Err(IdentifyError::MixedInputs {
-            inputs: runs.iter().chain(&logs).map(|p| p.display().to_string()).collect(),
-        });
-    }
-    Ok(!logs.is_empty())
 }
 
 /// Run identification on the inputs: [`plan`], then [`run_plan`].

@@ -64,25 +64,7 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
                 speed_idx.iter().map(|&i| sp.v[i]).collect(),
                 weave,
             );
-            match seg {
-                Some(mut s) if s.duration() >= 0.5 => {
-                    // The eigenvalue belongs to the fit window: compare and
-                    // draw it at that window's speeds.
-                    if k.mean_speed.is_finite() && k.speed_interval.iter().all(|v| v.is_finite()) {
-                        s.mean_speed = k.mean_speed;
-                        s.speed_interval = k.speed_interval;
-                    }
-                    s.weave_r2 = k.chosen_fit().map(|f| f.r2);
-                    segs.push(s)
-                }
-                _ => skipped.push(format!(
-                    "{}: kick at {:.2} s has no usable window ({:.2}-{:.2} s)",
-                    r.run.display(),
-                    k.kick_time,
-                    w0,
-                    w1
-                )),
-            }
+            keep(seg, 0.5, r, k, [w0, w1], &mut segs, &mut skipped);
         }
         if r.kicks.is_empty() {
             skipped.push(format!("{}: no kick found", r.run.display()));
@@ -129,27 +111,63 @@ fn log_segments(
             pick(&log.speed),
             weave,
         );
-        match seg {
-            Some(mut s) if s.duration() >= MIN_LOG_WINDOW => {
-                if k.mean_speed.is_finite() && k.speed_interval.iter().all(|v| v.is_finite()) {
-                    s.mean_speed = k.mean_speed;
-                    s.speed_interval = k.speed_interval;
-                }
-                s.weave_r2 = k.chosen_fit().map(|f| f.r2);
-                segs.push(s)
-            }
-            _ => skipped.push(format!(
-                "{}: kick at {:.2} s has no usable window ({:.2}-{:.2} s)",
-                r.run.display(),
-                k.kick_time,
-                w0,
-                w1
-            )),
-        }
+        keep(seg, MIN_LOG_WINDOW, r, k, [w0, w1], segs, skipped);
     }
     if r.kicks.is_empty() {
         skipped.push(format!("{}: no kick found", r.run.display()));
     }
+}
+
+/// Keep a kick's segment if it is at least `min_len` s long, with the
+/// eigenvalue fit's speeds and quality; else say why it was skipped.
+fn keep(
+    seg: Option<Segment>,
+    min_len: f64,
+    r: &bikedyn_runtime::experiment::RunReport,
+    k: &bikedyn_runtime::experiment::KickFit,
+    [w0, w1]: [f64; 2],
+    segs: &mut Vec<Segment>,
+    skipped: &mut Vec<String>,
+) {
+    match seg {
+        Some(mut s) if s.duration() >= min_len => {
+            // The eigenvalue belongs to the fit window: compare and draw it
+            // at that window's speeds.
+            if k.mean_speed.is_finite() && k.speed_interval.iter().all(|v| v.is_finite()) {
+                s.mean_speed = k.mean_speed;
+                s.speed_interval = k.speed_interval;
+            }
+            s.weave_r2 = k.chosen_fit().map(|f| f.r2);
+            segs.push(s)
+        }
+        _ => skipped.push(format!(
+            "{}: kick at {:.2} s has no usable window ({w0:.2}-{w1:.2} s)",
+            r.run.display(),
+            k.kick_time,
+        )),
+    }
+}
+
+/// Whether the inputs are TU Delft logs (the hub motor holds the speed, so
+/// it is imposed on the model) rather than thesis-style runs (free speed
+/// after the release). Both in one request is an error.
+pub fn speed_imposed(inputs: &[std::path::PathBuf]) -> Result<bool, super::IdentifyError> {
+    use bikedyn_runtime::experiment::{classify, Input};
+    let (mut logs, mut runs) = (Vec::new(), Vec::new());
+    for path in inputs {
+        for input in classify(path)? {
+            match input {
+                Input::Log(p) => logs.push(p),
+                Input::Set { .. } => runs.push(path.clone()),
+            }
+        }
+    }
+    if !logs.is_empty() && !runs.is_empty() {
+        return Err(super::IdentifyError::MixedInputs {
+            inputs: runs.iter().chain(&logs).map(|p| p.display().to_string()).collect(),
+        });
+    }
+    Ok(!logs.is_empty())
 }
 
 /// Shortest window of a log's kick (s): about a weave period of a heavily

@@ -1,0 +1,89 @@
+//! Reading a measured eigenvalue table (format in the parent module's doc).
+
+use super::super::IdentifyError;
+use serde::Serialize;
+use std::path::Path;
+
+/// One row of a measured eigenvalue table.
+#[derive(Clone, Debug, Serialize)]
+pub struct EigenPoint {
+    /// Line of the file.
+    pub line: usize,
+    /// Forward speed (m/s).
+    pub speed: f64,
+    /// Measured weave eigenvalue `[re, im]` (1/s).
+    pub eigenvalue: [f64; 2],
+    /// Its standard errors, if the table gives them.
+    pub stderr: Option<[f64; 2]>,
+}
+
+/// Read a measured eigenvalue table (see the module doc).
+pub fn read_eigen_table(path: &Path) -> Result<Vec<EigenPoint>, IdentifyError> {
+    let bad = |line: usize, message: String| IdentifyError::EigenTable {
+        path: path.to_path_buf(),
+        line,
+        message,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| bad(0, e.to_string()))?;
+    let mut points = Vec::new();
+    let mut seen_row = false;
+    for (i, raw) in text.lines().enumerate() {
+        let line = i + 1;
+        let l = raw.trim().trim_start_matches('\u{feff}');
+        if l.is_empty() || l.starts_with('#') {
+            continue;
+        }
+        let fields: Vec<&str> = l
+            .split(|c: char| c == ',' || c == ';' || c.is_whitespace())
+            .filter(|f| !f.is_empty())
+            .collect();
+        let numbers: Vec<Option<f64>> = fields.iter().map(|f| f.parse::<f64>().ok()).collect();
+        if !seen_row && numbers.iter().any(|x| x.is_none()) {
+            // The header, in the authors' words.
+            seen_row = true;
+            continue;
+        }
+        seen_row = true;
+        let Some(v) = numbers.iter().copied().collect::<Option<Vec<f64>>>() else {
+            return Err(bad(
+                line,
+                format!("`{l}`: every field after the header must be a number"),
+            ));
+        };
+        if v.len() != 3 && v.len() != 5 {
+            return Err(bad(
+                line,
+                format!(
+                    "{} fields; expected 3 (speed m/s, real 1/s, imaginary rad/s) or 5 (and their two standard errors)",
+                    v.len()
+                ),
+            ));
+        }
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err(bad(line, format!("`{l}`: not a finite number")));
+        }
+        if !(v[0] > 0.0) {
+            return Err(bad(line, format!("speed {} m/s: must be positive", v[0])));
+        }
+        if !(v[2] > 0.0) {
+            return Err(bad(
+                line,
+                format!("imaginary part {}: a weave eigenvalue is oscillatory (give the one with a positive imaginary part)", v[2]),
+            ));
+        }
+        let stderr = (v.len() == 5).then(|| [v[3], v[4]]);
+        if stderr.is_some_and(|s| !(s[0] > 0.0 && s[1] > 0.0)) {
+            return Err(bad(line, "standard errors must be positive".into()));
+        }
+        points.push(EigenPoint {
+            line,
+            speed: v[0],
+            eigenvalue: [v[1], v[2]],
+            stderr,
+        });
+    }
+    if points.len() < 3 {
+        return Err(bad(0, format!("{} rows; at least 3 speeds are needed", points.len())));
+    }
+    Ok(points)
+}

@@ -1,0 +1,98 @@
+//! The summary and the report folder of an identification from a table.
+
+use super::super::IdentifyError;
+use super::TableOutcome;
+use std::path::Path;
+
+/// The summary printed by `identify --eigenvalues`.
+pub fn table_summary(o: &TableOutcome) -> String {
+    let mut s = format!(
+        "eigenvalue table: {} speeds from {}; model {}\n",
+        o.points.len(),
+        o.table.display(),
+        o.driven_model
+    );
+    s += &format!(
+        "selected: {}\n",
+        if o.selected.is_empty() {
+            "no effect warranted".to_string()
+        } else {
+            o.selected.join(" + ")
+        }
+    );
+    let vals: Vec<String> = o
+        .parameters
+        .iter()
+        .map(|(k, (v, se))| format!("{k} = {v:.4} +- {:.4}", 1.96 * se))
+        .collect();
+    s += &format!(
+        "parameters (95 %): {}\n",
+        if vals.is_empty() { "-".into() } else { vals.join(", ") }
+    );
+    s += &format!(
+        "weave eigenvalue RMS {:.3} -> {:.3} 1/s (leave one speed out: {:.3})",
+        o.eigen_rms_before, o.eigen_rms_after, o.eigen_rms_held_out
+    );
+    for (name, why) in &o.not_tried {
+        s += &format!("\nnot tried: {name}: {why}");
+    }
+    s
+}
+
+/// Write `report.json` (the outcome) and `report.md` (summary, candidates
+/// at every step, per-speed table) into `dir`.
+pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyError> {
+    use bikedyn_report::output::{save_json, write_string_atomic};
+    use std::fmt::Write as _;
+    std::fs::create_dir_all(dir).map_err(|source| IdentifyError::CreateDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    save_json(
+        dir.join("report.json"),
+        &serde_json::to_value(o).map_err(|e| IdentifyError::EigenTable {
+            path: o.table.clone(),
+            line: 0,
+            message: e.to_string(),
+        })?,
+    )?;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# Identification from a measured eigenvalue table\n\n```\n{}\n```\n",
+        table_summary(o)
+    );
+    let _ = writeln!(s, "## Candidates\n\n| step | candidate | fitted values (+- standard error) | BIC change | leave-one-speed-out error | verdict |\n|---|---|---|---|---|---|");
+    for t in &o.trials {
+        let vals: Vec<String> = t
+            .values
+            .iter()
+            .map(|(k, (v, se))| format!("{k} = {v:.4} +- {se:.4}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "| {} | `{}` | {} | {:+.1} | {:.4} | {} |",
+            t.step,
+            t.name,
+            vals.join(", "),
+            t.bic_change,
+            t.cv,
+            t.verdict
+        );
+    }
+    let _ = writeln!(s, "\n## Per speed\n\n| line | speed (m/s) | measured | predicted before | predicted after |\n|---|---|---|---|---|");
+    let c = |z: Option<[f64; 2]>| z.map_or("-".to_string(), |z| format!("{:.3}{:+.3}i", z[0], z[1]));
+    for (i, p) in o.points.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "| {} | {:.2} | {} | {} | {} |",
+            p.line,
+            p.speed,
+            c(Some(p.eigenvalue)),
+            c(o.predicted_before[i]),
+            c(o.predicted_after[i])
+        );
+    }
+    write_string_atomic(dir.join("report.md"), &s)?;
+    Ok(())
+}
