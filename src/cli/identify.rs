@@ -4,7 +4,7 @@
 use super::args::IdentifyArgs;
 use super::ProgressDisplay;
 use anyhow::Result;
-use bikedyn::identify::{eigen_table, plan, report, run_plan, IdentifyRequest, Outcome};
+use bikedyn::identify::{eigen_table, plan, report, run_builtin_plan, IdentifyRequest, Outcome};
 
 /// The library's request from the command line.
 pub fn request(a: &IdentifyArgs) -> IdentifyRequest {
@@ -26,7 +26,7 @@ pub fn run_with_progress(request: &IdentifyRequest) -> Result<Outcome> {
         plan.model.name, plan.driven_model.name
     );
     let display = ProgressDisplay::new();
-    Ok(run_plan(&plan, request, &|p| display.show(p))?)
+    Ok(run_builtin_plan(&plan, request, &|p| display.show(p))?)
 }
 
 /// Run `bikedyn identify`.

@@ -118,6 +118,7 @@ pub fn emit(text: &str, output: &Option<PathBuf>) -> Result<()> {
 pub struct ProgressDisplay {
     bar: OnceLock<ProgressBar>,
     spinner: OnceLock<ProgressBar>,
+    start: std::time::Instant,
 }
 
 impl ProgressDisplay {
@@ -125,12 +126,25 @@ impl ProgressDisplay {
         Self {
             bar: OnceLock::new(),
             spinner: OnceLock::new(),
+            start: std::time::Instant::now(),
         }
     }
 
     /// Show one report (the library's callback).
     pub fn show(&self, p: Progress<'_>) {
         let terminal = std::io::stderr().is_terminal();
+        if !terminal {
+            // A log or a pipe gets one line per step instead of a bar.
+            let of = p.total.map_or(String::new(), |t| format!(" of {t}"));
+            let what = if p.step == "runs" {
+                "runs processed".to_string()
+            } else {
+                format!("fitted {}", p.step)
+            };
+            let secs = self.start.elapsed().as_secs_f64();
+            eprintln!("progress: {what} ({} done{of}, {secs:.1} s)", p.done);
+            return;
+        }
         match p.total {
             Some(total) => {
                 let bar = self.bar.get_or_init(|| {

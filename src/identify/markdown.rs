@@ -4,6 +4,7 @@
 use super::candidates::not_candidates;
 use super::report::{errors_json, fmt_c, median, summary};
 use super::{IdentifyRequest, Outcome};
+use bikedyn_runtime::identify::confounding::CONFOUNDED;
 use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::Value;
 use std::fmt::Write as _;
@@ -122,6 +123,42 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
             let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
         }
         let _ = writeln!(s);
+        if !step.confounded.is_empty() {
+            let _ = writeln!(
+                s,
+                "How far the data tell the added candidate from each rival that also lowered the criterion (largest canonical correlation of their parameters in the Fisher information, after every kick's initial state is fitted; 1: indistinguishable, at or above {CONFOUNDED}: not separable):\n"
+            );
+            let _ = writeln!(
+                s,
+                "| added | rival | correlation | kicks that would separate them (correlation) |\n|---|---|---|---|"
+            );
+            for c in &step.confounded {
+                let designs: Vec<String> = c
+                    .designs
+                    .iter()
+                    .take(4)
+                    .map(|d| format!("{} ({:.2})", d.description, d.correlation))
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "| `{}` | `{}` | {:.3}{} | {} |",
+                    c.chosen,
+                    c.rival,
+                    c.correlation,
+                    if c.correlation >= CONFOUNDED {
+                        " (not separable)"
+                    } else {
+                        ""
+                    },
+                    if designs.is_empty() {
+                        "-".to_string()
+                    } else {
+                        designs.join("; ")
+                    }
+                );
+            }
+            let _ = writeln!(s);
+        }
     }
     if id.selected.is_empty() {
         let _ = writeln!(s, "**No effect warranted.** No candidate lowered both the information criterion and the held-out error with physical parameter values: the residual of the base model is not explained better by any effect of the library than by noise. The model is left as it is.\n");

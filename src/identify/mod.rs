@@ -190,6 +190,18 @@ pub fn run_in<R: ModelRegistry>(
     run_plan(&plan_in::<R>(request)?, request, progress)
 }
 
+/// [`run_plan`] on the built-in models, compiled once in the library (a
+/// generic call would compile every model's equations again in the
+/// caller's crate).
+#[inline(never)]
+pub fn run_builtin_plan(
+    plan: &Plan,
+    request: &IdentifyRequest,
+    progress: OnProgress<'_>,
+) -> Result<Outcome, IdentifyError> {
+    run_plan(plan, request, progress)
+}
+
 /// Run identification as planned: the measured-run pipeline, the segments,
 /// the stepwise fits, the predictions before and after, the diagnosis.
 /// `progress` gets the measured runs processed (step `"runs"`) and each

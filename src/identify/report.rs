@@ -10,6 +10,7 @@ use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic};
+use bikedyn_runtime::identify::confounding::CONFOUNDED;
 use bikedyn_runtime::identify::{pooled_rms, Candidate};
 use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::{json, Value};
@@ -111,10 +112,28 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
             }));
         }
     }
+    let confounded: Vec<Value> = id
+        .steps
+        .iter()
+        .enumerate()
+        .flat_map(|(k, step)| {
+            step.confounded.iter().map(move |c| {
+                json!({
+                    "step": k + 1,
+                    "chosen": c.chosen,
+                    "rival": c.rival,
+                    "correlation": c.correlation,
+                    "confounded": c.correlation >= CONFOUNDED,
+                    "designs": c.designs,
+                })
+            })
+        })
+        .collect();
     json!({
         "selected_effects": sel,
         "parameters": params,
         "candidates": cands,
+        "confounded": confounded,
         "error_before": errors_json(o, false),
         "error_after": errors_json(o, true),
         "model": o.model,
@@ -140,6 +159,59 @@ pub(super) fn median(x: impl Iterator<Item = f64>) -> f64 {
 
 pub(super) fn fmt_c(z: Option<[f64; 2]>) -> String {
     z.map_or("-".into(), |z| format!("{:.3}{:+.3}i", z[0], z[1]))
+}
+
+/// One sentence per pair of candidates the data cannot tell apart: both,
+/// how alike they are, and the kicks that would separate them.
+pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
+    let id = &o.identification;
+    let mut out = Vec::new();
+    for step in &id.steps {
+        for c in step.confounded.iter().filter(|c| c.correlation >= CONFOUNDED) {
+            let values = |name: &str| {
+                step.tried
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map(|(_, f)| {
+                        let own = f.parameters.len().saturating_sub(
+                            o.candidates
+                                .iter()
+                                .find(|x| x.name == name)
+                                .map_or(0, |x| x.parameters.len()),
+                        );
+                        f.parameters
+                            .iter()
+                            .zip(f.values.iter().zip(&f.stderr))
+                            .skip(own)
+                            .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4} {}", p.symbol, v, 1.96 * se, p.unit))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    })
+                    .unwrap_or_default()
+            };
+            let better: Vec<String> = c
+                .designs
+                .iter()
+                .filter(|d| d.correlation < 0.8 * c.correlation.min(1.0))
+                .take(3)
+                .map(|d| format!("{} (correlation {:.2})", d.description, d.correlation))
+                .collect();
+            let separate = if better.is_empty() {
+                "none of the kicks tried (other speeds, three times the amplitude, a steer-torque kick) would separate them".to_string()
+            } else {
+                format!("data that would separate them: {}", better.join("; "))
+            };
+            out.push(format!(
+                "not separable: {} ({}) and {} ({}) move the responses alike (correlation {:.3} in the Fisher information); {separate}",
+                c.chosen,
+                values(&c.chosen),
+                c.rival,
+                values(&c.rival),
+                c.correlation
+            ));
+        }
+    }
+    out
 }
 
 /// Five-line summary.
@@ -179,6 +251,9 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
         id.selected.join(" + ")
     };
     let _ = writeln!(s, "selected: {sel}");
+    for line in confounding_lines(o) {
+        let _ = writeln!(s, "{line}");
+    }
     let vals: Vec<String> = id
         .after
         .parameters

@@ -342,3 +342,130 @@ fn verification_catches_a_dissipative_force_that_pumps_energy() {
         .collect();
     assert!(failed.iter().any(|n| n.starts_with("dissipative")), "{failed:?}");
 }
+
+/// Issue 17, point 5: the forward sensitivities of a simulation (dual
+/// numbers through the generated code, the constraint solve and the
+/// integrator) against central differences of whole simulations, for a
+/// driven model (the speed moves a parameter), a free-speed model with
+/// effects, and a model with extra first-order states (tyre forces).
+#[test]
+fn forward_sensitivities_match_central_differences_of_simulations() {
+    use bikedyn::generated::{ExtendedFree, ThesisWhipple, TyreFree};
+    use bikedyn::runtime::linearize::parameter_vector;
+    use bikedyn::runtime::parameters::ThesisParameters;
+    use bikedyn::runtime::scalar::Dual;
+    use bikedyn::runtime::simulate::sensitivity::{response, Carried, Directions, Response};
+    use bikedyn::runtime::simulate::{simulate, Events, InitialConditions, Inputs, SimOptions};
+    use bikedyn::runtime::MultibodyModel;
+
+    // Up to six directions: the dual width identification uses.
+    fn check<M: MultibodyModel>(set: &[(&str, f64)], free: &[&str], initial: &[usize]) {
+        let thesis = ThesisParameters::thesis_bicycle();
+        let mut param = parameter_vector::<M>(|s| thesis.get(s), 5.0).unwrap();
+        for (s, v) in set {
+            param[M::parameter_index(s).unwrap()] = *v;
+        }
+        let ic = InitialConditions {
+            roll: 0.02,
+            steer: -0.01,
+            roll_rate: 0.3,
+            steer_rate: 0.2,
+            speed: 5.0,
+            yaw: 0.0,
+        };
+        let opts = SimOptions {
+            rtol: 1e-12,
+            atol: 1e-14,
+            output_interval: 0.01,
+            events: Events {
+                roll_limit: Some(1.2),
+                steer_limit: Some(1.45),
+            },
+            ..SimOptions::default()
+        };
+        let k = free.len();
+        let mut dirs = Directions {
+            parameters: free
+                .iter()
+                .enumerate()
+                .map(|(d, s)| (M::parameter_index(s).unwrap(), d))
+                .collect(),
+            initial: [None; 5],
+        };
+        for (d, &which) in initial.iter().enumerate() {
+            dirs.initial[which] = Some(k + d);
+        }
+        let nd = k + initial.len();
+        assert!(nd <= 6);
+        let duration = 2.0;
+        let exact: Response<Dual<6>> = response::<M, Dual<6>>(&param, &ic, &dirs, duration, &opts, true).unwrap();
+        let plain: Response<f64> = response::<M, f64>(&param, &ic, &dirs, duration, &opts, true).unwrap();
+        // The lean response is the simulation's.
+        let sim = simulate::<M>(&param, &ic, &Inputs::default(), duration, &opts).unwrap();
+        let roll = sim.coordinate("theta").unwrap();
+        assert_eq!(plain.t.len(), sim.t.len());
+        for (i, (a, b)) in plain.roll.iter().zip(&roll).enumerate() {
+            assert!(
+                (a - b).abs() < 1e-10,
+                "{}: sample {i}: lean roll {a} against simulate {b}",
+                M::NAME
+            );
+            assert!((a - exact.roll[i].re).abs() < 1e-9);
+        }
+        let moved = |d: usize, h: f64| -> Response<f64> {
+            let mut p = param.clone();
+            let mut c = ic;
+            if d < k {
+                p[M::parameter_index(free[d]).unwrap()] += h;
+            } else {
+                match initial[d - k] {
+                    0 => c.roll += h,
+                    1 => c.steer += h,
+                    2 => c.roll_rate += h,
+                    3 => c.steer_rate += h,
+                    _ => c.speed += h,
+                }
+            }
+            response::<M, f64>(&p, &c, &Directions::default(), duration, &opts, true).unwrap()
+        };
+        for d in 0..nd {
+            let size = if d < k {
+                param[M::parameter_index(free[d]).unwrap()].abs().max(0.1)
+            } else {
+                0.1
+            };
+            let h = 1e-5 * size;
+            let (a, b) = (moved(d, h), moved(d, -h));
+            let channels: [(&str, &Vec<Dual<6>>, &Vec<f64>, &Vec<f64>); 4] = [
+                ("roll", &exact.roll, &a.roll, &b.roll),
+                ("roll rate", &exact.roll_rate, &a.roll_rate, &b.roll_rate),
+                ("steer", &exact.steer, &a.steer, &b.steer),
+                ("speed", &exact.speed, &a.speed, &b.speed),
+            ];
+            for (name, e, a, b) in channels {
+                let fd: Vec<f64> = a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * h)).collect();
+                let scale = fd.iter().fold(1e-3f64, |m, x| m.max(x.abs()));
+                let worst = e
+                    .iter()
+                    .zip(&fd)
+                    .map(|(x, f)| (x.derivative(d) - f).abs())
+                    .fold(0.0f64, f64::max);
+                println!(
+                    "{}: d {name} / d direction {d}: max |exact - central| = {worst:.2e} of {scale:.2e}",
+                    M::NAME
+                );
+                assert!(
+                    worst <= 1e-5 * scale,
+                    "{}: d {name} / d direction {d}: exact and central differences differ by {worst:.3e} (scale {scale:.3e})",
+                    M::NAME
+                );
+            }
+        }
+    }
+    let all = [0, 1, 2, 3, 4];
+    check::<ThesisWhipple>(&[], &["I3x"], &all);
+    let effects = [("c_steer", 0.3), ("CdA", 0.4), ("Crr_rear", 0.01)];
+    check::<ExtendedFree>(&effects, &["c_steer"], &all);
+    check::<ExtendedFree>(&effects, &["CdA", "I3x", "T_steer"], &[2, 4]);
+    check::<TyreFree>(&[("c_steer", 0.2)], &["c_steer", "sigma_front"], &[0, 3, 4]);
+}

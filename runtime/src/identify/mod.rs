@@ -22,11 +22,15 @@
 //!   eliminating each segment's 5x5 block, so an iteration costs linearly in
 //!   the number of kicks (a dense solver's QR grows with their cube, and a
 //!   hundred kicks of the TU Delft logs took minutes per iteration; the
-//!   `levenberg-marquardt` crate has no sparse path). Sensitivities are
-//!   forward differences of whole simulations at tight tolerance (rtol
-//!   1e-8), with a difference step (1e-3 of the parameter's scale) far
-//!   above the integration error; a column costs one simulation of one
-//!   segment. Segments run in parallel.
+//!   `levenberg-marquardt` crate has no sparse path). The Jacobian comes
+//!   from forward sensitivities (`simulate::sensitivity`): each segment is
+//!   simulated once in dual numbers carrying the derivatives along its
+//!   initial state and the effect parameters (in passes of [`WIDTH`]
+//!   directions), exact to the integration tolerance (rtol 1e-8); forward
+//!   differences of whole simulations (a column per simulation) remain
+//!   only where the explicit integrator fails (a stiff candidate, simulated
+//!   with Radau5). Residuals alone take the lean path of the same module
+//!   (channel samples only). Segments run in parallel.
 //! * **Roll channel and speed.** Thesis-style runs measure the roll angle
 //!   and leave the speed free after the release; a log of a gyro-equipped
 //!   bicycle whose motor holds the speed (the TU Delft logs) measures the
@@ -48,11 +52,17 @@
 //!   the measured-run pipeline before, and are never candidates.
 
 use crate::model::MultibodyModel;
+use crate::scalar::Dual;
+use crate::simulate::sensitivity::{response, Carried, Directions};
 use crate::simulate::{simulate, Events, InitialConditions, Inputs, Method, SimOptions};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
+
+pub mod confounding;
+pub use confounding::{Confounding, Design};
 
 /// Number of per-segment nuisance parameters: initial roll, steer (rad),
 /// roll rate, steer rate (rad/s) and forward speed (m/s).
@@ -332,7 +342,16 @@ pub struct Setup<'a> {
     slots: Vec<Vec<usize>>,
     pub parameters: Vec<EffectParameter>,
     simulate: fn(&[f64], &Segment, &[f64; NUISANCE], &SimOptions) -> Result<Sim, String>,
+    sensitivities: SensitivityFn,
+    /// Simulations run so far (a simulation in dual numbers counts as one).
+    simulations: AtomicUsize,
 }
+
+/// The simulated channels of a segment and their derivatives along the
+/// directions (one vector per direction, the channels concatenated as in
+/// the residuals), or `None` where forward sensitivities do not apply.
+type SensitivityFn =
+    fn(&[f64], &Segment, &[f64; NUISANCE], &SimOptions, &Directions, usize) -> Option<(Sim, Vec<Vec<f64>>)>;
 
 /// Simulated channels at the segment's sample times.
 pub struct Sim {
@@ -364,19 +383,17 @@ fn simulate_segment<M: MultibodyModel>(
     x0: &[f64; NUISANCE],
     opts: &SimOptions,
 ) -> Result<Sim, String> {
-    let ic = InitialConditions {
-        roll: x0[0],
-        steer: x0[1],
-        roll_rate: x0[2],
-        steer_rate: x0[3],
-        speed: x0[4],
-        yaw: 0.0,
-    };
-    let dt = (seg.t.get(1).copied().unwrap_or(0.01) - seg.t[0]).max(1e-3);
+    let ic = initial_conditions(x0);
+    let dt = sample_interval(seg);
     let opts = SimOptions {
         output_interval: dt,
         ..*opts
     };
+    // The lean path (samples of the channels alone), else the full
+    // simulation below.
+    if let Some((sim, _)) = sampled::<M, f64>(param, seg, x0, &opts, &Directions::default()) {
+        return Ok(sim);
+    }
     // A stiff candidate (a steep friction law) stops the explicit method:
     // retry with the implicit one.
     let sim = simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &opts)
@@ -407,6 +424,120 @@ fn simulate_segment<M: MultibodyModel>(
         steer: seg.t.iter().map(|&t| interp(&sim.t, &steer, t)).collect(),
         speed: seg.speed_t.iter().map(|&t| interp(&sim.t, &sim.speed, t)).collect(),
     })
+}
+
+/// The simulation's output interval for a segment: its sample interval.
+fn sample_interval(seg: &Segment) -> f64 {
+    (seg.t.get(1).copied().unwrap_or(0.01) - seg.t[0]).max(1e-3)
+}
+
+fn initial_conditions(x0: &[f64; NUISANCE]) -> InitialConditions {
+    InitialConditions {
+        roll: x0[0],
+        steer: x0[1],
+        roll_rate: x0[2],
+        steer_rate: x0[3],
+        speed: x0[4],
+        yaw: 0.0,
+    }
+}
+
+/// Linear interpolation of carried values (derivatives interpolated alike),
+/// holding the last value after a stop.
+fn interp_carried<T: Carried>(ts: &[f64], xs: &[T], t: f64) -> T {
+    let n = ts.len();
+    if t <= ts[0] {
+        return xs[0];
+    }
+    if t >= ts[n - 1] {
+        return xs[n - 1];
+    }
+    let k = ts.partition_point(|&x| x <= t);
+    let w = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+    xs[k - 1] + (xs[k] - xs[k - 1]) * T::cst(w)
+}
+
+/// A segment's channels at its sample times from [`response`] (DOP853), with
+/// their derivatives along `dirs` when `T` is a dual number; `None` when the
+/// explicit method fails (a stiff candidate).
+fn sampled<M: MultibodyModel, T: Carried>(
+    param: &[f64],
+    seg: &Segment,
+    x0: &[f64; NUISANCE],
+    opts: &SimOptions,
+    dirs: &Directions,
+) -> Option<(Sim, Vec<Vec<f64>>)> {
+    let dt = sample_interval(seg);
+    let opts = SimOptions {
+        output_interval: dt,
+        ..*opts
+    };
+    let ic = initial_conditions(x0);
+    let r = response::<M, T>(param, &ic, dirs, seg.duration() + dt, &opts, !seg.speed_t.is_empty()).ok()?;
+    let roll = match seg.roll_channel {
+        RollChannel::Angle => &r.roll,
+        RollChannel::Rate => &r.roll_rate,
+    };
+    let at = |xs: &[T], ts: &[f64]| -> Vec<T> { ts.iter().map(|&t| interp_carried(&r.t, xs, t)).collect() };
+    let roll = at(roll, &seg.t);
+    let steer = at(&r.steer, &seg.t);
+    let speed = if seg.speed_t.is_empty() {
+        Vec::new()
+    } else {
+        at(&r.speed, &seg.speed_t)
+    };
+    let columns: Vec<Vec<f64>> = (0..T::DIRECTIONS)
+        .map(|d| {
+            roll.iter()
+                .chain(&steer)
+                .chain(&speed)
+                .map(|x| x.derivative(d))
+                .collect()
+        })
+        .collect();
+    let value = |xs: &[T]| xs.iter().map(|x| x.re()).collect();
+    Some((
+        Sim {
+            roll: value(&roll),
+            steer: value(&steer),
+            speed: value(&speed),
+        },
+        columns,
+    ))
+}
+
+/// The dual width of the sensitivities: a kick's initial state and one
+/// effect parameter in one pass; more directions take more passes. One
+/// width only, because every width compiles every model's equations again.
+const WIDTH: usize = 6;
+
+/// [`sampled`] with derivatives along `nd` directions, in passes of
+/// [`WIDTH`] directions.
+fn segment_sensitivities<M: MultibodyModel>(
+    param: &[f64],
+    seg: &Segment,
+    x0: &[f64; NUISANCE],
+    opts: &SimOptions,
+    dirs: &Directions,
+    nd: usize,
+) -> Option<(Sim, Vec<Vec<f64>>)> {
+    let mut columns = Vec::with_capacity(nd);
+    let mut sim = None;
+    for first in (0..nd.max(1)).step_by(WIDTH) {
+        let inside = |d: usize| (first..first + WIDTH).contains(&d).then(|| d - first);
+        let pass = Directions {
+            parameters: dirs
+                .parameters
+                .iter()
+                .filter_map(|&(i, d)| Some((i, inside(d)?)))
+                .collect(),
+            initial: dirs.initial.map(|d| d.and_then(inside)),
+        };
+        let (s, c) = sampled::<M, Dual<WIDTH>>(param, seg, x0, opts, &pass)?;
+        columns.extend(c.into_iter().take(nd - first));
+        sim.get_or_insert(s);
+    }
+    Some((sim?, columns))
 }
 
 impl<'a> Setup<'a> {
@@ -462,6 +593,8 @@ impl<'a> Setup<'a> {
             slots,
             parameters,
             simulate: simulate_segment::<M>,
+            sensitivities: segment_sensitivities::<M>,
+            simulations: AtomicUsize::new(0),
         })
     }
 
@@ -485,6 +618,7 @@ impl<'a> Setup<'a> {
     /// Weighted residuals of one segment (roll, steer, speed blocks).
     pub fn residuals(&self, g: &[f64], i: usize, x0: &[f64; NUISANCE]) -> Result<Vec<f64>, String> {
         let seg = &self.segments[i];
+        self.simulations.fetch_add(1, Ordering::Relaxed);
         let s = (self.simulate)(&self.param(g), seg, x0, &self.options)?;
         let w = self.weights[i];
         let mut r = Vec::with_capacity(seg.len());
@@ -495,6 +629,65 @@ impl<'a> Setup<'a> {
             return Err("non-finite residual".into());
         }
         Ok(r)
+    }
+
+    /// The Jacobian of segment `i`'s weighted residuals by forward
+    /// sensitivities (one simulation in dual numbers): the columns of the
+    /// effect parameters when `shared`, then those of its initial state
+    /// when `nuisance`; `None` where they do not apply (a stiff candidate,
+    /// more than 10 columns).
+    fn jacobian(
+        &self,
+        g: &[f64],
+        i: usize,
+        x0: &[f64; NUISANCE],
+        shared: bool,
+        nuisance: bool,
+    ) -> Option<SegmentJacobian> {
+        let seg = &self.segments[i];
+        let k = if shared { self.k() } else { 0 };
+        let nn = if nuisance { NUISANCE } else { 0 };
+        let mut dirs = Directions::default();
+        if shared {
+            for (j, (slot, info)) in self.slots.iter().zip(&self.parameters).enumerate() {
+                // Below its floor the parameter is simulated at the floor:
+                // the response does not move with it.
+                if info.lower.is_some_and(|lo| g[j] < lo) {
+                    continue;
+                }
+                dirs.parameters.extend(slot.iter().map(|&p| (p, j)));
+            }
+        }
+        if nuisance {
+            for (d, dir) in dirs.initial.iter_mut().enumerate() {
+                *dir = Some(k + d);
+            }
+        }
+        self.simulations.fetch_add(1, Ordering::Relaxed);
+        let (_, columns) = (self.sensitivities)(&self.param(g), seg, x0, &self.options, &dirs, k + nn)?;
+        let w = self.weights[i];
+        let (nr, ns) = (seg.roll.len(), seg.steer.len());
+        let scale = |row: usize| {
+            if row < nr {
+                w.roll
+            } else if row < nr + ns {
+                w.steer
+            } else {
+                w.speed
+            }
+        };
+        let rows = columns.first().map_or(seg.len(), Vec::len);
+        let column = |d: usize| DVector::from_iterator(rows, columns[d].iter().enumerate().map(|(r, x)| -x / scale(r)));
+        let mut a = DMatrix::zeros(rows, k);
+        let mut b = DMatrix::zeros(rows, nn);
+        for d in 0..k {
+            a.set_column(d, &column(d));
+        }
+        for d in 0..nn {
+            b.set_column(d, &column(k + d));
+        }
+        let finite = a.iter().chain(b.iter()).all(|x| x.is_finite());
+        finite.then_some(SegmentJacobian { a, b })
     }
 
     /// Simulated channels of one segment (for plots).
@@ -609,15 +802,29 @@ struct SegmentJacobian {
 }
 
 impl Problem<'_, '_> {
-    /// Forward-difference Jacobian blocks at the current point, one per
-    /// segment taking part; a column costs one simulation of one segment.
+    /// Jacobian blocks at the current point, one per segment taking part:
+    /// by forward sensitivities (one simulation in dual numbers per
+    /// segment), else by forward differences (a column costs one
+    /// simulation of one segment).
     fn jacobian_blocks(&self) -> Option<Vec<SegmentJacobian>> {
         let base = self.all_residuals()?;
         let k = if self.free == Free::Nuisance { 0 } else { self.setup.k() };
         let nn = if self.free == Free::Shared { 0 } else { NUISANCE };
-        // Columns: (segment position, shared parameter or nuisance j).
+        let (shared, nuisance) = (k > 0, nn > 0);
+        let exact: Vec<Option<SegmentJacobian>> = self
+            .segs
+            .par_iter()
+            .zip(&base)
+            .map(|(&s, r)| {
+                self.setup
+                    .jacobian(&self.g, s, &self.x0[s], shared, nuisance)
+                    .filter(|j| j.a.nrows() == r.len() && j.b.nrows() == r.len())
+            })
+            .collect();
+        // Columns by differences where the sensitivities did not apply:
+        // (segment position, shared parameter or nuisance j).
         let mut tasks = Vec::new();
-        for p in 0..self.segs.len() {
+        for p in (0..self.segs.len()).filter(|&p| exact[p].is_none()) {
             tasks.extend((0..k).map(|j| (p, false, j)));
             tasks.extend((0..nn).map(|j| (p, true, j)));
         }
@@ -647,9 +854,12 @@ impl Problem<'_, '_> {
             .collect();
         let mut blocks: Vec<SegmentJacobian> = base
             .iter()
-            .map(|r| SegmentJacobian {
-                a: DMatrix::zeros(r.len(), k),
-                b: DMatrix::zeros(r.len(), nn),
+            .zip(exact)
+            .map(|(r, e)| {
+                e.unwrap_or_else(|| SegmentJacobian {
+                    a: DMatrix::zeros(r.len(), k),
+                    b: DMatrix::zeros(r.len(), nn),
+                })
             })
             .collect();
         for (p, nuisance, j, d) in cols? {
@@ -885,6 +1095,7 @@ fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
     let Some(mut c) = cost(&p) else { return p };
     let scales = p.scales();
     let budget = patience.max(1) * (k + NUISANCE + 1) * 4;
+
     let mut evals = 1;
     let mut lambda = 1e-3;
     'outer: while evals < budget {
@@ -951,7 +1162,7 @@ pub fn fit_candidate(
     if nseg == 0 {
         return Err(IdentifyError::NoData);
     }
-    let sims = std::sync::atomic::AtomicUsize::new(0);
+    let sims_before = setup.simulations.load(Ordering::Relaxed);
     let all: Vec<usize> = (0..nseg).collect();
     let problem = |segs: Vec<usize>, free: Free, g: Vec<f64>, x0: Vec<[f64; NUISANCE]>| Problem {
         setup,
@@ -965,15 +1176,7 @@ pub fn fit_candidate(
     // and states together (the base model: states alone).
     let free = if setup.k() == 0 { Free::Nuisance } else { Free::All };
     let full = lm_fit(problem(all.clone(), free, g0.to_vec(), x0.to_vec()), opts.patience);
-    let count = |p: &Problem<'_, '_>| {
-        // Each LM evaluation is one residual pass; a Jacobian is one
-        // simulation per free column per segment (approximate count).
-        sims.fetch_add(
-            p.segs.len() * (1 + p.n_free().min(setup.k() + NUISANCE)),
-            std::sync::atomic::Ordering::Relaxed,
-        );
-    };
-    count(&full);
+    let simulations = || setup.simulations.load(Ordering::Relaxed) - sims_before;
     let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
         run: setup.segments[0].run.clone(),
         message: "the fitted model does not simulate every segment".into(),
@@ -1037,7 +1240,7 @@ pub fn fit_candidate(
     if let Some(r) = reference {
         fit.bic = bic(&fit, r);
         if !(physical && fit.bic < bic(r, r)) {
-            fit.simulations = sims.into_inner();
+            fit.simulations = simulations();
             return Ok(fit);
         }
     }
@@ -1056,7 +1259,6 @@ pub fn fit_candidate(
         }
         let gf = if setup.k() > 0 && !train.is_empty() {
             let p = lm_fit(problem(train, Free::Shared, g.clone(), nuisance.clone()), opts.patience);
-            count(&p);
             p.g.clone()
         } else {
             g.clone()
@@ -1065,7 +1267,6 @@ pub fn fit_candidate(
             problem(test.clone(), Free::Nuisance, gf.clone(), nuisance.clone()),
             opts.patience,
         );
-        count(&p);
         if let Some(r) = p.all_residuals() {
             for (i, &s) in test.iter().enumerate() {
                 held_out[s] = SegmentError::of(&r[i], &setup.segments[s], setup.weights[s]);
@@ -1078,7 +1279,7 @@ pub fn fit_candidate(
     fit.cv = held_res.iter().flatten().map(|x| x * x).sum::<f64>() / n_cv.max(1) as f64;
     fit.held_out = held_out;
     fit.fold_values = fold_values;
-    fit.simulations = sims.into_inner();
+    fit.simulations = simulations();
     Ok(fit)
 }
 
@@ -1148,6 +1349,9 @@ pub struct Step {
     pub verdicts: Vec<(String, String)>,
     /// Candidates whose fit failed, with the reason.
     pub failed: Vec<(String, String)>,
+    /// The candidate added against each rival that also explained the
+    /// data: how far the data tell them apart ([`confounding`]).
+    pub confounded: Vec<Confounding>,
 }
 
 /// Outcome of identification.
@@ -1254,6 +1458,7 @@ pub fn identify<M: MultibodyModel>(
     let mut simulations = first.simulations + before.simulations;
     let candidates = &with_priors_on_the_data_scale(candidates, &before);
 
+    let main = Factory::<M>::new(base.to_vec());
     let mut current = before.clone();
     let mut selected: Vec<&Candidate> = Vec::new();
     let mut steps = Vec::new();
@@ -1330,6 +1535,20 @@ pub fn identify<M: MultibodyModel>(
         }
         let added = best.map(|b| tried[b].0.clone());
         let failed_names = failed.clone();
+        let confounded = match best {
+            Some(b) => rivals(&Rivals {
+                main: &main,
+                alternative,
+                segments,
+                weights: &weights,
+                selected: &selected,
+                candidates,
+                tried: &tried,
+                best: b,
+                base_bic,
+            }),
+            None => Vec::new(),
+        };
         let step = Step {
             base: current.effects.clone(),
             base_bic,
@@ -1338,6 +1557,7 @@ pub fn identify<M: MultibodyModel>(
             added: added.clone(),
             verdicts,
             failed: failed_names,
+            confounded,
         };
         steps.push(step);
         match best {
@@ -1359,6 +1579,77 @@ pub fn identify<M: MultibodyModel>(
         fold_of,
         simulations,
     })
+}
+
+/// What [`rivals`] looks at: a step's fits and what made them.
+struct Rivals<'r> {
+    main: &'r dyn ModelFactory,
+    alternative: Option<&'r dyn ModelFactory>,
+    segments: &'r [Segment],
+    weights: &'r [Weights],
+    selected: &'r [&'r Candidate],
+    candidates: &'r [Candidate],
+    tried: &'r [(String, CandidateFit)],
+    best: usize,
+    base_bic: f64,
+}
+
+/// The candidate a step adds against each rival that also lowered the
+/// information criterion: their correlation on the measured kicks, and for
+/// a confounded pair the designs of kicks that would separate them (at
+/// speeds from 1.5 m/s below the slowest kick to 1.5 m/s above the fastest).
+fn rivals(r: &Rivals<'_>) -> Vec<Confounding> {
+    let (name, fit) = &r.tried[r.best];
+    let find = |n: &str| r.candidates.iter().find(|c| c.name == n);
+    let Some(chosen) = find(name) else { return Vec::new() };
+    let speeds: Vec<f64> = {
+        let v = r.segments.iter().map(|s| s.mean_speed).filter(|v| v.is_finite());
+        let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+        if lo.is_finite() {
+            let (lo, hi) = ((lo - 1.5).max(1.0), hi + 1.5);
+            (0..6).map(|i| lo + (hi - lo) * i as f64 / 5.0).collect()
+        } else {
+            Vec::new()
+        }
+    };
+    let ks: usize = r.selected.iter().map(|c| c.parameters.len()).sum();
+    let kc = chosen.parameters.len();
+    let mut out = Vec::new();
+    for (i, (rival_name, rival_fit)) in r.tried.iter().enumerate() {
+        if i == r.best || !rival_fit.physical || !(rival_fit.bic < r.base_bic) {
+            continue;
+        }
+        let Some(rival) = find(rival_name) else { continue };
+        let mut active: Vec<&Candidate> = r.selected.to_vec();
+        active.push(chosen);
+        active.push(rival);
+        let factory = match r.alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
+            Some(f) => f,
+            None if active.iter().any(|a| a.alternative_model) => continue,
+            None => r.main,
+        };
+        let Ok(setup) = factory.setup(r.segments, r.weights, &active) else {
+            continue;
+        };
+        let mut g = fit.values.clone();
+        g.extend(rival_fit.values.iter().skip(ks));
+        if g.len() != setup.k() {
+            continue;
+        }
+        let a: Vec<usize> = (ks..ks + kc).collect();
+        let b: Vec<usize> = (ks + kc..setup.k()).collect();
+        if let Some((correlation, designs)) =
+            confounding::confounding(&setup, factory, &active, &g, &fit.nuisance, &a, &b, &speeds)
+        {
+            out.push(Confounding {
+                chosen: name.clone(),
+                rival: rival_name.clone(),
+                correlation,
+                designs,
+            });
+        }
+    }
+    out
 }
 
 /// Paired comparison of the held-out errors of two models, run by run:

@@ -80,6 +80,7 @@
 
 mod inputs;
 mod rhs;
+pub mod sensitivity;
 
 pub mod fit;
 pub mod trajectory;
@@ -686,6 +687,13 @@ fn integrate_to<M: MultibodyModel>(
     Ok(samples.y.into_iter().last().expect("integrate checks the end point"))
 }
 
+/// The parameter that imposes the forward speed in a driven model (whose
+/// independent coordinates are roll and steer alone); the initial
+/// conditions' speed sets it.
+pub(crate) fn imposed_speed_parameter<M: MultibodyModel>() -> Option<usize> {
+    M::FORWARD_SPEED_PARAMETER.filter(|_| M::INDEPENDENT.len() == 2)
+}
+
 /// The state vector for given initial conditions (consistent with all
 /// constraints), and the parameter vector with the speed set for a driven
 /// model.
@@ -708,8 +716,7 @@ pub fn initial_state<M: MultibodyModel>(
         }
     }
     let mut param = rhs::with_state_tail::<M>(param)?;
-    let driven = M::INDEPENDENT.len() == 2;
-    if let Some(k) = M::FORWARD_SPEED_PARAMETER.filter(|_| driven) {
+    if let Some(k) = imposed_speed_parameter::<M>() {
         if k < param.len() {
             param[k] = ic.speed;
         }

@@ -124,7 +124,7 @@ impl BicycleCoordinates {
 }
 
 /// Forward speed of the rear contact point, `xc' cos(phi) + yc' sin(phi)`.
-pub fn forward_speed(c: &BicycleCoordinates, p: &[f64], dp: &[f64]) -> f64 {
+pub fn forward_speed<T: Scalar>(c: &BicycleCoordinates, p: &[T], dp: &[T]) -> T {
     let (s, co) = p[c.yaw].sin_cos();
     dp[c.xc] * co + dp[c.yc] * s
 }
@@ -165,43 +165,43 @@ pub fn rolling_radius<M: MultibodyModel>(param: &[f64], c: &BicycleCoordinates) 
 
 /// Buffers of one evaluation (no allocation in the right-hand side).
 #[derive(Clone, Debug)]
-pub(crate) struct Workspace {
+pub(crate) struct Workspace<T: Scalar = f64> {
     /// Full coordinates (dependent ones warm-start the next Newton solve).
-    pub p: Vec<f64>,
+    pub p: Vec<T>,
     /// Full velocities.
-    pub dp: Vec<f64>,
+    pub dp: Vec<T>,
     /// Independent accelerations.
-    pub ddq: Vec<f64>,
+    pub ddq: Vec<T>,
     /// Max-norm of the holonomic residuals after the Newton solve.
     pub residual: f64,
     /// Newton iterations of the last solve.
     pub newton_iterations: usize,
     /// Coordinates and time of the previous evaluation (for the predictor).
-    p_prev: Vec<f64>,
+    p_prev: Vec<T>,
     t_prev: f64,
     have_prev: bool,
-    res: Vec<f64>,
-    step: Vec<f64>,
-    cq: Vec<f64>,
-    jac: Vec<f64>,
+    res: Vec<T>,
+    step: Vec<T>,
+    cq: Vec<T>,
+    jac: Vec<T>,
     piv: Vec<usize>,
-    d: Vec<f64>,
-    ct: Vec<f64>,
-    ddep: Vec<f64>,
-    x: Vec<f64>,
-    gamma: Vec<f64>,
-    e: Vec<f64>,
-    f: Vec<f64>,
-    mass: Vec<f64>,
-    qv: Vec<f64>,
-    qg: Vec<f64>,
-    qe: Vec<f64>,
-    qtot: Vec<f64>,
-    me: Vec<f64>,
-    mi: Vec<f64>,
+    d: Vec<T>,
+    ct: Vec<T>,
+    ddep: Vec<T>,
+    x: Vec<T>,
+    gamma: Vec<T>,
+    e: Vec<T>,
+    f: Vec<T>,
+    mass: Vec<T>,
+    qv: Vec<T>,
+    qg: Vec<T>,
+    qe: Vec<T>,
+    qtot: Vec<T>,
+    me: Vec<T>,
+    mi: Vec<T>,
     depv: Vec<usize>,
     /// Output of `all_quantities` and the offsets of the quantities used.
-    all: Vec<f64>,
+    all: Vec<T>,
     off: AllOffsets,
 }
 
@@ -244,7 +244,7 @@ impl AllOffsets {
     }
 }
 
-impl Workspace {
+impl<T: Scalar> Workspace<T> {
     pub fn new<M: MultibodyModel>() -> Self {
         let nq = M::nq();
         let nh = M::HOLONOMIC.len();
@@ -254,35 +254,35 @@ impl Workspace {
         let nd = depv.len();
         let (off, all_len) = AllOffsets::of::<M>();
         Workspace {
-            all: vec![0.0; all_len],
+            all: vec![T::zero(); all_len],
             off,
-            p: M::INITIAL_GUESS.to_vec(),
-            dp: vec![0.0; nq],
-            ddq: vec![0.0; ni],
+            p: M::INITIAL_GUESS.iter().map(|&x| T::cst(x)).collect(),
+            dp: vec![T::zero(); nq],
+            ddq: vec![T::zero(); ni],
             residual: 0.0,
             newton_iterations: 0,
-            p_prev: M::INITIAL_GUESS.to_vec(),
+            p_prev: M::INITIAL_GUESS.iter().map(|&x| T::cst(x)).collect(),
             t_prev: 0.0,
             have_prev: false,
-            res: vec![0.0; nh],
-            step: vec![0.0; nh],
-            cq: vec![0.0; nh * nq],
-            jac: vec![0.0; nh * nh],
+            res: vec![T::zero(); nh],
+            step: vec![T::zero(); nh],
+            cq: vec![T::zero(); nh * nq],
+            jac: vec![T::zero(); nh * nh],
             piv: vec![0; nq.max(nc)],
-            d: vec![0.0; nc * nq],
-            ct: vec![0.0; nh],
-            ddep: vec![0.0; nd * nd],
-            x: vec![0.0; nd * (ni + 1)],
-            gamma: vec![0.0; nc],
-            e: vec![0.0; nq * ni],
-            f: vec![0.0; nq],
-            mass: vec![0.0; nq * nq],
-            qv: vec![0.0; nq],
-            qg: vec![0.0; nq],
-            qe: vec![0.0; nq],
-            qtot: vec![0.0; nq],
-            me: vec![0.0; nq * ni],
-            mi: vec![0.0; ni * ni],
+            d: vec![T::zero(); nc * nq],
+            ct: vec![T::zero(); nh],
+            ddep: vec![T::zero(); nd * nd],
+            x: vec![T::zero(); nd * (ni + 1)],
+            gamma: vec![T::zero(); nc],
+            e: vec![T::zero(); nq * ni],
+            f: vec![T::zero(); nq],
+            mass: vec![T::zero(); nq * nq],
+            qv: vec![T::zero(); nq],
+            qg: vec![T::zero(); nq],
+            qe: vec![T::zero(); nq],
+            qtot: vec![T::zero(); nq],
+            me: vec![T::zero(); nq * ni],
+            mi: vec![T::zero(); ni * ni],
             depv,
         }
     }
@@ -292,17 +292,22 @@ impl Workspace {
 pub const NEWTON_TOL: f64 = 1e-13;
 const NEWTON_MAX: usize = 30;
 
-fn max_abs(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+fn max_abs<T: Scalar>(v: &[T]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.re().abs()))
 }
 
 /// Solve the holonomic constraints for the dependent coordinates of `w.p`
 /// (the other coordinates are set), starting from the values in `w.p`.
-fn newton<M: MultibodyModel>(param: &[f64], t: f64, w: &mut Workspace) -> Result<(), SimulateError> {
+/// With dual numbers the iteration runs on them too: once the values have
+/// converged, a Newton step gives the dependent coordinates' derivatives
+/// exactly (implicit function theorem), whatever derivatives it started
+/// from; the loop makes at least one step.
+fn newton<M: MultibodyModel, T: Scalar>(param: &[T], t: f64, w: &mut Workspace<T>) -> Result<(), SimulateError> {
     let nq = M::nq();
     let nh = M::HOLONOMIC.len();
     let dep = M::DEPENDENT;
-    M::holonomic_residuals(param, t, &w.p, &mut w.res);
+    let tt = T::cst(t);
+    M::holonomic_residuals(param, tt, &w.p, &mut w.res);
     let mut r = max_abs(&w.res);
     let mut it = 0;
     // At least one iteration: the result is then a function of the state
@@ -316,7 +321,7 @@ fn newton<M: MultibodyModel>(param: &[f64], t: f64, w: &mut Workspace) -> Result
                 iterations: it,
             });
         }
-        M::holonomic_jacobian(param, t, &w.p, &mut w.cq);
+        M::holonomic_jacobian(param, tt, &w.p, &mut w.cq);
         for i in 0..nh {
             for (k, &j) in dep.iter().enumerate() {
                 w.jac[i * nh + k] = w.cq[i * nq + j];
@@ -335,9 +340,9 @@ fn newton<M: MultibodyModel>(param: &[f64], t: f64, w: &mut Workspace) -> Result
         let mut lambda = 1.0;
         loop {
             for (k, &j) in dep.iter().enumerate() {
-                w.p[j] -= lambda * w.step[k];
+                w.p[j] -= T::cst(lambda) * w.step[k];
             }
-            M::holonomic_residuals(param, t, &w.p, &mut w.res);
+            M::holonomic_residuals(param, tt, &w.p, &mut w.res);
             let n = max_abs(&w.res);
             if n < r || lambda < 1e-3 || n <= NEWTON_TOL {
                 r = n;
@@ -345,7 +350,7 @@ fn newton<M: MultibodyModel>(param: &[f64], t: f64, w: &mut Workspace) -> Result
             }
             lambda *= 0.5;
             for (k, &j) in dep.iter().enumerate() {
-                w.p[j] += lambda * w.step[k];
+                w.p[j] += T::cst(lambda) * w.step[k];
             }
         }
         it += 1;
@@ -425,184 +430,25 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
     }
 
     /// Full coordinates and velocities from the state, then the independent
-    /// accelerations (thesis eq. 40-47): Newton on the holonomic constraints
-    /// (warm-started), `D_dep p'_dep = d - D_ind q'`, `E`, `F`,
-    /// `Mi q'' = Qi`. Results in the workspace.
+    /// accelerations (see [`evaluate_state`]). Results in the workspace.
     pub(crate) fn evaluate(&self, t: f64, y: &[f64], w: &mut Workspace) -> Result<(), SimulateError> {
         self.evaluations.set(self.evaluations.get() + 1);
-        let l = &self.layout;
-        let ni = l.ni();
-        let nq = M::nq();
-        if let Some(k) = y.iter().position(|x| !x.is_finite()) {
-            return Err(SimulateError::NotFinite {
-                what: format!("state component {k} at t = {t}"),
-            });
-        }
-        let nh = M::HOLONOMIC.len();
         let mut pz = self.pz.borrow_mut();
-        let np = M::PARAMETERS.len();
-        pz[np..].copy_from_slice(&y[l.extras()..l.extras() + l.extra]);
-        let param = &pz[..];
-        w.p_prev.copy_from_slice(&w.p);
-        for (k, &j) in l.independent.iter().enumerate() {
-            w.p[j] = y[k];
-        }
-        for (k, &j) in l.ignorable.iter().enumerate() {
-            w.p[j] = y[l.ignorables() + k];
-        }
-        if w.have_prev {
-            // Predictor: first-order change of the dependent coordinates from
-            // the holonomic Jacobian of the previous evaluation,
-            // `Cq_dep dp_dep = -(Cq_other dp_other + Ct dt)`. Without it a
-            // large change of a coordinate the constraints depend on
-            // periodically (the front wheel angle eps, which enters only as
-            // eps + xi) would send Newton to another branch.
-            for i in 0..nh {
-                let mut r = w.ct[i] * (t - w.t_prev);
-                for j in 0..nq {
-                    if !M::DEPENDENT.contains(&j) {
-                        r += w.d[i * nq + j] * (w.p[j] - w.p_prev[j]);
-                    }
-                }
-                w.res[i] = r;
-                for (k, &j) in M::DEPENDENT.iter().enumerate() {
-                    w.jac[i * nh + k] = w.d[i * nq + j];
-                }
-            }
-            if lu_factor(&mut w.jac, nh, &mut w.piv[..nh]).is_ok() {
-                lu_solve(&w.jac, nh, &w.piv[..nh], &mut w.res, 1);
-                for (k, &j) in M::DEPENDENT.iter().enumerate() {
-                    w.p[j] -= w.res[k];
-                }
-            }
-        }
-        w.have_prev = false;
-        if newton::<M>(param, t, w).is_err() {
-            // Retry from the model's initial guess (a poor warm start).
-            for &j in M::DEPENDENT {
-                w.p[j] = M::INITIAL_GUESS[j];
-            }
-            newton::<M>(param, t, w)?;
-        }
-        let nc = nh + M::NONHOLONOMIC.len();
-        let nd = w.depv.len();
-        M::holonomic_jacobian(param, t, &w.p, &mut w.d[..nh * nq]);
-        M::nonholonomic_matrix(param, t, &w.p, &mut w.d[nh * nq..]);
-        M::holonomic_time_derivative(param, t, &w.p, &mut w.ct);
-        w.have_prev = true;
-        w.t_prev = t;
-        for i in 0..nc {
-            for (k, &j) in w.depv.iter().enumerate() {
-                w.ddep[i * nd + k] = w.d[i * nq + j];
-            }
-            for (k, &j) in l.independent.iter().enumerate() {
-                w.x[i * (ni + 1) + k] = w.d[i * nq + j];
-            }
-            w.x[i * (ni + 1) + ni] = if i < nh { -w.ct[i] } else { 0.0 };
-        }
-        lu_factor(&mut w.ddep, nd, &mut w.piv[..nd]).map_err(|s| SimulateError::Singular {
-            t,
-            what: "velocity constraints (coordinate partitioning)",
-            column: s.column,
-            pivot: s.pivot,
-        })?;
-        lu_solve(&w.ddep, nd, &w.piv[..nd], &mut w.x, ni + 1);
-        for (k, &j) in l.independent.iter().enumerate() {
-            w.dp[j] = y[l.rates() + k];
-        }
-        for r in 0..nd {
-            let mut v = w.x[r * (ni + 1) + ni];
-            for k in 0..ni {
-                v -= w.x[r * (ni + 1) + k] * y[l.rates() + k];
-            }
-            w.dp[w.depv[r]] = v;
-        }
-        // Everything that needs the full velocities in one call (shared
-        // common subexpressions).
-        M::all_quantities(param, t, &w.p, &w.dp, &mut w.all);
-        let o = w.off;
-        let nnh = nc - nh;
-        w.gamma[..nh].copy_from_slice(&w.all[o.hconv..o.hconv + nh]);
-        w.gamma[nh..].copy_from_slice(&w.all[o.nhconv..o.nhconv + nnh]);
-        lu_solve(&w.ddep, nd, &w.piv[..nd], &mut w.gamma, 1);
-        w.e.iter_mut().for_each(|x| *x = 0.0);
-        w.f.iter_mut().for_each(|x| *x = 0.0);
-        for (k, &j) in l.independent.iter().enumerate() {
-            w.e[j * ni + k] = 1.0;
-        }
-        for r in 0..nd {
-            let j = w.depv[r];
-            for k in 0..ni {
-                w.e[j * ni + k] = -w.x[r * (ni + 1) + k];
-            }
-            w.f[j] = -w.gamma[r];
-        }
-        w.mass.copy_from_slice(&w.all[o.mass..o.mass + nq * nq]);
-        w.qv.copy_from_slice(&w.all[o.qv..o.qv + nq]);
-        w.qg.copy_from_slice(&w.all[o.qg..o.qg + nq]);
-        w.qe.copy_from_slice(&w.all[o.qe..o.qe + nq]);
-        let (a, b) = self.segment.get();
-        let inset = 1e-9 * (b - a).min(1.0);
-        let (tr, ts) = self.inputs.torques(t.max(a + inset).min(b - inset));
-        w.qe[self.coords.roll] += tr;
-        w.qe[self.coords.steer] += ts;
-        for r in 0..nq {
-            let mut s = w.qv[r] + w.qg[r] + w.qe[r];
-            for c in 0..nq {
-                s -= w.mass[r * nq + c] * w.f[c];
-            }
-            w.qtot[r] = s;
-        }
-        for r in 0..nq {
-            for k in 0..ni {
-                let mut s = 0.0;
-                for c in 0..nq {
-                    s += w.mass[r * nq + c] * w.e[c * ni + k];
-                }
-                w.me[r * ni + k] = s;
-            }
-        }
-        for a in 0..ni {
-            let mut qi = 0.0;
-            for r in 0..nq {
-                qi += w.e[r * ni + a] * w.qtot[r];
-            }
-            w.ddq[a] = qi;
-            for b in 0..ni {
-                let mut m = 0.0;
-                for r in 0..nq {
-                    m += w.e[r * ni + a] * w.me[r * ni + b];
-                }
-                w.mi[a * ni + b] = m;
-            }
-        }
-        lu_factor(&mut w.mi, ni, &mut w.piv[..ni]).map_err(|s| SimulateError::Singular {
-            t,
-            what: "reduced mass matrix",
-            column: s.column,
-            pivot: s.pivot,
-        })?;
-        lu_solve(&w.mi, ni, &w.piv[..ni], &mut w.ddq, 1);
-        Ok(())
+        let at = At {
+            layout: &self.layout,
+            coords: &self.coords,
+            inputs: self.inputs,
+            segment: self.segment.get(),
+        };
+        evaluate_state::<M, f64>(&at, t, y, &mut pz, w)
     }
 
     /// State derivative `dy` at `(t, y)`.
     pub fn derivative(&self, t: f64, y: &[f64], dy: &mut [f64]) -> Result<(), SimulateError> {
         let mut w = self.ws.borrow_mut();
         self.evaluate(t, y, &mut w)?;
-        let l = &self.layout;
-        let ni = l.ni();
-        dy[..ni].copy_from_slice(&y[l.rates()..l.rates() + ni]);
-        dy[ni..2 * ni].copy_from_slice(&w.ddq);
-        for (k, &j) in l.ignorable.iter().enumerate() {
-            dy[l.ignorables() + k] = w.dp[j];
-        }
-        dy[l.time()] = 1.0;
-        if l.extra > 0 {
-            // `evaluate` left this state's `z` in the parameter tail.
-            let pz = self.pz.borrow();
-            M::state_rates(&pz, t, &w.p, &w.dp, &mut dy[l.extras()..l.extras() + l.extra]);
-        }
+        let pz = self.pz.borrow();
+        state_derivative::<M, f64>(&self.layout, t, y, &pz, &w, dy);
         Ok(())
     }
 
@@ -673,6 +519,205 @@ impl<'a, M: MultibodyModel> Evaluator<'a, M> {
             y[r + k] += rhs[k];
         }
         Ok(())
+    }
+}
+
+/// What an evaluation reads besides the state: where things are in it,
+/// the bicycle's coordinates, the inputs and the integration segment.
+pub(crate) struct At<'a> {
+    pub layout: &'a StateLayout,
+    pub coords: &'a BicycleCoordinates,
+    pub inputs: &'a Inputs,
+    /// The integration segment `(start, end)` between breakpoints.
+    pub segment: (f64, f64),
+}
+
+/// Full coordinates and velocities from the state, then the independent
+/// accelerations (thesis eq. 40-47): Newton on the holonomic constraints
+/// (warm-started), `D_dep p'_dep = d - D_ind q'`, `E`, `F`,
+/// `Mi q'' = Qi`. Results in the workspace.
+pub(crate) fn evaluate_state<M: MultibodyModel, T: Scalar>(
+    at: &At<'_>,
+    t: f64,
+    y: &[T],
+    pz: &mut [T],
+    w: &mut Workspace<T>,
+) -> Result<(), SimulateError> {
+    let l = at.layout;
+    let ni = l.ni();
+    let nq = M::nq();
+    if let Some(k) = y.iter().position(|x| !x.re().is_finite()) {
+        return Err(SimulateError::NotFinite {
+            what: format!("state component {k} at t = {t}"),
+        });
+    }
+    let nh = M::HOLONOMIC.len();
+    let np = M::PARAMETERS.len();
+    pz[np..].copy_from_slice(&y[l.extras()..l.extras() + l.extra]);
+    let param = &*pz;
+    let tt = T::cst(t);
+    w.p_prev.copy_from_slice(&w.p);
+    for (k, &j) in l.independent.iter().enumerate() {
+        w.p[j] = y[k];
+    }
+    for (k, &j) in l.ignorable.iter().enumerate() {
+        w.p[j] = y[l.ignorables() + k];
+    }
+    if w.have_prev {
+        // Predictor: first-order change of the dependent coordinates from
+        // the holonomic Jacobian of the previous evaluation,
+        // `Cq_dep dp_dep = -(Cq_other dp_other + Ct dt)`. Without it a
+        // large change of a coordinate the constraints depend on
+        // periodically (the front wheel angle eps, which enters only as
+        // eps + xi) would send Newton to another branch.
+        for i in 0..nh {
+            let mut r = w.ct[i] * T::cst(t - w.t_prev);
+            for j in 0..nq {
+                if !M::DEPENDENT.contains(&j) {
+                    r += w.d[i * nq + j] * (w.p[j] - w.p_prev[j]);
+                }
+            }
+            w.res[i] = r;
+            for (k, &j) in M::DEPENDENT.iter().enumerate() {
+                w.jac[i * nh + k] = w.d[i * nq + j];
+            }
+        }
+        if lu_factor(&mut w.jac, nh, &mut w.piv[..nh]).is_ok() {
+            lu_solve(&w.jac, nh, &w.piv[..nh], &mut w.res, 1);
+            for (k, &j) in M::DEPENDENT.iter().enumerate() {
+                w.p[j] -= w.res[k];
+            }
+        }
+    }
+    w.have_prev = false;
+    if newton::<M, T>(param, t, w).is_err() {
+        // Retry from the model's initial guess (a poor warm start).
+        for &j in M::DEPENDENT {
+            w.p[j] = T::cst(M::INITIAL_GUESS[j]);
+        }
+        newton::<M, T>(param, t, w)?;
+    }
+    let nc = nh + M::NONHOLONOMIC.len();
+    let nd = w.depv.len();
+    M::holonomic_jacobian(param, tt, &w.p, &mut w.d[..nh * nq]);
+    M::nonholonomic_matrix(param, tt, &w.p, &mut w.d[nh * nq..]);
+    M::holonomic_time_derivative(param, tt, &w.p, &mut w.ct);
+    w.have_prev = true;
+    w.t_prev = t;
+    for i in 0..nc {
+        for (k, &j) in w.depv.iter().enumerate() {
+            w.ddep[i * nd + k] = w.d[i * nq + j];
+        }
+        for (k, &j) in l.independent.iter().enumerate() {
+            w.x[i * (ni + 1) + k] = w.d[i * nq + j];
+        }
+        w.x[i * (ni + 1) + ni] = if i < nh { -w.ct[i] } else { T::zero() };
+    }
+    lu_factor(&mut w.ddep, nd, &mut w.piv[..nd]).map_err(|s| SimulateError::Singular {
+        t,
+        what: "velocity constraints (coordinate partitioning)",
+        column: s.column,
+        pivot: s.pivot,
+    })?;
+    lu_solve(&w.ddep, nd, &w.piv[..nd], &mut w.x, ni + 1);
+    for (k, &j) in l.independent.iter().enumerate() {
+        w.dp[j] = y[l.rates() + k];
+    }
+    for r in 0..nd {
+        let mut v = w.x[r * (ni + 1) + ni];
+        for k in 0..ni {
+            v -= w.x[r * (ni + 1) + k] * y[l.rates() + k];
+        }
+        w.dp[w.depv[r]] = v;
+    }
+    // Everything that needs the full velocities in one call (shared
+    // common subexpressions).
+    M::all_quantities(param, tt, &w.p, &w.dp, &mut w.all);
+    let o = w.off;
+    let nnh = nc - nh;
+    w.gamma[..nh].copy_from_slice(&w.all[o.hconv..o.hconv + nh]);
+    w.gamma[nh..].copy_from_slice(&w.all[o.nhconv..o.nhconv + nnh]);
+    lu_solve(&w.ddep, nd, &w.piv[..nd], &mut w.gamma, 1);
+    w.e.iter_mut().for_each(|x| *x = T::zero());
+    w.f.iter_mut().for_each(|x| *x = T::zero());
+    for (k, &j) in l.independent.iter().enumerate() {
+        w.e[j * ni + k] = T::one();
+    }
+    for r in 0..nd {
+        let j = w.depv[r];
+        for k in 0..ni {
+            w.e[j * ni + k] = -w.x[r * (ni + 1) + k];
+        }
+        w.f[j] = -w.gamma[r];
+    }
+    w.mass.copy_from_slice(&w.all[o.mass..o.mass + nq * nq]);
+    w.qv.copy_from_slice(&w.all[o.qv..o.qv + nq]);
+    w.qg.copy_from_slice(&w.all[o.qg..o.qg + nq]);
+    w.qe.copy_from_slice(&w.all[o.qe..o.qe + nq]);
+    let (a, b) = at.segment;
+    let inset = 1e-9 * (b - a).min(1.0);
+    let (tr, ts) = at.inputs.torques(t.max(a + inset).min(b - inset));
+    w.qe[at.coords.roll] += T::cst(tr);
+    w.qe[at.coords.steer] += T::cst(ts);
+    for r in 0..nq {
+        let mut s = w.qv[r] + w.qg[r] + w.qe[r];
+        for c in 0..nq {
+            s -= w.mass[r * nq + c] * w.f[c];
+        }
+        w.qtot[r] = s;
+    }
+    for r in 0..nq {
+        for k in 0..ni {
+            let mut s = T::zero();
+            for c in 0..nq {
+                s += w.mass[r * nq + c] * w.e[c * ni + k];
+            }
+            w.me[r * ni + k] = s;
+        }
+    }
+    for a in 0..ni {
+        let mut qi = T::zero();
+        for r in 0..nq {
+            qi += w.e[r * ni + a] * w.qtot[r];
+        }
+        w.ddq[a] = qi;
+        for b in 0..ni {
+            let mut m = T::zero();
+            for r in 0..nq {
+                m += w.e[r * ni + a] * w.me[r * ni + b];
+            }
+            w.mi[a * ni + b] = m;
+        }
+    }
+    lu_factor(&mut w.mi, ni, &mut w.piv[..ni]).map_err(|s| SimulateError::Singular {
+        t,
+        what: "reduced mass matrix",
+        column: s.column,
+        pivot: s.pivot,
+    })?;
+    lu_solve(&w.mi, ni, &w.piv[..ni], &mut w.ddq, 1);
+    Ok(())
+}
+
+/// The state derivative from an evaluation at `(t, y)` (`pz`: the parameters
+/// with the state's `z` in their tail, as [`evaluate_state`] left them).
+pub(crate) fn state_derivative<M: MultibodyModel, T: Scalar>(
+    l: &StateLayout,
+    t: f64,
+    y: &[T],
+    pz: &[T],
+    w: &Workspace<T>,
+    dy: &mut [T],
+) {
+    let ni = l.ni();
+    dy[..ni].copy_from_slice(&y[l.rates()..l.rates() + ni]);
+    dy[ni..2 * ni].copy_from_slice(&w.ddq);
+    for (k, &j) in l.ignorable.iter().enumerate() {
+        dy[l.ignorables() + k] = w.dp[j];
+    }
+    dy[l.time()] = T::one();
+    if l.extra > 0 {
+        M::state_rates(pz, T::cst(t), &w.p, &w.dp, &mut dy[l.extras()..l.extras() + l.extra]);
     }
 }
 
