@@ -33,7 +33,7 @@ fn identify_bench() -> Result<()> {
     let _ = std::fs::remove_dir_all(&dir);
     println!("{}", report::summary(&o));
     println!(
-        "identify, 12-run set ({} kicks): {secs:.1} s wall clock on {} threads, {} simulations (target < 60 s on 2 cores)",
+        "identify, 12-run set ({} kicks): {secs:.1} s wall clock on {} threads, {} simulations (target < 5 s on 2 cores, issue 17)",
         o.segments.len(),
         rayon::current_num_threads(),
         o.identification.simulations
