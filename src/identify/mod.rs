@@ -10,6 +10,7 @@
 //! folder.
 
 pub mod candidates;
+mod confounded;
 pub mod corrections;
 pub mod diagnosis;
 pub mod eigen_table;

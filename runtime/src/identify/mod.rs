@@ -360,21 +360,23 @@ pub struct Sim {
     pub speed: Vec<f64>,
 }
 
-fn interp(ts: &[f64], xs: &[f64], t: f64) -> f64 {
+/// Linear interpolation of samples (a dual number's derivatives
+/// interpolated alike), holding the last value after a stop (a fall ends
+/// the simulation).
+fn interp<T: Carried>(ts: &[f64], xs: &[T], t: f64) -> T {
     let n = ts.len();
     if n == 0 {
-        return f64::NAN;
+        return T::cst(f64::NAN);
     }
     if t <= ts[0] {
         return xs[0];
     }
     if t >= ts[n - 1] {
-        // After a fall the simulation stops: hold its last value.
         return xs[n - 1];
     }
     let k = ts.partition_point(|&x| x <= t);
     let w = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
-    xs[k - 1] + w * (xs[k] - xs[k - 1])
+    xs[k - 1] + (xs[k] - xs[k - 1]) * T::cst(w)
 }
 
 fn simulate_segment<M: MultibodyModel>(
@@ -394,17 +396,13 @@ fn simulate_segment<M: MultibodyModel>(
     if let Some((sim, _)) = sampled::<M, f64>(param, seg, x0, &opts, &Directions::default()) {
         return Ok(sim);
     }
-    // A stiff candidate (a steep friction law) stops the explicit method:
-    // retry with the implicit one.
-    let sim = simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &opts)
-        .or_else(|_| {
-            let stiff = SimOptions {
-                method: Method::Radau5,
-                ..opts
-            };
-            simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &stiff)
-        })
-        .map_err(|e| e.to_string())?;
+    // The explicit method failed on the lean path: a stiff candidate (a
+    // steep friction law); the implicit one takes over.
+    let stiff = SimOptions {
+        method: Method::Radau5,
+        ..opts
+    };
+    let sim = simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &stiff).map_err(|e| e.to_string())?;
     use crate::model::CoordinateRole as R;
     let roll = match seg.roll_channel {
         RollChannel::Angle => sim.require_coordinate(R::Roll, "identification residuals"),
@@ -442,21 +440,6 @@ fn initial_conditions(x0: &[f64; NUISANCE]) -> InitialConditions {
     }
 }
 
-/// Linear interpolation of carried values (derivatives interpolated alike),
-/// holding the last value after a stop.
-fn interp_carried<T: Carried>(ts: &[f64], xs: &[T], t: f64) -> T {
-    let n = ts.len();
-    if t <= ts[0] {
-        return xs[0];
-    }
-    if t >= ts[n - 1] {
-        return xs[n - 1];
-    }
-    let k = ts.partition_point(|&x| x <= t);
-    let w = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
-    xs[k - 1] + (xs[k] - xs[k - 1]) * T::cst(w)
-}
-
 /// A segment's channels at its sample times from [`response`] (DOP853), with
 /// their derivatives along `dirs` when `T` is a dual number; `None` when the
 /// explicit method fails (a stiff candidate).
@@ -478,7 +461,7 @@ fn sampled<M: MultibodyModel, T: Carried>(
         RollChannel::Angle => &r.roll,
         RollChannel::Rate => &r.roll_rate,
     };
-    let at = |xs: &[T], ts: &[f64]| -> Vec<T> { ts.iter().map(|&t| interp_carried(&r.t, xs, t)).collect() };
+    let at = |xs: &[T], ts: &[f64]| -> Vec<T> { ts.iter().map(|&t| interp(&r.t, xs, t)).collect() };
     let roll = at(roll, &seg.t);
     let steer = at(&r.steer, &seg.t);
     let speed = if seg.speed_t.is_empty() {
