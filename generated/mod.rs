@@ -1,8 +1,10 @@
 //! Generated model code. `build.rs` writes every model and the registry into
 //! OUT_DIR; this module pulls the registry in (it lists the models, so no
-//! model name is written by hand here). `generated/snapshots/` holds
-//! committed, formatted copies, kept fresh by `tests/generated_code/snapshots.rs`
-//! (refresh with `UPDATE_SNAPSHOTS=1 cargo test --test behaviour snapshots`).
+//! model name is written by hand here). `generated/snapshots/` holds the
+//! committed, formatted code of each model, which the build uses when its
+//! inputs hash matches the model files (refresh with `cargo run --release
+//! -p bikedyn-modeler --features derive --bin bikedyn-derive`; CI checks
+//! it with `--check`).
 
 include!(concat!(env!("OUT_DIR"), "/models.rs"));
 

@@ -23,12 +23,19 @@
 //! `bikedyn_runtime::registry::ModelRegistry` for them) and
 //! `codegen_report.json` (derivation time and operation counts).
 
+#[cfg(feature = "derive")]
 use crate::derive::derive;
-use crate::emit::{emit, emit_registry, EmitError};
+#[cfg(feature = "derive")]
+use crate::emit::emit;
 use crate::model::Model;
+#[cfg(feature = "derive")]
+use crate::registry::emit_registry;
+use crate::registry::EmitError;
 use std::fmt;
 use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+#[cfg(feature = "derive")]
+use std::time::Instant;
 
 /// Why code generation failed.
 #[derive(Debug)]
@@ -104,6 +111,7 @@ impl CodegenReport {
     }
 }
 
+#[cfg(feature = "derive")]
 fn write(path: PathBuf, text: &str) -> Result<(), GenerateError> {
     // Rewrite only on change, so that cargo does not recompile unchanged code.
     if std::fs::read_to_string(&path).is_ok_and(|old| old == text) {
@@ -112,6 +120,7 @@ fn write(path: PathBuf, text: &str) -> Result<(), GenerateError> {
     std::fs::write(&path, text).map_err(|source| GenerateError::Io { path, source })
 }
 
+#[cfg(feature = "derive")]
 /// Exclusive use of Symbolica on this machine while it is held.
 ///
 /// Symbolica's non-commercial licence allows one Symbolica thread; two
@@ -132,11 +141,13 @@ pub struct SymbolicaGuard {
     _mutex: Option<std::sync::MutexGuard<'static, ()>>,
 }
 
+#[cfg(feature = "derive")]
 thread_local! {
     /// Whether this thread holds a [`SymbolicaGuard`] (for reentrancy).
     static HOLDS_SYMBOLICA: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
+#[cfg(feature = "derive")]
 impl Drop for SymbolicaGuard {
     fn drop(&mut self) {
         if self._mutex.is_some() {
@@ -145,6 +156,7 @@ impl Drop for SymbolicaGuard {
     }
 }
 
+#[cfg(feature = "derive")]
 /// Wait for exclusive use of Symbolica (see [`SymbolicaGuard`]).
 pub fn symbolica_guard() -> SymbolicaGuard {
     if HOLDS_SYMBOLICA.with(|h| h.get()) {
@@ -172,6 +184,7 @@ pub fn symbolica_guard() -> SymbolicaGuard {
     }
 }
 
+#[cfg(feature = "derive")]
 /// Run `f` on this process's one Symbolica thread (started on first use,
 /// alive until the process exits), holding the [`SymbolicaGuard`], and
 /// return its result; a panic in `f` is resumed in the caller. Every use of
@@ -204,6 +217,7 @@ pub fn on_symbolica_thread<R: Send + 'static>(f: impl FnOnce() -> R + Send + 'st
     }
 }
 
+#[cfg(feature = "derive")]
 /// Derive and emit every model into `out_dir` (see the module docs).
 pub fn generate(models: &[Model], out_dir: &Path) -> Result<CodegenReport, GenerateError> {
     let _one_symbolica = symbolica_guard();
@@ -248,4 +262,27 @@ pub fn generate(models: &[Model], out_dir: &Path) -> Result<CodegenReport, Gener
     };
     write(out_dir.join("codegen_report.json"), &report.to_json())?;
     Ok(report)
+}
+
+/// What a crate's `build.rs` calls: with the `derive` feature, derive and
+/// emit every model into `out_dir` ([`generate`]); without it, take each
+/// model's committed file from `snapshots` when its inputs hash matches
+/// ([`crate::snapshot::from_snapshots`]), else stop with the models that
+/// changed and the command that re-derives them. Returns the derivation
+/// report when the models were derived.
+pub fn build(
+    models: &[Model],
+    snapshots: &Path,
+    out_dir: &Path,
+) -> Result<Option<CodegenReport>, Box<dyn std::error::Error>> {
+    #[cfg(feature = "derive")]
+    {
+        let _ = snapshots;
+        Ok(Some(generate(models, out_dir)?))
+    }
+    #[cfg(not(feature = "derive"))]
+    {
+        crate::snapshot::from_snapshots(models, snapshots, out_dir)?;
+        Ok(None)
+    }
 }

@@ -1,15 +1,23 @@
 //! bikedyn's build-time modeler: declare a multibody model as data
 //! ([`model`]), derive its equations symbolically with Symbolica
-//! ([`derive`]), emit optimized Rust ([`emit`]), and write a crate's
-//! generated models and registry ([`codegen::generate`], for `build.rs`).
+//! (`derive`), emit optimized Rust (`emit`), and write a crate's generated
+//! models and registry ([`codegen::build`], for `build.rs`).
 //!
-//! Symbolica runs here only, at build time; the generated code and the
-//! runtime do not depend on it. Symbolica's own licence governs its use.
+//! Derivation and emission sit behind the `derive` feature, the only part
+//! that uses Symbolica (whose own licence governs its use). Without it, a
+//! build takes each model's committed generated file when the file's inputs
+//! hash says it is what derivation would give ([`snapshot`]), and stops
+//! with the command that re-derives a model that changed. The generated
+//! code and the runtime never depend on Symbolica.
 
 pub mod codegen;
+#[cfg(feature = "derive")]
 pub mod derive;
 pub mod effects;
+#[cfg(feature = "derive")]
 pub mod emit;
 pub mod expr;
 pub mod model;
 pub mod models;
+pub mod registry;
+pub mod snapshot;

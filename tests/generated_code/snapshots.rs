@@ -1,6 +1,10 @@
 //! The committed copies in `generated/snapshots/` must equal what build.rs
-//! emits, so that a model change shows up as a readable diff in review.
-//! Refresh them with `UPDATE_SNAPSHOTS=1 cargo test --test behaviour snapshots`.
+//! writes, so that a model change shows up as a readable diff in review.
+//! Without the `derive` feature build.rs takes them as they are (when their
+//! inputs hash matches); with `--features derive` this compares them with
+//! fresh derivations. `bikedyn-derive --check` (CI) does the same without
+//! building bikedyn; `bikedyn-derive` or `UPDATE_SNAPSHOTS=1 cargo test
+//! --features derive --test behaviour snapshots` refreshes them.
 
 use std::path::Path;
 
@@ -61,5 +65,6 @@ fn snapshots_have_a_header_naming_model_sources_and_hash() {
         assert!(first.contains(&format!("model \"{name}\"")), "{name}: {first}");
         assert!(first.contains("modeler/src/models/"), "{name}: {first}");
         assert!(first.contains("model hash"), "{name}: {first}");
+        assert!(first.contains("inputs hash"), "{name}: {first}");
     }
 }
