@@ -6,7 +6,8 @@
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Progress<'a> {
     /// What was just done: `"runs"` for measured runs processed by `fit`, or
-    /// the name of the candidate whose fit `identify` just finished.
+    /// a stage of `identify` in words (`"fitted steer_damping"`,
+    /// `"score test of 30 candidates"`, `"cross-validated steer_damping"`).
     pub step: &'a str,
     /// Steps done so far (1 after the first).
     pub done: usize,

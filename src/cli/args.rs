@@ -241,10 +241,11 @@ pub struct IdentifyArgs {
     #[arg(long, default_value_t = 4)]
     pub folds: usize,
     /// Largest number of parameter corrections (of the parameters whose
-    /// model declares an uncertainty) tried beside the effects; 0 (the
-    /// default): none.
-    #[arg(long, default_value_t = 0)]
-    pub corrections: usize,
+    /// model declares an uncertainty) tried beside the effects, those that
+    /// could explain most of the weave misfit first; 0: none (default:
+    /// every one that could explain some of it)
+    #[arg(long)]
+    pub corrections: Option<usize>,
 }
 
 /// Arguments of `bikedyn simulate`.

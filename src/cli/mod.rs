@@ -113,7 +113,7 @@ pub fn emit(text: &str, output: &Option<PathBuf>) -> Result<()> {
 
 /// Renders the library's progress reports on standard error: a bar for
 /// counted steps (runs processed; shown when there are more than three) and
-/// a spinner with the last candidate fitted. Nothing is drawn when standard
+/// a spinner with the last stage of identification done. Nothing is drawn when standard
 /// error is not a terminal, so logs and tests see only the results.
 pub struct ProgressDisplay {
     bar: OnceLock<ProgressBar>,
@@ -136,11 +136,7 @@ impl ProgressDisplay {
         if !terminal {
             // A log or a pipe gets one line per step instead of a bar.
             let of = p.total.map_or(String::new(), |t| format!(" of {t}"));
-            let what = if p.step == "runs" {
-                "runs processed".to_string()
-            } else {
-                format!("fitted {}", p.step)
-            };
+            let what = if p.step == "runs" { "runs processed" } else { p.step };
             let secs = self.start.elapsed().as_secs_f64();
             eprintln!("progress: {what} ({} done{of}, {secs:.1} s)", p.done);
             return;
@@ -165,7 +161,7 @@ impl ProgressDisplay {
                     s.enable_steady_tick(Duration::from_millis(200));
                     s
                 });
-                spinner.set_message(format!("identify: fitted {}", p.step));
+                spinner.set_message(format!("identify: {}", p.step));
             }
         }
     }

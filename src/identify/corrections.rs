@@ -52,17 +52,18 @@ pub fn corrected_parameter(candidate: &str) -> Option<&str> {
 /// Screen the declared-uncertain parameters of `free` (the identification
 /// model) on the measured weave eigenvalues of `segments` against the
 /// prediction of `driven` (`before`: its weave at each segment's speed),
-/// and return at most `max` corrections whose possible misfit reduction is
-/// at least one (one prior standard deviation's worth), best first.
+/// and return the corrections whose possible misfit reduction is at least
+/// one (one prior standard deviation's worth), best first, at most `max`
+/// of them (`None`: all).
 pub fn screen<R: ModelRegistry>(
     free: &ModelInfo,
     driven: &ModelInfo,
     bike: &Bicycle<R>,
     segments: &[Segment],
     before: &[Option<[f64; 2]>],
-    max: usize,
+    max: Option<usize>,
 ) -> Result<Vec<Screened>, IdentifyError> {
-    if max == 0 {
+    if max == Some(0) {
         return Ok(Vec::new());
     }
     let rows: Vec<(f64, [f64; 2], [f64; 2], Option<[f64; 2]>)> = segments
@@ -84,9 +85,9 @@ pub fn screen_points<R: ModelRegistry>(
     driven: &ModelInfo,
     bike: &Bicycle<R>,
     rows: &[(f64, [f64; 2], [f64; 2], Option<[f64; 2]>)],
-    max: usize,
+    max: Option<usize>,
 ) -> Result<Vec<Screened>, IdentifyError> {
-    if max == 0 {
+    if max == Some(0) {
         return Ok(Vec::new());
     }
     // Measured eigenvalues with their standard errors, where both the fit
@@ -145,7 +146,7 @@ pub fn screen_points<R: ModelRegistry>(
         }
     }
     out.sort_by(|a, b| b.reduction.total_cmp(&a.reduction));
-    out.truncate(max);
+    out.truncate(max.unwrap_or(usize::MAX));
     Ok(out)
 }
 

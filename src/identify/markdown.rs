@@ -122,6 +122,10 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
         for (name, why) in &step.failed {
             let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
         }
+        let screened = step.verdicts.iter().skip(step.tried.len());
+        for ((name, predicted), (_, why)) in step.screened_out.iter().zip(screened) {
+            let _ = writeln!(s, "| `{name}` | not fitted | {predicted:+.1} (predicted) | - | {why} |");
+        }
         let _ = writeln!(s);
         if !step.confounded.is_empty() {
             let _ = writeln!(

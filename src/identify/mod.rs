@@ -59,10 +59,11 @@ pub struct IdentifyRequest {
     pub effects: Vec<String>,
     /// Folds of the cross-validation over runs (default 4).
     pub folds: usize,
-    /// Largest number of parameter corrections tried beside the effects
-    /// (default 0: effects only, until corrections stop being selected
-    /// beside a found effect on sets that have none; see [`corrections`]).
-    pub corrections: usize,
+    /// Largest number of parameter corrections tried beside the effects,
+    /// the ones that could explain most of the measured weave misfit first
+    /// (`None`, the default: every one that could explain some of it;
+    /// `Some(0)`: effects only; see [`corrections`]).
+    pub corrections: Option<usize>,
 }
 
 impl Default for IdentifyRequest {
@@ -73,7 +74,7 @@ impl Default for IdentifyRequest {
             bike: "thesis".into(),
             effects: Vec::new(),
             folds: 4,
-            corrections: 0,
+            corrections: None,
         }
     }
 }

@@ -112,6 +112,22 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
                 "verdict": why,
             }));
         }
+        for ((name, predicted), (_, verdict)) in step
+            .screened_out
+            .iter()
+            .zip(step.verdicts.iter().skip(step.tried.len()))
+        {
+            cands.push(json!({
+                "step": k + 1,
+                "name": name,
+                "extends": step.base,
+                "score": Value::Null,
+                "predicted_score": predicted,
+                "cv": Value::Null,
+                "selected": false,
+                "verdict": verdict,
+            }));
+        }
     }
     let confounded: Vec<Value> = id
         .steps

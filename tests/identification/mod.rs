@@ -35,7 +35,12 @@ fn synth_with(name: &str, model: Option<&str>, effects: &str, seed: u64) -> Path
 }
 
 fn identify(dir: &Path, report: Option<&Path>) -> Value {
+    identify_with(dir, report, &[])
+}
+
+fn identify_with(dir: &Path, report: Option<&Path>, extra: &[&str]) -> Value {
     let mut args = vec!["identify", dir.to_str().unwrap(), "--json"];
+    args.extend(extra);
     if let Some(r) = report {
         args.extend(["--report", r.to_str().unwrap()]);
     }
@@ -48,7 +53,9 @@ fn identify(dir: &Path, report: Option<&Path>) -> Value {
     // Not a terminal: one progress line per step (issue 17, point 5).
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("progress: runs processed (1 done of ") && err.contains("progress: fitted steer_damping ("),
+        err.contains("progress: runs processed (1 done of ")
+            && err.contains("progress: fitted base model (")
+            && err.contains("progress: score test of "),
         "{err}"
     );
     serde_json::from_slice(&out.stdout).expect("JSON output")
@@ -61,13 +68,15 @@ fn f(v: &Value) -> f64 {
 /// The hidden effect is selected alone, its parameter within 20 %, and the
 /// error it drives (`error_key`) at least halved.
 fn recovers(name: &str, effects: &str, seed: u64, selected: &str, symbol: &str, truth: f64, error_key: &str) {
-    recovers_with(name, None, effects, seed, selected, symbol, truth, error_key)
+    recovers_with_args(name, None, &[], effects, seed, selected, symbol, truth, error_key)
 }
 
+/// [`recovers`] on runs of `model`, with more arguments to `identify`.
 #[allow(clippy::too_many_arguments)]
-fn recovers_with(
+fn recovers_with_args(
     name: &str,
     model: Option<&str>,
+    args: &[&str],
     effects: &str,
     seed: u64,
     selected: &str,
@@ -76,7 +85,7 @@ fn recovers_with(
     error_key: &str,
 ) {
     let dir = synth_with(name, model, effects, seed);
-    let j = identify(&dir, None);
+    let j = identify_with(&dir, None, args);
     let sel: Vec<&str> = j["selected_effects"]
         .as_array()
         .unwrap()
@@ -176,10 +185,16 @@ fn hidden_aero_drag_is_found() {
 fn hidden_tyre_relaxation_is_found() {
     // The runs come from the tyre model (lateral slip with relaxation,
     // cornering stiffness 14 per unit load); identification starts from the
-    // no-slip model and fits the relaxation length.
-    recovers_with(
+    // no-slip model and fits the relaxation length. Without corrections:
+    // each kick is simulated from no slip (the tyre forces at rest), while
+    // in the runs the forces are still building up at the window start, a
+    // gap that corrections of I4x and I3z then absorb (within a prior
+    // deviation each). The tyre forces at the window start are not yet
+    // nuisances of the fit.
+    recovers_with_args(
         "tyre",
         Some("tyre_free"),
+        &["--corrections", "0"],
         "sigma_rear=0.4,sigma_front=0.4",
         28,
         "tyre_relaxation",
@@ -269,7 +284,8 @@ fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
         dir.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "synth: {}", text(&out.stderr));
-    let out = bikedyn(&["identify", dir.to_str().unwrap(), "--corrections", "3", "--json"]);
+    // Corrections are candidates by default (issue 17, point 1).
+    let out = bikedyn(&["identify", dir.to_str().unwrap(), "--json"]);
     assert!(out.status.success(), "identify: {}", text(&out.stderr));
     let j = stdout_json(&out);
     let mut sel: Vec<&str> = j["selected_effects"]

@@ -140,6 +140,7 @@ pub fn confounding(
     let virtual_setup = factory.setup(&segments, &weights, active).ok()?;
     let states: Vec<[f64; NUISANCE]> = kicks.iter().map(|(_, x)| *x).collect();
     let mut designs: Vec<Design> = (0..kicks.len())
+        .into_par_iter()
         .filter_map(|i| {
             let f = reduced_information(&virtual_setup, g, &[i], &states)?;
             Some(Design {

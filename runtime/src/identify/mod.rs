@@ -47,7 +47,13 @@
 //!   residuals) *and* lowers the cross-validated error over held-out runs
 //!   (k-fold by run or log, the effect fitted on the other runs and only the
 //!   held-out run's initial state fitted to it), *and* its dissipative
-//!   parameters are positive (a negative damper is not physics). Sensor
+//!   parameters are positive (a negative damper is not physics). Each step
+//!   first screens its candidates by the score test ([`screen`]: one
+//!   simulation per kick in dual numbers linearises every candidate at
+//!   once); only those the linearisation says could lower the criterion
+//!   by at least `CONFOUNDED^2` of the best one's predicted gain are
+//!   fitted, and the fits are cross-validated in the order of the
+//!   criterion until one generalises. Sensor
 //!   nuisances (mounting misalignment, clock offset) are estimated per set by
 //!   the measured-run pipeline before, and are never candidates.
 
@@ -62,7 +68,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 pub mod confounding;
-pub use confounding::{Confounding, Design};
+mod screen;
+pub use confounding::{Confounding, Design, CONFOUNDED};
 
 /// Number of per-segment nuisance parameters: initial roll, steer (rad),
 /// roll rate, steer rate (rad/s) and forward speed (m/s).
@@ -1218,18 +1225,35 @@ pub fn fit_candidate(
         simulations: 0,
         physical,
     };
-    // Cross-validation is the costly half: a candidate already rejected by
-    // the information criterion or by physics is not cross-validated.
-    if let Some(r) = reference {
-        fit.bic = bic(&fit, r);
-        if !(physical && fit.bic < bic(r, r)) {
-            fit.simulations = simulations();
-            return Ok(fit);
-        }
+    // Cross-validation is the costly half: a candidate is cross-validated
+    // apart ([`cross_validate`]), only when selection needs its held-out
+    // error (not when the information criterion or physics rejects it).
+    match reference {
+        Some(r) => fit.bic = bic(&fit, r),
+        None => cross_validate(setup, &mut fit, fold_of, opts),
     }
-    // Cross-validation: for each fold, the effect parameters from the other
-    // segments (their initial states held at the full fit), then only the
-    // held-out segments' initial states fitted with those effect values.
+    fit.simulations = simulations();
+    Ok(fit)
+}
+
+/// Cross-validate a fit of `setup`: for each fold, the effect parameters
+/// from the other segments (their initial states held at the full fit),
+/// then only the held-out segments' initial states fitted with those effect
+/// values. Fills the fit's held-out errors, `cv` and fold values.
+pub fn cross_validate(setup: &Setup<'_>, fit: &mut CandidateFit, fold_of: &[usize], opts: &IdentifyOptions) {
+    let sims_before = setup.simulations.load(Ordering::Relaxed);
+    let nseg = setup.segments.len();
+    let all: Vec<usize> = (0..nseg).collect();
+    let problem = |segs: Vec<usize>, free: Free, g: Vec<f64>, x0: Vec<[f64; NUISANCE]>| Problem {
+        setup,
+        segs,
+        free,
+        g,
+        x0,
+        cache: Mutex::new(None),
+    };
+    let g = fit.values.clone();
+    let nuisance = fit.nuisance.clone();
     let nfold = fold_of.iter().copied().max().map_or(0, |m| m + 1);
     let mut held_out = vec![SegmentError::default(); nseg];
     let mut held_res: Vec<Vec<f64>> = vec![Vec::new(); nseg];
@@ -1262,8 +1286,7 @@ pub fn fit_candidate(
     fit.cv = held_res.iter().flatten().map(|x| x * x).sum::<f64>() / n_cv.max(1) as f64;
     fit.held_out = held_out;
     fit.fold_values = fold_values;
-    fit.simulations = simulations();
-    Ok(fit)
+    fit.simulations += setup.simulations.load(Ordering::Relaxed) - sims_before;
 }
 
 /// The candidates with their priors put on the scale of the weighted data.
@@ -1332,6 +1355,9 @@ pub struct Step {
     pub verdicts: Vec<(String, String)>,
     /// Candidates whose fit failed, with the reason.
     pub failed: Vec<(String, String)>,
+    /// Candidates not fitted because the score test predicted no gain,
+    /// with the predicted change of the criterion ([`screen`]).
+    pub screened_out: Vec<(String, f64)>,
     /// The candidate added against each rival that also explained the
     /// data: how far the data tell them apart ([`confounding`]).
     pub confounded: Vec<Confounding>,
@@ -1382,7 +1408,8 @@ pub fn folds_by_run(segments: &[Segment], folds: usize) -> (usize, Vec<usize>) {
 
 /// Identify which of `candidates` the data warrant, for the free-speed
 /// model `M` with base parameters `base` (no effect). `progress` is called
-/// after each candidate fit.
+/// after each stage (the base fit, a step's score test, each candidate's fit
+/// and cross-validation) with what was done.
 pub fn identify<M: MultibodyModel>(
     base: &[f64],
     segments: &[Segment],
@@ -1437,7 +1464,7 @@ pub fn identify<M: MultibodyModel>(
     let setup0 = Setup::new::<M>(base, segments, &weights, &[])?;
     let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts, None)?;
     before.bic = bic(&before, &before);
-    progress("base model");
+    progress("fitted base model");
     let mut simulations = first.simulations + before.simulations;
     let candidates = &with_priors_on_the_data_scale(candidates, &before);
 
@@ -1447,24 +1474,73 @@ pub fn identify<M: MultibodyModel>(
     let mut steps = Vec::new();
     while selected.len() < opts.max_effects {
         // After the first step, only candidates that improved the criterion
-        // on their own are combined: one that explained nothing alone is not
-        // revived by a partner (and each try costs a full fit).
+        // on their own (fitted, or predicted by the score test) are
+        // combined: one that explained nothing alone is not revived by a
+        // partner (and each try costs a full fit).
         let remaining: Vec<&Candidate> = candidates
             .iter()
             .filter(|c| !selected.iter().any(|s| s.name == c.name))
             .filter(|c| !c.alternative_model || alternative.is_some())
             .filter(|c| {
-                steps
-                    .first()
-                    .is_none_or(|s: &Step| s.tried.iter().any(|(n, f)| n == &c.name && f.bic < s.base_bic))
+                steps.first().is_none_or(|s: &Step| {
+                    s.tried.iter().any(|(n, f)| n == &c.name && f.bic < s.base_bic)
+                        || s.screened_out.iter().any(|(n, d)| n == &c.name && *d < 0.0)
+                })
             })
             .collect();
         if remaining.is_empty() {
             break;
         }
+        let base_bic = bic(&current, &current);
+        // The score test first (see [`screen`]): a candidate is fitted when
+        // its linearised best fit lowers the criterion below the current
+        // model's (itself linearised one step further), by at least
+        // CONFOUNDED^2 of the best candidate's predicted gain. One that
+        // explains less cannot be a rival the data fail to tell from the
+        // best (two candidates at that correlation explain the same misfit
+        // to within that factor) and is not the one a fit would select
+        // unless the linearisation is far off.
+        let screened = screen::screen(&screen::Screen {
+            main: &main,
+            alternative,
+            segments,
+            weights: &weights,
+            selected: &selected,
+            remaining: &remaining,
+            current: &current,
+        });
+        simulations += screened.simulations;
+        progress(&format!("score test of {} candidates", remaining.len()));
+        let reference_bic = screened.reference.map_or(base_bic, |r| r.min(base_bic));
+        let best_gain = screened
+            .predictions
+            .iter()
+            .flatten()
+            .map(|p| reference_bic - p)
+            .fold(0.0, f64::max);
+        let mut screened_out = Vec::new();
         let mut tried = Vec::new();
+        let mut setups = Vec::new();
         let mut failed: Vec<(String, String)> = Vec::new();
-        for c in &remaining {
+        for (c, predicted) in remaining.iter().zip(&screened.predictions) {
+            if let Some(p) = predicted {
+                let gain = reference_bic - p;
+                let why = if !(gain > 0.0) {
+                    format!("screened out: linearised at the current fit, its best BIC change is {:+.1} (score test; not fitted)", -gain)
+                } else if gain < CONFOUNDED * CONFOUNDED * best_gain {
+                    format!(
+                        "screened out: linearised, it gains {:.0} % of the criterion the best candidate gains (below {:.0} %: neither selected nor confounded with it; not fitted)",
+                        100.0 * gain / best_gain,
+                        100.0 * CONFOUNDED * CONFOUNDED
+                    )
+                } else {
+                    String::new()
+                };
+                if !why.is_empty() {
+                    screened_out.push((c.name.clone(), -gain, why));
+                    continue;
+                }
+            }
             let mut active = selected.clone();
             active.push(c);
             let setup = match alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
@@ -1476,25 +1552,35 @@ pub fn identify<M: MultibodyModel>(
             let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
             match fit_candidate(&setup, effects, &g0, &current.nuisance, &fold_of, opts, Some(&current)) {
                 Ok(f) => {
-                    simulations += f.simulations;
                     tried.push((c.name.clone(), f));
+                    setups.push(setup);
                 }
                 Err(e) => failed.push((c.name.clone(), format!("fit failed: {e}"))),
             }
-            progress(&c.name);
+            progress(&format!("fitted {}", c.name));
         }
-        let base_bic = bic(&current, &current);
-        let mut verdicts = Vec::new();
+        // Cross-validation in the order of the criterion: the first
+        // candidate that also generalises is added, and the ones behind it
+        // need no held-out error.
+        let mut order: Vec<usize> = (0..tried.len())
+            .filter(|&i| tried[i].1.physical && tried[i].1.bic < base_bic)
+            .collect();
+        order.sort_by(|&a, &b| tried[a].1.bic.total_cmp(&tried[b].1.bic));
         let mut best: Option<usize> = None;
-        for (i, (name, f)) in tried.iter().enumerate() {
-            let verdict = if !f.physical {
-                "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".to_string()
-            } else if !(f.bic < base_bic) {
-                format!(
-                    "rejected: BIC {:+.1} (no gain beyond its added parameters; not cross-validated)",
-                    f.bic - base_bic
-                )
-            } else if !(f.cv < current.cv) {
+        let mut held_verdict: Vec<Option<String>> = vec![None; tried.len()];
+        for &i in &order {
+            if best.is_some() {
+                held_verdict[i] = Some(format!(
+                    "not added: BIC {:+.1}, above that of {} (not cross-validated)",
+                    tried[i].1.bic - base_bic,
+                    best.map_or("", |b| tried[b].0.as_str())
+                ));
+                continue;
+            }
+            cross_validate(&setups[i], &mut tried[i].1, &fold_of, opts);
+            progress(&format!("cross-validated {}", tried[i].0));
+            let f = &tried[i].1;
+            held_verdict[i] = Some(if !(f.cv < current.cv) {
                 format!(
                     "rejected: held-out error {:.4} not below {:.4} (does not generalise)",
                     f.cv, current.cv
@@ -1504,18 +1590,37 @@ pub fn identify<M: MultibodyModel>(
                     "rejected: held-out gain per run {d:.4} within two standard errors ({se:.4}) of zero (not a consistent improvement)"
                 )
             } else {
-                if best.is_none_or(|b| f.bic < tried[b].1.bic) {
-                    best = Some(i);
-                }
+                best = Some(i);
                 format!(
                     "warranted: BIC {:+.1}, held-out error {:.4} (was {:.4})",
                     f.bic - base_bic,
                     f.cv,
                     current.cv
                 )
+            });
+        }
+        for (i, (_, f)) in tried.iter_mut().enumerate() {
+            f.simulations = setups[i].simulations.load(Ordering::Relaxed);
+            simulations += f.simulations;
+        }
+        let mut verdicts = Vec::new();
+        for (i, (name, f)) in tried.iter().enumerate() {
+            let verdict = if !f.physical {
+                "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".to_string()
+            } else if !(f.bic < base_bic) {
+                format!(
+                    "rejected: BIC {:+.1} (no gain beyond its added parameters; not cross-validated)",
+                    f.bic - base_bic
+                )
+            } else {
+                held_verdict[i].clone().unwrap_or_default()
             };
             verdicts.push((name.clone(), verdict));
         }
+        for (name, _, why) in &screened_out {
+            verdicts.push((name.clone(), why.clone()));
+        }
+        let screened_out: Vec<(String, f64)> = screened_out.into_iter().map(|(n, d, _)| (n, d)).collect();
         let added = best.map(|b| tried[b].0.clone());
         let failed_names = failed.clone();
         let confounded = match best {
@@ -1540,6 +1645,7 @@ pub fn identify<M: MultibodyModel>(
             added: added.clone(),
             verdicts,
             failed: failed_names,
+            screened_out,
             confounded,
         };
         steps.push(step);

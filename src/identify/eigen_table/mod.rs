@@ -46,8 +46,9 @@ pub struct TableRequest {
     pub bike: String,
     /// Candidate effects (empty: every one with a linearization).
     pub effects: Vec<String>,
-    /// Largest number of parameter corrections tried beside the effects.
-    pub corrections: usize,
+    /// Largest number of parameter corrections tried beside the effects
+    /// (`None`: every one that could explain some of the misfit).
+    pub corrections: Option<usize>,
 }
 
 /// One candidate tried at one step.
