@@ -11,13 +11,12 @@
 
 use crate::derive::{Derived, Quantity, Shape};
 use crate::model::Role;
+use crate::registry::camel;
+pub use crate::registry::{emit_registry, EmitError};
 use proc_macro2::{Ident, Span, TokenStream};
 use quote::{format_ident, quote};
 use std::collections::HashMap;
-use crate::registry::camel;
-pub use crate::registry::{emit_registry, EmitError};
 use symbolica::prelude::*;
-
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 enum Input {

@@ -119,4 +119,3 @@ pub(crate) fn camel(s: &str) -> String {
         })
         .collect()
 }
-

@@ -22,7 +22,11 @@ pub const DERIVE_COMMAND: &str = "cargo run --release -p bikedyn-modeler --featu
 
 /// The code that turns a model into its emitted file, besides the model
 /// itself: a change to any of it changes every inputs hash.
-const DERIVATION_CODE: [&str; 3] = [include_str!("derive.rs"), include_str!("emit.rs"), include_str!("snapshot.rs")];
+const DERIVATION_CODE: [&str; 3] = [
+    include_str!("derive.rs"),
+    include_str!("emit.rs"),
+    include_str!("snapshot.rs"),
+];
 
 /// Versions the emitted code depends on.
 const VERSIONS: &str = concat!("bikedyn-modeler ", env!("CARGO_PKG_VERSION"), ", symbolica =3.0.0");
@@ -76,7 +80,10 @@ pub struct StaleModel {
 pub enum SnapshotError {
     /// Models changed since their code was derived.
     Stale(Vec<StaleModel>),
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     Emit(EmitError),
     DuplicateModel(String),
 }
@@ -203,7 +210,9 @@ mod tests {
         from_snapshots(std::slice::from_ref(&m), &snap, &out).expect("fresh");
         let copied = std::fs::read_to_string(out.join("pendulum.rs")).unwrap();
         assert!(copied.ends_with(body) && copied.starts_with("// @generated"));
-        assert!(std::fs::read_to_string(out.join("models.rs")).unwrap().contains("pub mod pendulum"));
+        assert!(std::fs::read_to_string(out.join("models.rs"))
+            .unwrap()
+            .contains("pub mod pendulum"));
         assert!(std::fs::read_to_string(out.join("codegen_report.json"))
             .unwrap()
             .contains("\"derived\":false"));
@@ -214,9 +223,18 @@ mod tests {
         assert_ne!(inputs_hash(&m), inputs_hash(&changed));
         let e = from_snapshots(std::slice::from_ref(&changed), &snap, &out).unwrap_err();
         let msg = e.to_string();
-        assert!(matches!(e, SnapshotError::Stale(ref s) if s.len() == 1 && !s[0].missing), "{msg}");
-        assert!(msg.contains("model `pendulum`") && msg.contains("modeler/src/models/thesis_whipple.rs"), "{msg}");
-        assert!(msg.contains(DERIVE_COMMAND) && msg.contains("--features derive"), "{msg}");
+        assert!(
+            matches!(e, SnapshotError::Stale(ref s) if s.len() == 1 && !s[0].missing),
+            "{msg}"
+        );
+        assert!(
+            msg.contains("model `pendulum`") && msg.contains("modeler/src/models/thesis_whipple.rs"),
+            "{msg}"
+        );
+        assert!(
+            msg.contains(DERIVE_COMMAND) && msg.contains("--features derive"),
+            "{msg}"
+        );
 
         // A missing file is named as such.
         let e = from_snapshots(std::slice::from_ref(&m), &scratch("empty"), &out).unwrap_err();

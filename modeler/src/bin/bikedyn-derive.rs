@@ -28,7 +28,11 @@ fn main() -> ExitCode {
                 println!("bikedyn-derive [--check] [--dir DIR]: re-derive the models into DIR (default generated/snapshots), or check that DIR holds what derivation gives");
                 return ExitCode::SUCCESS;
             }
-            other => return fail(&format!("unknown argument `{other}` (bikedyn-derive [--check] [--dir DIR])")),
+            other => {
+                return fail(&format!(
+                    "unknown argument `{other}` (bikedyn-derive [--check] [--dir DIR])"
+                ))
+            }
         }
     }
     let models = match models::all() {

@@ -1243,6 +1243,16 @@ pub fn fit_candidate(
 pub fn cross_validate(setup: &Setup<'_>, fit: &mut CandidateFit, fold_of: &[usize], opts: &IdentifyOptions) {
     let sims_before = setup.simulations.load(Ordering::Relaxed);
     let nseg = setup.segments.len();
+    let nfold = fold_of.iter().copied().max().map_or(0, |m| m + 1);
+    // With no shared parameter each segment's fit is its own: fitting the
+    // held-out segments' initial states again gives the full fit's.
+    if setup.k() == 0 {
+        let n: usize = fit.errors.iter().map(|e| e.channel_n.iter().sum::<usize>()).sum();
+        fit.cv = fit.chi2 / n.max(1) as f64;
+        fit.held_out = fit.errors.clone();
+        fit.fold_values = vec![Vec::new(); nfold];
+        return;
+    }
     let all: Vec<usize> = (0..nseg).collect();
     let problem = |segs: Vec<usize>, free: Free, g: Vec<f64>, x0: Vec<[f64; NUISANCE]>| Problem {
         setup,
@@ -1254,7 +1264,6 @@ pub fn cross_validate(setup: &Setup<'_>, fit: &mut CandidateFit, fold_of: &[usiz
     };
     let g = fit.values.clone();
     let nuisance = fit.nuisance.clone();
-    let nfold = fold_of.iter().copied().max().map_or(0, |m| m + 1);
     let mut held_out = vec![SegmentError::default(); nseg];
     let mut held_res: Vec<Vec<f64>> = vec![Vec::new(); nseg];
     let mut fold_values = vec![g.clone(); nfold];
