@@ -326,13 +326,47 @@ impl AppliedForce {
     }
 }
 
+/// A file a model is declared in, as a model file declares it: its path
+/// and, for the files inside the modeler, its text (`include_str!` of the
+/// file itself). The text is hashed into the committed generated code's
+/// inputs hash, so that any edit of the file is noticed and named.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SourceFile {
+    pub path: &'static str,
+    pub text: Option<&'static str>,
+}
+
+impl SourceFile {
+    /// A file whose text is part of the model's inputs.
+    pub const fn new(path: &'static str, text: &'static str) -> SourceFile {
+        SourceFile { path, text: Some(text) }
+    }
+}
+
+/// A path alone: a user's model file outside the modeler (derived at every
+/// build, so nothing needs its text).
+impl From<&'static str> for SourceFile {
+    fn from(path: &'static str) -> SourceFile {
+        SourceFile { path, text: None }
+    }
+}
+
+/// A file a model came from, as the model records it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Source {
+    pub path: String,
+    /// FNV-1a hash of the file's text, when the model file gave it.
+    pub text_hash: Option<u64>,
+}
+
 /// A frozen, validated model.
 #[derive(Clone, Debug)]
 pub struct Model {
     pub name: String,
     pub doc: String,
-    /// Source files the model is declared in (for the generated header).
-    pub sources: Vec<String>,
+    /// Files the model is declared in: its model files and the effects it
+    /// applies (named in the generated header).
+    pub sources: Vec<Source>,
     /// The base model this one is declared from (its own name for a base).
     pub base: String,
     /// True when forward speed is a degree of freedom (no driving constraint).
@@ -586,10 +620,23 @@ impl ModelBuilder {
         self.m.doc = doc.to_string();
         self
     }
-    /// A source file the model is declared in (shown in generated headers).
-    pub fn source(mut self, path: &str) -> Self {
-        self.m.sources.push(path.to_string());
+    /// A file the model is declared in (shown in generated headers; with
+    /// its text, part of the inputs hash of the committed code).
+    pub fn source(mut self, file: impl Into<SourceFile>) -> Self {
+        self.add_source(file);
         self
+    }
+    /// Record one more file the model comes from (an effect's file, a
+    /// variant's base model file); a path already recorded is kept once.
+    pub fn add_source(&mut self, file: impl Into<SourceFile>) {
+        let file = file.into();
+        if self.m.sources.iter().any(|s| s.path == file.path) {
+            return;
+        }
+        self.m.sources.push(Source {
+            path: file.path.to_string(),
+            text_hash: file.text.map(|t| crate::registry::fnv1a(t.as_bytes())),
+        });
     }
     /// Declare a coordinate (and its rate).
     pub fn coordinate(&mut self, name: &str, role: Role, guess: f64, doc: &str) -> Expr {

@@ -17,7 +17,7 @@
 //! every model already, and the identification frees them by name.
 
 use crate::expr::Expr;
-use crate::model::{BodyId, FrameId, ModelBuilder, PointId};
+use crate::model::{BodyId, FrameId, ModelBuilder, PointId, SourceFile};
 
 /// The parts of a bicycle model an effect may refer to.
 #[derive(Clone, Debug)]
@@ -204,6 +204,9 @@ pub enum LinearEquivalent {
 
 /// Apply `effect` to the model being declared.
 pub fn apply(m: &mut ModelBuilder, parts: &BicycleParts, effect: &Effect) {
+    if let Some(file) = library_file(effect.name) {
+        m.add_source(file);
+    }
     m.begin_effect(effect.name, effect.doc);
     m.declare_identification(effect.identification);
     (effect.apply)(m, parts);
@@ -217,6 +220,23 @@ macro_rules! effects {
         /// order (the extended models apply all of them).
         pub fn all() -> Vec<Effect> {
             vec![$($name::effect()),*]
+        }
+
+        /// The file that declares the library effect `name`, with its text
+        /// (part of the inputs of the committed code of every model that
+        /// applies it); `None` for an effect declared outside the library.
+        pub fn library_file(name: &str) -> Option<SourceFile> {
+            match name {
+                $(stringify!($name) => Some(SourceFile::new(
+                    concat!("modeler/src/effects/", stringify!($name), ".rs"),
+                    include_str!(concat!(stringify!($name), ".rs")),
+                )),)*
+                "tyre_relaxation" => Some(SourceFile::new(
+                    "modeler/src/effects/tyre_relaxation.rs",
+                    include_str!("tyre_relaxation.rs"),
+                )),
+                _ => None,
+            }
         }
     };
 }

@@ -12,7 +12,7 @@ use crate::model::{Model, ModelError};
 
 /// Every effect on the benchmark-compatible geometry, driven speed.
 pub fn model() -> Result<Model, ModelError> {
-    let (mut m, parts) = declare("extended", "modeler/src/models/extended.rs", Speed::Driven);
+    let (mut m, parts) = declare("extended", crate::model::SourceFile::new("modeler/src/models/extended.rs", include_str!("extended.rs")), Speed::Driven);
     m.set_doc("Whipple bicycle of any geometry (front mass centre offset d4) with driven speed and every effect of the library, each absent at its default");
     for e in effects::all() {
         effects::apply(&mut m, &parts, &e);

@@ -10,7 +10,7 @@ use crate::model::{Model, ModelError};
 
 /// Every effect on the benchmark-compatible geometry, free speed.
 pub fn model() -> Result<Model, ModelError> {
-    let (mut m, parts) = declare("extended_free", "modeler/src/models/extended_free.rs", Speed::Free);
+    let (mut m, parts) = declare("extended_free", crate::model::SourceFile::new("modeler/src/models/extended_free.rs", include_str!("extended_free.rs")), Speed::Free);
     m.set_doc("Whipple bicycle of any geometry (front mass centre offset d4) with free forward speed and every effect of the library, each absent at its default");
     for e in effects::all() {
         effects::apply(&mut m, &parts, &e);

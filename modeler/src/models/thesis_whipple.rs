@@ -8,11 +8,11 @@ use crate::effects::BicycleParts;
 use crate::expr::{exact, inertia_wheel, inertia_xz, num, rate, time, vec3};
 use crate::model::{
     Axis, BodyId, CoordinateRole, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, ParameterRole, Role,
-    Uncertainty, GROUND,
+    SourceFile, Uncertainty, GROUND,
 };
 use std::f64::consts::PI;
 
-const SOURCE: &str = "modeler/src/models/thesis_whipple.rs";
+const SOURCE: SourceFile = SourceFile::new("modeler/src/models/thesis_whipple.rs", include_str!("thesis_whipple.rs"));
 
 /// How forward speed enters a bicycle model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -28,17 +28,15 @@ pub enum Speed {
 
 /// Declare the thesis model under `name`, from the model file `source`
 /// (variants start from here and add to the returned builder).
-pub fn declare(name: &str, source: &str, speed: Speed) -> (ModelBuilder, BicycleParts) {
+pub fn declare(name: &str, source: impl Into<SourceFile>, speed: Speed) -> (ModelBuilder, BicycleParts) {
+    let source = source.into();
     let doc = match speed {
         Speed::Driven => {
             "Whipple bicycle of Martin Recuero (2009), section 3: 9 coordinates, driving constraint psi = V t / Rt"
         }
         Speed::Free => "Whipple bicycle of Martin Recuero (2009), section 3, with free forward speed (no driving constraint; rear wheel rotation psi independent)",
     };
-    let mut m = Model::builder(name).doc(doc).source(SOURCE);
-    if source != SOURCE {
-        m = m.source(source);
-    }
+    let mut m = Model::builder(name).doc(doc).source(SOURCE).source(source);
     m.set_base("thesis_whipple");
     let psi_role = match speed {
         Speed::Driven => Role::Dependent,

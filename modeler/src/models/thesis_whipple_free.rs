@@ -8,5 +8,5 @@ use crate::model::{Model, ModelError};
 
 /// The free-speed thesis model.
 pub fn model() -> Result<Model, ModelError> {
-    declare("thesis_whipple_free", "modeler/src/models/thesis_whipple_free.rs", Speed::Free).0.build()
+    declare("thesis_whipple_free", crate::model::SourceFile::new("modeler/src/models/thesis_whipple_free.rs", include_str!("thesis_whipple_free.rs")), Speed::Free).0.build()
 }

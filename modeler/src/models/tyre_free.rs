@@ -11,7 +11,7 @@ use crate::model::{Model, ModelError};
 
 /// Tyre slip and every effect on the benchmark-compatible geometry, free speed.
 pub fn model() -> Result<Model, ModelError> {
-    let (mut m, parts) = declare("tyre_free", "modeler/src/models/tyre_free.rs", Speed::Free);
+    let (mut m, parts) = declare("tyre_free", crate::model::SourceFile::new("modeler/src/models/tyre_free.rs", include_str!("tyre_free.rs")), Speed::Free);
     m.set_doc("Whipple bicycle of any geometry with free forward speed, tyre lateral slip with relaxation, and every effect of the library");
     effects::apply(&mut m, &parts, &effects::tyre_relaxation::effect());
     for e in effects::all() {

@@ -7,16 +7,14 @@
 use super::thesis_whipple::{self, Speed};
 use crate::effects::BicycleParts;
 use crate::expr::{num, vec3};
-use crate::model::{Model, ModelBuilder, ModelError, Uncertainty};
+use crate::model::{Model, ModelBuilder, ModelError, SourceFile, Uncertainty};
 
-const SOURCE: &str = "modeler/src/models/whipple_offset.rs";
+const SOURCE: SourceFile = SourceFile::new("modeler/src/models/whipple_offset.rs", include_str!("whipple_offset.rs"));
 
 /// Declare the offset variant under `name` (model file `source`).
-pub fn declare(name: &str, source: &str, speed: Speed) -> (ModelBuilder, BicycleParts) {
+pub fn declare(name: &str, source: impl Into<SourceFile>, speed: Speed) -> (ModelBuilder, BicycleParts) {
     let (mut m, parts) = thesis_whipple::declare(name, source, speed);
-    if source != SOURCE {
-        m = m.source(SOURCE);
-    }
+    m.add_source(SOURCE);
     m.set_base("whipple_offset");
     m.set_doc(match speed {
         Speed::Driven => "Whipple bicycle with the handlebar/fork mass centre a distance d4 ahead of the steer axis (benchmark-compatible)",

@@ -7,5 +7,5 @@ use crate::model::{Model, ModelError};
 
 /// The free-speed offset model.
 pub fn model() -> Result<Model, ModelError> {
-    declare("whipple_offset_free", "modeler/src/models/whipple_offset_free.rs", Speed::Free).0.build()
+    declare("whipple_offset_free", crate::model::SourceFile::new("modeler/src/models/whipple_offset_free.rs", include_str!("whipple_offset_free.rs")), Speed::Free).0.build()
 }
