@@ -39,13 +39,16 @@ fn front_brake() -> Effect {
 }
 // --------------------------------------------------------------------------
 
+/// A base model's `declare` with a plain path as its model file.
+type Declare = fn(&str, &'static str, Speed) -> (ModelBuilder, BicycleParts);
+
 #[test]
 fn a_new_effect_applies_to_every_base_model_and_speed_variant() {
     let mut models = Vec::new();
     for speed in [Speed::Driven, Speed::Free] {
         for (base, declare) in [
-            ("thesis_whipple", thesis_whipple::declare as fn(&str, &str, Speed) -> _),
-            ("whipple_offset", whipple_offset::declare),
+            ("thesis_whipple", (|n, f, s| thesis_whipple::declare(n, f, s)) as Declare),
+            ("whipple_offset", |n, f, s| whipple_offset::declare(n, f, s)),
         ] {
             let name = format!("{base}_{speed:?}_brake").to_lowercase();
             let (mut m, parts) = declare(&name, "modeler/tests/new_effect.rs", speed);
