@@ -60,6 +60,92 @@ pub enum FitError {
     /// A plot could not be drawn or written.
     #[error(transparent)]
     Plot(#[from] PlotError),
+    /// The same run or log was given twice (by path, or a copy with the
+    /// same data files): it would be counted twice and, in identification,
+    /// held out against itself.
+    #[error("{} and {} are the same {what}{how}: give each run or log once", first.display(), second.display())]
+    DuplicateInput {
+        first: PathBuf,
+        second: PathBuf,
+        /// "run" or "log".
+        what: &'static str,
+        /// Empty for the same path, or why two paths are the same data.
+        how: &'static str,
+    },
+}
+
+/// A hash of the data of a run folder (every file but `run.toml`, whose
+/// `kind` a copy may change) or of a log file, and the path's canonical
+/// form; `None` when it cannot be read (the pipeline reports that).
+fn identity(path: &Path) -> Option<(PathBuf, u64)> {
+    use std::hash::{Hash, Hasher};
+    let canonical = std::fs::canonicalize(path).ok()?;
+    let mut h = std::hash::DefaultHasher::new();
+    if canonical.is_dir() {
+        let mut files: Vec<PathBuf> = std::fs::read_dir(&canonical)
+            .ok()?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_file() && p.file_name().is_some_and(|n| n != "run.toml"))
+            .collect();
+        files.sort();
+        for f in files {
+            f.file_name().hash(&mut h);
+            std::fs::read(&f).ok()?.hash(&mut h);
+        }
+    } else {
+        std::fs::read(&canonical).ok()?.hash(&mut h);
+    }
+    Some((canonical, h.finish()))
+}
+
+/// Refuse a run folder or log that the inputs name twice, by path or by
+/// content (a copied run), and a calibration that is a copy of a run. One
+/// calibration shared by several sets is no duplicate.
+fn check_duplicates(inputs: &[Input], calibration: Option<&PathBuf>) -> Result<(), FitError> {
+    let mut data: Vec<(&PathBuf, &'static str)> = Vec::new();
+    let mut calibrations: Vec<&PathBuf> = calibration.into_iter().collect();
+    for i in inputs {
+        match i {
+            Input::Set { runs, calibration } => {
+                data.extend(runs.iter().map(|p| (p, "run")));
+                calibrations.extend(calibration.iter());
+            }
+            Input::Log(p) => data.push((p, "log")),
+        }
+    }
+    let mut seen: Vec<(&PathBuf, PathBuf, u64)> = Vec::new();
+    for (path, what) in data {
+        let Some((canonical, hash)) = identity(path) else {
+            continue;
+        };
+        if let Some((first, first_canonical, _)) = seen.iter().find(|(_, c, h)| *c == canonical || *h == hash) {
+            return Err(FitError::DuplicateInput {
+                first: (*first).clone(),
+                second: path.clone(),
+                what,
+                how: if *first_canonical == canonical {
+                    ""
+                } else {
+                    " (the same data files: a copy)"
+                },
+            });
+        }
+        seen.push((path, canonical, hash));
+    }
+    for cal in calibrations {
+        let Some((_, hash)) = identity(cal) else {
+            continue;
+        };
+        if let Some((run, _, _)) = seen.iter().find(|(_, _, h)| *h == hash) {
+            return Err(FitError::DuplicateInput {
+                first: (*run).clone(),
+                second: cal.clone(),
+                what: "run",
+                how: " (the same data files: the calibration is a copy of a run)",
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Everything `fit` found: reports per run and errors per skipped run.
@@ -113,6 +199,7 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
             Err(e) => errors.push(e.to_string()),
         }
     }
+    check_duplicates(&inputs, opts.calibration.as_ref())?;
     let total: usize = inputs
         .iter()
         .map(|i| match i {
@@ -130,6 +217,15 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
             total: Some(total),
         })
     };
+    // Calibration runs that calibrate some runs given (a calibration given
+    // alone is listed as skipped, not dropped silently).
+    let calibrating: Vec<PathBuf> = inputs
+        .iter()
+        .filter_map(|i| match i {
+            Input::Set { runs, calibration } if !runs.is_empty() => calibration.clone(),
+            _ => None,
+        })
+        .collect();
     let mut reports = Vec::new();
     let mut calibrations = Vec::new();
     for input in inputs {
@@ -143,6 +239,12 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
             }
             Input::Set { runs, calibration } => {
                 if runs.is_empty() {
+                    if let Some(c) = calibration.filter(|c| !calibrating.contains(c)) {
+                        errors.push(format!(
+                            "{}: skipped: a calibration run (the bicycle at rest, kind = \"calibration\" in its run.toml), with no kick to fit",
+                            c.display()
+                        ));
+                    }
                     continue;
                 }
                 let cal = opts.calibration.clone().or(calibration);
@@ -174,6 +276,13 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
             }
         }
     }
+    // A kick without a speed is fitted but cannot be compared with any
+    // model: say so (and the exit status says something was left out).
+    for r in &reports {
+        for k in r.kicks.iter().filter(|k| !k.mean_speed.is_finite()) {
+            errors.push(format!("{} kick at {:.2} s: {NO_SPEED}", k.run.display(), k.kick_time));
+        }
+    }
     Ok(FitOutcome {
         reports,
         errors,
@@ -181,6 +290,9 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
         calibrations,
     })
 }
+
+/// Why a kick has no predicted weave although it was fitted.
+const NO_SPEED: &str = "no usable speed record in the fit window (the wheel sensor gave no speed there), so no speed to predict the weave at";
 
 fn pair(x: [f64; 2]) -> Value {
     json!([x[0], x[1]])
@@ -219,7 +331,10 @@ pub fn kick_json(k: &KickFit, linear: Option<&dyn LinearBicycle>) -> Value {
     if let Some(o) = k.clock_offset {
         v["clock_offset"] = json!({"value": o.value, "stderr": o.stderr, "from_data": o.from_data});
     }
-    if let Some(c) = linear {
+    if !k.mean_speed.is_finite() {
+        v["predicted_weave"] = Value::Null;
+        v["no_prediction"] = json!(NO_SPEED);
+    } else if let Some(c) = linear {
         let [lo, hi] = k.speed_interval;
         v["predicted_weave"] = match compare::predict(c, k.mean_speed, lo, hi) {
             Some(p) => json!({
@@ -239,6 +354,9 @@ pub fn residuals(out: &FitOutcome) -> Vec<compare::Residual> {
     let mut rows = Vec::new();
     for r in &out.reports {
         for k in &r.kicks {
+            if !k.mean_speed.is_finite() {
+                continue;
+            }
             let (Some(f), Some(p)) = (k.chosen_fit(), compare::predicted_weave(c, k.mean_speed)) else {
                 continue;
             };

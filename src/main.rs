@@ -3,9 +3,28 @@
 //! `cli/args.rs`.
 
 use anyhow::Result;
-use clap::Parser;
+use clap::{CommandFactory, FromArgMatches};
 use cli::args::{Cli, Command};
 use std::process::ExitCode;
+
+/// `print!` to standard output that returns an error from the enclosing
+/// function when the write fails (a closed pipe such as `| head -1`, a
+/// full disk) instead of panicking as `print!` does.
+macro_rules! out {
+    ($($t:tt)*) => {
+        crate::cli::write_out(format_args!($($t)*))?
+    };
+}
+
+/// `println!` that returns the write error (see [`out!`]).
+macro_rules! outln {
+    () => {
+        crate::cli::write_out(format_args!("\n"))?
+    };
+    ($($t:tt)*) => {
+        crate::cli::write_out(format_args!("{}\n", format_args!($($t)*)))?
+    };
+}
 
 mod cli;
 
@@ -62,7 +81,23 @@ fn error_message(e: &anyhow::Error) -> String {
 }
 
 fn main() -> ExitCode {
-    match run(Cli::parse()) {
+    // Flush here so that a failed final write is an error too (at exit it
+    // would be ignored).
+    // Negative numbers are values, not flags (`--speed -5`, `--values
+    // -1:1:0.1`), in every command.
+    let command = Cli::command().mut_subcommands(|c| c.allow_negative_numbers(true));
+    let cli = match Cli::from_arg_matches(&command.get_matches()) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
+    cli::set_verbose(cli.verbose);
+    bikedyn::bicycle::allow_implausible_units(cli.allow_units);
+    let result = run(cli).and_then(|ok| {
+        use std::io::Write;
+        std::io::stdout().flush().map_err(cli::stdout_error)?;
+        Ok(ok)
+    });
+    match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(1),
         Err(e) => {

@@ -51,8 +51,11 @@ pub struct SynthOptions {
     pub runs: usize,
     /// Seed of the run plans (run k uses seed + k; default 1).
     pub seed: u64,
-    /// Output folder.
+    /// Output folder: it must not exist or be empty, unless `force`.
     pub out: PathBuf,
+    /// Replace a non-empty output folder (its old content is removed once
+    /// the new set is complete).
+    pub force: bool,
 }
 
 impl Default for SynthOptions {
@@ -65,6 +68,7 @@ impl Default for SynthOptions {
             runs: 3,
             seed: 1,
             out: PathBuf::from("synth"),
+            force: false,
         }
     }
 }
@@ -85,6 +89,21 @@ pub struct SynthRun {
 /// Why a synthetic set could not be made.
 #[derive(Debug, Error)]
 pub enum SynthError {
+    /// The output folder holds files already (a set must never be mixed
+    /// with another's runs or overwrite measured data).
+    #[error("{} is not empty: choose a new folder, or pass --force to replace its content", path.display())]
+    OutputNotEmpty { path: PathBuf },
+    /// The output path names no folder (`.`, `..`, a root).
+    #[error("{}: name a folder to create (not `.`, `..` or a root)", path.display())]
+    OutputName { path: PathBuf },
+    /// The finished set could not be moved into place.
+    #[error("moving the finished set from {} to {}", from.display(), to.display())]
+    Rename {
+        from: PathBuf,
+        to: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
     /// The number of runs is outside 1 to 1000.
     #[error("--runs must be between 1 and 1000")]
     RunCount { runs: usize },
@@ -122,6 +141,72 @@ pub enum SynthError {
     /// The sensor truth could not be put into JSON.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
+}
+
+/// A set being written: a hidden folder beside the output folder, removed
+/// if the set is not completed (an error, a full disk), and renamed onto
+/// the output folder once every file is written, so the output folder
+/// holds a whole set or stays as it was.
+struct PartialSet {
+    dir: PathBuf,
+    done: bool,
+}
+
+impl PartialSet {
+    fn new(out: &Path, force: bool) -> Result<PartialSet, SynthError> {
+        let name = out
+            .file_name()
+            .filter(|n| *n != "." && *n != "..")
+            .ok_or_else(|| SynthError::OutputName {
+                path: out.to_path_buf(),
+            })?;
+        if !force {
+            let non_empty = match std::fs::read_dir(out) {
+                Ok(mut entries) => entries.next().is_some(),
+                // Not a folder (a file): creating the set will fail and say so.
+                Err(e) => e.kind() != std::io::ErrorKind::NotFound,
+            };
+            if non_empty {
+                return Err(SynthError::OutputNotEmpty {
+                    path: out.to_path_buf(),
+                });
+            }
+        }
+        let parent = out
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let dir = parent.join(format!(".{}.partial-{}", name.to_string_lossy(), std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        create_dir(&dir)?;
+        Ok(PartialSet { dir, done: false })
+    }
+
+    /// Put the finished set in place of `out` (removing what `out` held).
+    fn finish(mut self, out: &Path) -> Result<(), SynthError> {
+        if out.is_dir() {
+            std::fs::remove_dir_all(out).map_err(|source| SynthError::Rename {
+                from: self.dir.clone(),
+                to: out.to_path_buf(),
+                source,
+            })?;
+        }
+        std::fs::rename(&self.dir, out).map_err(|source| SynthError::Rename {
+            from: self.dir.clone(),
+            to: out.to_path_buf(),
+            source,
+        })?;
+        self.done = true;
+        Ok(())
+    }
+}
+
+impl Drop for PartialSet {
+    fn drop(&mut self) {
+        if !self.done {
+            let _ = std::fs::remove_dir_all(&self.dir);
+        }
+    }
 }
 
 fn create_dir(dir: &Path) -> Result<(), SynthError> {
@@ -205,7 +290,8 @@ impl<F: Fn(&str) -> Option<f64>> ModelVisitor for OneRun<'_, F> {
 }
 
 /// Make the set with the built-in models: `on_run` is called after each
-/// run is written.
+/// run is written (into a hidden folder beside `out`: the set appears in
+/// `out` only when it is complete).
 pub fn synth(a: &SynthOptions, on_run: &mut dyn FnMut(&SynthRun)) -> Result<(), SynthError> {
     synth_in::<BuiltIn>(a, on_run)
 }
@@ -247,7 +333,8 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
     // model simulated, damping, controllers and tyre states included (not
     // the bare Whipple bicycle's).
     let linear = bike.linear_with(Some(info.name))?;
-    create_dir(&a.out)?;
+    let set = PartialSet::new(&a.out, a.force)?;
+    let out = set.dir.clone();
     let lookup = bike.lookup()?;
     // Sensors like the thesis's instrumentation (FORMAT.md), on this
     // bicycle's rear wheel.
@@ -298,7 +385,7 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
             let mut sensors = sensors.clone();
             sensors.clock_offset = clock_offset(sensors.nominal_offset, a.seed);
             write_run(
-                &a.out.join("calibration"),
+                &out.join("calibration"),
                 "calibration",
                 RunKind::Calibration,
                 &cal,
@@ -309,7 +396,7 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
         let mut sensors = sensors.clone();
         sensors.clock_offset = clock_offset(sensors.nominal_offset, a.seed.wrapping_add(1 + k as u64));
         let sensor_truth = write_run(
-            &a.out.join(&name),
+            &out.join(&name),
             &name,
             RunKind::Run,
             &sensor_trajectory(&tr),
@@ -318,7 +405,7 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
         )?;
         let mut truth = truth;
         truth["sensors"] = serde_json::to_value(&sensor_truth)?;
-        write_physical_run(&a.out.join("truth"), &name, &tr, &truth)?;
+        write_physical_run(&out.join("truth"), &name, &tr, &truth)?;
         on_run(&SynthRun {
             model: info.name,
             stop: sim.stop.to_string(),
@@ -326,5 +413,5 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
             plan,
         });
     }
-    Ok(())
+    set.finish(&a.out)
 }

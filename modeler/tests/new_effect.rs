@@ -47,7 +47,10 @@ fn a_new_effect_applies_to_every_base_model_and_speed_variant() {
     let mut models = Vec::new();
     for speed in [Speed::Driven, Speed::Free] {
         for (base, declare) in [
-            ("thesis_whipple", (|n, f, s| thesis_whipple::declare(n, f, s)) as Declare),
+            (
+                "thesis_whipple",
+                (|n, f, s| thesis_whipple::declare(n, f, s)) as Declare,
+            ),
             ("whipple_offset", |n, f, s| whipple_offset::declare(n, f, s)),
         ] {
             let name = format!("{base}_{speed:?}_brake").to_lowercase();

@@ -105,6 +105,15 @@ pub enum OutputError {
         /// Underlying error.
         source: io::Error,
     },
+    /// An output folder holds files that are not an earlier output of
+    /// the same kind (so replacing it would destroy someone's files).
+    #[error("cannot write {}: the folder holds files but no {marker} of an earlier run; choose a new or empty folder", .path.display())]
+    ForeignFolder {
+        /// The folder.
+        path: PathBuf,
+        /// The file an earlier output would hold (`report.json`).
+        marker: &'static str,
+    },
     /// Producing the content failed (encoding or rendering).
     #[error("cannot write {}: {source}", .path.display())]
     Content {
@@ -124,6 +133,7 @@ impl OutputError {
             | OutputError::DanglingSymlink { path, .. }
             | OutputError::InvalidPath { path }
             | OutputError::Io { path, .. }
+            | OutputError::ForeignFolder { path, .. }
             | OutputError::Content { path, .. } => path,
         }
     }
@@ -395,6 +405,125 @@ where
 /// Atomically write `contents` to `path`.
 pub fn write_string_atomic(path: impl AsRef<Path>, contents: &str) -> Result<(), OutputError> {
     write_atomic(path, |w| w.write_all(contents.as_bytes()))
+}
+
+/// An output folder written as a whole (a report): its files go into a
+/// hidden folder beside it, which takes the target's place on
+/// [`StagedDir::commit`]; dropped without a commit (an error on the way), it
+/// is removed and the target is left as it was. A target that exists must
+/// be empty or an earlier output (holding `marker`), which is replaced
+/// whole, so no file of the old output stays beside the new ones.
+pub struct StagedDir {
+    staging: PathBuf,
+    target: PathBuf,
+    committed: bool,
+}
+
+impl StagedDir {
+    /// Check that `target` can be written (before any work): its parent
+    /// folder exists and takes a new folder, and `target` is new, empty or
+    /// an earlier output holding `marker`.
+    pub fn check(target: &Path, marker: &'static str) -> Result<(), OutputError> {
+        drop(StagedDir::new(target, marker)?);
+        Ok(())
+    }
+
+    /// Start writing `target` (see [`StagedDir::check`]).
+    pub fn new(target: &Path, marker: &'static str) -> Result<StagedDir, OutputError> {
+        let name = target
+            .file_name()
+            .filter(|n| *n != "." && *n != "..")
+            .ok_or_else(|| OutputError::InvalidPath {
+                path: target.to_path_buf(),
+            })?;
+        match fs::read_dir(target) {
+            Ok(mut entries) => {
+                if entries.next().is_some() && !target.join(marker).is_file() {
+                    return Err(OutputError::ForeignFolder {
+                        path: target.to_path_buf(),
+                        marker,
+                    });
+                }
+            }
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+            Err(e) => {
+                let (op, source) = if target.is_dir() {
+                    ("read the folder", e)
+                } else {
+                    (
+                        "create the folder",
+                        io::Error::new(io::ErrorKind::AlreadyExists, "a file of that name exists"),
+                    )
+                };
+                return Err(OutputError::Io {
+                    path: target.to_path_buf(),
+                    op,
+                    source,
+                });
+            }
+        }
+        let parent = target
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        if !parent.is_dir() {
+            return Err(OutputError::NoSuchDirectory {
+                path: target.to_path_buf(),
+                dir: parent.to_path_buf(),
+            });
+        }
+        let staging = parent.join(format!(".{}.partial-{}", name.to_string_lossy(), std::process::id()));
+        let _ = fs::remove_dir_all(&staging);
+        fs::create_dir(&staging).map_err(|source| OutputError::Io {
+            path: target.to_path_buf(),
+            op: "create a folder beside it",
+            source,
+        })?;
+        Ok(StagedDir {
+            staging,
+            target: target.to_path_buf(),
+            committed: false,
+        })
+    }
+
+    /// The folder to write the files into.
+    pub fn path(&self) -> &Path {
+        &self.staging
+    }
+
+    /// Put the written folder in the target's place (an earlier output is
+    /// moved aside first and removed once the new one is in place).
+    pub fn commit(mut self) -> Result<(), OutputError> {
+        let io = |op: &'static str| {
+            let path = self.target.clone();
+            move |source| OutputError::Io { path, op, source }
+        };
+        let old = self.staging.with_extension("old");
+        let had_old = self.target.exists();
+        if had_old {
+            let _ = fs::remove_dir_all(&old);
+            fs::rename(&self.target, &old).map_err(io("move the earlier output aside"))?;
+        }
+        if let Err(e) = fs::rename(&self.staging, &self.target) {
+            if had_old {
+                let _ = fs::rename(&old, &self.target);
+            }
+            return Err(io("move the new output into place")(e));
+        }
+        self.committed = true;
+        if had_old {
+            let _ = fs::remove_dir_all(&old);
+        }
+        Ok(())
+    }
+}
+
+impl Drop for StagedDir {
+    fn drop(&mut self) {
+        if !self.committed {
+            let _ = fs::remove_dir_all(&self.staging);
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------
@@ -847,16 +976,34 @@ pub fn stability_map_csv_header(m: &StabilityMap) -> Vec<String> {
 pub fn write_stability_map_csv<W: Write>(w: W, m: &StabilityMap) -> Result<(), csv::Error> {
     let mut wr = csv::Writer::from_writer(w);
     wr.write_record(stability_map_csv_header(m))?;
+    write_stability_map_csv_rows(&mut wr, m, 0)?;
+    wr.flush()?;
+    Ok(())
+}
+
+/// The rows of `m` (no header), its first-parameter index counted from
+/// `i0`: a map computed a row (one value of the first parameter) at a time
+/// is streamed as one CSV, the same as [`write_stability_map_csv`] gives
+/// for the whole map.
+pub fn write_stability_map_csv_rows<W: Write>(
+    wr: &mut csv::Writer<W>,
+    m: &StabilityMap,
+    i0: usize,
+) -> Result<(), csv::Error> {
     let (nx, ny) = m.shape();
     for i in 0..nx {
         for j in 0..ny {
             let Some(c) = m.cell(i, j) else { continue };
-            let mut row = vec![num(m.x.values[i]), num(m.y.values[j]), i.to_string(), j.to_string()];
+            let mut row = vec![
+                num(m.x.values[i]),
+                num(m.y.values[j]),
+                (i0 + i).to_string(),
+                j.to_string(),
+            ];
             row.extend(cell_fields(c));
             wr.write_record(&row)?;
         }
     }
-    wr.flush()?;
     Ok(())
 }
 

@@ -32,12 +32,17 @@ pub enum BicycleError {
     Parameters(#[from] ParameterError),
     #[error("linearization of `{bike}` failed: {source}")]
     Linearize { bike: String, source: LinearizeError },
-    #[error("unknown parameter `{name}`: use a thesis symbol ({thesis}) or a benchmark symbol ({benchmark})")]
+    #[error("unknown parameter `{name}`{suggestion}: effect parameters are {effects}; masses, inertias and geometry are thesis symbols ({thesis}) or benchmark symbols ({benchmark})")]
     UnknownParameter {
         name: String,
+        /// ` (did you mean `X`?)` for a close symbol, else empty.
+        suggestion: String,
+        effects: String,
         thesis: String,
         benchmark: String,
     },
+    #[error("{file}: {warning}; lengths are in metres (pass --allow-units if this value is meant)")]
+    LooksLikeMillimetres { file: String, warning: String },
     #[error("`{spec}` is neither a built-in bicycle (thesis, benchmark) nor an existing file")]
     NotFound { spec: String },
     #[error("unknown model `{name}` (models: {known})")]
@@ -76,6 +81,17 @@ pub struct Bicycle<R: ModelRegistry = BuiltIn> {
     registry: PhantomData<R>,
 }
 
+/// Whether a parameter file with a length that looks like millimetres
+/// (over 10 m) is accepted with a warning instead of refused.
+static ALLOW_IMPLAUSIBLE_UNITS: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Accept parameter files whose lengths look like millimetres (the
+/// command line's `--allow-units`), for this process: a length over 10 m is
+/// then a warning, not an error.
+pub fn allow_implausible_units(allow: bool) {
+    ALLOW_IMPLAUSIBLE_UNITS.store(allow, std::sync::atomic::Ordering::Relaxed);
+}
+
 impl Bicycle {
     /// Resolve `thesis`, `benchmark` or a parameter file (TOML in either form,
     /// or the `name = value[+/-std]` text form of bicycleparameters/HumanControl)
@@ -106,6 +122,18 @@ impl<R: ModelRegistry> Bicycle<R> {
                 let loaded = ParameterSet::load_with_extra(path, &extra)?;
                 for (name, &value) in &loaded.effects {
                     check_effect_value_in::<R>(name, value, path)?;
+                }
+                if !ALLOW_IMPLAUSIBLE_UNITS.load(std::sync::atomic::Ordering::Relaxed) {
+                    if let Some(w) = loaded
+                        .warnings
+                        .iter()
+                        .find(|w| matches!(w, ParameterWarning::LooksLikeMillimetres { .. }))
+                    {
+                        return Err(BicycleError::LooksLikeMillimetres {
+                            file: path.to_string(),
+                            warning: w.to_string(),
+                        });
+                    }
                 }
                 return Ok(Bicycle {
                     name: spec.to_string(),
@@ -253,11 +281,7 @@ impl<R: ModelRegistry> Bicycle<R> {
         } else if BenchmarkParameters::SYMBOLS.contains(&symbol) {
             ParameterSet::Benchmark(set_field(&self.parameters.to_benchmark()?, symbol, value)?)
         } else {
-            return Err(BicycleError::UnknownParameter {
-                name: symbol.to_string(),
-                thesis: ThesisParameters::SYMBOLS.join(", "),
-                benchmark: BenchmarkParameters::SYMBOLS.join(", "),
-            });
+            return Err(unknown_parameter::<R>(symbol));
         };
         let warnings = parameters.validate()?;
         Ok(Bicycle {
@@ -268,6 +292,18 @@ impl<R: ModelRegistry> Bicycle<R> {
             uncertainties: self.uncertainties.clone(),
             registry: PhantomData,
         })
+    }
+
+    /// The effect parameters the file set, as TOML lines that any
+    /// parameter file may end with (neither form's table holds them), so
+    /// that a converted or refitted file keeps them; empty when there are
+    /// none.
+    pub fn effects_toml(&self) -> String {
+        let mut s = String::new();
+        for (k, v) in &self.effects {
+            s.push_str(&format!("{k} = {v:e}\n"));
+        }
+        s
     }
 
     /// Value of a thesis or benchmark symbol.
@@ -307,6 +343,46 @@ pub fn check_effect_value_in<R: ModelRegistry>(name: &str, value: f64, file: &st
     }
 }
 
+/// The error for a symbol that names no parameter, listing the effect
+/// parameters first (what `--effects` is for) and suggesting the closest
+/// symbol of any kind when one is close.
+fn unknown_parameter<R: ModelRegistry>(symbol: &str) -> BicycleError {
+    let effects: Vec<&str> = effect_parameters_in::<R>().iter().map(|p| p.name).collect();
+    let closest = effects
+        .iter()
+        .chain(ThesisParameters::SYMBOLS.iter())
+        .chain(BenchmarkParameters::SYMBOLS.iter())
+        .map(|c| (edit_distance(&symbol.to_lowercase(), &c.to_lowercase()), *c))
+        .min();
+    let suggestion = match closest {
+        Some((d, c)) if d <= 2.max(symbol.len() / 3) && d < symbol.len() => format!(" (did you mean `{c}`?)"),
+        _ => String::new(),
+    };
+    BicycleError::UnknownParameter {
+        name: symbol.to_string(),
+        suggestion,
+        effects: effects.join(", "),
+        thesis: ThesisParameters::SYMBOLS.join(", "),
+        benchmark: BenchmarkParameters::SYMBOLS.join(", "),
+    }
+}
+
+/// Levenshtein distance (for suggestions among a few dozen symbols).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let next = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(row[j + 1] + 1);
+            prev = row[j + 1];
+            row[j + 1] = next;
+        }
+    }
+    row[b.len()]
+}
+
 /// Set one serde-named field (the parameter symbol) of a parameter struct.
 fn set_field<P: serde::Serialize + serde::de::DeserializeOwned>(
     p: &P,
@@ -315,11 +391,7 @@ fn set_field<P: serde::Serialize + serde::de::DeserializeOwned>(
 ) -> Result<P, BicycleError> {
     let mut v = serde_json::to_value(p).expect("parameter structs serialize");
     v[symbol] = serde_json::Value::from(value);
-    serde_json::from_value(v).map_err(|_| BicycleError::UnknownParameter {
-        name: symbol.to_string(),
-        thesis: ThesisParameters::SYMBOLS.join(", "),
-        benchmark: BenchmarkParameters::SYMBOLS.join(", "),
-    })
+    serde_json::from_value(v).map_err(|_| unknown_parameter::<BuiltIn>(symbol))
 }
 
 /// The default model of a bicycle without effect parameters, as

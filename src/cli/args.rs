@@ -13,6 +13,14 @@ use std::path::PathBuf;
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
+    /// Print every parameter-file warning in full (also those of the
+    /// built-in bicycles, which are known and documented).
+    #[arg(long, global = true)]
+    pub verbose: bool,
+    /// Accept parameter files with lengths that look like millimetres (over
+    /// 10 m), which are otherwise refused.
+    #[arg(long, global = true)]
+    pub allow_units: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -88,8 +96,8 @@ pub enum Command {
         /// Model name (default: all models).
         #[arg(long)]
         model: Option<String>,
-        /// Number of random states.
-        #[arg(long, default_value_t = 20)]
+        /// Number of random states (1 to 100000).
+        #[arg(long, default_value_t = 20, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..=100_000))]
         states: usize,
         /// Seed of the random states.
         #[arg(long, default_value_t = 1)]
@@ -104,7 +112,7 @@ pub enum Command {
         bike: BikeArg,
         /// Speeds START:STOP:STEP (m/s) at which to print the state-space
         /// matrices A(v), B(v) of a bicycle without canonical form.
-        #[arg(long, default_value = "0:10:2")]
+        #[arg(long, default_value = "0:10:2", allow_hyphen_values = true)]
         speeds: String,
         #[arg(long)]
         json: bool,
@@ -114,7 +122,7 @@ pub enum Command {
         #[command(flatten)]
         bike: BikeArg,
         /// Speeds START:STOP:STEP (m/s).
-        #[arg(long, default_value = "0:10:0.5")]
+        #[arg(long, default_value = "0:10:0.5", allow_hyphen_values = true)]
         speeds: String,
         #[command(flatten)]
         out: OutputArgs,
@@ -237,8 +245,9 @@ pub struct IdentifyArgs {
     /// Print the JSON summary instead of the text summary.
     #[arg(long)]
     pub json: bool,
-    /// Folds of the cross-validation over runs.
-    #[arg(long, default_value_t = 4)]
+    /// Folds of the cross-validation over runs (2 to 1000; at most one per
+    /// run or log: more are reduced to that, and the console says so).
+    #[arg(long, default_value_t = 4, value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1000))]
     pub folds: usize,
     /// Largest number of parameter corrections (of the parameters whose
     /// model declares an uncertainty) tried beside the effects, those that
@@ -344,9 +353,13 @@ pub struct SynthArgs {
     /// Seed of the run plans (run k uses seed + k).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Output folder.
+    /// Output folder (new or empty; the set appears there only when it is
+    /// complete).
     #[arg(long)]
     pub out: PathBuf,
+    /// Replace the content of a non-empty output folder.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `bikedyn sweep`: stability over one or two parameters.
@@ -358,13 +371,13 @@ pub struct SweepArgs {
     #[arg(long)]
     pub param: String,
     /// Values START:STOP:STEP.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub values: String,
     /// Second parameter for a two-parameter stability map.
     #[arg(long)]
     pub param2: Option<String>,
     /// Values of the second parameter START:STOP:STEP.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     pub values2: Option<String>,
     /// Upper end of the searched speed range (m/s).
     #[arg(long, default_value_t = 10.0)]

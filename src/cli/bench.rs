@@ -31,8 +31,8 @@ fn identify_bench() -> Result<()> {
     let o = super::identify::run_with_progress(&request)?;
     let secs = t.elapsed().as_secs_f64();
     let _ = std::fs::remove_dir_all(&dir);
-    println!("{}", report::summary(&o));
-    println!(
+    outln!("{}", report::summary(&o));
+    outln!(
         "identify, 12-run set ({} kicks): {secs:.1} s wall clock on {} threads, {} simulations (target < 5 s on 2 cores, issue 17)",
         o.segments.len(),
         rayon::current_num_threads(),
@@ -51,7 +51,7 @@ pub fn experiment(quick: bool) -> Result<()> {
     use bikedyn::runtime::experiment::synth::{rest_trajectory, ResponseSpec, SensorModel};
     use std::time::Instant;
     let reps = if quick { 5 } else { 30 };
-    println!("\n== measured runs (bikedyn fit), median of {reps}, one thread ==");
+    outln!("\n== measured runs (bikedyn fit), median of {reps}, one thread ==");
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared");
     let (run_dir, cal_dir, log) = if root.join("data/dev/run01").is_dir() {
         (
@@ -86,7 +86,7 @@ pub fn experiment(quick: bool) -> Result<()> {
         std::hint::black_box(Calibration::estimate(&cal_run, opt.frame_pitch));
         times.push(t.elapsed().as_secs_f64());
     }
-    println!(
+    outln!(
         "calibration run (misalignment estimate, read excluded): {:>8.2} ms",
         1e3 * median(times)
     );
@@ -98,7 +98,7 @@ pub fn experiment(quick: bool) -> Result<()> {
         std::hint::black_box(experiment::process_thesis_run(&run, &cal, &opt));
         times.push(t.elapsed().as_secs_f64());
     }
-    println!(
+    outln!(
         "thesis-style run, end to end ({}): {:>8.2} ms",
         run_dir.display(),
         1e3 * median(times)
@@ -112,7 +112,7 @@ pub fn experiment(quick: bool) -> Result<()> {
             kicks = experiment::process_tudelft(&l, &opt).kicks.len();
             times.push(t.elapsed().as_secs_f64());
         }
-        println!(
+        outln!(
             "TU Delft log, end to end ({kicks} kicks, {}): {:>8.2} ms",
             log.display(),
             1e3 * median(times)

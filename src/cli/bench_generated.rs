@@ -27,21 +27,21 @@ fn per_call(reps: usize, mut f: impl FnMut(usize)) -> f64 {
 /// Print the figures. `quick` uses fewer repetitions.
 pub fn run(quick: bool) -> anyhow::Result<()> {
     let reps = if quick { 20_000 } else { 400_000 };
-    println!("== code generation (build.rs, last build) ==");
+    outln!("== code generation (build.rs, last build) ==");
     let report: serde_json::Value = serde_json::from_str(CODEGEN_REPORT)?;
     if report["derived"] == false {
-        println!(
+        outln!(
             "this build took every model's committed generated code (nothing derived); `cargo build --release --features derive` derives them and records the timings"
         );
     } else {
-        println!(
+        outln!(
             "all {} models: derivation + emission {:.2} s (budget 30 s)",
             report["models"].as_array().map_or(0, |m| m.len()),
             report["total_s"].as_f64().unwrap_or(f64::NAN)
         );
     }
     for m in report["models"].as_array().into_iter().flatten() {
-        println!(
+        outln!(
             "model {:<16} derivation {:>6.2} s   derivation + emission {:>6.2} s   operations {:>9} before / {:>6} after optimisation",
             m["model"].as_str().unwrap_or("?"),
             m["derivation_s"].as_f64().unwrap_or(f64::NAN),
@@ -51,7 +51,7 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         );
     }
 
-    println!("\n== generated functions of thesis_whipple (f64, one state per call, {reps} calls) ==");
+    outln!("\n== generated functions of thesis_whipple (f64, one state per call, {reps} calls) ==");
     type M = ThesisWhipple;
     let param = default_parameters::<M>();
     let nq = M::nq();
@@ -71,13 +71,16 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
     let mut buf = vec![0.0; (nq * nq).max(n_jac)];
     let flops = |name: &str| M::FLOPS.iter().find(|(n, _)| *n == name).map(|x| x.1).unwrap_or(0);
     let mut total = 0.0;
+    // Rows are collected and printed after the timing (a failed write to
+    // standard output is then an error of this function).
+    let mut lines = Vec::new();
     let mut row = |name: &str, secs: f64| {
         total += secs;
-        println!(
+        lines.push(format!(
             "  {name:<28} {:>8.1} ns/call   {:>6} flops/call",
             secs * 1e9,
             flops(name)
-        );
+        ));
     };
     let s = &states;
     row(
@@ -198,8 +201,11 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
             black_box(&buf);
         }),
     );
+    for l in &lines {
+        outln!("{l}");
+    }
     let singles: usize = M::FLOPS.iter().filter(|x| x.0 != "all_quantities").map(|x| x.1).sum();
-    println!(
+    outln!(
         "  {:<28} {:>8.1} ns/state  {:>6} flops/state",
         "sum of the calls above",
         total * 1e9,
@@ -212,14 +218,14 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         M::all_quantities(&param, 0.1, p, dp, &mut all);
         black_box(&all);
     });
-    println!(
+    outln!(
         "  {:<28} {:>8.1} ns/state  {:>6} flops/state (target: under 1000 ns)",
         "all_quantities (one call)",
         t_all * 1e9,
         flops("all_quantities")
     );
 
-    println!("\n== linearization and eigenvalues (thesis bicycle) ==");
+    outln!("\n== linearization and eigenvalues (thesis bicycle) ==");
     let thesis = ThesisParameters::thesis_bicycle();
     let lin_reps = if quick { 200 } else { 2000 };
     // The fast upright path and the general path it replaced (the whole
@@ -255,22 +261,22 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         &z,
     )?;
     let reduced_flops = Counted::count();
-    println!("  reduced equations Ec = Mi q'' - Qi, one evaluation at the solved configuration: {reduced_flops} flops (counted; the f64 Newton iterations before it are not included)");
-    println!(
+    outln!("  reduced equations Ec = Mi q'' - Qi, one evaluation at the solved configuration: {reduced_flops} flops (counted; the f64 Newton iterations before it are not included)");
+    outln!(
         "  exact linearization (canonical M0, C1, K0, K2 from the generated equations, once per design): {:>8.2} us (fast upright path: f64 Newton only when the closed-form guess misses the constraints, 2-direction duals for the configuration terms, the velocity terms from their generated symbolic Jacobian in f64 by the chain rule, one real LU, scratch buffers on the stack; target: under 5 us{})",
         t_lin * 1e6,
         if t_lin < 5e-6 { ", target met" } else { ", not met here" }
     );
-    println!(
+    outln!(
         "  exact linearization, previous method (general path: the whole reduced system in 4-direction duals; model chosen directly): {:>8.2} us, ~{} flops (~5 flops per dual op); two full linearizations before that: ~18 us",
         t_lin_general * 1e6,
         5 * reduced_flops
     );
-    println!(
+    outln!(
         "  eigenvalues of the 4x4 state matrix per speed point:                                     {:>8.1} ns",
         t_eig * 1e9
     );
-    println!("  one speed point including its share of the linearization over 100 speeds:               {:>8.1} ns (target: under 2000 ns per core)", (t_eig + t_lin / 100.0) * 1e9);
+    outln!("  one speed point including its share of the linearization over 100 speeds:               {:>8.1} ns (target: under 2000 ns per core)", (t_eig + t_lin / 100.0) * 1e9);
 
     let (designs, speeds) = if quick { (100usize, 1000usize) } else { (1000, 1000) };
     let t = Instant::now();
@@ -292,7 +298,7 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         })
         .sum();
     let el = t.elapsed().as_secs_f64();
-    println!(
+    outln!(
         "  design x speed sweep: {designs} designs x {speeds} speeds = {} points on {} threads in {:.3} s ({:.0} ns/point; {stable} stable points) (target: 10^6 points under 2 s)",
         designs * speeds,
         rayon::current_num_threads(),

@@ -46,7 +46,7 @@ fn variant<M: MultibodyModel>(label: &str, effects: &[(&str, f64)], reps: usize)
     }
     let (secs, sim) = time_run::<M>(&param, reps, 0.1)?;
     let n = sim.stats.rhs_evaluations as f64;
-    println!(
+    outln!(
         "  {label:<48} ({}): {:>7.3} ms per run = {:>6.0}x real time; {:>5} rhs evaluations, {:>5.2} us per evaluation",
         M::NAME,
         secs * 1e3,
@@ -60,13 +60,13 @@ fn variant<M: MultibodyModel>(label: &str, effects: &[(&str, f64)], reps: usize)
 /// Print the simulation figures.
 pub fn run(quick: bool) -> anyhow::Result<()> {
     let reps = if quick { 5 } else { 50 };
-    println!("\n== nonlinear simulation (thesis model, 5 s response to a 3 N s saddle kick at 4.5 m/s, rtol 1e-8, best of {reps}) ==");
+    outln!("\n== nonlinear simulation (thesis model, 5 s response to a 3 N s saddle kick at 4.5 m/s, rtol 1e-8, best of {reps}) ==");
     type M = ThesisWhipple;
     let param = default_parameters::<M>();
     for (label, dt) in [("output every 0.1 s", 0.1), ("output every 0.01 s", 0.01)] {
         let (secs, sim) = time_run::<M>(&param, reps, dt)?;
         let n = sim.stats.rhs_evaluations as f64;
-        println!(
+        outln!(
             "  driven speed, no effects, {label:<20}: {:>7.3} ms per run = {:>6.0}x real time; {:>5} rhs evaluations ({} steps), {:>5.2} us per evaluation incl. sampling = {:.0} evaluations/s (target: > 2000x real time, 5 s in < 2.5 ms)",
             secs * 1e3,
             5.0 / secs,
@@ -99,7 +99,7 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         eval.derivative(h, &y, &mut dy)?;
     }
     let per = t.elapsed().as_secs_f64() / n as f64;
-    println!(
+    outln!(
         "  right-hand side alone (Newton with predictor, velocity solve, all_quantities, Mi q'' = Qi): {:.2} us per evaluation = {:.0} evaluations/s",
         per * 1e6,
         1.0 / per
@@ -116,6 +116,6 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
     variant::<ThesisWhippleFree>("free speed, no effects", &[], reps)?;
     variant::<Extended>("driven speed, steer damping", effects, reps)?;
     variant::<ExtendedFree>("free speed, damping + rolling resistance + drag", effects, reps)?;
-    println!("  peer anchor: a Python/sympy implementation at about 0.2 ms per right-hand-side evaluation");
+    outln!("  peer anchor: a Python/sympy implementation at about 0.2 ms per right-hand-side evaluation");
     Ok(())
 }

@@ -17,10 +17,10 @@ pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
             if json {
                 let mut v = canonical_json(c);
                 v["model"] = serde_json::json!(lin.model);
-                println!("{}", serde_json::to_string_pretty(&v)?);
+                outln!("{}", serde_json::to_string_pretty(&v)?);
             } else {
-                println!("model: {}", lin.model);
-                print!("{}", canonical_text(c));
+                outln!("model: {}", lin.model);
+                out!("{}", canonical_text(c));
             }
         }
         None => {
@@ -62,13 +62,13 @@ pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
                     "inputs": ["roll_torque", "steer_torque"],
                     "state_space": v,
                 });
-                println!("{}", serde_json::to_string_pretty(&out)?);
+                outln!("{}", serde_json::to_string_pretty(&out)?);
             } else {
-                println!("model: {}", lin.model);
-                println!("no canonical form: {why}");
-                println!("state-space form x' = A(v) x + B(v) u, x = [roll, steer, roll rate, steer rate] (rad, rad/s), u = [roll torque, steer torque] (N m), benchmark signs:");
+                outln!("model: {}", lin.model);
+                outln!("no canonical form: {why}");
+                outln!("state-space form x' = A(v) x + B(v) u, x = [roll, steer, roll rate, steer rate] (rad, rad/s), u = [roll torque, steer torque] (N m), benchmark signs:");
                 for (v, a, minv) in &rows {
-                    print!("{}", state_space_text(*v, a, minv));
+                    out!("{}", state_space_text(*v, a, minv));
                 }
             }
         }
@@ -110,18 +110,18 @@ fn first_order(model: &str, eq: &dyn StateSpaceBicycle, speeds: &[f64], json: bo
             "state": names,
             "state_space": v,
         });
-        println!("{}", serde_json::to_string_pretty(&out)?);
+        outln!("{}", serde_json::to_string_pretty(&out)?);
     } else {
-        println!("model: {model}");
-        println!("no canonical form: {why}");
-        println!(
+        outln!("model: {model}");
+        outln!("no canonical form: {why}");
+        outln!(
             "first-order lateral equations x' = A(v) x, x = [{}] (the model's own coordinates and signs; rates are d + coordinate, then the extra states):",
             names.join(", ")
         );
         for (v, l) in &rows {
-            println!("v = {v} m/s");
+            outln!("v = {v} m/s");
             let e: Vec<f64> = l.a.transpose().iter().copied().collect();
-            print!("{}", matrix_text("A", l.a.ncols(), &e));
+            out!("{}", matrix_text("A", l.a.ncols(), &e));
         }
     }
     Ok(true)

@@ -36,8 +36,8 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plot: Option<PathBuf>
             Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep(c, n, speed, fmt, w))?,
             None => {
                 let mut w = std::io::BufWriter::new(std::io::stdout().lock());
-                output::stream_eigen_sweep(c, n, speed, fmt, &mut w).map_err(|e| anyhow::anyhow!(e))?;
-                std::io::Write::flush(&mut w)?;
+                output::stream_eigen_sweep(c, n, speed, fmt, &mut w).map_err(super::stdout_error_of)?;
+                std::io::Write::flush(&mut w).map_err(super::stdout_error)?;
             }
         }
         Ok(())

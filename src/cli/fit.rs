@@ -65,15 +65,15 @@ pub fn run(args: &FitArgs) -> Result<bool> {
             .flat_map(|r| r.kicks.iter())
             .map(|k| kick_json(k, out.linear.as_ref().map(|l| l as &dyn LinearBicycle)))
             .collect();
-        println!("{}", serde_json::to_string_pretty(&list)?);
+        outln!("{}", serde_json::to_string_pretty(&list)?);
     } else {
-        print!("{}", calibration_text(&out));
-        print!("{}", kicks_table(&out));
+        out!("{}", calibration_text(&out));
+        out!("{}", kicks_table(&out));
         let rows = residuals(&out);
         if !rows.is_empty() {
             let model = out.linear.as_ref().map_or("", |l| l.model);
-            println!("\nmeasured against predicted weave eigenvalue (model {model}; z = difference / standard error)");
-            print!("{}", compare::format_residuals(&rows));
+            outln!("\nmeasured against predicted weave eigenvalue (model {model}; z = difference / standard error)");
+            out!("{}", compare::format_residuals(&rows));
         }
     }
     if let Some(dir) = &args.plot {

@@ -31,6 +31,11 @@ pub fn run_with_progress(request: &IdentifyRequest) -> Result<Outcome> {
 
 /// Run `bikedyn identify`.
 pub fn run(a: &IdentifyArgs) -> Result<bool> {
+    // A report folder that cannot be written fails now, not after the
+    // computation.
+    if let Some(dir) = &a.report {
+        bikedyn::report::output::StagedDir::check(dir, "report.json")?;
+    }
     if let Some(table) = &a.eigenvalues {
         let o = eigen_table::identify_table(&eigen_table::TableRequest {
             path: table.clone(),
@@ -42,24 +47,36 @@ pub fn run(a: &IdentifyArgs) -> Result<bool> {
             eigen_table::write_table_report(&o, dir)?;
         }
         if a.json {
-            println!("{}", serde_json::to_string_pretty(&o)?);
+            outln!("{}", serde_json::to_string_pretty(&o)?);
         } else {
-            println!("{}", eigen_table::table_summary(&o));
+            outln!("{}", eigen_table::table_summary(&o));
         }
         return Ok(true);
     }
     let request = request(a);
     let o = run_with_progress(&request)?;
+    if o.identification.folds != request.folds {
+        eprintln!(
+            "note: --folds {}: cross-validation used {} folds (each fold holds out whole runs or logs, and there are {} kicks in {} runs or logs)",
+            request.folds,
+            o.identification.folds,
+            o.segments.len(),
+            o.segments.iter().map(|s| s.run.as_str()).collect::<std::collections::BTreeSet<_>>().len()
+        );
+    }
     if let Some(dir) = &a.report {
         report::write_report(&o, &request, dir)?;
     }
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report::outcome_json(&o))?);
+        outln!("{}", serde_json::to_string_pretty(&report::outcome_json(&o))?);
     } else {
-        println!("{}", report::summary(&o));
+        outln!("{}", report::summary(&o));
         if let Some(dir) = &a.report {
-            println!("report: {}", dir.join("report.md").display());
+            outln!("report: {}", dir.join("report.md").display());
         }
     }
-    Ok(true)
+    // As `fit`: exit status 1 when a run or log could not be processed (the
+    // summary and the JSON say why; kicks that are no weave are listed too,
+    // but they are the data's, not a failure).
+    Ok(o.failed_inputs.is_empty())
 }

@@ -83,10 +83,71 @@ pub fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
 
 pub fn load(bike: &str) -> Result<Bicycle> {
     let b = Bicycle::resolve(bike)?;
-    for w in &b.warnings {
-        eprintln!("warning ({}): {w}", b.name);
-    }
+    show_warnings(&b);
     Ok(b)
+}
+
+static VERBOSE: AtomicBool = AtomicBool::new(false);
+
+/// `--verbose`: every parameter warning in full.
+pub fn set_verbose(verbose: bool) {
+    VERBOSE.store(verbose, Ordering::Relaxed);
+}
+
+/// A bicycle's parameter warnings on standard error, once per file per
+/// command. The built-in bicycles' warnings are known (the thesis's
+/// measured inertias violate the triangle inequality, as published) and
+/// shown only with `--verbose`; a file's notes that ask for no action (the
+/// triangle inequality, names kept aside) are one summary line each, with
+/// what they mean; the rest in full.
+pub fn show_warnings<R: bikedyn::registry::ModelRegistry>(b: &bikedyn::bicycle::Bicycle<R>) {
+    use bikedyn::runtime::parameters::ParameterWarning;
+    static SHOWN: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
+    let verbose = VERBOSE.load(Ordering::Relaxed);
+    let built_in = matches!(b.name.as_str(), "thesis" | "benchmark");
+    if b.warnings.is_empty() || (built_in && !verbose) {
+        return;
+    }
+    if let Ok(mut shown) = SHOWN.lock() {
+        if shown.contains(&b.name) {
+            return;
+        }
+        shown.push(b.name.clone());
+    }
+    if verbose {
+        for w in &b.warnings {
+            eprintln!("warning ({}): {w}", b.name);
+        }
+        return;
+    }
+    let mut triangle = Vec::new();
+    let mut extra = Vec::new();
+    for w in &b.warnings {
+        match w {
+            ParameterWarning::TriangleInequality { body, .. } => triangle.push(*body),
+            ParameterWarning::ExtraField { field, .. } => extra.push(field.as_str()),
+            w => eprintln!("warning ({}): {w}", b.name),
+        }
+    }
+    if !triangle.is_empty() {
+        eprintln!(
+            "note ({}): the inertia of the {} violates the triangle inequality: no rigid body has such principal moments (a measurement or transcription error in the source); bikedyn uses them as given (--verbose for the values)",
+            b.name,
+            triangle.join(" and the ")
+        );
+    }
+    if !extra.is_empty() {
+        eprintln!(
+            "note ({}): {} not a model parameter and kept aside: {} (--verbose for what each means)",
+            b.name,
+            if extra.len() == 1 {
+                "one name is"
+            } else {
+                "these names are"
+            },
+            extra.join(", ")
+        );
+    }
 }
 
 /// Check every output before any work (a data file and, optionally, a
@@ -103,10 +164,45 @@ pub fn check_outputs(out: Option<&std::path::Path>, plot: Option<&std::path::Pat
     Ok(())
 }
 
+/// Write to standard output, turning a failed write into an error that
+/// says what happened (see the `out!` macro).
+pub fn write_out(args: std::fmt::Arguments<'_>) -> Result<()> {
+    use std::io::Write;
+    std::io::stdout().lock().write_fmt(args).map_err(stdout_error)
+}
+
+/// The error of a failed write to standard output.
+pub fn stdout_error(e: std::io::Error) -> anyhow::Error {
+    if e.kind() == std::io::ErrorKind::BrokenPipe {
+        anyhow::anyhow!(
+            "standard output was closed before everything was written (broken pipe); the output is incomplete"
+        )
+    } else {
+        anyhow::anyhow!("writing to standard output: {e}; the output is incomplete")
+    }
+}
+
+/// A streamed write's error: when a closed pipe or another I/O error on
+/// standard output is its cause, the message of [`stdout_error`].
+pub fn stdout_error_of(e: Box<dyn std::error::Error + Send + Sync>) -> anyhow::Error {
+    let mut cause: Option<&(dyn std::error::Error + 'static)> = Some(&*e);
+    while let Some(c) = cause {
+        if let Some(io) = c.downcast_ref::<std::io::Error>() {
+            return stdout_error(std::io::Error::new(io.kind(), io.to_string()));
+        }
+        // A CSV writer's I/O error is its kind, not its source.
+        if let Some(csv::ErrorKind::Io(io)) = c.downcast_ref::<csv::Error>().map(|e| e.kind()) {
+            return stdout_error(std::io::Error::new(io.kind(), io.to_string()));
+        }
+        cause = c.source();
+    }
+    anyhow::anyhow!(e)
+}
+
 pub fn emit(text: &str, output: &Option<PathBuf>) -> Result<()> {
     match output {
         Some(p) => output::write_string_atomic(p, text)?,
-        None => print!("{text}"),
+        None => out!("{text}"),
     }
     Ok(())
 }

@@ -8,9 +8,9 @@ pub fn run(json: bool) -> Result<bool> {
     let ms = bikedyn::models::models();
     if json {
         let v: Vec<_> = ms.iter().map(bikedyn::models::model_json).collect();
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        print!("{}", models_text(ms));
+        out!("{}", models_text(ms));
     }
     Ok(true)
 }

@@ -11,22 +11,26 @@ pub fn run(command: ParamsCommand) -> Result<bool> {
     match command {
         ParamsCommand::Convert { to, file, output: out } => {
             let b = load(&file)?;
-            let text = match to {
+            let mut text = match to {
                 FormName::Benchmark => b.parameters.to_benchmark()?.to_toml_string(),
                 FormName::Thesis => b.thesis()?.to_toml_string(),
             };
+            let effects = b.effects_toml();
+            if !effects.is_empty() {
+                text.push_str(&format!("\n# Effect parameters of {}:\n{effects}", b.name));
+            }
             emit(&text, &out)?;
             Ok(true)
         }
         ParamsCommand::Show { file, bike, model } => {
             let b = load(file.as_deref().unwrap_or(&bike))?;
-            print!("{}", params_show_text(&b, model.as_deref())?);
+            out!("{}", params_show_text(&b, model.as_deref())?);
             // Derived geometry, whatever the form of the file (issue 10,
             // point 9), as TOML comments so the output still loads.
             let g = bikedyn::runtime::geometry::DerivedGeometry::of(&b.parameters.to_benchmark()?);
-            println!("\n# Derived geometry (Meijaard et al. 2007, appendix A; benchmark axes):");
+            outln!("\n# Derived geometry (Meijaard et al. 2007, appendix A; benchmark axes):");
             for (sym, value, unit, what) in g.rows() {
-                println!(
+                outln!(
                     "# {sym:<8} = {:>14} {unit:<7} {what}",
                     output::format_significant(value, 8)
                 );

@@ -19,7 +19,7 @@ pub fn run(out: PathBuf) -> Result<bool> {
     let mut ok = true;
     for m in bikedyn::models::model_names() {
         let r = bikedyn::models::verify_model(m, &VerifyOptions::default()).expect("known model");
-        println!("verify {m}: {}", if r.passed { "passed" } else { "FAILED" });
+        outln!("verify {m}: {}", if r.passed { "passed" } else { "FAILED" });
         ok &= r.passed;
     }
     let speeds = parse_range("0:10:0.01", "speeds")?;
@@ -27,8 +27,8 @@ pub fn run(out: PathBuf) -> Result<bool> {
         let b = load(name)?;
         let c = b.canonical()?;
         let crit = critical_speeds(&c, 0.0, 10.0)?;
-        println!("\n{}", stability_text(name, &crit));
-        println!("{}", canonical_text(&c));
+        outln!("\n{}", stability_text(name, &crit));
+        outln!("{}", canonical_text(&c));
         let sweep = eigen_sweep(&c, &speeds)?;
         output::save_eigen_sweep_csv(out.join(format!("{name}_eigenvalues.csv")), &sweep)?;
         output::save_eigen_sweep_json(out.join(format!("{name}_eigenvalues.json")), &sweep)?;
@@ -46,7 +46,7 @@ pub fn run(out: PathBuf) -> Result<bool> {
         }
         output::save_json(out.join(format!("{name}_stability.json")), &stability_json(name, &crit))?;
     }
-    println!("wrote tables and plots to {}", out.display());
+    outln!("wrote tables and plots to {}", out.display());
     // Close the loop on the committed example set (made by `bikedyn
     // synth` with steer damping hidden): measured eigenvalues on the
     // continuation diagram, the identified effect, before and after.
@@ -55,14 +55,14 @@ pub fn run(out: PathBuf) -> Result<bool> {
         inputs: vec![set.clone()],
         ..IdentifyRequest::default()
     };
-    println!(
+    outln!(
         "\nidentify {} (runs made by `bikedyn synth` with an effect hidden):",
         set.display()
     );
     let o = super::identify::run_with_progress(&request)?;
     let dir = out.join("identify");
     report::write_report(&o, &request, &dir)?;
-    println!("{}", report::summary(&o));
-    println!("report: {}", dir.join("report.md").display());
+    outln!("{}", report::summary(&o));
+    outln!("report: {}", dir.join("report.md").display());
     Ok(ok)
 }

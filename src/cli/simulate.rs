@@ -14,13 +14,14 @@ use bikedyn::runtime::simulate::{
 use bikedyn::simulate;
 use std::time::Instant;
 
-fn numbers(spec: &str, what: &str) -> Result<Vec<f64>> {
+/// The numbers of a colon-separated spec; `format` is the expected form,
+/// shown when a part is not a number (`--kick 1,3` names TIME:IMPULSE).
+fn numbers(spec: &str, what: &str, format: &str) -> Result<Vec<f64>> {
     spec.split(':')
         .map(|p| {
-            let x: f64 = p
-                .trim()
-                .parse()
-                .with_context(|| format!("{what} `{spec}`: `{p}` is not a number"))?;
+            let x: f64 = p.trim().parse().ok().with_context(|| {
+                format!("{what} `{spec}`: `{p}` is not a number (expected {format}, parts separated by colons)")
+            })?;
             if !x.is_finite() {
                 bail!("{what} `{spec}`: `{p}` is not finite");
             }
@@ -31,7 +32,8 @@ fn numbers(spec: &str, what: &str) -> Result<Vec<f64>> {
 
 /// Parse `TIME:IMPULSE[:AHEAD:HEIGHT]`.
 pub fn parse_kick(spec: &str) -> Result<Kick> {
-    match numbers(spec, "--kick")?.as_slice() {
+    const FORMAT: &str = "TIME:IMPULSE or TIME:IMPULSE:AHEAD:HEIGHT, e.g. 1.0:3";
+    match numbers(spec, "--kick", FORMAT)?.as_slice() {
         [t, j] => Ok(Kick::at_saddle(*t, *j)),
         [t, j, a, h] => Ok(Kick {
             time: *t,
@@ -39,7 +41,7 @@ pub fn parse_kick(spec: &str) -> Result<Kick> {
             ahead: *a,
             height: *h,
         }),
-        _ => bail!("--kick `{spec}`: expected TIME:IMPULSE or TIME:IMPULSE:AHEAD:HEIGHT"),
+        _ => bail!("--kick `{spec}`: expected {FORMAT}"),
     }
 }
 
@@ -59,7 +61,11 @@ pub fn parse_pulse(spec: &str) -> Result<TorquePulse> {
         "halfsine" | "half-sine" => PulseShape::HalfSine,
         other => bail!("--pulse `{spec}`: shape `{other}` is neither rect nor halfsine"),
     };
-    let x = numbers(&parts[1..4].join(":"), "--pulse")?;
+    let x = numbers(
+        &parts[1..4].join(":"),
+        "--pulse",
+        "roll|steer:START:DURATION:AMPLITUDE[:rect|halfsine]",
+    )?;
     if x[1] <= 0.0 {
         bail!("--pulse `{spec}`: duration must be positive");
     }
@@ -78,9 +84,7 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
         bikedyn::report::plot::ImageFormat::from_path(p)?;
     }
     let bike = Bicycle::resolve(&a.bike)?;
-    for w in &bike.warnings {
-        eprintln!("warning ({}): {w}", bike.name);
-    }
+    super::show_warnings(&bike);
     let info = simulate::choose_model(&bike, a.model.as_deref(), a.free_speed)?;
     if !(a.speed.is_finite()) {
         bail!("--speed must be a finite number");
@@ -112,14 +116,14 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
     let sim = simulate::run(&bike, info, &ic, &inputs, a.duration, &opts)?;
     let wall = start.elapsed().as_secs_f64();
     let simulated = sim.t.last().copied().unwrap_or(0.0);
-    println!(
+    outln!(
         "model {} ({}), bicycle {}",
         sim.model,
         if info.free_speed { "free speed" } else { "driven speed" },
         a.bike
     );
-    println!("  stop: {}", sim.stop);
-    println!(
+    outln!("  stop: {}", sim.stop);
+    outln!(
         "  {}: simulated {simulated:.3} s in {:.3} ms ({:.0}x real time), {} right-hand-side evaluations, {} steps ({} rejected)",
         opts.method.name(),
         wall * 1e3,
@@ -128,7 +132,7 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
         sim.stats.accepted_steps,
         sim.stats.rejected_steps
     );
-    println!(
+    outln!(
         "  max holonomic constraint residual {:.2e}, max velocity-constraint residual {:.2e}, relative energy change {:.2e}",
         sim.max_constraint_residual(),
         sim.max_velocity_residual(),

@@ -15,10 +15,10 @@ pub fn run(bike: BikeArg, speed_max: f64, json: bool) -> Result<bool> {
     if json {
         let mut v = stability_json(&bike, &crit);
         v["model"] = serde_json::json!(lin.model);
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!("model: {}", lin.model);
-        print!("{}", stability_text(&bike, &crit));
+        outln!("model: {}", lin.model);
+        out!("{}", stability_text(&bike, &crit));
     }
     Ok(true)
 }

@@ -76,6 +76,51 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                 );
             }
             b.with_parameter(&param, xs[0])?.with_parameter(&p2, ys[0])?;
+            if plot.is_none() && matches!(format, Format::Csv) {
+                // A large map streams its CSV a row (one value of the first
+                // parameter) at a time, as `eig` does, instead of printing
+                // nothing until the whole grid is done.
+                let bar = CellProgressBar::new(xs.len() * ys.len(), "stability map");
+                let stream = |w: &mut dyn std::io::Write| -> Result<(), output::BoxError> {
+                    let mut wr = csv::Writer::from_writer(w);
+                    for (i, &x) in xs.iter().enumerate() {
+                        let row = stability_map(
+                            ParamAxis::new(param.clone(), vec![x]),
+                            ParamAxis::new(p2.clone(), ys.clone()),
+                            |x, y| {
+                                b.with_parameter(&param, x)
+                                    .and_then(|b| b.with_parameter(&p2, y))
+                                    .and_then(|b| b.linear_with(model.as_deref()))
+                            },
+                            &opts,
+                            &|done, total| bar.cell_done(done, total),
+                        )?;
+                        refuse_failed_cells(
+                            row.cells
+                                .iter()
+                                .zip(&ys)
+                                .map(|(c, y)| (format!("{param} = {x}, {p2} = {y}"), c)),
+                        )
+                        .map_err(|e| -> output::BoxError { e.to_string().into() })?;
+                        if i == 0 {
+                            wr.write_record(output::stability_map_csv_header(&row))?;
+                        }
+                        output::write_stability_map_csv_rows(&mut wr, &row, i)?;
+                        wr.flush()?;
+                    }
+                    Ok(())
+                };
+                match &out {
+                    Some(p) => output::write_atomic(p, |w| stream(w))?,
+                    None => {
+                        let mut w = std::io::BufWriter::new(std::io::stdout().lock());
+                        stream(&mut w).map_err(super::stdout_error_of)?;
+                        std::io::Write::flush(&mut w).map_err(super::stdout_error)?;
+                    }
+                }
+                drop(bar);
+                return Ok(true);
+            }
             let bar = CellProgressBar::new(xs.len() * ys.len(), "stability map");
             let map = stability_map(
                 ParamAxis::new(param.clone(), xs),

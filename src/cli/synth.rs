@@ -4,6 +4,7 @@
 
 use super::args::SynthArgs;
 use anyhow::{Context, Result};
+use bikedyn::progress::Progress;
 use bikedyn::synth::{synth, SynthOptions, SynthRun};
 use std::path::Path;
 
@@ -21,6 +22,20 @@ fn effect(e: &str) -> Result<(String, f64)> {
     Ok((sym.trim().to_string(), val))
 }
 
+/// Every `SYMBOL=VALUE` of `--effects`, each symbol once (a repeated one
+/// would silently take its last value).
+fn effects(list: &[String]) -> Result<Vec<(String, f64)>> {
+    let mut out: Vec<(String, f64)> = Vec::new();
+    for e in list {
+        let (sym, val) = effect(e)?;
+        if let Some((_, first)) = out.iter().find(|(s, _)| *s == sym) {
+            anyhow::bail!("--effects: `{sym}` is given twice ({first} and {val}); give each symbol once");
+        }
+        out.push((sym, val));
+    }
+    Ok(out)
+}
+
 /// `LO:HI` of `--speeds` (m/s).
 fn speeds(s: &str) -> Result<[f64; 2]> {
     let (lo, hi) = s
@@ -31,12 +46,12 @@ fn speeds(s: &str) -> Result<[f64; 2]> {
     Ok([lo, hi])
 }
 
-fn print_run(r: &SynthRun) {
+fn print_run(r: &SynthRun) -> Result<()> {
     let plan = &r.plan;
     if r.name == "run01" {
-        println!("model: {}", r.model);
+        outln!("model: {}", r.model);
     }
-    println!(
+    outln!(
         "{}: release at {:.2} s, {:.2} m/s, kick {:+.2} N s at {:.2} s, {}",
         r.name,
         plan.launch_duration,
@@ -45,12 +60,28 @@ fn print_run(r: &SynthRun) {
         plan.launch_duration + plan.kick_delay,
         r.stop
     );
+    Ok(())
 }
 
-/// Make the set and print a line per run and the folder.
+/// Make the set, then print a line per run and the folder: the files are
+/// complete before anything is printed, so a closed pipe cannot leave a
+/// half-made set.
 fn make(opts: &SynthOptions) -> Result<bool> {
-    synth(opts, &mut print_run)?;
-    println!("wrote {} runs to {}", opts.runs, opts.out.display());
+    let display = super::ProgressDisplay::new();
+    let mut runs = Vec::new();
+    synth(opts, &mut |r: &SynthRun| {
+        runs.push(r.clone());
+        display.show(Progress {
+            step: "runs simulated",
+            done: runs.len(),
+            total: Some(opts.runs),
+        });
+    })?;
+    drop(display);
+    for r in &runs {
+        print_run(r)?;
+    }
+    outln!("wrote {} runs to {}", opts.runs, opts.out.display());
     Ok(true)
 }
 
@@ -59,7 +90,7 @@ pub fn run(a: SynthArgs) -> Result<bool> {
     if a.runs == 0 || a.runs > 1000 {
         anyhow::bail!("--runs must be between 1 and 1000");
     }
-    let effects = a.effects.iter().map(|e| effect(e)).collect::<Result<_>>()?;
+    let effects = effects(&a.effects)?;
     make(&SynthOptions {
         speeds: speeds(&a.speeds)?,
         bike: a.bike,
@@ -68,6 +99,7 @@ pub fn run(a: SynthArgs) -> Result<bool> {
         runs: a.runs,
         seed: a.seed,
         out: a.out,
+        force: a.force,
     })
 }
 
@@ -75,7 +107,7 @@ pub fn run(a: SynthArgs) -> Result<bool> {
 /// (`SYMBOL=VALUE`) hidden (for the identification bench).
 pub fn thesis_set(out: &Path, runs: usize, seed: u64, effects: &[&str]) -> Result<bool> {
     make(&SynthOptions {
-        effects: effects.iter().map(|e| effect(e)).collect::<Result<_>>()?,
+        effects: self::effects(&effects.iter().map(|e| e.to_string()).collect::<Vec<_>>())?,
         speeds: [4.0, 6.5],
         runs,
         seed,

@@ -103,6 +103,14 @@ pub fn params_show_text(b: &Bicycle, model: Option<&str>) -> Result<String> {
         let line = format!("{} = {v:?}", p.name);
         s += &format!("{line:<32} # {} [effect {}]\n", p.doc, p.effect.unwrap_or(""));
     }
+    if !b.uncertainties.is_empty() {
+        s += "# standard deviations the file gives (`value+/-std`, in the file's symbols and units; identification uses them as priors):\n";
+        for (sym, std) in &b.uncertainties {
+            let value = b.value(sym).or_else(|| b.effects.get(sym).copied());
+            let value = value.map_or(String::new(), |v| format!("{} ", output::format_significant(v, 6)));
+            s += &format!("#   {sym:<8} = {value}+/- {}\n", output::format_significant(*std, 3));
+        }
+    }
     Ok(s)
 }
 

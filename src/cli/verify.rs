@@ -32,15 +32,15 @@ pub fn run(model: Option<String>, states: usize, seed: u64, json: bool) -> Resul
                 "model": r.model, "name": q.name, "max_rel_error": q.max_rel_error, "tolerance": q.tolerance, "passed": q.passed
             })))
             .collect();
-        println!(
+        outln!(
             "{}",
             serde_json::to_string_pretty(&serde_json::json!({"passed": passed, "quantities": quantities}))?
         );
     } else {
         for r in &reports {
-            println!("model {} ({} random states, seed {}):", r.model, r.states, r.seed);
+            outln!("model {} ({} random states, seed {}):", r.model, r.states, r.seed);
             for q in &r.quantities {
-                println!(
+                outln!(
                     "  {:<40} max rel error {:>10.3e}  tolerance {:>8.1e}  {}",
                     q.name,
                     q.max_rel_error,
@@ -49,7 +49,7 @@ pub fn run(model: Option<String>, states: usize, seed: u64, json: bool) -> Resul
                 );
             }
         }
-        println!(
+        outln!(
             "{}",
             if passed {
                 "verification passed"

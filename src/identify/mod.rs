@@ -108,6 +108,10 @@ pub struct Outcome<R: ModelRegistry = BuiltIn> {
     pub segments: Vec<Segment>,
     /// Runs and kicks left out, with the reason.
     pub skipped: Vec<String>,
+    /// Of those, the runs and logs that could not be processed at all (as
+    /// `fit` reports them): the command line's exit status is 1 when there
+    /// are any, as `fit`'s is. A kick that is no weave is not one of them.
+    pub failed_inputs: Vec<String>,
     /// The candidate effects tried.
     pub candidates: Vec<Candidate>,
     /// The residual diagnosis of the base model.
@@ -232,6 +236,7 @@ pub fn run_plan<R: ModelRegistry>(
     let out = run_fit_in::<R>(&fit_options, progress)?;
     let (segs, mut skipped) = segments(&out);
     skipped.extend(out.errors.iter().cloned());
+    let failed_inputs = out.errors.clone();
     if segs.len() < 2 {
         return Err(IdentifyError::TooFewKicks {
             found: segs.len(),
@@ -344,6 +349,7 @@ pub fn run_plan<R: ModelRegistry>(
         identification: id,
         segments: segs,
         skipped,
+        failed_inputs,
         candidates: cands.clone(),
         findings,
         predicted_before,

@@ -10,7 +10,7 @@ use super::weave_errors::{eigen_rms, eigen_weighted_rms};
 use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
-use bikedyn_report::output::{save_json, write_string_atomic};
+use bikedyn_report::output::{save_json, write_string_atomic, StagedDir};
 use bikedyn_runtime::identify::confounding::CONFOUNDED;
 use bikedyn_runtime::identify::{pooled_rms, Candidate};
 use bikedyn_runtime::registry::ModelRegistry;
@@ -288,22 +288,21 @@ fn fitted_toml<R: ModelRegistry>(
         "\n# Effects identified by `bikedyn identify` (model {}; driven-speed twin {}).",
         o.model, o.driven_model
     );
-    for (k, v) in &fitted.effects {
-        let _ = writeln!(s, "{k} = {v:e}");
-    }
+    s.push_str(&fitted.effects_toml());
     Ok(s)
 }
 
 /// Write the report folder; the bicycle of `a` is resolved against the
 /// registry the identification ran on.
 pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: &Path) -> Result<(), IdentifyError> {
-    std::fs::create_dir_all(dir).map_err(|source| IdentifyError::CreateDir {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+    // Written beside `dir` and moved into its place at the end: a failure
+    // leaves an earlier report as it was, and no old file stays beside the
+    // new ones.
+    let staged = StagedDir::new(dir, "report.json")?;
+    let out = staged.path();
     let bike = Bicycle::<R>::resolve_in(&a.bike)?;
-    save_json(dir.join("report.json"), &outcome_json(o))?;
-    write_string_atomic(dir.join("fitted.toml"), &fitted_toml(&bike, &o.values_after, o)?)?;
+    save_json(out.join("report.json"), &outcome_json(o))?;
+    write_string_atomic(out.join("fitted.toml"), &fitted_toml(&bike, &o.values_after, o)?)?;
     // Continuation diagram before and after.
     let vmax = o.segments.iter().map(|s| s.speed_interval[1]).fold(7.0, f64::max) + 1.0;
     let speeds: Vec<f64> = (1..=200).map(|i| vmax * i as f64 / 200.0).collect();
@@ -358,7 +357,7 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
         .expect("the identification's driven model is registered");
     for ext in ["svg", "png"] {
         plot_continuation(
-            &dir.join(format!("continuation.{ext}")),
+            &out.join(format!("continuation.{ext}")),
             &curve(&BTreeMap::new())?,
             &curve(&linear_equivalent(driven_info, &o.values_after, median_rate))?,
             &label,
@@ -375,7 +374,7 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
         let (ms, bs, as_) = (deg(&s.steer), deg(&b.steer), deg(&a.steer));
         for ext in ["svg", "png"] {
             plot_run(
-                &dir.join(format!("run_residuals.{ext}")),
+                &out.join(format!("run_residuals.{ext}")),
                 &format!(
                     "{} (window from {:.2} s): measured and simulated, before and after",
                     Path::new(&s.run)
@@ -412,6 +411,7 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
             )?;
         }
     }
-    write_string_atomic(dir.join("report.md"), &report_markdown(o, a, dir))?;
+    write_string_atomic(out.join("report.md"), &report_markdown(o, a, dir))?;
+    staged.commit()?;
     Ok(())
 }

@@ -37,14 +37,27 @@ fn head_angle_in_degrees_is_refused() {
     assert!(text(&out.stderr).contains("`lam`"), "{}", text(&out.stderr));
 }
 
-/// A wheelbase of 1020 (millimetres) and a frame mass
-/// centre below the ground give warnings that name the field.
+/// A wheelbase of 1020 (millimetres) is refused, naming the file and the
+/// field, unless `--allow-units` (then a warning); a frame mass centre
+/// below the ground gives a warning that names the field.
 #[test]
-fn millimetres_and_mass_centre_below_ground_warn() {
+fn millimetres_are_refused_and_mass_centre_below_ground_warns() {
     let p = benchmark_with("w = 1.02 ", "w = 1020 ", "w1020.toml");
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
     let err = text(&out.stderr);
-    assert!(err.contains("`w` = 1020.0 m") && err.contains("millimetres"), "{err}");
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(out.stdout.is_empty());
+    assert!(
+        err.contains("w1020.toml")
+            && err.contains("`w` = 1020.0 m")
+            && err.contains("millimetres")
+            && err.contains("--allow-units"),
+        "{err}"
+    );
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap(), "--allow-units"]);
+    let err = text(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("warning") && err.contains("`w` = 1020.0 m"), "{err}");
     let p = benchmark_with("zB = -0.9 ", "zB = 0.2 ", "zb.toml");
     let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
     assert!(out.status.success());
@@ -56,6 +69,38 @@ fn millimetres_and_mass_centre_below_ground_warn() {
     // The benchmark bicycle itself gets no such warning.
     let out = bikedyn(&["canonical", "--bike", "benchmark"]);
     assert!(text(&out.stderr).is_empty(), "{}", text(&out.stderr));
+}
+
+/// The built-in thesis bicycle's inertias violate the triangle inequality
+/// as published: that is known, so it is shown only with `--verbose`; a
+/// file with the same values gets one note with what it means, once.
+#[test]
+fn warnings_nobody_can_act_on_are_quiet() {
+    let out = bikedyn(&["eig", "--bike", "thesis", "--speeds", "5"]);
+    assert!(out.status.success());
+    let err = text(&out.stderr);
+    assert!(!err.contains("triangle"), "{err}");
+    let out = bikedyn(&["eig", "--bike", "thesis", "--speeds", "5", "--verbose"]);
+    let err = text(&out.stderr);
+    assert_eq!(err.matches("violate the triangle inequality").count(), 2, "{err}");
+    let thesis = tmp("thesis-file.toml");
+    let out = bikedyn(&[
+        "params",
+        "convert",
+        "--to",
+        "thesis",
+        "thesis",
+        "--output",
+        thesis.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = bikedyn(&["eig", "--bike", thesis.to_str().unwrap(), "--speeds", "5"]);
+    let err = text(&out.stderr);
+    assert_eq!(err.matches("triangle inequality").count(), 1, "{err}");
+    assert!(
+        err.contains("handlebar and the front wheel") && err.contains("uses them as given"),
+        "{err}"
+    );
 }
 
 /// `stability` lists every crossing with its mode; for the

@@ -2,3 +2,4 @@
 
 mod commands;
 mod inputs_and_outputs;
+mod reliability;

@@ -65,7 +65,8 @@ pub struct KickFit {
     pub window_end: kicks::WindowEnd,
     /// Speed interval covered by the window `[low, high]` (m/s).
     pub speed_interval: [f64; 2],
-    /// Mean speed over the window (m/s).
+    /// Mean speed over the window (m/s); NaN when the window has no usable
+    /// speed sample.
     pub mean_speed: f64,
     /// Every fit that converged.
     pub fits: Vec<FitResult>,
@@ -171,7 +172,13 @@ fn fit_window(
     let (lo, hi) = finite_v
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
-    let mean = finite_v.iter().sum::<f64>() / finite_v.len().max(1) as f64;
+    // No speed sample in the window: no mean speed (NaN, null in JSON), so
+    // that nothing is predicted at a made-up speed of zero.
+    let mean = if finite_v.is_empty() {
+        f64::NAN
+    } else {
+        finite_v.iter().sum::<f64>() / finite_v.len() as f64
+    };
     let mut fits = Vec::new();
     let mut failed = Vec::new();
     // The speed-varying form needs a speed that changes measurably over the

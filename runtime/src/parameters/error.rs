@@ -109,6 +109,12 @@ pub enum ParameterError {
         why: &'static str,
     },
 
+    /// A raw measurement file of bicycleparameters (`<Name>Measured.txt`:
+    /// pendulum periods, lengths and angles measured on the bicycle), not a
+    /// parameter set: it must be processed into one first.
+    #[error("{}:{line}: `{field}` is a raw measurement: this is a bicycleparameters `<Name>Measured.txt` file (pendulum periods, measured lengths and angles), not a parameter set; process it with bicycleparameters into `<Name>Benchmark.txt` and give that", path.display())]
+    RawMeasurementFile { path: PathBuf, line: usize, field: String },
+
     /// The same parameter is given twice in a text file.
     #[error("{}:{line}: parameter `{field}` given twice (first on line {first_line})", path.display())]
     DuplicateField {
@@ -394,6 +400,7 @@ impl ParameterError {
         match self {
             ParameterError::MissingField { field, .. }
             | ParameterError::UnknownField { field, .. }
+            | ParameterError::RawMeasurementFile { field, .. }
             | ParameterError::DuplicateField { field, .. }
             | ParameterError::WrongType { field, .. }
             | ParameterError::NotFinite { field, .. }
@@ -411,6 +418,7 @@ impl ParameterError {
             ParameterError::Toml { line, .. } => *line,
             ParameterError::Syntax { line, .. }
             | ParameterError::UnknownField { line, .. }
+            | ParameterError::RawMeasurementFile { line, .. }
             | ParameterError::DuplicateField { line, .. }
             | ParameterError::WrongType { line, .. }
             | ParameterError::InvalidUncertainty { line, .. }

@@ -179,6 +179,12 @@ impl MeasuredBenchmark {
                     line,
                     meaning,
                 });
+            } else if is_raw_measurement(name) {
+                return Err(ParameterError::RawMeasurementFile {
+                    path: pb(),
+                    line,
+                    field: name.to_string(),
+                });
             } else if !BenchmarkParameters::SYMBOLS.contains(&name) {
                 return Err(ParameterError::UnknownField {
                     path: pb(),
@@ -351,4 +357,24 @@ impl Expr<'_> {
         let token = String::from_utf8_lossy(&self.s[start..self.pos]);
         token.parse::<f64>().map_err(|_| format!("`{token}` is not a number"))
     }
+}
+
+/// Whether `name` is one of the raw measurements of bicycleparameters'
+/// `<Name>Measured.txt` files (and no benchmark symbol): pendulum periods
+/// (`TcB1`, `TtH2`, ...), mass-centre measurements (`aB1`, `alphaH3`),
+/// fork and wheel measurements (`lP`, `nF`, `dR`, `f`, `gamma`, ...).
+fn is_raw_measurement(name: &str) -> bool {
+    const PLAIN: &[&str] = &[
+        "lP", "lF", "lR", "nF", "nR", "dP", "dF", "dR", "f", "gamma", "lamst", "lsp", "lst", "lcs", "hbb", "whb",
+        "LhbF", "LhbR",
+    ];
+    const NUMBERED: &[&str] = &[
+        "d", "h", "aB", "aH", "aS", "aG", "alphaB", "alphaH", "alphaS", "alphaG", "TcB", "TcH", "TcF", "TcR", "TcS",
+        "TcG", "TcD", "TtB", "TtH", "TtF", "TtR", "TtP", "TtS", "TtG", "TtD",
+    ];
+    PLAIN.contains(&name)
+        || NUMBERED.iter().any(|p| {
+            name.strip_prefix(p)
+                .is_some_and(|rest| !rest.is_empty() && rest.chars().all(|c| c.is_ascii_digit()))
+        })
 }

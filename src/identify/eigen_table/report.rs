@@ -44,12 +44,12 @@ pub fn table_summary(o: &TableOutcome) -> String {
 pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyError> {
     use bikedyn_report::output::{save_json, write_string_atomic};
     use std::fmt::Write as _;
-    std::fs::create_dir_all(dir).map_err(|source| IdentifyError::CreateDir {
-        path: dir.to_path_buf(),
-        source,
-    })?;
+    // Written beside `dir` and moved into place at the end (see
+    // `bikedyn_report::output::StagedDir`).
+    let staged = bikedyn_report::output::StagedDir::new(dir, "report.json")?;
+    let out = staged.path();
     save_json(
-        dir.join("report.json"),
+        out.join("report.json"),
         &serde_json::to_value(o).map_err(|e| IdentifyError::EigenTable {
             path: o.table.clone(),
             line: 0,
@@ -93,6 +93,7 @@ pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyEr
             c(o.predicted_after[i])
         );
     }
-    write_string_atomic(dir.join("report.md"), &s)?;
+    write_string_atomic(out.join("report.md"), &s)?;
+    staged.commit()?;
     Ok(())
 }

@@ -1,0 +1,481 @@
+//! Regressions of the reliability audit (issue 20, point 5): each test is
+//! one defect the audit found, driven through the command line as a user
+//! would meet it.
+
+use crate::common::*;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = scratch("reliability").join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    d
+}
+
+/// Run `args` with standard output a pipe whose reading end is closed at
+/// once (as `| head -0` does), and return the exit code and standard error.
+fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    (out.status.code(), text(&out.stderr))
+}
+
+fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
+/// A closed pipe or a full device on standard output used to panic (exit
+/// 101) in most commands: now it is an error (exit 2) that says the output
+/// is incomplete. Outputs larger than a pipe's buffer (64 KiB), so the
+/// write surely fails: a streamed CSV and two aligned tables.
+#[test]
+fn a_failed_write_to_standard_output_is_an_error_not_a_panic() {
+    for args in [
+        &[
+            "eig",
+            "--bike",
+            "benchmark",
+            "--speeds",
+            "0:100:0.001",
+            "--format",
+            "csv",
+        ][..],
+        &["eig", "--bike", "benchmark", "--speeds", "0:20:0.001"][..],
+        &[
+            "sweep",
+            "--bike",
+            "benchmark",
+            "--param",
+            "c",
+            "--values",
+            "0:0.2:0.0001",
+        ][..],
+    ] {
+        let (code, stderr) = with_closed_stdout(args);
+        assert_eq!(code, Some(2), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("broken pipe") && stderr.contains("incomplete"),
+            "{args:?}: {stderr}"
+        );
+    }
+    if Path::new("/dev/full").exists() {
+        let full = std::fs::OpenOptions::new().write(true).open("/dev/full").unwrap();
+        let out = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
+            .args(["models"])
+            .stdout(full)
+            .output()
+            .unwrap();
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(
+            stderr.contains("writing to standard output") && !stderr.contains("panicked"),
+            "{stderr}"
+        );
+    }
+}
+
+/// `synth --out` into a folder with files in it used to overwrite its
+/// calibration and first runs and keep the rest: now it is refused and the
+/// folder left as it was; `--force` replaces the whole content (no run of
+/// the old set survives beside the new ones). A set is written beside the
+/// folder and renamed into place, so a refused or failed run leaves no
+/// partial folder.
+#[test]
+fn synth_refuses_a_folder_with_files_and_replaces_it_whole_when_forced() {
+    let dir = tmp("synth-existing");
+    std::fs::create_dir_all(dir.join("run09")).unwrap();
+    std::fs::write(dir.join("run09/run.toml"), "measured data\n").unwrap();
+    let out_arg = dir.to_str().unwrap();
+    let out = bikedyn(&["synth", "--runs", "1", "--out", out_arg]);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = text(&out.stderr);
+    assert!(
+        stderr.contains("is not empty") && stderr.contains("--force"),
+        "{stderr}"
+    );
+    assert_eq!(entries(&dir), vec!["run09"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("run09/run.toml")).unwrap(),
+        "measured data\n"
+    );
+
+    let out = bikedyn(&["synth", "--runs", "1", "--out", out_arg, "--force"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(entries(&dir), vec!["calibration", "run01", "truth"]);
+    let parent = entries(dir.parent().unwrap());
+    assert!(!parent.iter().any(|n| n.contains(".partial-")), "{parent:?}");
+}
+
+/// `synth | head -1` used to leave a half-written set: the set is now
+/// complete before the first line is printed, so a closed pipe costs only
+/// the console lines.
+#[test]
+fn synth_into_a_closed_pipe_still_writes_the_whole_set() {
+    let dir = tmp("synth-closed-pipe");
+    let (code, stderr) = with_closed_stdout(&["synth", "--runs", "2", "--out", dir.to_str().unwrap()]);
+    assert_eq!(code, Some(2), "{stderr}");
+    assert_eq!(entries(&dir), vec!["calibration", "run01", "run02", "truth"]);
+    assert!(!entries(&dir.join("truth")).is_empty());
+}
+
+/// A synthetic set of `runs` runs of the thesis bicycle in a fresh folder.
+fn synth_set(name: &str, runs: usize) -> PathBuf {
+    let dir = tmp(name);
+    let out = bikedyn(&[
+        "synth",
+        "--runs",
+        &runs.to_string(),
+        "--seed",
+        "5",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "synth: {}", text(&out.stderr));
+    dir
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+}
+
+/// `identify R R R` used to report three kicks from one run and
+/// cross-validate on copies of the training run; a copy of a run (even one
+/// marked as a calibration) was counted as data. Both are refused, naming
+/// the two paths.
+#[test]
+fn the_same_run_given_twice_is_refused() {
+    let set = synth_set("duplicates", 2);
+    let run = set.join("run01");
+    let r = run.to_str().unwrap();
+    for cmd in ["fit", "identify"] {
+        let out = bikedyn(&[cmd, r, r, r]);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{cmd}: {stderr}");
+        assert!(
+            stderr.contains("are the same run") && stderr.contains("run01"),
+            "{cmd}: {stderr}"
+        );
+    }
+    // A copy inside the set, under another name: the same data files.
+    copy_dir(&run, &set.join("run03"));
+    let out = bikedyn(&["fit", set.to_str().unwrap()]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("a copy") && stderr.contains("run03"), "{stderr}");
+    // The copy marked as a calibration, given as the calibration.
+    let cal = set.join("run03");
+    let toml = std::fs::read_to_string(cal.join("run.toml")).unwrap();
+    std::fs::write(
+        cal.join("run.toml"),
+        toml.replace("kind = \"run\"", "kind = \"calibration\""),
+    )
+    .unwrap();
+    let out = bikedyn(&["fit", r, "--calibration", cal.to_str().unwrap()]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("calibration is a copy of a run"), "{stderr}");
+}
+
+/// A calibration run given alone used to vanish from the counts: it is
+/// listed as skipped with the reason, and the exit status says so.
+#[test]
+fn a_calibration_given_as_data_is_listed_as_skipped() {
+    let set = synth_set("calibration-as-data", 1);
+    let out = bikedyn(&[
+        "fit",
+        set.join("calibration").to_str().unwrap(),
+        set.join("run01").to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    // Given with the run it calibrates: used, nothing skipped.
+    assert!(out.status.success(), "{stderr}");
+    let other = synth_set("calibration-alone", 1);
+    let out = bikedyn(&[
+        "fit",
+        other.join("calibration").to_str().unwrap(),
+        set.join("run01").to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("skipped: ") && stderr.contains("a calibration run"),
+        "{stderr}"
+    );
+}
+
+/// A run whose speed sensor recorded nothing used to be a success with a
+/// mean speed of -0.0: now the kick is fitted, its prediction is skipped
+/// with the reason, and the exit status is 1.
+#[test]
+fn a_run_without_a_speed_record_says_so() {
+    let set = synth_set("no-speed", 1);
+    let speed = set.join("run01/speed_switch.csv");
+    let flat: String = std::fs::read_to_string(&speed)
+        .unwrap()
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i == 0 {
+                format!("{l}\n")
+            } else {
+                format!("{},0.000\n", l.split(',').next().unwrap())
+            }
+        })
+        .collect();
+    std::fs::write(&speed, flat).unwrap();
+    let out = bikedyn(&["fit", set.to_str().unwrap(), "--bike", "thesis", "--json"]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no usable speed record"), "{stderr}");
+    let kicks = stdout_json(&out);
+    for k in kicks.as_array().unwrap() {
+        assert!(k["mean_speed"].is_null() && k["predicted_weave"].is_null(), "{k}");
+        assert!(
+            k["no_prediction"].as_str().unwrap().contains("no usable speed record"),
+            "{k}"
+        );
+    }
+}
+
+/// `params convert` used to drop the effect parameters (a fitted.toml lost
+/// `CdA` and `c_steer`): they follow the converted table, and the converted
+/// file loads back with the same values.
+#[test]
+fn params_convert_keeps_effect_parameters() {
+    let dir = tmp("convert");
+    std::fs::create_dir_all(&dir).unwrap();
+    let src = dir.join("damped.toml");
+    let benchmark = include_str!("../../runtime/data/benchmark_bicycle.toml");
+    std::fs::write(&src, format!("{benchmark}\nc_steer = 0.25\nCdA = 0.4\n")).unwrap();
+    for form in ["thesis", "benchmark"] {
+        let converted = dir.join(format!("to-{form}.toml"));
+        let out = bikedyn(&[
+            "params",
+            "convert",
+            "--to",
+            form,
+            src.to_str().unwrap(),
+            "--output",
+            converted.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let text_out = std::fs::read_to_string(&converted).unwrap();
+        assert!(
+            text_out.contains("c_steer = 2.5e-1") && text_out.contains("CdA = 4e-1"),
+            "{text_out}"
+        );
+        let out = bikedyn(&["params", "show", converted.to_str().unwrap()]);
+        let shown = text(&out.stdout);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert!(shown.contains("c_steer") && shown.contains("CdA"), "{shown}");
+    }
+}
+
+/// `--effects` with an unknown symbol used to list 52 geometry symbols and
+/// not `c_steer`; a repeated symbol silently took its last value.
+#[test]
+fn effect_symbols_are_listed_suggested_and_given_once() {
+    let dir = tmp("effects-args");
+    let out = bikedyn(&[
+        "synth",
+        "--runs",
+        "1",
+        "--effects",
+        "c_stear=0.1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("did you mean `c_steer`?"), "{stderr}");
+    assert!(
+        stderr.contains("effect parameters are ") && stderr.contains("CdA"),
+        "{stderr}"
+    );
+    let out = bikedyn(&[
+        "synth",
+        "--runs",
+        "1",
+        "--effects",
+        "c_steer=0.1,c_steer=0.3",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("`c_steer` is given twice (0.1 and 0.3)"), "{stderr}");
+    assert!(!dir.exists());
+}
+
+/// `verify --states 0` used to report "verification passed" having checked
+/// nothing, and `--states` and `--folds` took any count (folds silently
+/// clamped): the counts are bounded with the range in the message.
+#[test]
+fn counts_on_the_command_line_are_bounded() {
+    for args in [
+        &["verify", "--states", "0"][..],
+        &["verify", "--states", "100001"][..],
+        &["identify", "x", "--folds", "1"][..],
+        &["identify", "x", "--folds", "0"][..],
+    ] {
+        let out = bikedyn(args);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("not in 1..=100000") || stderr.contains("not in 2..=1000"),
+            "{args:?}: {stderr}"
+        );
+    }
+}
+
+/// A raw bicycleparameters measurement file (`<Name>Measured.txt`) is
+/// recognised and the message says what it is and what to do with it.
+#[test]
+fn a_raw_measurement_file_is_recognised() {
+    let dir = tmp("measured");
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("CrescendoMeasured.txt");
+    std::fs::write(
+        &p,
+        "lF = 0.301+/-0.001\nlP = 1.05+/-0.001\nnF = 13\nTcB1 = 1.16+/-0.01\n",
+    )
+    .unwrap();
+    let out = bikedyn(&["canonical", "--bike", p.to_str().unwrap()]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("CrescendoMeasured.txt:1")
+            && stderr.contains("raw measurement")
+            && stderr.contains("Benchmark.txt"),
+        "{stderr}"
+    );
+}
+
+/// Uncertainties (`+/-`) of a parameter file are kept and shown by
+/// `params show`, not dropped silently.
+#[test]
+fn params_show_shows_the_uncertainties() {
+    let out = bikedyn(&["params", "show", &fixture_arg("Balanceassistv1Benchmark.txt")]);
+    let shown = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(shown.contains("standard deviations the file gives"), "{shown}");
+    assert!(
+        shown.lines().any(|l| l.starts_with("#   w ") && l.contains("+/- ")),
+        "{shown}"
+    );
+}
+
+/// Negative numbers after a flag are values (`--speed -5`), ranges may
+/// start below zero, and a kick in the wrong format shows the right one.
+#[test]
+fn negative_values_and_kick_formats() {
+    let out = bikedyn(&["eig", "--bike", "benchmark", "--speeds", "-1:1:1", "--format", "csv"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(
+        text(&out.stdout).lines().filter(|l| l.starts_with("-1")).count(),
+        1,
+        "{}",
+        text(&out.stdout)
+    );
+    let out = bikedyn(&["simulate", "--speed", "-5", "--duration", "0.1"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let out = bikedyn(&["simulate", "--speed", "5", "--duration", "1", "--kick", "1,3"]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("TIME:IMPULSE") && stderr.contains("1.0:3"), "{stderr}");
+}
+
+/// `identify --report` into a folder that cannot take a report fails before
+/// any computation; an earlier report is replaced whole (a failed run
+/// would leave it as it was: the new one is written beside it and moved
+/// into place), so no old file stays beside the new ones.
+#[test]
+fn an_identify_report_is_checked_first_and_replaced_whole() {
+    let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping");
+    let foreign = tmp("report-foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("thesis.tex"), "a user's file\n").unwrap();
+    let out = bikedyn(&["identify", set.to_str().unwrap(), "--report", foreign.to_str().unwrap()]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("no report.json of an earlier run") && !stderr.contains("progress:"),
+        "{stderr}"
+    );
+    assert_eq!(entries(&foreign), vec!["thesis.tex"]);
+    let under_file = foreign.join("thesis.tex").join("report");
+    let out = bikedyn(&[
+        "identify",
+        set.to_str().unwrap(),
+        "--report",
+        under_file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!text(&out.stderr).contains("progress:"), "{}", text(&out.stderr));
+
+    let earlier = tmp("report-earlier");
+    std::fs::create_dir_all(&earlier).unwrap();
+    std::fs::write(earlier.join("report.json"), "{}\n").unwrap();
+    std::fs::write(earlier.join("stale_plot.svg"), "<svg/>\n").unwrap();
+    let out = bikedyn(&["identify", set.to_str().unwrap(), "--report", earlier.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let files = entries(&earlier);
+    assert!(
+        files.contains(&"report.md".to_string()) && !files.contains(&"stale_plot.svg".to_string()),
+        "{files:?}"
+    );
+    let parent = entries(earlier.parent().unwrap());
+    assert!(
+        !parent.iter().any(|n| n.contains(".partial-") || n.ends_with(".old")),
+        "{parent:?}"
+    );
+}
+
+/// A two-parameter `sweep` streams its CSV a row at a time (a 1001 x 401
+/// grid used to print nothing for 40 s): the streamed table is the one
+/// the whole map gives (computed whole when a plot is asked for too).
+#[test]
+fn a_stability_map_streams_the_same_csv() {
+    let args = [
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0:0.12:0.02",
+        "--param2",
+        "lam",
+        "--values2",
+        "0.2:0.5:0.1",
+        "--format",
+        "csv",
+    ];
+    let streamed = bikedyn(&args);
+    assert!(streamed.status.success(), "{}", text(&streamed.stderr));
+    let plot = tmp("map-plot").with_extension("svg");
+    let mut whole_args = args.to_vec();
+    whole_args.extend(["--plot", plot.to_str().unwrap()]);
+    let whole = bikedyn(&whole_args);
+    assert!(whole.status.success(), "{}", text(&whole.stderr));
+    let s = text(&streamed.stdout);
+    assert_eq!(s, text(&whole.stdout));
+    assert_eq!(s.lines().count(), 1 + 7 * 4, "{s}");
+    assert!(s.lines().last().unwrap().starts_with("0.12,0.5,6,3,"), "{s}");
+}
