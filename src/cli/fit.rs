@@ -42,9 +42,7 @@ pub fn run(args: &FitArgs) -> Result<bool> {
         for n in &r.notes {
             eprintln!("{}: {n}", r.run.display());
         }
-        for g in &r.gaps {
-            eprintln!("{g}");
-        }
+        show_gaps(&r.gaps);
         if r.renormalised.iter().any(|&n| n > 0) {
             eprintln!(
                 "{}: normalised {} frame and {} handlebar quaternions",
@@ -80,4 +78,32 @@ pub fn run(args: &FitArgs) -> Result<bool> {
         plots(&out, dir)?;
     }
     Ok(out.errors.is_empty())
+}
+
+/// The gaps of a run, a few per file: a wrong nominal rate in run.toml
+/// makes every sample a "gap" (1,213 lines for one run), which says less
+/// than one line with the likely cause.
+fn show_gaps(gaps: &[String]) {
+    const SHOWN: usize = 3;
+    let mut files: Vec<(&str, Vec<&String>)> = Vec::new();
+    for g in gaps {
+        // "FILE:LINE: gap ..."; a path may hold colons, the line may not.
+        let file = g.rsplitn(3, ':').nth(2).unwrap_or(g);
+        match files.iter_mut().find(|(f, _)| *f == file) {
+            Some((_, list)) => list.push(g),
+            None => files.push((file, vec![g])),
+        }
+    }
+    for (file, list) in files {
+        for g in list.iter().take(SHOWN) {
+            eprintln!("{g}");
+        }
+        if list.len() > SHOWN {
+            eprintln!(
+                "{file}: {} more gaps ({} in all); if the sensor recorded without interruption, the nominal rate in run.toml ([imu] or [speed_switch] rate_hz) does not match its time stamps",
+                list.len() - SHOWN,
+                list.len()
+            );
+        }
+    }
 }

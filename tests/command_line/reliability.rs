@@ -479,3 +479,20 @@ fn a_stability_map_streams_the_same_csv() {
     assert_eq!(s.lines().count(), 1 + 7 * 4, "{s}");
     assert!(s.lines().last().unwrap().starts_with("0.12,0.5,6,3,"), "{s}");
 }
+
+/// A wrong nominal IMU rate in run.toml made every sample a gap, one line
+/// each (1,213 lines): a few are shown per file, then one line with the
+/// count and the likely cause.
+#[test]
+fn a_wrong_imu_rate_gives_a_few_gap_lines_and_the_cause() {
+    let set = synth_set("wrong-rate", 1);
+    let toml_path = set.join("run01/run.toml");
+    let toml = std::fs::read_to_string(&toml_path).unwrap();
+    assert!(toml.contains("rate_hz = 120"), "{toml}");
+    std::fs::write(&toml_path, toml.replacen("rate_hz = 120", "rate_hz = 400", 1)).unwrap();
+    let out = bikedyn(&["fit", set.join("run01").to_str().unwrap()]);
+    let stderr = text(&out.stderr);
+    let gap_lines = stderr.lines().filter(|l| l.contains(": gap ")).count();
+    assert!(gap_lines <= 6, "{gap_lines} gap lines: {stderr}");
+    assert!(stderr.contains("more gaps") && stderr.contains("rate_hz"), "{stderr}");
+}
