@@ -1144,3 +1144,22 @@ pub fn format_matrix_entries(entries: &[f64], digits: usize) -> Vec<String> {
     let decimals = (digits as i32 - 1 - e).max(0) as usize;
     entries.iter().map(|&x| format_fixed(x, decimals, false)).collect()
 }
+
+/// The stability of a bicycle as JSON (`bikedyn stability --json`, the
+/// Python package's `Bicycle.stability()`): weave, capsize and real-pair
+/// merge speeds (m/s), the self-stable intervals and every crossing of a
+/// mode's real part through zero, with its frequency (rad/s).
+pub fn stability_json(name: &str, c: &bikedyn_runtime::eigen::CriticalSpeeds) -> serde_json::Value {
+    serde_json::json!({
+        "bike": name,
+        "weave_speed": c.weave_speed,
+        "capsize_speed": c.capsize_speed,
+        "weave_real_pair_merge_speed": c.weave_real_pair_merge,
+        "stable_intervals": c.stable_intervals,
+        "crossings": c.crossings.iter().map(|x| serde_json::json!({
+            "speed": x.speed, "mode": x.mode.name(), "direction": format!("{:?}", x.direction).to_lowercase(),
+            "kind": match x.kind { bikedyn_runtime::eigen::CrossingKind::RealRoot => "real_root", bikedyn_runtime::eigen::CrossingKind::ComplexPair => "complex_pair" },
+            "frequency": x.frequency
+        })).collect::<Vec<_>>(),
+    })
+}

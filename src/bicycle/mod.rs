@@ -99,6 +99,11 @@ impl Bicycle {
     pub fn resolve(spec: &str) -> Result<Bicycle, BicycleError> {
         Self::resolve_in(spec)
     }
+
+    /// [`Bicycle::from_values_in`] against the built-in models.
+    pub fn from_values(name: &str, values: &[(String, f64, Option<f64>)]) -> Result<Bicycle, BicycleError> {
+        Self::from_values_in(name, values)
+    }
 }
 
 impl<R: ModelRegistry> Bicycle<R> {
@@ -152,6 +157,82 @@ impl<R: ModelRegistry> Bicycle<R> {
             warnings,
             effects: BTreeMap::new(),
             uncertainties: BTreeMap::new(),
+            registry: PhantomData,
+        })
+    }
+
+    /// A bicycle from named values, as a notebook holds them (a Python
+    /// dict): every benchmark symbol (Meijaard et al. 2007, Table 1; the
+    /// parameter dict of bicycleparameters' `Meijaard2007ParameterSet`) or
+    /// every thesis symbol, in SI units, plus any effect parameters of
+    /// `R`'s models. A value may carry its standard deviation (kept as a
+    /// file's `+/-` is). `v` (the nominal speed some sets carry) is not a
+    /// bicycle parameter and is ignored: speeds are given to each analysis.
+    /// `name` names the bicycle in messages; errors name the key.
+    pub fn from_values_in(name: &str, values: &[(String, f64, Option<f64>)]) -> Result<Bicycle<R>, BicycleError> {
+        let effect_names: Vec<&str> = effect_parameters_in::<R>().iter().map(|p| p.name).collect();
+        let bad = |key: &str, why: String| BicycleError::EffectParameter {
+            file: name.to_string(),
+            why: format!("`{key}`: {why}"),
+        };
+        let mut effects = BTreeMap::new();
+        let mut uncertainties = BTreeMap::new();
+        let mut geometry: Vec<(&str, f64)> = Vec::new();
+        for (key, value, sd) in values {
+            let key = key.as_str();
+            if !value.is_finite() {
+                return Err(bad(key, format!("{value} is not a finite number")));
+            }
+            if let Some(sd) = sd {
+                if !(sd.is_finite() && *sd >= 0.0) {
+                    return Err(bad(
+                        key,
+                        format!("standard deviation {sd} is not a finite, non-negative number"),
+                    ));
+                }
+            }
+            if key == "v" {
+                continue;
+            }
+            if effect_names.contains(&key) {
+                check_effect_value_in::<R>(key, *value, name)?;
+                effects.insert(key.to_string(), *value);
+            } else if ThesisParameters::SYMBOLS.contains(&key) || BenchmarkParameters::SYMBOLS.contains(&key) {
+                geometry.push((key, *value));
+            } else {
+                return Err(unknown_parameter::<R>(key));
+            }
+            if let Some(sd) = sd {
+                uncertainties.insert(key.to_string(), *sd);
+            }
+        }
+        // The form is the one whose symbols are given: a thesis-only symbol
+        // makes it the thesis form (the two share `g` and a few names).
+        let thesis = geometry
+            .iter()
+            .any(|(k, _)| ThesisParameters::SYMBOLS.contains(k) && !BenchmarkParameters::SYMBOLS.contains(k));
+        let mut text = format!("form = \"{}\"\n", if thesis { "thesis" } else { "benchmark" });
+        for (k, v) in &geometry {
+            text.push_str(&format!("{k} = {v:?}\n"));
+        }
+        let (parameters, _, warnings) = ParameterSet::from_toml_str_with_extra(&text, name, &[])?;
+        if !ALLOW_IMPLAUSIBLE_UNITS.load(std::sync::atomic::Ordering::Relaxed) {
+            if let Some(w) = warnings
+                .iter()
+                .find(|w| matches!(w, ParameterWarning::LooksLikeMillimetres { .. }))
+            {
+                return Err(BicycleError::LooksLikeMillimetres {
+                    file: name.to_string(),
+                    warning: w.to_string(),
+                });
+            }
+        }
+        Ok(Bicycle {
+            name: name.to_string(),
+            parameters,
+            warnings,
+            effects,
+            uncertainties,
             registry: PhantomData,
         })
     }

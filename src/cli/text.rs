@@ -8,20 +8,7 @@ use bikedyn::report::output;
 use bikedyn::runtime::eigen::{CriticalSpeeds, CrossingDirection, CrossingKind};
 use bikedyn::runtime::CanonicalMatrices;
 
-pub fn stability_json(name: &str, c: &CriticalSpeeds) -> serde_json::Value {
-    serde_json::json!({
-        "bike": name,
-        "weave_speed": c.weave_speed,
-        "capsize_speed": c.capsize_speed,
-        "weave_real_pair_merge_speed": c.weave_real_pair_merge,
-        "stable_intervals": c.stable_intervals,
-        "crossings": c.crossings.iter().map(|x| serde_json::json!({
-            "speed": x.speed, "mode": x.mode.name(), "direction": format!("{:?}", x.direction).to_lowercase(),
-            "kind": match x.kind { CrossingKind::RealRoot => "real_root", CrossingKind::ComplexPair => "complex_pair" },
-            "frequency": x.frequency
-        })).collect::<Vec<_>>(),
-    })
-}
+pub use bikedyn::report::output::stability_json;
 
 pub fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
     let f = |x: Option<f64>| {

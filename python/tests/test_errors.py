@@ -1,0 +1,72 @@
+"""Bad input raises a Python exception with the command line's message
+(file, line, field); nothing reaches Python as a Rust panic."""
+
+import math
+
+import numpy as np
+import pytest
+
+import bikedyn
+from conftest import meijaard2007
+
+
+def test_missing_file_is_file_not_found():
+    with pytest.raises(FileNotFoundError, match="no-such-bike.toml"):
+        bikedyn.Bicycle("no-such-bike.toml")
+    with pytest.raises(bikedyn.Error):
+        bikedyn.Bicycle("no-such-bike.toml")
+
+
+def test_bad_parameter_file_names_file_line_and_field(tmp_path):
+    text = bikedyn.Bicycle("benchmark").to_toml().replace("mB = 85", "mB = -85")
+    assert "mB = -85" in text
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    with pytest.raises(ValueError) as e:
+        bikedyn.Bicycle(str(p))
+    assert isinstance(e.value, bikedyn.ParameterError)
+    msg = str(e.value)
+    assert "bad.toml" in msg and "mB" in msg
+
+
+def test_dict_errors_name_the_key():
+    par = dict(meijaard2007()["parameters"])
+    del par["IHxz"]
+    with pytest.raises(bikedyn.ParameterError, match="IHxz"):
+        bikedyn.Bicycle(par)
+    par = dict(meijaard2007()["parameters"], w=math.nan)
+    with pytest.raises(ValueError, match="`w`"):
+        bikedyn.Bicycle(par)
+    par = dict(meijaard2007()["parameters"], trail=0.08)
+    with pytest.raises(ValueError, match="trail"):
+        bikedyn.Bicycle(par)
+    par = dict(meijaard2007()["parameters"], c="eight")
+    with pytest.raises(ValueError, match="`c`"):
+        bikedyn.Bicycle(par)
+
+
+def test_bad_arguments():
+    b = bikedyn.Bicycle("benchmark")
+    with pytest.raises(ValueError, match=r"speeds\[1\]"):
+        b.eig([1.0, float("nan")])
+    with pytest.raises(ValueError, match="no speeds"):
+        b.eig([])
+    with pytest.raises(bikedyn.InvalidArgumentError):
+        b.eig(np.zeros((2, 2)))
+    with pytest.raises(bikedyn.ModelError, match="unknown model"):
+        bikedyn.Bicycle("benchmark", model="no_such_model")
+    with pytest.raises(bikedyn.ParameterError, match="did you mean `c_steer`"):
+        b.with_parameter("c_stear", 0.1)
+    with pytest.raises(ValueError, match="c_steer"):
+        bikedyn.Bicycle("thesis").with_parameter("c_steer", -1.0)
+    with pytest.raises(ValueError, match="speed range"):
+        b.stability(speed_max=-1)
+    with pytest.raises(bikedyn.InvalidArgumentError, match="method"):
+        bikedyn.simulate(b, duration=0.1, method="euler-forward-please")
+    with pytest.raises(FileNotFoundError, match="nowhere"):
+        bikedyn.fit(["nowhere"])
+
+
+def test_sweep_errors_name_the_design():
+    with pytest.raises(bikedyn.ParameterError, match="mB = -1"):
+        bikedyn.sweep("benchmark", "mB", [85.0, -1.0], [5.0])

@@ -1,0 +1,130 @@
+"""Linear analysis from Python against the published benchmark
+(Meijaard et al. 2007, Proc. R. Soc. A 463:1955-1982, Tables 1-2 and
+section 5.3), and invariants that tie the arrays together."""
+
+import numpy as np
+import pytest
+
+import bikedyn
+from conftest import meijaard2007
+
+
+def test_canonical_matrices_match_the_paper():
+    ref = meijaard2007()["canonical"]
+    c = bikedyn.Bicycle("benchmark").canonical()
+    for name, key in [("M0", "M"), ("C1", "C1"), ("K0", "K0"), ("K2", "K2")]:
+        want = np.array(ref[key])
+        scale = np.abs(want).max()
+        assert np.allclose(c[name], want, rtol=1e-12, atol=1e-12 * scale), (name, c[name], want)
+    assert isinstance(c["model"], str)
+
+
+def test_stability_gives_the_published_speeds():
+    ref = meijaard2007()["critical_speeds"]
+    s = bikedyn.Bicycle("benchmark").stability(speed_max=10)
+    assert abs(s["weave_speed"] - ref["weave_speed"]) < 1e-10
+    assert abs(s["capsize_speed"] - ref["capsize_speed"]) < 1e-10
+    assert abs(s["weave_real_pair_merge_speed"] - ref["weave_real_pair_merge"]) < 1e-8
+    assert s["stable_intervals"][0][0] == pytest.approx(ref["weave_speed"], abs=1e-10)
+    assert {c["mode"] for c in s["crossings"]} >= {"weave", "capsize"}
+    # Out of range: None, as the command line's JSON has null.
+    assert bikedyn.Bicycle("benchmark").stability(speed_max=3)["weave_speed"] is None
+
+
+def test_eig_gives_table2_and_labels_the_modes():
+    ref = meijaard2007()
+    rows = [r for r in ref["eigenvalues"] if "weave" in r]
+    speeds = np.array([r["v"] for r in rows])
+    e = bikedyn.Bicycle("benchmark").eig(speeds)
+    assert e.eigenvalues.shape == (len(speeds), 4) and e.eigenvalues.dtype == complex
+    assert e.modes.shape == (len(speeds), 4)
+    assert e.eigenvectors.shape == (len(speeds), 4, 4)
+    weave = e.mode("weave")
+    for i, r in enumerate(rows):
+        re, im = r["weave"]
+        assert abs(weave[i] - complex(re, im)) < 1e-10, (r["v"], weave[i])
+        cap = e.eigenvalues[i, e.modes[i] == "capsize"]
+        assert abs(cap[0].real - r["capsize"]) < 1e-10
+
+
+def test_eigenvectors_are_right_eigenvectors_of_the_state_matrix():
+    bike = bikedyn.Bicycle("benchmark")
+    speeds = np.linspace(0.5, 9.5, 7)
+    A, B = bike.state_space(speeds)
+    assert A.shape == (7, 4, 4) and B.shape == (7, 4, 2)
+    e = bike.eig(speeds)
+    for i in range(len(speeds)):
+        for j in range(4):
+            v = e.eigenvectors[i, :, j]
+            lam = e.eigenvalues[i, j]
+            assert np.linalg.norm(A[i] @ v - lam * v) < 1e-8 * max(1, abs(lam)) * np.linalg.norm(v)
+        # The eigenvalues of A are those of eig.
+        assert np.allclose(np.sort_complex(np.linalg.eigvals(A[i])), np.sort_complex(e.eigenvalues[i]), atol=1e-9)
+    # B is [0; M0^-1] (inputs roll and steer torque).
+    m0 = bike.canonical()["M0"]
+    assert np.allclose(B[0, 2:], np.linalg.inv(m0), rtol=1e-12)
+    assert np.all(B[:, :2] == 0)
+
+
+def test_a_dict_bicycle_is_the_file_bicycle():
+    # The dict of bicycleparameters' Meijaard2007ParameterSet: Table 1
+    # symbols plus the speed v, which is no bicycle parameter.
+    par = dict(meijaard2007()["parameters"])
+    par["v"] = 5.0
+    a = bikedyn.Bicycle(par, name="Meijaard2007ParameterSet")
+    b = bikedyn.Bicycle("benchmark")
+    v = np.linspace(0, 10, 41)
+    assert np.array_equal(a.eig(v).eigenvalues, b.eig(v).eigenvalues)
+    assert a.form == "benchmark" and a.parameters["mB"] == 85.0
+    # Thesis symbols make a thesis-form bicycle with the same dynamics.
+    t = bikedyn.Bicycle("thesis")
+    t2 = bikedyn.Bicycle(t.parameters, name="thesis dict")
+    assert t2.form == "thesis"
+    assert np.array_equal(t.eig(v).eigenvalues, t2.eig(v).eigenvalues)
+
+
+def test_uncertainties_of_ufloats_are_kept():
+    class UFloat:  # what `uncertainties.ufloat` offers
+        def __init__(self, n, s):
+            self.nominal_value, self.std_dev = n, s
+
+    par = dict(meijaard2007()["parameters"])
+    par["c"] = UFloat(0.08, 0.002)
+    b = bikedyn.Bicycle(par)
+    assert b.uncertainties == {"c": 0.002}
+    assert b.value("c") == 0.08
+
+
+def test_effects_and_models():
+    names = [m["name"] for m in bikedyn.models()]
+    assert len(names) >= 3
+    bike = bikedyn.Bicycle("thesis").with_parameter("c_steer", 0.3)
+    assert bike.model != bikedyn.Bicycle("thesis").model
+    # Steer damping stabilises the weave at a lower speed (Sharp 2008;
+    # it is the premise of the damping tests of the Rust suite).
+    assert bike.stability()["weave_speed"] != bikedyn.Bicycle("thesis").stability()["weave_speed"]
+    with pytest.raises(bikedyn.ModelError, match="canonical"):
+        bike.canonical()
+    # Without a canonical form, eig and state_space still work.
+    e = bike.eig([3.0, 5.0])
+    A, B = bike.state_space([3.0, 5.0])
+    for i in range(2):
+        assert np.allclose(np.sort_complex(np.linalg.eigvals(A[i])), np.sort_complex(e.eigenvalues[i]), atol=1e-8)
+
+
+def test_geometry_names_the_benchmark_trail():
+    g = bikedyn.Bicycle("benchmark").geometry()
+    assert g["c"] == pytest.approx(0.08, abs=1e-12)
+    assert g["w"] == pytest.approx(1.02, abs=1e-12)
+    assert "mT" in g
+
+
+def test_the_fast_eigenvalues_are_eigs_sorted():
+    for bike in [bikedyn.Bicycle("benchmark"), bikedyn.Bicycle("thesis").with_parameter("c_steer", 0.2)]:
+        v = np.linspace(-2.0, 12.0, 3001)
+        fast = bike.eigenvalues(v)
+        full = bike.eig(v).eigenvalues
+        assert fast.shape == full.shape
+        for i in range(len(v)):
+            assert np.allclose(np.sort_complex(fast[i]), np.sort_complex(full[i]), atol=1e-9)
+            assert np.all(np.diff(fast[i].real) <= 0)
