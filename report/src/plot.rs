@@ -215,6 +215,22 @@ impl Default for PlotOptions {
     }
 }
 
+/// The subject of a figure (see [`PlotOptions::subject`]): the bicycle (a
+/// built-in name, or a parameter file by its name without directory and
+/// extension) and the model, e.g. "bicycle benchmark, model whipple_offset".
+pub fn subject(bike: &str, model: Option<&str>) -> String {
+    let p = Path::new(bike);
+    let name = if bike.contains(std::path::MAIN_SEPARATOR) || p.extension().is_some() {
+        p.file_stem().map_or(bike.into(), |s| s.to_string_lossy().into_owned())
+    } else {
+        bike.to_string()
+    };
+    match model {
+        Some(m) => format!("bicycle {name}, model {m}"),
+        None => format!("bicycle {name}"),
+    }
+}
+
 impl PlotOptions {
     /// Check the options (size, scale, font size, ranges) for a plot to `path`.
     pub fn check(&self, path: &Path) -> Result<(), PlotError> {
