@@ -459,9 +459,12 @@ pub fn kicks_table(out: &FitOutcome) -> String {
 }
 
 /// Response plots (one per kick) and, with a bicycle, the continuation
-/// diagram with the measured eigenvalues, in `dir` (created).
-pub fn plots(out: &FitOutcome, dir: &Path) -> Result<(), FitError> {
+/// diagram with the measured eigenvalues, in `dir` (created), each as SVG
+/// and PNG. The axis limits of `opts` apply to the continuation diagram
+/// only; its subject gets the model's name there.
+pub fn plots(out: &FitOutcome, dir: &Path, opts: &bikedyn_report::plot::PlotOptions) -> Result<(), FitError> {
     use bikedyn_report::experiment::plot as xplot;
+    use bikedyn_report::plot::PlotOptions;
     std::fs::create_dir_all(dir).map_err(|source| FitError::CreateDir {
         path: dir.to_path_buf(),
         source,
@@ -472,14 +475,27 @@ pub fn plots(out: &FitOutcome, dir: &Path) -> Result<(), FitError> {
             .file_stem()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_else(|| "run".into());
+        let response = PlotOptions {
+            x_range: None,
+            y_range: None,
+            ..opts.clone()
+        };
         for (i, k) in r.kicks.iter().enumerate() {
-            let path = dir.join(format!("{stem}_kick{:02}.svg", i + 1));
-            xplot::plot_response(&path, k)?;
+            for ext in ["svg", "png"] {
+                let path = dir.join(format!("{stem}_kick{:02}.{ext}", i + 1));
+                xplot::plot_response(&path, k, &response)?;
+            }
         }
     }
     let kicks: Vec<&KickFit> = out.reports.iter().flat_map(|r| r.kicks.iter()).collect();
     if let Some(c) = &out.linear {
-        xplot::plot_measured_continuation(&dir.join("continuation_measured.svg"), c, &kicks)?;
+        let o = PlotOptions {
+            subject: opts.subject.as_ref().map(|s| format!("{s}, model {}", c.model)),
+            ..opts.clone()
+        };
+        for ext in ["svg", "png"] {
+            xplot::plot_measured_continuation(&dir.join(format!("continuation_measured.{ext}")), c, &kicks, &o)?;
+        }
     }
     Ok(())
 }

@@ -1,9 +1,21 @@
 //! Publication plots with plotters: the eigenvalue continuation diagram
-//! (Meijaard et al. 2007, Fig. 3) and two-parameter stability maps.
+//! (Meijaard et al. 2007, Fig. 3), the root locus and mode shapes
+//! ([`locus`]), two-parameter stability maps and one-parameter sweeps
+//! ([`sweep`]).
 //!
 //! The format follows the file extension: `.svg` (vector, for papers) or
-//! `.png` (raster); anything else is [`PlotError::UnsupportedFormat`]. Files
-//! are written atomically (see [`crate::output`]).
+//! `.png` (raster, antialiased, with its resolution recorded); anything
+//! else is [`PlotError::UnsupportedFormat`]. Files are written atomically
+//! (see [`crate::output`]). Every figure of the crate (these, the
+//! simulation, fit and identification plots) shares one style
+//! ([`style`]) and one drawing surface (`canvas`), and takes the same
+//! [`PlotOptions`]: size, resolution, title, axis limits, legend.
+//!
+//! # Size and resolution
+//! `width x height` are pixels at `scale = 1`, which is 100 dpi: the default
+//! 800 x 600 is an 8 x 6 inch figure. `scale` multiplies pixels, fonts and
+//! lines alike, so `scale = 3` is the same figure at 300 dpi (what the PNG
+//! records in its `pHYs` chunk).
 //!
 //! # Fonts
 //! plotters is built with its pure-Rust `ab_glyph` text engine, which needs a
@@ -21,16 +33,21 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use plotters::coord::Shift;
-use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
-use crate::output::{write_atomic_via_path, write_string_atomic, OutputError};
+use crate::output::{write_atomic, write_string_atomic, OutputError};
 use bikedyn_runtime::eigen::{CriticalSpeeds, EigenSweep, Mode};
 use bikedyn_runtime::sweep::{MapQuantity, StabilityMap};
+use canvas::Canvas;
+use style::{Area, Frame, Icon, Legend, Stroke};
 
 /// Font family name under which the font is registered and used.
 const FAMILY: &str = "sans-serif";
+
+mod canvas;
+pub mod locus;
+pub(crate) mod style;
+pub mod sweep;
 
 /// Environment variable naming a TTF/OTF font file for plot text.
 pub const FONT_ENV: &str = "BIKEDYN_FONT";
@@ -118,8 +135,8 @@ impl ImageFormat {
 /// Where the legend goes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
 pub enum LegendPosition {
-    /// The plot-area corner that covers the fewest curve points (ties: lower
-    /// left, lower right, upper left, upper right).
+    /// A corner (or the middle of the top or bottom edge) of the plot area
+    /// that covers no data, else right of the plot area.
     #[default]
     Auto,
     /// Upper left corner of the plot area.
@@ -130,12 +147,15 @@ pub enum LegendPosition {
     LowerLeft,
     /// Lower right corner.
     LowerRight,
+    /// Right of the plot area.
+    Outside,
     /// No legend.
     Hidden,
 }
 
-/// Plot options. `PlotOptions::default()` gives an 800x600 figure with
-/// automatic ranges, no title, 18 px text and an automatically placed legend.
+/// Plot options. `PlotOptions::default()` gives an 800x600 figure (8 x 6
+/// inches at 100 dpi) with automatic ranges, each figure's default title,
+/// 18 px text and a legend placed where it covers no data.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlotOptions {
     /// Width in pixels at `scale = 1` (default 800).
@@ -145,8 +165,13 @@ pub struct PlotOptions {
     /// Multiplies the pixel size, fonts and line widths (default 1; use 2-3
     /// for print-resolution PNG). SVG output is resolution independent anyway.
     pub scale: f64,
-    /// Title above the plot (default none; papers usually use a caption).
+    /// Title above the plot (default: a description of the figure; the
+    /// command line names the bicycle and the model). `Some("")`: none.
     pub title: Option<String>,
+    /// What the figure shows the dynamics of, e.g. "benchmark bicycle, model
+    /// whipple_offset": put before each figure's own description in the
+    /// default title (default none).
+    pub subject: Option<String>,
     /// Horizontal range; default: the data's range.
     pub x_range: Option<(f64, f64)>,
     /// Vertical range (continuation diagram); default: all eigenvalue parts
@@ -163,8 +188,8 @@ pub struct PlotOptions {
     pub font_size: f64,
     /// Legend placement (default [`LegendPosition::Auto`]).
     pub legend: LegendPosition,
-    /// Shade the self-stable speed intervals and mark `v_w`, `v_c` (default true;
-    /// needs critical speeds).
+    /// Shade the self-stable speed intervals and mark `v_d`, `v_w`, `v_c`
+    /// (default true; needs critical speeds).
     pub show_stable_band: bool,
     /// TTF/OTF font for text (default: search, see the module docs).
     pub font_path: Option<PathBuf>,
@@ -177,6 +202,7 @@ impl Default for PlotOptions {
             height: 600,
             scale: 1.0,
             title: None,
+            subject: None,
             x_range: None,
             y_range: None,
             x_label: None,
@@ -189,8 +215,25 @@ impl Default for PlotOptions {
     }
 }
 
+/// The subject of a figure (see [`PlotOptions::subject`]): the bicycle (a
+/// built-in name, or a parameter file by its name without directory and
+/// extension) and the model, e.g. "bicycle benchmark, model whipple_offset".
+pub fn subject(bike: &str, model: Option<&str>) -> String {
+    let p = Path::new(bike);
+    let name = if bike.contains(std::path::MAIN_SEPARATOR) || p.extension().is_some() {
+        p.file_stem().map_or(bike.into(), |s| s.to_string_lossy().into_owned())
+    } else {
+        bike.to_string()
+    };
+    match model {
+        Some(m) => format!("bicycle {name}, model {m}"),
+        None => format!("bicycle {name}"),
+    }
+}
+
 impl PlotOptions {
-    fn check(&self, path: &Path) -> Result<(), PlotError> {
+    /// Check the options (size, scale, font size, ranges) for a plot to `path`.
+    pub fn check(&self, path: &Path) -> Result<(), PlotError> {
         let bad = |m: String| {
             Err(PlotError::InvalidOptions {
                 path: path.to_path_buf(),
@@ -217,14 +260,28 @@ impl PlotOptions {
         Ok(())
     }
 
-    fn pixel_size(&self) -> (u32, u32) {
+    /// Resolution of a PNG (dots per inch): 100 at `scale = 1`.
+    pub fn dpi(&self) -> f64 {
+        100.0 * self.scale
+    }
+
+    /// The same options with `s` times the scale (the canvas of a figure).
+    fn oversampled(&self, s: u32) -> Self {
+        PlotOptions {
+            scale: self.scale * s as f64,
+            ..self.clone()
+        }
+    }
+
+    /// Image size in pixels.
+    pub fn pixel_size(&self) -> (u32, u32) {
         (
             (self.width as f64 * self.scale).round() as u32,
             (self.height as f64 * self.scale).round() as u32,
         )
     }
 
-    fn px(&self, x: f64) -> f64 {
+    pub(crate) fn px(&self, x: f64) -> f64 {
         x * self.scale
     }
 
@@ -406,11 +463,12 @@ pub(crate) fn de<E: std::fmt::Display>(e: E) -> DrawErr {
     e.to_string()
 }
 
-/// A figure that can draw itself on any plotters backend.
+/// A figure: draws itself on a canvas with the options scaled to it.
 pub(crate) trait Figure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr>;
+    fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr>;
 }
 
+/// Draw `fig` to `path` (SVG or PNG by extension), atomically.
 pub(crate) fn render(path: &Path, opts: &PlotOptions, fig: &impl Figure) -> Result<(), PlotError> {
     let format = ImageFormat::from_path(path)?;
     opts.check(path)?;
@@ -424,26 +482,26 @@ pub(crate) fn render(path: &Path, opts: &PlotOptions, fig: &impl Figure) -> Resu
         ImageFormat::Svg => {
             let mut svg = String::new();
             {
-                let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
-                fig.draw(&root).map_err(drawing)?;
+                let o = opts.oversampled(canvas::SVG_OVERSAMPLING);
+                let root = Canvas::svg(&mut svg, size).into_drawing_area();
+                fig.draw(&root, &o).map_err(drawing)?;
                 root.present().map_err(|e| drawing(e.to_string()))?;
             }
             write_string_atomic(path, &svg)?;
         }
         ImageFormat::Png => {
-            let mut draw_error = None;
-            let r = write_atomic_via_path(path, |tmp| -> Result<(), String> {
-                let root = BitMapBackend::new(tmp, size).into_drawing_area();
-                let res = fig.draw(&root).and_then(|()| root.present().map_err(de));
-                if let Err(e) = &res {
-                    draw_error = Some(e.clone());
-                }
-                res
-            });
-            if let Some(m) = draw_error {
-                return Err(drawing(m));
+            let s = canvas::png_oversampling(size);
+            let mut big = vec![255u8; (size.0 * s) as usize * (size.1 * s) as usize * 3];
+            {
+                let o = opts.oversampled(s);
+                let root = Canvas::bitmap(&mut big, size, s).into_drawing_area();
+                fig.draw(&root, &o).map_err(drawing)?;
+                root.present().map_err(|e| drawing(e.to_string()))?;
             }
-            r?;
+            let rgb = canvas::downsample(&big, size, s);
+            drop(big);
+            let bytes = canvas::encode_png(&rgb, size, opts.dpi()).map_err(drawing)?;
+            write_atomic(path, |w| w.write_all(&bytes))?;
         }
     }
     Ok(())
@@ -452,28 +510,44 @@ pub(crate) fn render(path: &Path, opts: &PlotOptions, fig: &impl Figure) -> Resu
 // ---------------------------------------------------------------------------
 // Helpers
 
-const WEAVE: RGBColor = RGBColor(0, 114, 178);
-const CAPSIZE: RGBColor = RGBColor(213, 94, 0);
-const CASTERING: RGBColor = RGBColor(117, 112, 179);
-const OTHER: RGBColor = RGBColor(110, 110, 110);
-const BAND: RGBColor = RGBColor(0, 158, 115);
-const GRID: RGBColor = RGBColor(225, 225, 225);
+const BAND: RGBColor = style::GREEN;
 const MISSING: RGBColor = RGBColor(200, 200, 200);
 const FAILED: RGBColor = RGBColor(120, 120, 120);
 
-fn mode_class(m: Mode) -> usize {
+/// Class of a mode label in the diagrams: each single mode, each merged
+/// pair and the unclassified modes have their own colour.
+pub(crate) fn mode_class(m: Mode) -> usize {
     match m {
         Mode::Weave => 0,
         Mode::Capsize => 1,
         Mode::Castering => 2,
-        Mode::WeaveCapsize | Mode::WeaveCastering | Mode::CapsizeCastering => 3,
-        Mode::Other(_) => 4,
+        Mode::WeaveCapsize => 3,
+        Mode::WeaveCastering => 4,
+        Mode::CapsizeCastering => 5,
+        Mode::Other(_) => 6,
     }
 }
 
-const MERGED: RGBColor = RGBColor(204, 121, 167);
-const CLASS_NAMES: [&str; 5] = ["weave", "capsize", "castering", "merged pair", "other"];
-const CLASS_COLORS: [RGBColor; 5] = [WEAVE, CAPSIZE, CASTERING, MERGED, OTHER];
+pub(crate) const CLASS_NAMES: [&str; 7] = [
+    "weave",
+    "capsize",
+    "castering",
+    "weave-capsize pair",
+    "weave-castering pair",
+    "capsize-castering pair",
+    "other",
+];
+/// Single modes: blue, vermilion, purple; merged pairs: pink, sky blue,
+/// olive (none close to a single mode's colour); others grey.
+pub(crate) const CLASS_COLORS: [RGBColor; 7] = [
+    style::BLUE,
+    style::VERMILION,
+    style::PURPLE,
+    style::PINK,
+    style::SKY,
+    style::OLIVE,
+    style::GREY,
+];
 
 /// Tick label: shortest decimal of the value rounded to 6 significant places.
 pub(crate) fn tick(v: f64) -> String {
@@ -499,7 +573,7 @@ pub(crate) fn tick(v: f64) -> String {
 }
 
 /// Clip a polyline to the box, returning the visible pieces.
-fn clip_polyline(pts: &[(f64, f64)], (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> Vec<Vec<(f64, f64)>> {
+pub(crate) fn clip_polyline(pts: &[(f64, f64)], (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> Vec<Vec<(f64, f64)>> {
     let mut out: Vec<Vec<(f64, f64)>> = Vec::new();
     let mut cur: Vec<(f64, f64)> = Vec::new();
     let inside = |p: (f64, f64)| p.0 >= x0 && p.0 <= x1 && p.1 >= y0 && p.1 <= y1;
@@ -556,12 +630,7 @@ fn clip_polyline(pts: &[(f64, f64)], (x0, x1): (f64, f64), (y0, y1): (f64, f64))
 
 /// Width of the widest tick label of `lo..hi` with about `n` "nice" ticks
 /// (1-2-5 steps, as plotters chooses them).
-fn widest_tick<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    font: &TextStyle<'_>,
-    (lo, hi): (f64, f64),
-    n: usize,
-) -> u32 {
+fn widest_tick(root: &Area<'_>, font: &TextStyle<'_>, (lo, hi): (f64, f64), n: usize) -> u32 {
     let raw = (hi - lo) / n.max(1) as f64;
     let mut widest = 0;
     if raw.is_finite() && raw > 0.0 {
@@ -586,12 +655,7 @@ fn widest_tick<DB: DrawingBackend>(
 
 /// Width of the left label area: widest tick label plus tick marks and the
 /// rotated axis description.
-fn label_area_width<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    o: &PlotOptions,
-    range: (f64, f64),
-    n: usize,
-) -> u32 {
+pub(crate) fn label_area_width(root: &Area<'_>, o: &PlotOptions, range: (f64, f64), n: usize) -> u32 {
     widest_tick(root, &o.font(0.9), range, n) + o.pxu(5.0 + 8.0) + o.pxu(o.font_size * 1.9)
 }
 
@@ -714,18 +778,19 @@ fn continuation_curves(sweep: &EigenSweep) -> Vec<Curve> {
 
 struct Continuation<'a> {
     critical: Option<&'a CriticalSpeeds>,
-    opts: &'a PlotOptions,
     curves: Vec<Curve>,
     xr: (f64, f64),
     yr: (f64, f64),
 }
 
 /// Draw the continuation diagram of `sweep` (real parts solid, imaginary parts
-/// dashed, one colour per mode) to `path` (`.svg` or `.png`).
+/// dashed, one colour per mode and per merged pair) to `path` (`.svg` or
+/// `.png`).
 ///
-/// With `critical`, the self-stable speed intervals are shaded and `v_w`,
-/// `v_c` are marked and annotated (if in the plotted range and
-/// [`PlotOptions::show_stable_band`] is set).
+/// With `critical`, the self-stable speed intervals are shaded and `v_d`,
+/// `v_w`, `v_c` are marked and labelled above the plot, in rows when they are
+/// close (if in the plotted range and [`PlotOptions::show_stable_band`] is
+/// set).
 pub fn plot_continuation(
     path: impl AsRef<Path>,
     sweep: &EigenSweep,
@@ -734,6 +799,7 @@ pub fn plot_continuation(
 ) -> Result<(), PlotError> {
     let path = path.as_ref();
     ImageFormat::from_path(path)?;
+    opts.check(path)?;
     if sweep.points.is_empty() {
         return Err(PlotError::NoData {
             path: path.to_path_buf(),
@@ -764,7 +830,6 @@ pub fn plot_continuation(
         opts,
         &Continuation {
             critical,
-            opts,
             curves,
             xr,
             yr,
@@ -775,8 +840,8 @@ pub fn plot_continuation(
 /// Layout of "main, subscript, rest" (e.g. "v", "w", " = 4.29 m/s"): x
 /// offsets of the three parts and the total width. Leading spaces of the rest
 /// become an explicit gap (SVG viewers drop leading whitespace in text).
-fn subscript_layout<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
+pub(crate) fn subscript_layout(
+    root: &Area<'_>,
     parts: (&str, &str, &str),
     o: &PlotOptions,
 ) -> Result<([i32; 3], i32), DrawErr> {
@@ -795,8 +860,8 @@ fn subscript_layout<DB: DrawingBackend>(
 }
 
 /// Draw a subscripted label (see [`subscript_layout`]) with its top-left at `(x, y)`.
-fn draw_subscripted<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
+pub(crate) fn draw_subscripted(
+    root: &Area<'_>,
     (x, y): (i32, i32),
     parts: (&str, &str, &str),
     o: &PlotOptions,
@@ -816,219 +881,164 @@ fn draw_subscripted<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Labels of marked speeds, placed in rows above the plot: each centred on
+/// its line when it can be, moved to the next row when it would overlap a
+/// label already placed. `marks` are `(pixel x, label width)`; `(x0, x1)`
+/// the plot's pixel range. Returns each label's left edge and row.
+pub(crate) fn layout_mark_labels(marks: &[(i32, i32)], (x0, x1): (i32, i32), gap: i32) -> Vec<(i32, usize)> {
+    let mut order: Vec<usize> = (0..marks.len()).collect();
+    order.sort_by_key(|&k| marks[k].0);
+    let mut placed: Vec<(i32, i32, usize)> = Vec::new();
+    let mut out = vec![(0, 0); marks.len()];
+    for k in order {
+        let (x, w) = marks[k];
+        let left = (x - w / 2).clamp(x0, (x1 - w).max(x0));
+        let mut row = 0;
+        while placed
+            .iter()
+            .any(|&(a, b, r)| r == row && left < b + gap && left + w + gap > a)
+        {
+            row += 1;
+        }
+        placed.push((left, left + w, row));
+        out[k] = (left, row);
+    }
+    out
+}
+
 impl Figure for Continuation<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
-        let o = self.opts;
+    fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
         let (xr, yr) = (self.xr, self.yr);
         root.fill(&WHITE).map_err(de)?;
-        let mut builder = ChartBuilder::on(root);
-        builder
-            .margin_top(o.pxu(if o.title.is_some() { 10.0 } else { 18.0 }))
-            .margin_right(o.pxu(24.0))
-            .margin_left(o.pxu(10.0))
-            .margin_bottom(o.pxu(10.0))
-            .x_label_area_size(o.pxu(o.font_size * 3.4))
-            .y_label_area_size(label_area_width(root, o, yr, 10));
-        if let Some(t) = &o.title {
-            builder.caption(t, o.font(1.25));
-        }
-        let mut chart = builder.build_cartesian_2d(xr.0..xr.1, yr.0..yr.1).map_err(de)?;
-        let xl = o.x_label.clone().unwrap_or_else(|| "forward speed v (m/s)".into());
-        let yl = o.y_label.clone().unwrap_or_else(|| "eigenvalue (1/s)".into());
-        chart
-            .configure_mesh()
-            .bold_line_style(GRID.stroke_width(o.pxu(1.0)))
-            .light_line_style(TRANSPARENT)
-            .axis_style(BLACK.stroke_width(o.pxu(1.0)))
-            .set_all_tick_mark_size(o.pxi(5.0))
-            .x_labels(11)
-            .y_labels(10)
-            .x_label_formatter(&|v| tick(*v))
-            .y_label_formatter(&|v| tick(*v))
-            .label_style(o.font(0.9))
-            .axis_desc_style(o.font(1.0))
-            .x_desc(xl)
-            .y_desc(yl)
-            .draw()
-            .map_err(de)?;
+        let area = style::titled(root, o, "eigenvalues over forward speed")?;
 
-        // Stable band(s) and critical speeds.
         let band = o.show_stable_band.then_some(self.critical).flatten();
-        let mut has_band = false;
-        if let Some(cs) = band {
-            for [lo, hi] in &cs.stable_intervals {
-                let (lo, hi) = (lo.max(xr.0), hi.min(xr.1));
-                if hi > lo {
-                    has_band = true;
-                    chart
-                        .draw_series(std::iter::once(Rectangle::new(
-                            [(lo, yr.0), (hi, yr.1)],
-                            BAND.mix(0.13).filled(),
-                        )))
-                        .map_err(de)?;
-                }
-            }
-        }
-        // Zero line.
-        chart
-            .draw_series(std::iter::once(PathElement::new(
-                vec![(xr.0, 0.0), (xr.1, 0.0)],
-                BLACK.stroke_width(o.pxu(1.0)),
-            )))
-            .map_err(de)?;
-        let marks: Vec<(f64, &str)> = band
+        let stable: Vec<(f64, f64)> = band
             .map(|cs| {
-                [(cs.weave_speed, "w"), (cs.capsize_speed, "c")]
-                    .into_iter()
-                    .filter_map(|(v, s)| v.filter(|v| *v >= xr.0 && *v <= xr.1).map(|v| (v, s)))
+                cs.stable_intervals
+                    .iter()
+                    .map(|[lo, hi]| (lo.max(xr.0), hi.min(xr.1)))
+                    .filter(|(lo, hi)| hi > lo)
                     .collect()
             })
             .unwrap_or_default();
-        for (v, _) in &marks {
-            chart
-                .draw_series(std::iter::once(DashedPathElement::new(
-                    vec![(*v, yr.0), (*v, yr.1)],
-                    o.pxi(5.0),
-                    o.pxi(4.0),
-                    RGBColor(90, 90, 90).stroke_width(o.pxu(1.0)),
-                )))
-                .map_err(de)?;
-        }
-
-        // Curves: imaginary (dashed) first so real parts are on top.
-        let lw = o.pxu(2.0);
-        for imag in [true, false] {
-            for c in self.curves.iter().filter(|c| c.imag == imag) {
-                let style = CLASS_COLORS[c.class].stroke_width(lw);
-                for piece in clip_polyline(&c.points, xr, yr) {
-                    if imag {
-                        chart
-                            .draw_series(std::iter::once(DashedPathElement::new(
-                                piece,
-                                o.pxi(9.0),
-                                o.pxi(5.0),
-                                style,
-                            )))
-                            .map_err(de)?;
-                    } else {
-                        chart.draw_series(LineSeries::new(piece, style)).map_err(de)?;
-                    }
-                }
-            }
-        }
-        // Frame.
-        chart
-            .draw_series(std::iter::once(Rectangle::new(
-                [(xr.0, yr.0), (xr.1, yr.1)],
-                BLACK.stroke_width(o.pxu(1.0)),
-            )))
-            .map_err(de)?;
-        // Crossing markers and annotations.
-        let mut obstacles: Vec<(i32, i32, i32, i32)> = Vec::new();
-        if yr.0 <= 0.0 && yr.1 >= 0.0 {
-            for (v, _) in &marks {
-                chart
-                    .draw_series(std::iter::once(Circle::new((*v, 0.0), o.pxi(4.0), BLACK.filled())))
-                    .map_err(de)?;
-            }
-        }
-        let (px0, py0) = chart.backend_coord(&(xr.0, yr.1));
-        let (px1, _) = chart.backend_coord(&(xr.1, yr.1));
-        for (k, (v, sub)) in marks.iter().enumerate() {
-            let value = format!(" = {} m/s", fmt_speed(*v));
-            let parts = ("v", *sub, value.as_str());
-            let w = subscript_layout(root, parts, o)?.1;
-            let (xv, _) = chart.backend_coord(&(*v, yr.1));
-            let gap = o.pxi(5.0);
-            // Lower mark: label left of its line; upper: right (outside the band).
-            let left_side = marks.len() == 2 && k == 0 || (marks.len() == 1 && xv - px0 > px1 - xv);
-            let mut x = if left_side { xv - gap - w } else { xv + gap };
-            x = x.clamp(px0 + gap, (px1 - gap - w).max(px0 + gap));
-            let y = py0 + o.pxi(6.0);
-            // White backing so the label stays readable over the mesh.
-            root.draw(&Rectangle::new(
+        // Marked speeds: v_d (at the double real root when known), v_w, v_c.
+        let marks: Vec<(f64, &str, Option<f64>)> = band
+            .map(|cs| {
                 [
-                    (x - o.pxi(2.0), y - o.pxi(1.0)),
-                    (x + w + o.pxi(2.0), y + o.pxi(o.font_size * 1.3)),
-                ],
-                WHITE.mix(0.85).filled(),
-            ))
-            .map_err(de)?;
-            draw_subscripted(root, (x, y), parts, o)?;
-            obstacles.push((x, y, x + w, y + o.pxi(o.font_size * 1.3)));
-        }
+                    (cs.weave_real_pair_merge, "d", cs.weave_merge_eigenvalue),
+                    (cs.weave_speed, "w", Some(0.0)),
+                    (cs.capsize_speed, "c", Some(0.0)),
+                ]
+                .into_iter()
+                .filter_map(|(v, s, y)| v.filter(|v| *v >= xr.0 && *v <= xr.1).map(|v| (v, s, y)))
+                .collect()
+            })
+            .unwrap_or_default();
 
-        if o.legend == LegendPosition::Hidden {
-            return Ok(());
-        }
-        // Legend entries: modes present, line styles, band.
+        let mut legend = Legend::default();
         let mut classes: Vec<usize> = self.curves.iter().map(|c| c.class).collect();
         classes.sort();
         classes.dedup();
-        let legend_len = o.px(28.0) as i32;
         for &cl in &classes {
-            let color = CLASS_COLORS[cl];
-            let sw = o.pxu(2.0);
-            chart
-                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
-                .map_err(de)?
-                .label(CLASS_NAMES[cl])
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + legend_len, y)], color.stroke_width(sw)));
+            legend.add(CLASS_NAMES[cl], Icon::Line(Stroke::solid(CLASS_COLORS[cl])));
         }
-        let grey = RGBColor(60, 60, 60);
-        let sw = o.pxu(2.0);
-        chart
-            .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
-            .map_err(de)?
-            .label("real part")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + legend_len, y)], grey.stroke_width(sw)));
+        legend.add("real part", Icon::Line(Stroke::solid(style::DATA)));
         if self.curves.iter().any(|c| c.imag) {
-            let (dash, gap) = (o.pxi(9.0), o.pxi(5.0));
-            chart
-                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
-                .map_err(de)?
-                .label("imaginary part")
-                .legend(move |(x, y)| {
-                    DashedPathElement::new(vec![(x, y), (x + legend_len, y)], dash, gap, grey.stroke_width(sw))
-                });
+            legend.add("imaginary part", Icon::Line(Stroke::dashed(style::DATA)));
         }
-        if has_band {
-            let h = o.pxi(6.0);
-            chart
-                .draw_series(std::iter::empty::<PathElement<(f64, f64)>>())
-                .map_err(de)?
-                .label("self-stable")
-                .legend(move |(x, y)| Rectangle::new([(x, y - h), (x + legend_len, y + h)], BAND.mix(0.25).filled()));
+        if !stable.is_empty() {
+            legend.add("self-stable", Icon::Patch(BAND, 0.25));
         }
-        let n_entries = classes.len() + 1 + self.curves.iter().any(|c| c.imag) as usize + has_band as usize;
-        let label_font = o.font(0.9);
-        let longest = ["imaginary part", "self-stable", "castering"]
+        let data: Vec<&[(f64, f64)]> = self.curves.iter().map(|c| c.points.as_slice()).collect();
+
+        // Mark labels above the plot: rows as needed.
+        let texts: Vec<String> = marks
             .iter()
-            .map(|s| root.estimate_text_size(s, &label_font).map(|t| t.0).unwrap_or(0))
-            .max()
-            .unwrap_or(0) as i32;
-        // plotters' legend box: margin 5 + entries of ~font height + 10 spacing.
-        let entry_h = o.pxi(o.font_size * 0.9) + o.pxi(10.0).max(10);
-        let box_w = longest + legend_len + o.pxi(25.0);
-        let box_h = n_entries as i32 * entry_h + o.pxi(10.0);
-        let pos = choose_legend(
-            o.legend,
-            &chart_pixels(&chart, &self.curves, xr, yr),
-            &obstacles,
-            &chart,
-            (box_w, box_h),
-        );
-        chart
-            .configure_series_labels()
-            .position(pos)
-            .margin(o.pxu(8.0))
-            .legend_area_size(legend_len + o.pxi(6.0))
-            .label_font(label_font)
-            .background_style(WHITE.mix(0.9).filled())
-            .border_style(RGBColor(160, 160, 160).stroke_width(o.pxu(1.0)))
-            .draw()
-            .map_err(de)?;
-        Ok(())
+            .map(|(v, _, _)| format!(" = {} m/s", fmt_speed(*v)))
+            .collect();
+        let widths: Vec<i32> = marks
+            .iter()
+            .zip(&texts)
+            .map(|((_, sub, _), t)| subscript_layout(root, ("v", sub, t), o).map(|l| l.1))
+            .collect::<Result<_, _>>()?;
+        let row_h = o.font_size * 1.35;
+        let gap = o.pxi(10.0);
+        let layout_on = |chart: &style::Chart<'_, '_>| {
+            let r = chart.plotting_area().get_pixel_range();
+            let pos: Vec<(i32, i32)> = marks
+                .iter()
+                .zip(&widths)
+                .map(|((v, _, _), w)| (chart.backend_coord(&(*v, yr.1)).0, *w))
+                .collect();
+            layout_mark_labels(&pos, (r.0.start, r.0.end), gap)
+        };
+        let rows_of = |l: &[(i32, usize)]| l.iter().map(|p| p.1 + 1).max().unwrap_or(0);
+        let first = style::chart(&area, o, xr, yr, Frame::default())?;
+        let rows = rows_of(&layout_on(&first));
+        drop(first);
+        let frame = Frame {
+            top: rows as f64 * row_h,
+            ..Frame::default()
+        };
+        let (mut chart, place, frame) = style::chart_with_legend(&area, o, xr, yr, frame, &legend, &data, &[])?;
+        let mut layout = layout_on(&chart);
+        if rows_of(&layout) > rows {
+            let f = Frame {
+                top: rows_of(&layout) as f64 * row_h,
+                ..frame
+            };
+            chart = style::chart(&area, o, xr, yr, f)?;
+            layout = layout_on(&chart);
+        }
+        let xl = o.x_label.clone().unwrap_or_else(|| "forward speed v (m/s)".into());
+        let yl = o.y_label.clone().unwrap_or_else(|| "eigenvalue (1/s)".into());
+        style::mesh(&mut chart, o, &xl, &yl)?;
+        for (lo, hi) in &stable {
+            chart
+                .draw_series(std::iter::once(Rectangle::new(
+                    [(*lo, yr.0), (*hi, yr.1)],
+                    BAND.mix(0.13).filled(),
+                )))
+                .map_err(de)?;
+        }
+        if yr.0 <= 0.0 && yr.1 >= 0.0 {
+            style::hline(&mut chart, o, 0.0)?;
+        }
+        for (v, _, _) in &marks {
+            style::vline(&mut chart, o, *v, style::MARK)?;
+        }
+        // Curves: imaginary (dashed) first so real parts are on top.
+        for imag in [true, false] {
+            for c in self.curves.iter().filter(|c| c.imag == imag) {
+                let s = if imag {
+                    Stroke::dashed(CLASS_COLORS[c.class])
+                } else {
+                    Stroke::solid(CLASS_COLORS[c.class])
+                };
+                style::curve(&mut chart, o, &c.points, s)?;
+            }
+        }
+        style::frame(&mut chart, o)?;
+        for (v, _, y) in &marks {
+            if let Some(y) = y.filter(|y| *y >= yr.0 && *y <= yr.1) {
+                chart
+                    .draw_series(std::iter::once(Circle::new((*v, y), o.pxu(4.0), BLACK.filled())))
+                    .map_err(de)?;
+            }
+        }
+        // Labels above the plot, bottom row nearest to it.
+        let top = chart.plotting_area().get_pixel_range().1.start;
+        let (ox, oy) = {
+            let r = root.get_pixel_range();
+            (r.0.start, r.1.start)
+        };
+        let total = rows_of(&layout);
+        for (((_, sub, _), t), (left, row)) in marks.iter().zip(&texts).zip(&layout) {
+            let y = top - (total - row) as i32 * o.pxi(row_h) - o.pxi(2.0);
+            draw_subscripted(root, (left - ox, y - oy), ("v", sub, t), o)?;
+        }
+        legend.draw(root, &chart, o, place)
     }
 }
 
@@ -1036,88 +1046,11 @@ fn fmt_speed(v: f64) -> String {
     format!("{v:.2}")
 }
 
-type Chart<'a, DB> =
-    ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>>;
-
-/// Curve samples in backend pixels, densified to ~4 px spacing.
-fn chart_pixels<DB: DrawingBackend>(
-    chart: &Chart<'_, DB>,
-    curves: &[Curve],
-    xr: (f64, f64),
-    yr: (f64, f64),
-) -> Vec<(i32, i32)> {
-    let mut out = Vec::new();
-    for c in curves {
-        for piece in clip_polyline(&c.points, xr, yr) {
-            for w in piece.windows(2) {
-                let a = chart.backend_coord(&w[0]);
-                let b = chart.backend_coord(&w[1]);
-                let d = ((b.0 - a.0) as f64).hypot((b.1 - a.1) as f64);
-                let n = (d / 4.0).ceil().max(1.0) as i32;
-                for k in 0..=n {
-                    let t = k as f64 / n as f64;
-                    out.push((
-                        (a.0 as f64 + t * (b.0 - a.0) as f64) as i32,
-                        (a.1 as f64 + t * (b.1 - a.1) as f64) as i32,
-                    ));
-                }
-            }
-        }
-    }
-    out
-}
-
-fn choose_legend<DB: DrawingBackend>(
-    pref: LegendPosition,
-    pixels: &[(i32, i32)],
-    obstacles: &[(i32, i32, i32, i32)],
-    chart: &Chart<'_, DB>,
-    (w, h): (i32, i32),
-) -> SeriesLabelPosition {
-    let fixed = match pref {
-        LegendPosition::UpperLeft => Some(SeriesLabelPosition::UpperLeft),
-        LegendPosition::UpperRight => Some(SeriesLabelPosition::UpperRight),
-        LegendPosition::LowerLeft => Some(SeriesLabelPosition::LowerLeft),
-        LegendPosition::LowerRight => Some(SeriesLabelPosition::LowerRight),
-        LegendPosition::Auto | LegendPosition::Hidden => None,
-    };
-    if let Some(p) = fixed {
-        return p;
-    }
-    let area = chart.plotting_area();
-    let ((ax0, ay0), (ax1, ay1)) = {
-        let r = area.get_pixel_range();
-        ((r.0.start, r.1.start), (r.0.end, r.1.end))
-    };
-    let m = 5 + 8; // plotters' 5 px plus our margin
-    let candidates = [
-        (SeriesLabelPosition::LowerLeft, (ax0 + m, ay1 - m - h)),
-        (SeriesLabelPosition::LowerRight, (ax1 - m - w, ay1 - m - h)),
-        (SeriesLabelPosition::UpperLeft, (ax0 + m, ay0 + m)),
-        (SeriesLabelPosition::UpperRight, (ax1 - m - w, ay0 + m)),
-    ];
-    let pad = 6;
-    let mut best = (usize::MAX, SeriesLabelPosition::LowerLeft);
-    for (pos, (x, y)) in candidates {
-        let inside = |p: &(i32, i32)| p.0 >= x - pad && p.0 <= x + w + pad && p.1 >= y - pad && p.1 <= y + h + pad;
-        let mut cost = pixels.iter().filter(|p| inside(p)).count();
-        for o in obstacles {
-            if o.0 < x + w && o.2 > x && o.1 < y + h && o.3 > y {
-                cost += 10_000;
-            }
-        }
-        if cost < best.0 {
-            best = (cost, pos);
-        }
-    }
-    best.1
-}
-
 // ---------------------------------------------------------------------------
 // Stability map
 
 /// Viridis colour map (matplotlib), `t` in `[0, 1]`.
-fn viridis(t: f64) -> RGBColor {
+pub(crate) fn viridis(t: f64) -> RGBColor {
     const C: [(u8, u8, u8); 9] = [
         (68, 1, 84),
         (72, 40, 120),
@@ -1178,21 +1111,97 @@ fn missing_label(q: MapQuantity) -> &'static str {
 struct MapFigure<'a> {
     map: &'a StabilityMap,
     quantity: MapQuantity,
-    opts: &'a PlotOptions,
+    probe_speed: Option<f64>,
     vrange: (f64, f64),
+    signed: bool,
+}
+
+/// Diverging colour map (ColorBrewer RdBu, reversed): `t = 0` blue
+/// (negative: stable), `t = 0.5` white (zero), `t = 1` red (positive).
+pub(crate) fn diverging(t: f64) -> RGBColor {
+    const C: [(u8, u8, u8); 9] = [
+        (33, 102, 172),
+        (67, 147, 195),
+        (146, 197, 222),
+        (209, 229, 240),
+        (247, 247, 247),
+        (253, 219, 199),
+        (244, 165, 130),
+        (214, 96, 77),
+        (178, 24, 43),
+    ];
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.5 };
+    let s = t * (C.len() - 1) as f64;
+    let k = (s.floor() as usize).min(C.len() - 2);
+    let f = s - k as f64;
+    let lerp = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
+    RGBColor(
+        lerp(C[k].0, C[k + 1].0),
+        lerp(C[k].1, C[k + 1].1),
+        lerp(C[k].2, C[k + 1].2),
+    )
+}
+
+/// The zero contour of `f` over a grid (marching squares on the cell
+/// centres `xs x ys`; `f(i, j)` is `None` where the value is missing):
+/// line segments, linear interpolation along the square's edges.
+pub(crate) fn zero_contour(xs: &[f64], ys: &[f64], f: impl Fn(usize, usize) -> Option<f64>) -> Vec<[(f64, f64); 2]> {
+    let mut out = Vec::new();
+    if xs.len() < 2 || ys.len() < 2 {
+        return out;
+    }
+    for i in 0..xs.len() - 1 {
+        for j in 0..ys.len() - 1 {
+            let c = [(i, j), (i + 1, j), (i + 1, j + 1), (i, j + 1)];
+            let v: Option<Vec<f64>> = c.iter().map(|&(a, b)| f(a, b)).collect();
+            let Some(v) = v else { continue };
+            let p = |k: usize| (xs[c[k].0], ys[c[k].1]);
+            let mut cuts = Vec::new();
+            for k in 0..4 {
+                let (a, b) = (v[k], v[(k + 1) % 4]);
+                if (a < 0.0) != (b < 0.0) {
+                    let t = a / (a - b);
+                    let (pa, pb) = (p(k), p((k + 1) % 4));
+                    cuts.push((pa.0 + t * (pb.0 - pa.0), pa.1 + t * (pb.1 - pa.1)));
+                }
+            }
+            match cuts.len() {
+                2 => out.push([cuts[0], cuts[1]]),
+                4 => {
+                    // Saddle: pair the cuts by the sign of the centre.
+                    let centre = v.iter().sum::<f64>() / 4.0;
+                    if (centre < 0.0) == (v[0] < 0.0) {
+                        out.push([cuts[0], cuts[3]]);
+                        out.push([cuts[1], cuts[2]]);
+                    } else {
+                        out.push([cuts[0], cuts[1]]);
+                        out.push([cuts[2], cuts[3]]);
+                    }
+                }
+                _ => {}
+            }
+        }
+    }
+    out
 }
 
 /// Draw a heat map of `quantity` over the grid of `map` with a colour bar to
 /// `path` (`.svg` or `.png`). Cells without the quantity (e.g. never
-/// self-stable) are light grey, failed cells dark grey.
+/// self-stable) are light grey, failed cells dark grey. A signed quantity
+/// (the real part of the least stable eigenvalue at `probe_speed`) is drawn
+/// in a diverging colour map centred on zero (blue stable, red unstable)
+/// with its zero contour; the figure says the speed it was made at (the
+/// probe speed, or the range of speeds searched).
 pub fn plot_stability_map(
     path: impl AsRef<Path>,
     map: &StabilityMap,
     quantity: MapQuantity,
+    probe_speed: Option<f64>,
     opts: &PlotOptions,
 ) -> Result<(), PlotError> {
     let path = path.as_ref();
     ImageFormat::from_path(path)?;
+    opts.check(path)?;
     let (nx, ny) = map.shape();
     if nx == 0 || ny == 0 || map.cells.len() != nx * ny {
         return Err(PlotError::NoData {
@@ -1209,11 +1218,19 @@ pub fn plot_stability_map(
     let (mut lo, hi) = vals
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    let signed = quantity == MapQuantity::LeastStableRealPart;
     if quantity == MapQuantity::StableWidth {
         lo = 0.0;
     }
     let vrange = if vals.is_empty() {
         (0.0, 1.0)
+    } else if signed {
+        let m = lo.abs().max(hi.abs());
+        if m > 0.0 {
+            (-m, m)
+        } else {
+            (-1.0, 1.0)
+        }
     } else if hi - lo > 1e-12 * hi.abs().max(1.0) {
         (lo, hi)
     } else {
@@ -1225,21 +1242,55 @@ pub fn plot_stability_map(
         &MapFigure {
             map,
             quantity,
-            opts,
+            probe_speed,
             vrange,
+            signed,
         },
     )
 }
 
+impl MapFigure<'_> {
+    fn color(&self, v: f64) -> RGBColor {
+        let (lo, hi) = self.vrange;
+        let t = (v - lo) / (hi - lo);
+        if self.signed {
+            diverging(t)
+        } else {
+            viridis(t)
+        }
+    }
+
+    /// Colour-bar label, with the speed the map was made at.
+    fn bar_label(&self) -> String {
+        match (self.quantity, self.probe_speed) {
+            (MapQuantity::LeastStableRealPart, Some(v)) => {
+                format!("largest real part at v = {} m/s (1/s)", tick(v))
+            }
+            (q, _) => q.label().to_string(),
+        }
+    }
+
+    fn default_title(&self) -> String {
+        let [a, b] = self.map.speed_range;
+        match (self.quantity, self.probe_speed) {
+            (MapQuantity::LeastStableRealPart, Some(v)) => {
+                format!("least stable eigenvalue's real part at v = {} m/s", tick(v))
+            }
+            (q, _) => format!(
+                "{} (speeds {}-{} m/s searched)",
+                q.label().split(" (").next().unwrap_or(""),
+                tick(a),
+                tick(b)
+            ),
+        }
+    }
+}
+
 impl Figure for MapFigure<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
-        let o = self.opts;
+    fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
         let m = self.map;
         root.fill(&WHITE).map_err(de)?;
-        let area = match &o.title {
-            Some(t) => root.titled(t, o.font(1.25)).map_err(de)?,
-            None => root.clone(),
-        };
+        let area = style::titled(root, o, &self.default_title())?;
         let (w, _) = area.dim_in_pixel();
         let (vlo, vhi) = self.vrange;
         let any_missing = m.cells.iter().any(|c| c.is_ok() && self.quantity.value(c).is_none());
@@ -1293,7 +1344,7 @@ impl Figure for MapFigure<'_> {
                 let color = match (c, self.quantity.value(c)) {
                     (Err(_), _) => FAILED,
                     (Ok(_), None) => MISSING,
-                    (Ok(_), Some(v)) => viridis((v - vlo) / (vhi - vlo)),
+                    (Ok(_), Some(v)) => self.color(v),
                 };
                 let (x0, x1) = (xe[i].0.max(xr.0), xe[i].1.min(xr.1));
                 let (y0, y1) = (ye[j].0.max(yr.0), ye[j].1.min(yr.1));
@@ -1319,13 +1370,26 @@ impl Figure for MapFigure<'_> {
         }
         let any_cut = !cut.is_empty();
         chart.draw_series(cut).map_err(de)?;
-        if any_cut {
-            main.draw_text(
-                "o: stable up to the speed limit (range cut there)",
-                &o.font(0.8),
-                (o.pxi(12.0), o.pxi(2.0)),
-            )
-            .map_err(de)?;
+        // The zero contour of a signed quantity (stable on its blue side).
+        let mut contour = false;
+        if self.signed {
+            let (xs, ys) = (&m.x.values, &m.y.values);
+            for [a, b] in zero_contour(xs, ys, |i, j| m.cell(i, j).and_then(|c| self.quantity.value(c))) {
+                contour = true;
+                style::curve(&mut chart, o, &[a, b], Stroke::solid(BLACK))?;
+            }
+        }
+        let notes: Vec<&str> = [
+            (contour, "black line: real part = 0"),
+            (any_cut, "o: stable up to the speed limit (range cut there)"),
+        ]
+        .iter()
+        .filter(|n| n.0)
+        .map(|n| n.1)
+        .collect();
+        if !notes.is_empty() {
+            main.draw_text(&notes.join("; "), &o.font(0.8), (o.pxi(12.0), o.pxi(2.0)))
+                .map_err(de)?;
         }
         let xl = o.x_label.clone().unwrap_or_else(|| m.x.name.clone());
         let yl = o.y_label.clone().unwrap_or_else(|| m.y.name.clone());
@@ -1375,7 +1439,7 @@ impl Figure for MapFigure<'_> {
         cb.draw_series((0..steps).map(|k| {
             let a = vlo + (vhi - vlo) * k as f64 / steps as f64;
             let b = vlo + (vhi - vlo) * (k + 1) as f64 / steps as f64;
-            Rectangle::new([(0.0, a), (1.0, b)], viridis((k as f64 + 0.5) / steps as f64).filled())
+            Rectangle::new([(0.0, a), (1.0, b)], self.color(0.5 * (a + b)).filled())
         }))
         .map_err(de)?;
         cb.configure_mesh()
@@ -1387,7 +1451,7 @@ impl Figure for MapFigure<'_> {
             .y_label_formatter(&|v| tick(*v))
             .label_style(tick_font.clone())
             .axis_desc_style(o.font(0.95))
-            .y_desc(self.quantity.label())
+            .y_desc(self.bar_label())
             .draw()
             .map_err(de)?;
         cb.draw_series(std::iter::once(Rectangle::new(
@@ -1462,6 +1526,70 @@ mod tests {
         assert_eq!(viridis(0.0), RGBColor(68, 1, 84));
         assert_eq!(viridis(1.0), RGBColor(253, 231, 37));
         assert_eq!(viridis(f64::NAN), RGBColor(68, 1, 84));
+    }
+
+    /// Issue 20: the colours of merged pairs differ from every single
+    /// mode's (and from one another).
+    #[test]
+    fn issue_20_merged_pair_colours_are_distinct() {
+        let d = |a: RGBColor, b: RGBColor| {
+            ((a.0 as f64 - b.0 as f64).powi(2) + (a.1 as f64 - b.1 as f64).powi(2) + (a.2 as f64 - b.2 as f64).powi(2))
+                .sqrt()
+        };
+        for merged in 3..6 {
+            for other in 0..7 {
+                if other != merged {
+                    let dist = d(CLASS_COLORS[merged], CLASS_COLORS[other]);
+                    assert!(dist > 60.0, "{} vs {}: {dist}", CLASS_NAMES[merged], CLASS_NAMES[other]);
+                }
+            }
+        }
+    }
+
+    /// Issue 20: labels of close speeds go on separate rows; distant ones
+    /// share the first.
+    #[test]
+    fn issue_20_mark_labels_keep_apart() {
+        let l = layout_mark_labels(&[(100, 80), (130, 80), (400, 80)], (0, 800), 10);
+        assert_eq!(l[0].1, 0);
+        assert_eq!(l[1].1, 1);
+        assert_eq!(l[2].1, 0);
+        // Clamped inside the plot.
+        assert_eq!(layout_mark_labels(&[(5, 80)], (0, 800), 10)[0].0, 0);
+    }
+
+    /// Issue 20: PNG lines are antialiased (intermediate shades beside a
+    /// diagonal), not pixel steps.
+    #[test]
+    fn issue_20_png_lines_are_smooth() {
+        struct Diagonal;
+        impl Figure for Diagonal {
+            fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
+                root.fill(&WHITE).map_err(de)?;
+                let (w, h) = root.dim_in_pixel();
+                root.draw(&canvas::Line {
+                    points: vec![(0, 0), (w as i32, (h as i32) / 3)],
+                    color: BLACK,
+                    width: o.pxu(1.0),
+                    dash: None,
+                })
+                .map_err(de)
+            }
+        }
+        let path = std::env::temp_dir().join(format!("bikedyn-smooth-{}.png", std::process::id()));
+        let opts = PlotOptions {
+            width: 300,
+            height: 200,
+            ..PlotOptions::default()
+        };
+        render(&path, &opts, &Diagonal).unwrap();
+        let decoder = png::Decoder::new(std::fs::File::open(&path).unwrap());
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        reader.next_frame(&mut buf).unwrap();
+        let _ = std::fs::remove_file(&path);
+        let grey: std::collections::HashSet<u8> = buf.chunks(3).map(|p| p[0]).filter(|v| *v > 10 && *v < 245).collect();
+        assert!(grey.len() > 5, "{} intermediate shades", grey.len());
     }
 
     #[test]

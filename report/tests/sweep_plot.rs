@@ -446,8 +446,8 @@ fn plot_stability_map_svg_and_png() {
     let m = stability_map(x, y, scaled, &quiet(0.0, 10.0), &no_progress).unwrap();
     let dir = test_dir("map");
     let opts = PlotOptions::default();
-    plot_stability_map(dir.join("map.svg"), &m, MapQuantity::StableWidth, &opts).unwrap();
-    plot_stability_map(dir.join("map.png"), &m, MapQuantity::WeaveSpeed, &opts).unwrap();
+    plot_stability_map(dir.join("map.svg"), &m, MapQuantity::StableWidth, None, &opts).unwrap();
+    plot_stability_map(dir.join("map.png"), &m, MapQuantity::WeaveSpeed, None, &opts).unwrap();
     let svg = fs::read_to_string(dir.join("map.svg")).unwrap();
     assert!(svg.contains("K2 scale") && svg.contains("C1 scale"));
     let png = fs::read(dir.join("map.png")).unwrap();
@@ -469,4 +469,286 @@ fn plot_rejects_unknown_extension_and_bad_font() {
     fs::write(&not_a_font, b"definitely not a font").unwrap();
     assert!(matches!(use_font(&not_a_font), Err(PlotError::Font { .. })));
     assert_eq!(entries(&dir), ["bad.ttf"]);
+}
+
+// ---------------------------------------------------------------------------
+// Figures read back (issue 20): the drawn SVG and PNG, not only their
+// existence.
+
+/// The `<tag ...>` openings of an SVG.
+fn tags<'a>(svg: &'a str, tag: &str) -> Vec<&'a str> {
+    svg.split(&format!("<{tag}"))
+        .skip(1)
+        .map(|t| t.split('>').next().unwrap())
+        .collect()
+}
+
+/// An attribute of a tag.
+fn attr<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let start = tag.find(&format!(" {name}=\""))? + name.len() + 3;
+    tag[start..].split('"').next()
+}
+
+/// The points of a polyline.
+fn points(tag: &str) -> Vec<(f64, f64)> {
+    attr(tag, "points")
+        .unwrap_or("")
+        .split_whitespace()
+        .map(|p| {
+            let (x, y) = p.split_once(',').unwrap();
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect()
+}
+
+/// The texts of an SVG with their positions.
+fn texts(svg: &str) -> Vec<(String, f64, f64)> {
+    svg.split("<text")
+        .skip(1)
+        .map(|t| {
+            let head = t.split('>').next().unwrap();
+            let body = t.split('>').nth(1).unwrap().split('<').next().unwrap();
+            (
+                body.to_string(),
+                attr(head, "x").unwrap().parse().unwrap(),
+                attr(head, "y").unwrap().parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// PNG width, height (IHDR) and pixels per metre (pHYs).
+fn png_header(bytes: &[u8]) -> (u32, u32, Option<u32>) {
+    let be = |b: &[u8]| u32::from_be_bytes([b[0], b[1], b[2], b[3]]);
+    let (w, h) = (be(&bytes[16..20]), be(&bytes[20..24]));
+    let phys = bytes
+        .windows(4)
+        .position(|c| c == b"pHYs")
+        .map(|k| be(&bytes[k + 4..k + 8]));
+    (w, h, phys)
+}
+
+/// Issue 20: the continuation diagram has a title (the subject and the
+/// figure), real parts solid and imaginary parts dashed (`stroke-dasharray`),
+/// curves at sub-pixel coordinates (no pixel steps), v_d, v_w and v_c
+/// marked, and a legend box that covers no curve.
+#[test]
+fn issue_20_continuation_reads_back() {
+    let c = benchmark();
+    let sweep = speed_sweep(&c, &linspace(0.0, 10.0, 501)).unwrap();
+    let crit = bikedyn_runtime::eigen::critical_speeds(&c, 0.0, 10.0).unwrap();
+    let dir = test_dir("readback");
+    let opts = PlotOptions {
+        subject: Some("benchmark bicycle, model whipple_offset".into()),
+        ..PlotOptions::default()
+    };
+    plot_continuation(dir.join("fig.svg"), &sweep, Some(&crit), &opts).unwrap();
+    let svg = fs::read_to_string(dir.join("fig.svg")).unwrap();
+    let t = texts(&svg);
+    assert!(
+        t.iter()
+            .any(|x| x.0 == "benchmark bicycle, model whipple_offset: eigenvalues over forward speed"),
+        "{t:?}"
+    );
+    let lines = tags(&svg, "polyline");
+    let dashed = lines.iter().filter(|l| l.contains("stroke-dasharray")).count();
+    let curves: Vec<&&str> = lines.iter().filter(|l| points(l).len() > 50).collect();
+    assert!(
+        curves.iter().any(|l| l.contains("stroke-dasharray")),
+        "dashed imaginary parts"
+    );
+    assert!(
+        curves.iter().any(|l| !l.contains("stroke-dasharray")),
+        "solid real parts"
+    );
+    assert!(
+        dashed >= 2,
+        "{dashed} dashed lines (imaginary part of the weave, the legend)"
+    );
+    // Sub-pixel vertices: many coordinates are not whole pixels.
+    let frac = curves
+        .iter()
+        .flat_map(|l| points(l))
+        .filter(|p| p.0.fract() != 0.0 || p.1.fract() != 0.0)
+        .count();
+    assert!(frac > 100, "{frac} vertices off the pixel grid");
+    // The three speeds, labelled (subscript d, w, c) with their values.
+    let vd = crit.weave_real_pair_merge.unwrap();
+    for (sub, v) in [("d", vd), ("w", WEAVE_SPEED), ("c", CAPSIZE_SPEED)] {
+        assert!(t.iter().any(|x| x.0 == sub), "v_{sub}");
+        let value = format!("= {v:.2} m/s");
+        assert!(t.iter().any(|x| x.0 == value), "{value} in {t:?}");
+    }
+    // Legend box (the white, slightly transparent rectangle) covers no
+    // vertex of a curve.
+    let legend = tags(&svg, "rect")
+        .into_iter()
+        .find(|r| attr(r, "fill") == Some("#FFFFFF") && attr(r, "opacity").is_some())
+        .expect("legend box");
+    let num = |n| attr(legend, n).unwrap().parse::<f64>().unwrap();
+    let (x, y, w, h) = (num("x"), num("y"), num("width"), num("height"));
+    for l in &curves {
+        for p in points(l) {
+            assert!(
+                !(p.0 > x && p.0 < x + w && p.1 > y && p.1 < y + h),
+                "legend ({x}, {y}, {w}, {h}) covers {p:?}"
+            );
+        }
+    }
+}
+
+/// Issue 20: labels of close speeds are kept apart (a wide speed range
+/// puts v_w and v_c 70 px apart: their labels go on two rows).
+#[test]
+fn issue_20_close_speed_labels_do_not_overlap() {
+    let c = benchmark();
+    let sweep = speed_sweep(&c, &linspace(0.0, 60.0, 601)).unwrap();
+    let crit = bikedyn_runtime::eigen::critical_speeds(&c, 0.0, 60.0).unwrap();
+    let dir = test_dir("labels");
+    plot_continuation(dir.join("fig.svg"), &sweep, Some(&crit), &PlotOptions::default()).unwrap();
+    let svg = fs::read_to_string(dir.join("fig.svg")).unwrap();
+    let t = texts(&svg);
+    let find = |v: f64| t.iter().find(|x| x.0 == format!("= {v:.2} m/s")).unwrap().clone();
+    let (w, c) = (find(WEAVE_SPEED), find(CAPSIZE_SPEED));
+    // Either on different rows or far enough apart across.
+    assert!((w.2 - c.2).abs() > 10.0 || (w.1 - c.1).abs() > 100.0, "{w:?} {c:?}");
+}
+
+/// Issue 20: size and resolution: a PNG is `width x height` times the
+/// scale and records 100 x scale dpi; lines are antialiased.
+#[test]
+fn issue_20_png_size_and_dpi() {
+    let sweep = speed_sweep(&benchmark(), &linspace(0.0, 10.0, 101)).unwrap();
+    let dir = test_dir("dpi");
+    let opts = PlotOptions {
+        width: 600,
+        height: 400,
+        scale: 2.0,
+        ..PlotOptions::default()
+    };
+    plot_continuation(dir.join("fig.png"), &sweep, None, &opts).unwrap();
+    let bytes = fs::read(dir.join("fig.png")).unwrap();
+    let (w, h, ppm) = png_header(&bytes);
+    assert_eq!((w, h), (1200, 800));
+    // 200 dpi = 7874 pixels per metre.
+    assert_eq!(ppm, Some(7874));
+}
+
+/// Issue 20: a map of a signed quantity (the least stable real part at a
+/// probe speed) uses a diverging colour map centred on zero (blue and red
+/// cells, white at zero), draws the zero contour and says the speed.
+#[test]
+fn issue_20_signed_map_is_diverging_with_zero_contour() {
+    let x = ParamAxis::new("K2 scale", linspace(0.2, 1.8, 17));
+    let y = ParamAxis::new("C1 scale", linspace(0.2, 1.8, 15));
+    let opts = SweepOptions {
+        probe_speed: Some(5.0),
+        ..quiet(0.0, 10.0)
+    };
+    let m = stability_map(x, y, scaled, &opts, &no_progress).unwrap();
+    let vals: Vec<f64> = m
+        .cells
+        .iter()
+        .filter_map(|c| MapQuantity::LeastStableRealPart.value(c))
+        .collect();
+    assert!(
+        vals.iter().any(|v| *v < 0.0) && vals.iter().any(|v| *v > 0.0),
+        "both signs on the grid"
+    );
+    let dir = test_dir("signed");
+    plot_stability_map(
+        dir.join("map.svg"),
+        &m,
+        MapQuantity::LeastStableRealPart,
+        Some(5.0),
+        &PlotOptions::default(),
+    )
+    .unwrap();
+    let svg = fs::read_to_string(dir.join("map.svg")).unwrap();
+    let fills: Vec<(u8, u8, u8)> = tags(&svg, "rect")
+        .iter()
+        .filter_map(|r| attr(r, "fill"))
+        .filter(|f| f.len() == 7)
+        .map(|f| {
+            let h = |k: usize| u8::from_str_radix(&f[k..k + 2], 16).unwrap();
+            (h(1), h(3), h(5))
+        })
+        .collect();
+    assert!(fills.iter().any(|c| c.2 > c.0 + 80), "blue (stable) cells");
+    assert!(fills.iter().any(|c| c.0 > c.2 + 80), "red (unstable) cells");
+    let contour = tags(&svg, "polyline")
+        .iter()
+        .filter(|l| attr(l, "stroke") == Some("#000000") && points(l).len() == 2)
+        .count();
+    assert!(contour > 5, "{contour} contour segments");
+    let t = texts(&svg);
+    assert!(t.iter().any(|x| x.0.contains("at v = 5 m/s")), "{t:?}");
+}
+
+/// Issue 20: a one-parameter sweep is drawn as the quantity against the
+/// parameter, with a point per value.
+#[test]
+fn issue_20_parameter_sweep_plot() {
+    use bikedyn_report::plot::sweep::plot_parameter_sweep;
+    let s = parameter_sweep(
+        ParamAxis::new("K2 scale", linspace(0.5, 1.5, 11)),
+        |a| scaled(a, 1.0),
+        &quiet(0.0, 10.0),
+        &no_progress,
+    )
+    .unwrap();
+    let dir = test_dir("param");
+    plot_parameter_sweep(
+        dir.join("s.svg"),
+        &s,
+        MapQuantity::WeaveSpeed,
+        None,
+        &PlotOptions::default(),
+    )
+    .unwrap();
+    let svg = fs::read_to_string(dir.join("s.svg")).unwrap();
+    let t = texts(&svg);
+    assert!(t.iter().any(|x| x.0 == "K2 scale") && t.iter().any(|x| x.0 == "weave speed (m/s)"));
+    assert!(t.iter().any(|x| x.0.contains("speeds 0-10 m/s searched")), "{t:?}");
+    let line = tags(&svg, "polyline")
+        .into_iter()
+        .map(points)
+        .max_by_key(|p| p.len())
+        .unwrap();
+    assert_eq!(line.len(), 11);
+    // 11 points with a white rim each.
+    assert!(tags(&svg, "circle").len() >= 22);
+}
+
+/// Issue 20: the root locus draws every eigenvalue at every speed as a
+/// point coloured by speed, with a colour bar; the mode shapes draw roll and
+/// steer phasors per mode with amplitude and phase.
+#[test]
+fn issue_20_root_locus_and_mode_shapes() {
+    use bikedyn_report::plot::locus::{plot_mode_shapes, plot_root_locus};
+    let sweep = speed_sweep(&benchmark(), &linspace(0.0, 10.0, 51)).unwrap();
+    let dir = test_dir("locus");
+    plot_root_locus(dir.join("l.svg"), &sweep, &PlotOptions::default()).unwrap();
+    let svg = fs::read_to_string(dir.join("l.svg")).unwrap();
+    let circles = tags(&svg, "circle");
+    assert_eq!(circles.len(), 51 * 4);
+    let colours: std::collections::HashSet<&str> = circles.iter().filter_map(|c| attr(c, "fill")).collect();
+    assert!(colours.len() > 40, "{} colours", colours.len());
+    let t = texts(&svg);
+    assert!(t.iter().any(|x| x.0 == "forward speed v (m/s)"));
+    assert!(t.iter().any(|x| x.0 == "imaginary part (rad/s)"));
+
+    let at5 = speed_sweep(&benchmark(), &[5.0]).unwrap();
+    plot_mode_shapes(dir.join("m.png"), &at5.points[0], &PlotOptions::default()).unwrap();
+    plot_mode_shapes(dir.join("m.svg"), &at5.points[0], &PlotOptions::default()).unwrap();
+    let svg = fs::read_to_string(dir.join("m.svg")).unwrap();
+    let t = texts(&svg);
+    for m in ["weave", "capsize", "castering"] {
+        assert!(t.iter().any(|x| x.0.starts_with(&format!("{m}: "))), "{m} in {t:?}");
+    }
+    // Three modes, roll and steer each.
+    assert_eq!(t.iter().filter(|x| x.0.starts_with("roll: amplitude")).count(), 3);
+    assert!(t.iter().filter(|x| x.0.trim_start().starts_with("phase ")).count() == 6);
+    assert_eq!(t.iter().filter(|x| x.0.starts_with("steer: amplitude")).count(), 3);
+    assert!(t.iter().any(|x| x.0.contains("mode shapes at v = 5 m/s")));
 }

@@ -71,6 +71,25 @@ pub struct OutputArgs {
     pub output: Option<PathBuf>,
 }
 
+/// Size, resolution and axis limits of the figures a command draws.
+#[derive(Args, Clone, Debug, Default)]
+pub struct PlotArgs {
+    /// Figure size WIDTHxHEIGHT in inches (default 8x6; e.g. 3.5x2.6 for a
+    /// journal column), or with a unit: 16x12cm, 800x600px (pixels at 100 dpi).
+    #[arg(long, value_name = "WxH")]
+    pub plot_size: Option<String>,
+    /// Resolution of PNG figures in dots per inch (default 100; 300 for
+    /// print): more pixels, the same figure. SVG is resolution independent.
+    #[arg(long, value_name = "DPI")]
+    pub dpi: Option<f64>,
+    /// Horizontal axis limits A:B (e.g. --xlim 0:8).
+    #[arg(long, value_name = "A:B", allow_hyphen_values = true)]
+    pub xlim: Option<String>,
+    /// Vertical axis limits A:B (e.g. --ylim=-10:10).
+    #[arg(long, value_name = "A:B", allow_hyphen_values = true)]
+    pub ylim: Option<String>,
+}
+
 #[derive(Subcommand)]
 pub enum Command {
     /// Measured weave eigenvalues from raw logs (thesis-style run sets, TU Delft kick logs).
@@ -129,6 +148,19 @@ pub enum Command {
         /// Continuation diagram (.svg or .png).
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// Root locus (.svg or .png): the eigenvalues over --speeds in the
+        /// complex plane, coloured by speed.
+        #[arg(long, value_name = "FILE")]
+        plot_root_locus: Option<PathBuf>,
+        /// Mode shapes at --speed (.svg or .png): roll and steer amplitude and
+        /// phase of each mode as phasors.
+        #[arg(long, value_name = "FILE", requires = "speed")]
+        plot_mode_shapes: Option<PathBuf>,
+        /// Speed (m/s) of --plot-mode-shapes.
+        #[arg(long, allow_hyphen_values = true)]
+        speed: Option<f64>,
+        #[command(flatten)]
+        plot_args: PlotArgs,
     },
     /// Weave and capsize speeds and the self-stable speed interval(s).
     Stability {
@@ -205,9 +237,14 @@ pub struct FitArgs {
     /// JSON output (one entry per kick).
     #[arg(long)]
     pub json: bool,
-    /// Write plots (responses with speed, continuation diagram) to this folder.
+    /// Write plots (responses with speed, continuation diagram; SVG and PNG)
+    /// to this folder.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Size and resolution of the plots; the limits apply to the
+    /// continuation diagram.
+    #[command(flatten)]
+    pub plot_args: PlotArgs,
     /// Angle method: direct (default) or thesis (eq. 87-93).
     #[arg(long, default_value = "direct")]
     pub angles: String,
@@ -255,6 +292,10 @@ pub struct IdentifyArgs {
     /// every one that could explain some of it)
     #[arg(long)]
     pub corrections: Option<usize>,
+    /// Size and resolution of the report's plots; the limits apply to the
+    /// continuation diagram.
+    #[command(flatten)]
+    pub plot_args: PlotArgs,
 }
 
 /// Arguments of `bikedyn simulate`.
@@ -323,9 +364,14 @@ pub struct SimulateArgs {
     /// CSV output (columns: t, coordinates, rates, speed, energies, residual).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Plot of roll, steer and speed against time (.svg or .png).
+    /// Plot of roll, steer and speed against time (.svg or .png), with the
+    /// kicks and pulses marked.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Size and resolution of the plot; --xlim is the time range, --ylim
+    /// the range of the roll and steer panels.
+    #[command(flatten)]
+    pub plot_args: PlotArgs,
 }
 
 /// Arguments of `bikedyn synth`.
@@ -384,10 +430,13 @@ pub struct SweepArgs {
     pub speed_max: f64,
     #[command(flatten)]
     pub out: OutputArgs,
-    /// Stability map plot (.svg or .png), two-parameter sweeps only.
+    /// Plot (.svg or .png): a two-parameter sweep's stability map, or a
+    /// one-parameter sweep's --map quantity against the parameter.
     #[arg(long)]
     pub plot: Option<PathBuf>,
-    /// Quantity mapped by --plot: the self-stable range width, the weave
+    #[command(flatten)]
+    pub plot_args: PlotArgs,
+    /// Quantity drawn by --plot: the self-stable range width, the weave
     /// or capsize speed, or the real part of the least stable eigenvalue
     /// at --at-speed. Cells whose stable range reaches --speed-max are
     /// marked (the range is cut there).

@@ -1,20 +1,47 @@
 //! `bikedyn eig`: eigenvalues and modes over forward speed (table, CSV or
 //! JSON, streamed when long) and the continuation diagram.
 
-use super::args::{BikeArg, Format, OutputArgs};
-use super::{check_outputs, emit, load, range_spec, MAX_STREAMED_POINTS, MAX_TABLE_ROWS};
-use anyhow::Result;
+use super::args::{BikeArg, Format, OutputArgs, PlotArgs};
+use super::{check_outputs, emit, load, plot_options, range_spec, MAX_STREAMED_POINTS, MAX_TABLE_ROWS};
+use anyhow::{bail, Result};
 use bikedyn::report::output;
-use bikedyn::report::plot::{plot_continuation, PlotOptions};
+use bikedyn::report::plot::locus::{plot_mode_shapes, plot_root_locus};
+use bikedyn::report::plot::{plot_continuation, subject};
 use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, LinearBicycle};
 use std::path::PathBuf;
 
+/// The figures `eig` draws and their options.
+pub struct Plots {
+    /// Continuation diagram (`--plot`).
+    pub continuation: Option<PathBuf>,
+    /// Root locus (`--plot-root-locus`).
+    pub root_locus: Option<PathBuf>,
+    /// Mode shapes at `speed` (`--plot-mode-shapes`).
+    pub mode_shapes: Option<PathBuf>,
+    /// `--speed` of the mode shapes.
+    pub speed: Option<f64>,
+    /// Size, resolution and limits.
+    pub args: PlotArgs,
+}
+
 /// Run `bikedyn eig`.
-pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plot: Option<PathBuf>) -> Result<bool> {
+pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Result<bool> {
     let BikeArg { spec: bike, model } = bike;
     let OutputArgs { format, output: out } = out;
+    // Every output and plot option is checked before any work.
+    let mut opts = plot_options(&plots.args, None)?;
+    check_outputs(out.as_deref(), plots.continuation.as_deref())?;
+    check_outputs(None, plots.root_locus.as_deref())?;
+    check_outputs(None, plots.mode_shapes.as_deref())?;
+    if let Some(v) = plots.speed {
+        if !v.is_finite() {
+            bail!("--speed must be a finite speed (m/s), found {v}");
+        }
+        if plots.mode_shapes.is_none() {
+            bail!("--speed is the speed of --plot-mode-shapes FILE: give that too (the table's speeds are --speeds)");
+        }
+    }
     let b = load(&bike)?;
-    check_outputs(out.as_deref(), plot.as_deref())?;
     let limit = match format {
         Format::Table => MAX_TABLE_ROWS,
         Format::Csv | Format::Json => MAX_STREAMED_POINTS,
@@ -29,6 +56,7 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plot: Option<PathBuf>
     })?;
     let lin = b.linear_with(model.as_deref())?;
     eprintln!("model: {}", lin.model);
+    opts.subject = Some(subject(&b.name, Some(lin.model)));
     let c: &dyn LinearBicycle = &lin;
     let speed = |k: usize| start + k as f64 * step;
     let stream = |fmt: output::StreamFormat| -> Result<()> {
@@ -50,7 +78,7 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plot: Option<PathBuf>
         Format::Csv => stream(output::StreamFormat::Csv)?,
         Format::Json => stream(output::StreamFormat::Json)?,
     }
-    if let Some(p) = plot {
+    if plots.continuation.is_some() || plots.root_locus.is_some() {
         // A diagram needs no more than 20,001 points: longer ranges are
         // plotted at evenly spaced speeds over the same interval.
         const PLOT_POINTS: usize = 20_001;
@@ -63,9 +91,20 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plot: Option<PathBuf>
                 .collect()
         };
         let sweep = eigen_sweep_of(c, &speeds)?;
-        let vmax = last.max(start + 1e-9);
-        let crit = critical_speeds_of(c, start, vmax).ok();
-        plot_continuation(&p, &sweep, crit.as_ref(), &PlotOptions::default())?;
+        if let Some(p) = &plots.continuation {
+            let vmax = last.max(start + 1e-9);
+            let crit = critical_speeds_of(c, start, vmax).ok();
+            plot_continuation(p, &sweep, crit.as_ref(), &opts)?;
+            eprintln!("wrote {}", p.display());
+        }
+        if let Some(p) = &plots.root_locus {
+            plot_root_locus(p, &sweep, &opts)?;
+            eprintln!("wrote {}", p.display());
+        }
+    }
+    if let (Some(p), Some(v)) = (&plots.mode_shapes, plots.speed) {
+        let at = eigen_sweep_of(c, &[v])?;
+        plot_mode_shapes(p, &at.points[0], &opts)?;
         eprintln!("wrote {}", p.display());
     }
     Ok(true)

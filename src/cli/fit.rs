@@ -29,6 +29,8 @@ pub fn options(args: &FitArgs) -> Result<FitOptions> {
 /// Run `bikedyn fit`: `Ok(false)` when some run was skipped (its error is
 /// on stderr; the others are output).
 pub fn run(args: &FitArgs) -> Result<bool> {
+    let subject = args.bike.as_deref().map(|b| bikedyn::report::plot::subject(b, None));
+    let plot_opts = super::plot_options(&args.plot_args, subject)?;
     let opts = options(args)?;
     let out = {
         // The bar is cleared before anything is printed.
@@ -75,7 +77,7 @@ pub fn run(args: &FitArgs) -> Result<bool> {
         }
     }
     if let Some(dir) = &args.plot {
-        plots(&out, dir)?;
+        plots(&out, dir, &plot_opts)?;
     }
     Ok(out.errors.is_empty())
 }

@@ -33,6 +33,7 @@ pub fn run_with_progress(request: &IdentifyRequest) -> Result<Outcome> {
 pub fn run(a: &IdentifyArgs) -> Result<bool> {
     // A report folder that cannot be written fails now, not after the
     // computation.
+    let plot_opts = super::plot_options(&a.plot_args, None)?;
     if let Some(dir) = &a.report {
         bikedyn::report::output::StagedDir::check(dir, "report.json")?;
     }
@@ -65,7 +66,7 @@ pub fn run(a: &IdentifyArgs) -> Result<bool> {
         );
     }
     if let Some(dir) = &a.report {
-        report::write_report(&o, &request, dir)?;
+        report::write_report(&o, &request, dir, &plot_opts)?;
     }
     if a.json {
         outln!("{}", serde_json::to_string_pretty(&report::outcome_json(&o))?);

@@ -164,6 +164,74 @@ pub fn check_outputs(out: Option<&std::path::Path>, plot: Option<&std::path::Pat
     Ok(())
 }
 
+/// The plot options of `--plot-size`, `--dpi`, `--xlim`, `--ylim` with
+/// the figure's `subject`, checked before any computation: a bad value is
+/// an error naming its flag.
+pub fn plot_options(a: &args::PlotArgs, subject: Option<String>) -> Result<bikedyn::report::plot::PlotOptions> {
+    use anyhow::bail;
+    use bikedyn::report::plot::PlotOptions;
+    let mut o = PlotOptions {
+        subject,
+        ..PlotOptions::default()
+    };
+    if let Some(d) = a.dpi {
+        if !(d.is_finite() && (10.0..=2400.0).contains(&d)) {
+            bail!("--dpi {d}: the resolution must be between 10 and 2400 dots per inch");
+        }
+        o.scale = d / 100.0;
+    }
+    if let Some(spec) = &a.plot_size {
+        let t = spec.trim().to_ascii_lowercase();
+        let (num, per_inch) = if let Some(n) = t.strip_suffix("cm") {
+            (n, 1.0 / 2.54)
+        } else if let Some(n) = t.strip_suffix("mm") {
+            (n, 1.0 / 25.4)
+        } else if let Some(n) = t.strip_suffix("px") {
+            (n, 0.01)
+        } else {
+            (t.strip_suffix("in").unwrap_or(&t), 1.0)
+        };
+        let parts: Vec<&str> = num.split(['x', '*']).collect();
+        let vals: Option<Vec<f64>> = parts.iter().map(|p| p.trim().parse::<f64>().ok()).collect();
+        let (w, h) = match vals.as_deref() {
+            Some([w, h]) => (*w * per_inch, *h * per_inch),
+            _ => bail!(
+                "--plot-size `{spec}`: expected WIDTHxHEIGHT in inches (e.g. 8x6), or with cm, mm or px (e.g. 16x12cm)"
+            ),
+        };
+        if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0) {
+            bail!("--plot-size `{spec}`: width and height must be positive");
+        }
+        o.width = (w * 100.0).round() as u32;
+        o.height = (h * 100.0).round() as u32;
+        if o.width < 200 || o.height < 150 {
+            bail!("--plot-size `{spec}`: too small for a figure with axes and labels (at least 2x1.5 inches)");
+        }
+    }
+    let (pw, ph) = o.pixel_size();
+    if pw > 20_000 || ph > 20_000 {
+        bail!(
+            "--plot-size {} at --dpi {} gives {pw}x{ph} pixels, more than 20000 on a side",
+            a.plot_size.as_deref().unwrap_or("8x6"),
+            o.dpi()
+        );
+    }
+    let limits = |flag: &str, spec: &Option<String>| -> Result<Option<(f64, f64)>> {
+        let Some(spec) = spec else { return Ok(None) };
+        let v: Option<Vec<f64>> = spec.split(':').map(|p| p.trim().parse::<f64>().ok()).collect();
+        match v.as_deref() {
+            Some([a, b]) if a.is_finite() && b.is_finite() && a < b => Ok(Some((*a, *b))),
+            Some([a, b]) if a.is_finite() && b.is_finite() => {
+                bail!("{flag} {spec}: the lower limit must be below the upper (A:B with A < B)")
+            }
+            _ => bail!("{flag} `{spec}`: expected two finite numbers A:B (e.g. {flag} 0:10, or {flag}=-10:10)"),
+        }
+    };
+    o.x_range = limits("--xlim", &a.xlim)?;
+    o.y_range = limits("--ylim", &a.ylim)?;
+    Ok(o)
+}
+
 /// Write to standard output, turning a failed write into an error that
 /// says what happened (see the `out!` macro).
 pub fn write_out(args: std::fmt::Arguments<'_>) -> Result<()> {

@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use bikedyn::bicycle::BUILT_IN;
 use bikedyn::identify::{report, IdentifyRequest};
 use bikedyn::report::output;
-use bikedyn::report::plot::{plot_continuation, PlotOptions};
+use bikedyn::report::plot::{plot_continuation, subject, PlotOptions};
 use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep};
 use bikedyn::runtime::verify::VerifyOptions;
 use std::path::PathBuf;
@@ -34,6 +34,7 @@ pub fn run(out: PathBuf) -> Result<bool> {
         output::save_eigen_sweep_json(out.join(format!("{name}_eigenvalues.json")), &sweep)?;
         let opts = PlotOptions {
             y_range: Some((-10.0, 10.0)),
+            subject: Some(subject(name, Some("canonical form"))),
             ..PlotOptions::default()
         };
         for ext in ["svg", "png"] {
@@ -61,7 +62,7 @@ pub fn run(out: PathBuf) -> Result<bool> {
     );
     let o = super::identify::run_with_progress(&request)?;
     let dir = out.join("identify");
-    report::write_report(&o, &request, &dir)?;
+    report::write_report(&o, &request, &dir, &PlotOptions::default())?;
     outln!("{}", report::summary(&o));
     outln!("report: {}", dir.join("report.md").display());
     Ok(ok)

@@ -5,7 +5,6 @@
 use super::args::SimulateArgs;
 use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::Bicycle;
-use bikedyn::report::plot::PlotOptions;
 use bikedyn::report::simulate::plot::plot_simulation;
 use bikedyn::report::simulate::save_simulation_csv;
 use bikedyn::runtime::simulate::{
@@ -80,8 +79,9 @@ pub fn parse_pulse(spec: &str) -> Result<TorquePulse> {
 
 /// Run `bikedyn simulate`.
 pub fn run(a: SimulateArgs) -> Result<bool> {
+    let mut plot_opts = super::plot_options(&a.plot_args, None)?;
     if let Some(p) = &a.plot {
-        bikedyn::report::plot::ImageFormat::from_path(p)?;
+        super::check_outputs(None, Some(p))?;
     }
     let bike = Bicycle::resolve(&a.bike)?;
     super::show_warnings(&bike);
@@ -143,7 +143,8 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
         eprintln!("wrote {}", out.display());
     }
     if let Some(plot) = &a.plot {
-        plot_simulation(plot, &sim, &PlotOptions::default())?;
+        plot_opts.subject = Some(bikedyn::report::plot::subject(&a.bike, Some(&sim.model)));
+        plot_simulation(plot, &sim, &inputs, &plot_opts)?;
         eprintln!("wrote {}", plot.display());
     }
     Ok(true)

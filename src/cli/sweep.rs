@@ -1,11 +1,12 @@
 //! `bikedyn sweep`: stability over one parameter, or a stability map over two.
 
 use super::args::{BikeArg, Format, MapArg, OutputArgs, SweepArgs};
-use super::{check_outputs, emit, load, parse_range, CellProgressBar, MAX_MAP_CELLS};
+use super::{check_outputs, emit, load, parse_range, plot_options, CellProgressBar, MAX_MAP_CELLS};
 use anyhow::{bail, Result};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::report::output;
-use bikedyn::report::plot::{plot_stability_map, PlotOptions};
+use bikedyn::report::plot::sweep::plot_parameter_sweep;
+use bikedyn::report::plot::{plot_stability_map, subject, PlotOptions};
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
 
 /// Run `bikedyn sweep`.
@@ -19,11 +20,13 @@ pub fn run(a: SweepArgs) -> Result<bool> {
         speed_max,
         out: OutputArgs { format, output: out },
         plot,
+        plot_args,
         map,
         at_speed,
     } = a;
-    let b = load(&bike)?;
+    let base_opts = plot_options(&plot_args, None)?;
     check_outputs(out.as_deref(), plot.as_deref())?;
+    let b = load(&bike)?;
     let quantity = match map {
         MapArg::Width => MapQuantity::StableWidth,
         MapArg::Weave => MapQuantity::WeaveSpeed,
@@ -142,9 +145,10 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                 let opts = PlotOptions {
                     x_label: Some(axis_label(&param)),
                     y_label: Some(axis_label(&p2)),
-                    ..PlotOptions::default()
+                    subject: Some(subject(&b.name, model.as_deref())),
+                    ..base_opts.clone()
                 };
-                plot_stability_map(p, &map, quantity, &opts)?;
+                plot_stability_map(p, &map, quantity, at_speed, &opts)?;
                 eprintln!("wrote {}", p.display());
             }
             match format {
@@ -159,9 +163,6 @@ pub fn run(a: SweepArgs) -> Result<bool> {
         }
         (None, None) => {
             b.with_parameter(&param, xs[0])?;
-            if plot.is_some() {
-                bail!("--plot draws a two-parameter stability map: give --param2 and --values2");
-            }
             let bar = CellProgressBar::new(xs.len(), "parameter sweep");
             let s = parameter_sweep(
                 ParamAxis::new(param.clone(), xs),
@@ -179,6 +180,15 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                     .zip(&s.param.values)
                     .map(|(c, x)| (format!("{param} = {x}"), c)),
             )?;
+            if let Some(p) = &plot {
+                let opts = PlotOptions {
+                    x_label: Some(axis_label(&param)),
+                    subject: Some(subject(&b.name, model.as_deref())),
+                    ..base_opts.clone()
+                };
+                plot_parameter_sweep(p, &s, quantity, at_speed, &opts)?;
+                eprintln!("wrote {}", p.display());
+            }
             match format {
                 Format::Table => output::format_parameter_table(&s),
                 Format::Json => serde_json::to_string_pretty(&output::parameter_sweep_json(&s))? + "\n",

@@ -294,7 +294,14 @@ fn fitted_toml<R: ModelRegistry>(
 
 /// Write the report folder; the bicycle of `a` is resolved against the
 /// registry the identification ran on.
-pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: &Path) -> Result<(), IdentifyError> {
+/// The plots take the size and resolution of `plot`; its axis limits apply
+/// to the continuation diagram; their subject is the bicycle and the model.
+pub fn write_report<R: ModelRegistry>(
+    o: &Outcome<R>,
+    a: &IdentifyRequest,
+    dir: &Path,
+    plot: &bikedyn_report::plot::PlotOptions,
+) -> Result<(), IdentifyError> {
     // Written beside `dir` and moved into its place at the end: a failure
     // leaves an earlier report as it was, and no old file stays beside the
     // new ones.
@@ -355,6 +362,13 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
         .iter()
         .find(|m| m.name == o.driven_model)
         .expect("the identification's driven model is registered");
+    let plot = bikedyn_report::plot::PlotOptions {
+        subject: Some(bikedyn_report::plot::subject(
+            &a.bike,
+            Some(&o.driven_model.to_string()),
+        )),
+        ..plot.clone()
+    };
     for ext in ["svg", "png"] {
         plot_continuation(
             &out.join(format!("continuation.{ext}")),
@@ -362,8 +376,14 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
             &curve(&linear_equivalent(driven_info, &o.values_after, median_rate))?,
             &label,
             &measured,
+            &plot,
         )?;
     }
+    let run_plot = bikedyn_report::plot::PlotOptions {
+        x_range: None,
+        y_range: None,
+        ..plot.clone()
+    };
     if let Some(rp) = &o.run_plot {
         let s = &o.segments[rp.segment];
         let deg = |x: &[f64]| x.iter().map(|v| v.to_degrees()).collect::<Vec<f64>>();
@@ -408,6 +428,7 @@ pub fn write_report<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequest, dir: 
                         after: &a.speed,
                     },
                 ],
+                &run_plot,
             )?;
         }
     }

@@ -384,7 +384,8 @@ fn sweep_maps_a_chosen_quantity() {
     assert!((cell["least_stable_real_part"].as_f64().unwrap() + 0.32286642900408524).abs() < 1e-12);
     assert_eq!(cell["open_ended"].as_bool(), Some(true));
     let drawn = std::fs::read_to_string(&svg).unwrap();
-    assert!(drawn.contains("real part of the least stable eigenvalue"));
+    // Issue 20: the map says the speed it was made at.
+    assert!(drawn.contains("largest real part at v = 5 m/s (1/s)"), "{drawn}");
     assert!(drawn.contains("range cut there"));
     // The weave-speed map is another quantity on the same grid.
     let svg2 = tmp("weave.svg");

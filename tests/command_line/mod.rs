@@ -2,4 +2,5 @@
 
 mod commands;
 mod inputs_and_outputs;
+mod plots;
 mod reliability;

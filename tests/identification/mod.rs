@@ -235,6 +235,16 @@ fn example_set_report_folder() {
     ] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
+    // Issue 20: the continuation before and after tells real (solid) and
+    // imaginary (dashed) parts apart, shows the measured points with a
+    // legend entry, and its title names bicycle and model.
+    let svg = std::fs::read_to_string(dir.join("continuation.svg")).unwrap();
+    assert!(svg.matches("stroke-dasharray").count() >= 2, "dashed imaginary parts");
+    assert!(
+        svg.contains(">measured real part (bar: 1 s.e.)<"),
+        "measured in the legend"
+    );
+    assert!(svg.contains("bicycle thesis, model"), "title");
     // The fitted parameter file loads, carries the effect, and refits to
     // nothing more.
     let toml = std::fs::read_to_string(dir.join("fitted.toml")).unwrap();

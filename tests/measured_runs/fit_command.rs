@@ -204,8 +204,9 @@ fn the_plotted_fit_follows_the_measured_points() {
         let points: Vec<(f64, f64)> = svg
             .split("<circle")
             .skip(1)
-            // Data points have radius 2, the legend's marker 3.
-            .filter(|c| attr(c, "r") == 2.0)
+            // Data points are filled in the data colour (their white rims
+            // and the legend's marker aside).
+            .filter(|c| c.contains("fill=\"#282828\""))
             .map(|c| (attr(c, "cx"), attr(c, "cy")))
             .collect();
         let line: Vec<(f64, f64)> = svg
@@ -257,7 +258,16 @@ fn the_plotted_fit_follows_the_measured_points() {
         let vb: f64 = pairs.iter().map(|p| (p.1 - mb).powi(2)).sum();
         let corr = cov / (va * vb).sqrt();
         assert!(corr > 0.9, "{}: drawn fit and points correlate {corr}", path.display());
+        // Issue 20: a PNG beside each SVG, the measured points and the fit
+        // in the legend.
+        assert!(path.with_extension("png").is_file(), "{}: no PNG", path.display());
+        assert!(
+            svg.contains(">measured<") && svg.contains(">fit<"),
+            "{}: legend",
+            path.display()
+        );
         plots += 1;
     }
     assert!(plots >= 6, "{plots} kick plots");
+    assert!(d.join("continuation_measured.png").is_file() || !d.join("continuation_measured.svg").is_file());
 }

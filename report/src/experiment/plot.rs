@@ -1,31 +1,18 @@
-//! Plots of measured runs (SVG): the response with its fit and the speed
-//! trace (like the thesis's Figures 9-10), and the continuation diagram with
-//! each measured weave eigenvalue on its speed segment with error bars
-//! (Figures 14-15).
+//! Plots of measured runs: the response with its fit and the speed trace
+//! (like the thesis's Figures 9-10), and the continuation diagram with
+//! each measured weave eigenvalue at its mean speed, with error bars and
+//! its speed interval (Figures 14-15). Same style, formats and options as
+//! every figure ([`crate::plot`]).
 
-use crate::output::write_string_atomic;
-use crate::plot::{find_font, use_font, PlotError};
+use crate::identify::plot::{measured_parts, MeasuredWeave};
+use crate::plot::style::{self, Area, Frame, Icon, Legend, Marker, Measured, Stroke};
+use crate::plot::{de, label_area_width, render, DrawErr, Figure, PlotError, PlotOptions};
+use crate::simulate::plot::speed_range;
 use bikedyn_runtime::eigen::{eigen_sweep_of, LinearBicycle, Mode};
 use bikedyn_runtime::experiment::fit::FitForm;
 use bikedyn_runtime::experiment::KickFit;
 use plotters::prelude::*;
 use std::path::Path;
-
-const MEASURED: RGBColor = RGBColor(90, 90, 90);
-const FITTED: RGBColor = RGBColor(213, 94, 0);
-const REAL: RGBColor = RGBColor(0, 114, 178);
-const IMAG: RGBColor = RGBColor(0, 158, 115);
-
-fn font_ready() -> Result<(), PlotError> {
-    use_font(find_font()?)
-}
-
-fn drawing(path: &Path, e: impl std::fmt::Display) -> PlotError {
-    PlotError::Drawing {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    }
-}
 
 /// Data range with 8 % padding (`(0, 1)` without finite data).
 pub(crate) fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
@@ -40,112 +27,133 @@ pub(crate) fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
 }
 
 /// Measured roll (deg) or roll rate (deg/s, for roll-rate fits) with the
-/// reported fit, over the window, and the speed below.
-pub fn plot_response(path: &Path, k: &KickFit) -> Result<(), PlotError> {
-    let s = &k.samples;
-    if s.t.is_empty() {
+/// reported fit, over the window, and the speed below. The default size
+/// (when `opts` has the 800x600 default) is 900x620.
+pub fn plot_response(path: &Path, k: &KickFit, opts: &PlotOptions) -> Result<(), PlotError> {
+    if k.samples.t.is_empty() {
         return Err(PlotError::NoData {
             path: path.to_path_buf(),
         });
     }
-    font_ready()?;
-    let fit = k.chosen_fit();
-    let on_rate = fit.is_some_and(|f| matches!(f.form, FitForm::RollRate | FitForm::SpeedVaryingRollRate));
-    let y: Vec<f64> = if on_rate { &s.roll_rate } else { &s.roll }
-        .iter()
-        .map(|v| v.to_degrees())
-        .collect();
-    let fitted: Vec<f64> = match fit {
-        Some(f) => f.evaluate(&s.t).iter().map(|v| v.to_degrees()).collect(),
-        None => Vec::new(),
-    };
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (900, 620)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| drawing(path, e))?;
-        let (top, bottom) = root.split_vertically(420);
-        let (x0, x1) = (s.t[0], s.t[s.t.len() - 1]);
-        let (y0, y1) = range(y.iter().chain(fitted.iter()).copied());
+    let mut o = opts.clone();
+    if o.width == 800 && o.height == 600 {
+        (o.width, o.height) = (900, 620);
+    }
+    render(path, &o, &Response { k })
+}
+
+struct Response<'a> {
+    k: &'a KickFit,
+}
+
+impl Figure for Response<'_> {
+    fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
+        let (k, s) = (self.k, &self.k.samples);
+        let fit = k.chosen_fit();
+        let on_rate = fit.is_some_and(|f| matches!(f.form, FitForm::RollRate | FitForm::SpeedVaryingRollRate));
+        let y: Vec<f64> = if on_rate { &s.roll_rate } else { &s.roll }
+            .iter()
+            .map(|v| v.to_degrees())
+            .collect();
+        let fitted: Vec<(f64, f64)> = match fit {
+            Some(f) => {
+                s.t.iter()
+                    .copied()
+                    .zip(f.evaluate(&s.t).iter().map(|v| v.to_degrees()))
+                    .collect()
+            }
+            None => Vec::new(),
+        };
+        let run = k
+            .run
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
         let title = match fit {
             Some(f) => format!(
-                "{} kick {:.2} s: {:.3} {:+.3} i (r2 {:.4}, {})",
-                k.run
-                    .file_name()
-                    .map(|n| n.to_string_lossy().into_owned())
-                    .unwrap_or_default(),
+                "{run}, kick at {:.2} s: eigenvalue {:.3} {:+.3}i 1/s (r2 {:.4}, {})",
                 k.kick_time,
                 f.eigenvalue[0],
                 f.eigenvalue[1],
                 f.r2,
                 f.form.name()
             ),
-            None => format!("kick {:.2} s: no fit", k.kick_time),
+            None => format!("{run}, kick at {:.2} s: no fit", k.kick_time),
         };
-        let mut c = ChartBuilder::on(&top)
-            .caption(title, ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(30)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| drawing(path, e))?;
-        c.configure_mesh()
-            .y_desc(if on_rate { "roll rate (deg/s)" } else { "roll (deg)" })
-            .draw()
-            .map_err(|e| drawing(path, e))?;
-        c.draw_series(
+        root.fill(&WHITE).map_err(de)?;
+        let area = style::titled(root, o, &title)?;
+        let (h, _) = (area.dim_in_pixel().1, ());
+        let (top, bottom) = area.split_vertically((h as f64 * 0.68) as u32);
+        let xr = o.x_range.unwrap_or((s.t[0], s.t[s.t.len() - 1]));
+        let yr = o
+            .y_range
+            .unwrap_or_else(|| range(y.iter().copied().chain(fitted.iter().map(|p| p.1))));
+        let vr = speed_range(&s.speed);
+        let label_w = [yr, vr]
+            .iter()
+            .map(|r| label_area_width(root, o, *r, 8))
+            .max()
+            .unwrap_or(0);
+        let measured: Vec<Measured> =
             s.t.iter()
                 .zip(&y)
-                .map(|(a, b)| Circle::new((*a, *b), 2, MEASURED.filled())),
-        )
-        .map_err(|e| drawing(path, e))?
-        .label("measured")
-        .legend(|(x, y)| Circle::new((x + 8, y), 3, MEASURED.filled()));
+                .map(|(t, y)| Measured {
+                    x: *t,
+                    y: *y,
+                    err: None,
+                    x_span: None,
+                })
+                .collect();
+        let dots = Marker::filled(style::DATA).size(0.6);
+        let mut legend = Legend::default();
+        legend.add("measured", Icon::Point(dots));
         if !fitted.is_empty() {
-            c.draw_series(LineSeries::new(
-                s.t.iter().zip(&fitted).map(|(a, b)| (*a, *b)),
-                FITTED.stroke_width(2),
-            ))
-            .map_err(|e| drawing(path, e))?
-            .label("fit")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], FITTED.stroke_width(2)));
+            legend.add("fit", Icon::Line(Stroke::solid(style::VERMILION)));
         }
-        c.configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(|e| drawing(path, e))?;
-        let (v0, v1) = range(s.speed.iter().copied());
-        let mut c2 = ChartBuilder::on(&bottom)
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(x0..x1, v0..v1)
-            .map_err(|e| drawing(path, e))?;
-        c2.configure_mesh()
-            .x_desc("time (s)")
-            .y_desc("speed (m/s)")
-            .draw()
-            .map_err(|e| drawing(path, e))?;
-        c2.draw_series(LineSeries::new(
+        let pts: Vec<(f64, f64)> = measured.iter().map(|m| (m.x, m.y)).collect();
+        let frame = Frame {
+            x_desc: false,
+            y_label_width: Some(label_w),
+            ..Frame::default()
+        };
+        let (mut c, place, _) = style::chart_with_legend(&top, o, xr, yr, frame, &legend, &[&pts, &fitted], &[])?;
+        style::mesh(&mut c, o, "", if on_rate { "roll rate (deg/s)" } else { "roll (deg)" })?;
+        if yr.0 < 0.0 && yr.1 > 0.0 {
+            style::hline(&mut c, o, 0.0)?;
+        }
+        style::measured(&mut c, o, &measured, dots)?;
+        if !fitted.is_empty() {
+            style::curve(&mut c, o, &fitted, Stroke::solid(style::VERMILION))?;
+        }
+        style::frame(&mut c, o)?;
+        legend.draw(root, &c, o, place)?;
+        let frame = Frame {
+            y_label_width: Some(label_w),
+            ..Frame::default()
+        };
+        let mut c2 = style::chart(&bottom, o, xr, vr, frame)?;
+        style::mesh(&mut c2, o, "time (s)", "speed (m/s)")?;
+        let speed: Vec<(f64, f64)> =
             s.t.iter()
                 .zip(&s.speed)
                 .filter(|(_, v)| v.is_finite())
-                .map(|(a, b)| (*a, *b)),
-            REAL.stroke_width(2),
-        ))
-        .map_err(|e| drawing(path, e))?;
-        root.present().map_err(|e| drawing(path, e))?;
+                .map(|(a, b)| (*a, *b))
+                .collect();
+        style::curve(&mut c2, o, &speed, Stroke::solid(style::GREEN))?;
+        style::frame(&mut c2, o)
     }
-    write_string_atomic(path, &svg)?;
-    Ok(())
 }
 
-/// The model's weave eigenvalue (real and imaginary parts) over speed, and
-/// each measured eigenvalue as a segment over its speed interval with error
-/// bars (one standard error) at its mean speed.
-pub fn plot_measured_continuation(path: &Path, c: &dyn LinearBicycle, kicks: &[&KickFit]) -> Result<(), PlotError> {
-    font_ready()?;
+/// The model's weave eigenvalue (real part solid, imaginary part dashed)
+/// over speed, and each measured eigenvalue at its mean speed with error
+/// bars (one standard error) and its speed interval. The default size
+/// (when `opts` has the 800x600 default) is 900x620.
+pub fn plot_measured_continuation(
+    path: &Path,
+    c: &dyn LinearBicycle,
+    kicks: &[&KickFit],
+    opts: &PlotOptions,
+) -> Result<(), PlotError> {
     let vmax = kicks
         .iter()
         .map(|k| k.speed_interval[1])
@@ -153,74 +161,83 @@ pub fn plot_measured_continuation(path: &Path, c: &dyn LinearBicycle, kicks: &[&
         .fold(8.0f64, f64::max)
         + 1.0;
     let speeds: Vec<f64> = (0..=400).map(|i| vmax * i as f64 / 400.0).collect();
-    let sweep = eigen_sweep_of(c, &speeds).map_err(|e| drawing(path, e))?;
-    let mut re = Vec::new();
-    let mut im = Vec::new();
+    let sweep = eigen_sweep_of(c, &speeds).map_err(|e| PlotError::Drawing {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let mut model = Vec::new();
     for p in &sweep.points {
         for k in 0..4 {
             if p.modes[k] == Mode::Weave && p.eigenvalues[k].im > 0.0 {
-                re.push((p.v, p.eigenvalues[k].re));
-                im.push((p.v, p.eigenvalues[k].im));
+                model.push((p.v, p.eigenvalues[k].re, p.eigenvalues[k].im));
             }
         }
     }
-    let meas: Vec<_> = kicks.iter().filter_map(|k| k.chosen_fit().map(|f| (k, f))).collect();
-    let (y0, y1) = range(
-        re.iter()
-            .chain(im.iter())
-            .map(|p| p.1)
-            .chain(meas.iter().flat_map(|(_, f)| f.eigenvalue)),
-    );
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, (900, 620)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| drawing(path, e))?;
-        let mut ch = ChartBuilder::on(&root)
-            .caption("weave eigenvalue: model and measured", ("sans-serif", 18))
-            .margin(10)
-            .x_label_area_size(40)
-            .y_label_area_size(60)
-            .build_cartesian_2d(0.0..vmax, y0.max(-15.0)..y1.min(15.0))
-            .map_err(|e| drawing(path, e))?;
-        ch.configure_mesh()
-            .x_desc("speed (m/s)")
-            .y_desc("eigenvalue (1/s)")
-            .draw()
-            .map_err(|e| drawing(path, e))?;
-        ch.draw_series(LineSeries::new(re.clone(), REAL.stroke_width(2)))
-            .map_err(|e| drawing(path, e))?
-            .label("model, real part")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], REAL.stroke_width(2)));
-        ch.draw_series(LineSeries::new(im.clone(), IMAG.stroke_width(2)))
-            .map_err(|e| drawing(path, e))?
-            .label("model, imaginary part")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], IMAG.stroke_width(2)));
-        for (k, f) in &meas {
-            let [lo, hi] = k.speed_interval;
-            for (val, se, col) in [
-                (f.eigenvalue[0], f.eigenvalue_stderr[0], REAL),
-                (f.eigenvalue[1], f.eigenvalue_stderr[1], IMAG),
-            ] {
-                ch.draw_series(std::iter::once(PathElement::new(
-                    vec![(lo, val), (hi, val)],
-                    col.stroke_width(3),
-                )))
-                .map_err(|e| drawing(path, e))?;
-                ch.draw_series(std::iter::once(PathElement::new(
-                    vec![(k.mean_speed, val - se), (k.mean_speed, val + se)],
-                    BLACK.stroke_width(1),
-                )))
-                .map_err(|e| drawing(path, e))?;
-            }
-        }
-        ch.configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .draw()
-            .map_err(|e| drawing(path, e))?;
-        root.present().map_err(|e| drawing(path, e))?;
+    let measured: Vec<MeasuredWeave> = kicks
+        .iter()
+        .filter_map(|k| {
+            k.chosen_fit().map(|f| MeasuredWeave {
+                speed_interval: k.speed_interval,
+                mean_speed: k.mean_speed,
+                eigenvalue: f.eigenvalue,
+                stderr: f.eigenvalue_stderr,
+            })
+        })
+        .collect();
+    let mut o = opts.clone();
+    if o.width == 800 && o.height == 600 {
+        (o.width, o.height) = (900, 620);
     }
-    write_string_atomic(path, &svg)?;
-    Ok(())
+    render(path, &o, &MeasuredContinuation { model, measured, vmax })
+}
+
+struct MeasuredContinuation {
+    model: Vec<(f64, f64, f64)>,
+    measured: Vec<MeasuredWeave>,
+    vmax: f64,
+}
+
+impl Figure for MeasuredContinuation {
+    fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
+        root.fill(&WHITE).map_err(de)?;
+        let area = style::titled(root, o, "weave eigenvalue: model and measured")?;
+        let re: Vec<(f64, f64)> = self.model.iter().map(|p| (p.0, p.1)).collect();
+        let im: Vec<(f64, f64)> = self.model.iter().map(|p| (p.0, p.2)).collect();
+        let [mre, mim] = measured_parts(&self.measured);
+        let xr = o.x_range.unwrap_or((0.0, self.vmax));
+        let yr = o.y_range.unwrap_or_else(|| {
+            let (y0, y1) = range(
+                re.iter()
+                    .chain(&im)
+                    .map(|p| p.1)
+                    .chain(self.measured.iter().flat_map(|m| m.eigenvalue)),
+            );
+            (y0.max(-15.0), y1.min(15.0))
+        });
+        let mut legend = Legend::default();
+        legend.add("model, real part", Icon::Line(Stroke::solid(style::BLUE)));
+        legend.add("model, imaginary part", Icon::Line(Stroke::dashed(style::BLUE)));
+        if !self.measured.is_empty() {
+            legend.add(
+                "measured real part (bar: 1 s.e.)",
+                Icon::Point(Marker::filled(style::DATA)),
+            );
+            legend.add("measured imaginary part", Icon::Point(Marker::open(style::DATA)));
+        }
+        let points: Vec<(f64, f64)> = mre.iter().chain(&mim).map(|m| (m.x, m.y)).collect();
+        let (mut ch, place, _) =
+            style::chart_with_legend(&area, o, xr, yr, Frame::default(), &legend, &[&re, &im, &points], &[])?;
+        let xl = o.x_label.clone().unwrap_or_else(|| "forward speed v (m/s)".into());
+        let yl = o.y_label.clone().unwrap_or_else(|| "weave eigenvalue (1/s)".into());
+        style::mesh(&mut ch, o, &xl, &yl)?;
+        if yr.0 < 0.0 && yr.1 > 0.0 {
+            style::hline(&mut ch, o, 0.0)?;
+        }
+        style::curve(&mut ch, o, &im, Stroke::dashed(style::BLUE))?;
+        style::curve(&mut ch, o, &re, Stroke::solid(style::BLUE))?;
+        style::measured(&mut ch, o, &mre, Marker::filled(style::DATA))?;
+        style::measured(&mut ch, o, &mim, Marker::open(style::DATA))?;
+        style::frame(&mut ch, o)?;
+        legend.draw(root, &ch, o, place)
+    }
 }

@@ -1,17 +1,19 @@
-//! Plots of an identification report (SVG): the weave eigenvalue over speed
-//! before and after adding the selected effect, with each measured
-//! eigenvalue on its speed segment; and the residual time series of one run
-//! before and after.
+//! Plots of an identification report: the weave eigenvalue over speed
+//! before and after adding the selected effect (real parts solid,
+//! imaginary parts dashed), with each measured eigenvalue at its mean speed
+//! (error bar: one standard error; its speed interval as a light segment);
+//! and the residual time series of one run before and after. Same style
+//! and options as every figure ([`crate::plot`]).
 
 use crate::experiment::plot::range;
-use crate::plot::{de, render, DrawErr, Figure, PlotError, PlotOptions};
-use plotters::coord::Shift;
+use crate::plot::style::{self, Area, Frame, Icon, Legend, Marker, Measured, Stroke};
+use crate::plot::{de, label_area_width, render, DrawErr, Figure, PlotError, PlotOptions};
 use plotters::prelude::*;
 use std::path::Path;
 
-const BEFORE: RGBColor = RGBColor(0, 114, 178);
-const AFTER: RGBColor = RGBColor(213, 94, 0);
-const MEASURED: RGBColor = RGBColor(60, 60, 60);
+const BEFORE: RGBColor = style::BLUE;
+const AFTER: RGBColor = style::VERMILION;
+const MEASURED: RGBColor = style::DATA;
 
 /// A measured weave eigenvalue on its speed segment (m/s; 1/s).
 pub struct MeasuredWeave {
@@ -22,22 +24,23 @@ pub struct MeasuredWeave {
 }
 
 /// Weave eigenvalue curves `(speed, re, im)` of the model before and after,
-/// and the measured eigenvalues.
+/// and the measured eigenvalues. The default size (when `opts` has the
+/// 800x600 default) is 900x620.
 pub fn plot_continuation(
     path: &Path,
     before: &[(f64, f64, f64)],
     after: &[(f64, f64, f64)],
     after_label: &str,
     measured: &[MeasuredWeave],
+    opts: &PlotOptions,
 ) -> Result<(), PlotError> {
-    let opts = PlotOptions {
-        width: 900,
-        height: 620,
-        ..PlotOptions::default()
-    };
+    let mut o = opts.clone();
+    if o.width == 800 && o.height == 600 {
+        (o.width, o.height) = (900, 620);
+    }
     render(
         path,
-        &opts,
+        &o,
         &Continuation {
             before,
             after,
@@ -54,76 +57,82 @@ struct Continuation<'a> {
     measured: &'a [MeasuredWeave],
 }
 
+/// Measured real parts (filled points) and imaginary parts (open points)
+/// with their error bars and speed intervals.
+pub(crate) fn measured_parts(measured: &[MeasuredWeave]) -> [Vec<Measured>; 2] {
+    let part = |k: usize| {
+        measured
+            .iter()
+            .map(|m| Measured {
+                x: m.mean_speed,
+                y: m.eigenvalue[k],
+                err: Some(m.stderr[k]),
+                x_span: Some((m.speed_interval[0], m.speed_interval[1])),
+            })
+            .collect()
+    };
+    [part(0), part(1)]
+}
+
 impl Figure for Continuation<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
-        let (before, after, after_label, measured) = (self.before, self.after, self.after_label, self.measured);
+    fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
+        let (before, after, measured) = (self.before, self.after, self.measured);
+        root.fill(&WHITE).map_err(de)?;
+        let area = style::titled(root, o, "weave eigenvalue before and after identification")?;
         let vmax = before.iter().chain(after).map(|p| p.0).fold(1.0, f64::max);
-        let (y0, y1) = range(
-            before
-                .iter()
-                .chain(after)
-                .flat_map(|p| [p.1, p.2])
-                .chain(measured.iter().flat_map(|m| m.eigenvalue)),
+        let xr = o.x_range.unwrap_or((0.0, vmax));
+        let yr = o.y_range.unwrap_or_else(|| {
+            let (y0, y1) = range(
+                before
+                    .iter()
+                    .chain(after)
+                    .flat_map(|p| [p.1, p.2])
+                    .chain(measured.iter().flat_map(|m| m.eigenvalue)),
+            );
+            (y0.max(-15.0), y1.min(15.0))
+        });
+        let curves: Vec<(Vec<(f64, f64)>, Stroke)> = [(before, BEFORE), (after, AFTER)]
+            .iter()
+            .flat_map(|(c, col)| {
+                [
+                    (c.iter().map(|p| (p.0, p.1)).collect(), Stroke::solid(*col)),
+                    (c.iter().map(|p| (p.0, p.2)).collect(), Stroke::dashed(*col)),
+                ]
+            })
+            .collect();
+        let [re, im] = measured_parts(measured);
+        let mut legend = Legend::default();
+        legend.add("model before", Icon::Line(Stroke::solid(BEFORE)));
+        legend.add(
+            format!("model after ({})", self.after_label),
+            Icon::Line(Stroke::solid(AFTER)),
         );
-        {
-            root.fill(&WHITE).map_err(de)?;
-            let mut ch = ChartBuilder::on(root)
-                .caption("weave eigenvalue before and after identification", ("sans-serif", 18))
-                .margin(10)
-                .x_label_area_size(40)
-                .y_label_area_size(60)
-                .build_cartesian_2d(0.0..vmax, y0.max(-15.0)..y1.min(15.0))
-                .map_err(de)?;
-            ch.configure_mesh()
-                .x_desc("forward speed (m/s)")
-                .y_desc("weave eigenvalue, real and imaginary parts (1/s)")
-                .draw()
-                .map_err(de)?;
-            for (curve, col, label, dashed) in [
-                (before, BEFORE, "model before".to_string(), true),
-                (after, AFTER, format!("model after ({after_label})"), false),
-            ] {
-                for part in 0..2 {
-                    let pts: Vec<(f64, f64)> = curve.iter().map(|p| (p.0, if part == 0 { p.1 } else { p.2 })).collect();
-                    let style = col.stroke_width(if dashed { 1 } else { 2 });
-                    let s = ch.draw_series(LineSeries::new(pts, style)).map_err(de)?;
-                    if part == 0 {
-                        let l = format!("{label}: real (lower) and imaginary (upper) parts");
-                        s.label(l)
-                            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], style));
-                    }
-                }
-            }
-            for (i, m) in measured.iter().enumerate() {
-                for part in 0..2 {
-                    let (val, se) = (m.eigenvalue[part], m.stderr[part]);
-                    let [lo, hi] = m.speed_interval;
-                    let s = ch
-                        .draw_series(std::iter::once(PathElement::new(
-                            vec![(lo, val), (hi, val)],
-                            MEASURED.stroke_width(3),
-                        )))
-                        .map_err(de)?;
-                    if i == 0 && part == 0 {
-                        s.label("measured (over its speed interval, bar: one standard error)")
-                            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], MEASURED.stroke_width(3)));
-                    }
-                    ch.draw_series(std::iter::once(PathElement::new(
-                        vec![(m.mean_speed, val - se), (m.mean_speed, val + se)],
-                        BLACK.stroke_width(1),
-                    )))
-                    .map_err(de)?;
-                }
-            }
-            ch.configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 13))
-                .draw()
-                .map_err(de)?;
+        legend.add("real part", Icon::Line(Stroke::solid(style::GREY)));
+        legend.add("imaginary part", Icon::Line(Stroke::dashed(style::GREY)));
+        if !measured.is_empty() {
+            legend.add(
+                "measured real part (bar: 1 s.e.)",
+                Icon::Point(Marker::filled(MEASURED)),
+            );
+            legend.add("measured imaginary part", Icon::Point(Marker::open(MEASURED)));
         }
-        Ok(())
+        let points: Vec<(f64, f64)> = re.iter().chain(&im).map(|m| (m.x, m.y)).collect();
+        let mut data: Vec<&[(f64, f64)]> = curves.iter().map(|c| c.0.as_slice()).collect();
+        data.push(&points);
+        let (mut chart, place, _) = style::chart_with_legend(&area, o, xr, yr, Frame::default(), &legend, &data, &[])?;
+        let xl = o.x_label.clone().unwrap_or_else(|| "forward speed v (m/s)".into());
+        let yl = o.y_label.clone().unwrap_or_else(|| "weave eigenvalue (1/s)".into());
+        style::mesh(&mut chart, o, &xl, &yl)?;
+        if yr.0 < 0.0 && yr.1 > 0.0 {
+            style::hline(&mut chart, o, 0.0)?;
+        }
+        for (pts, s) in &curves {
+            style::curve(&mut chart, o, pts, *s)?;
+        }
+        style::measured(&mut chart, o, &re, Marker::filled(MEASURED))?;
+        style::measured(&mut chart, o, &im, Marker::open(MEASURED))?;
+        style::frame(&mut chart, o)?;
+        legend.draw(root, &chart, o, place)
     }
 }
 
@@ -137,14 +146,15 @@ pub struct Channel<'a> {
     pub after: &'a [f64],
 }
 
-/// Measured and simulated roll, steer and speed of one run, before and after.
-pub fn plot_run(path: &Path, title: &str, channels: &[Channel<'_>]) -> Result<(), PlotError> {
-    let opts = PlotOptions {
-        width: 900,
-        height: 260 * channels.len() as u32 + 40,
-        ..PlotOptions::default()
-    };
-    render(path, &opts, &RunFigure { title, channels })
+/// Measured and simulated roll, steer and speed of one run, before and
+/// after, in stacked panels sharing the time axis. The default size (when
+/// `opts` has the 800x600 default) is 900 wide and 260 per channel.
+pub fn plot_run(path: &Path, title: &str, channels: &[Channel<'_>], opts: &PlotOptions) -> Result<(), PlotError> {
+    let mut o = opts.clone();
+    if o.width == 800 && o.height == 600 {
+        (o.width, o.height) = (900, 260 * channels.len() as u32 + 40);
+    }
+    render(path, &o, &RunFigure { title, channels })
 }
 
 struct RunFigure<'a, 'b> {
@@ -153,47 +163,64 @@ struct RunFigure<'a, 'b> {
 }
 
 impl Figure for RunFigure<'_, '_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
-        let (title, channels) = (self.title, self.channels);
-        {
-            root.fill(&WHITE).map_err(de)?;
-            let root = root.titled(title, ("sans-serif", 18)).map_err(de)?;
-            let areas = root.split_evenly((channels.len(), 1));
-            for (area, c) in areas.iter().zip(channels) {
-                if c.t.is_empty() {
-                    continue;
-                }
-                let x1 = c.t.last().copied().unwrap_or(1.0).max(1e-3);
-                let (y0, y1) = range(c.measured.iter().chain(c.before).chain(c.after).copied());
-                let mut ch = ChartBuilder::on(area)
-                    .margin(8)
-                    .x_label_area_size(35)
-                    .y_label_area_size(60)
-                    .build_cartesian_2d(0.0..x1, y0..y1)
-                    .map_err(de)?;
-                ch.configure_mesh()
-                    .x_desc("time after the window start (s)")
-                    .y_desc(format!("{} ({})", c.name, c.unit))
-                    .draw()
-                    .map_err(de)?;
-                let series = [
-                    (c.measured, MEASURED, "measured", 1),
-                    (c.before, BEFORE, "model before", 2),
-                    (c.after, AFTER, "model after", 2),
-                ];
-                for (y, col, label, w) in series {
-                    let pts: Vec<(f64, f64)> = c.t.iter().copied().zip(y.iter().copied()).collect();
-                    ch.draw_series(LineSeries::new(pts, col.stroke_width(w)))
-                        .map_err(de)?
-                        .label(label)
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(w)));
-                }
-                ch.configure_series_labels()
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .label_font(("sans-serif", 12))
-                    .draw()
-                    .map_err(de)?;
+    fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
+        let channels = self.channels;
+        root.fill(&WHITE).map_err(de)?;
+        let area = style::titled(root, o, self.title)?;
+        let areas = area.split_evenly((channels.len().max(1), 1));
+        let ranges: Vec<(f64, f64)> = channels
+            .iter()
+            .map(|c| range(c.measured.iter().chain(c.before).chain(c.after).copied()))
+            .collect();
+        let label_w = ranges
+            .iter()
+            .map(|r| label_area_width(root, o, *r, 8))
+            .max()
+            .unwrap_or(0);
+        let mut legend = Legend::default();
+        legend.add("measured", Icon::Line(Stroke::solid(MEASURED).width(0.75)));
+        legend.add("model before", Icon::Line(Stroke::dashed(BEFORE)));
+        legend.add("model after", Icon::Line(Stroke::solid(AFTER)));
+        let n = channels.len();
+        for (k, ((panel, c), yr)) in areas.iter().zip(channels).zip(&ranges).enumerate() {
+            if c.t.is_empty() {
+                continue;
+            }
+            let x1 = c.t.last().copied().unwrap_or(1.0).max(1e-3);
+            let xr = o.x_range.unwrap_or((0.0, x1));
+            let series: Vec<(Vec<(f64, f64)>, Stroke)> = [
+                (c.measured, Stroke::solid(MEASURED).width(0.75)),
+                (c.before, Stroke::dashed(BEFORE)),
+                (c.after, Stroke::solid(AFTER)),
+            ]
+            .iter()
+            .map(|(y, s)| (c.t.iter().copied().zip(y.iter().copied()).collect(), *s))
+            .collect();
+            let last = k + 1 == n;
+            let frame = Frame {
+                x_desc: last,
+                y_label_width: Some(label_w),
+                ..Frame::default()
+            };
+            let data: Vec<&[(f64, f64)]> = series.iter().map(|s| s.0.as_slice()).collect();
+            let (mut ch, place) = if k == 0 {
+                let (c, p, _) = style::chart_with_legend(panel, o, xr, *yr, frame, &legend, &data, &[])?;
+                (c, Some(p))
+            } else {
+                (style::chart(panel, o, xr, *yr, frame)?, None)
+            };
+            style::mesh(
+                &mut ch,
+                o,
+                if last { "time after the window start (s)" } else { "" },
+                &format!("{} ({})", c.name, c.unit),
+            )?;
+            for (pts, s) in &series {
+                style::curve(&mut ch, o, pts, *s)?;
+            }
+            style::frame(&mut ch, o)?;
+            if let Some(p) = place {
+                legend.draw(root, &ch, o, p)?;
             }
         }
         Ok(())

@@ -1,28 +1,37 @@
 //! Time-history plot of a simulation: roll and steer (degrees) and forward
-//! speed against time, in three stacked panels sharing the time axis. Same
-//! fonts, formats (`.svg`, `.png`) and atomic writing as [`crate::plot`].
+//! speed against time, in three stacked panels sharing the time axis (one
+//! time label, at the bottom), with the kicks and torque pulses marked. Same
+//! style, formats (`.svg`, `.png`) and atomic writing as [`crate::plot`].
 
 use std::path::Path;
 
-use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::plot::{de, padded, render, tick, DrawErr, Figure, PlotError, PlotOptions};
+use crate::plot::style::{self, Area, Frame, Icon, Legend, Stroke};
+use crate::plot::{de, label_area_width, padded, render, tick, DrawErr, Figure, PlotError, PlotOptions};
 
-use bikedyn_runtime::simulate::Simulation;
+use bikedyn_runtime::simulate::{Inputs, PulseTarget, Simulation};
 
 struct TimeHistory<'a> {
     sim: &'a Simulation,
-    opts: &'a PlotOptions,
+    inputs: &'a Inputs,
     roll: Vec<f64>,
     steer: Vec<f64>,
 }
 
-/// Plot roll, steer and speed of `sim` against time to `path`. The default
-/// size (when `opts` has the 800x600 default) is 800x900.
-pub fn plot_simulation(path: impl AsRef<Path>, sim: &Simulation, opts: &PlotOptions) -> Result<(), PlotError> {
+/// Plot roll, steer and speed of `sim` against time to `path`, marking the
+/// kicks and torque pulses of `inputs`. The default size (when `opts` has
+/// the 800x600 default) is 800x900. The speed axis spans the speed's own
+/// variation (a constant speed is drawn in a narrow band around its value).
+pub fn plot_simulation(
+    path: impl AsRef<Path>,
+    sim: &Simulation,
+    inputs: &Inputs,
+    opts: &PlotOptions,
+) -> Result<(), PlotError> {
     let path = path.as_ref();
     crate::plot::ImageFormat::from_path(path)?;
+    opts.check(path)?;
     use bikedyn_runtime::model::CoordinateRole as R;
     let (roll, steer) = match (sim.coordinate_of(R::Roll), sim.coordinate_of(R::Steer)) {
         (Some(r), Some(s)) if sim.t.len() >= 2 => (r, s),
@@ -41,75 +50,152 @@ pub fn plot_simulation(path: impl AsRef<Path>, sim: &Simulation, opts: &PlotOpti
         &o,
         &TimeHistory {
             sim,
-            opts: &o,
+            inputs,
             roll: roll.iter().map(|x| x.to_degrees()).collect(),
             steer: steer.iter().map(|x| x.to_degrees()).collect(),
         },
     )
 }
 
+/// Range of the speed panel: the speed's variation with 10 % padding, or a
+/// band of ±1 % around a constant speed.
+pub(crate) fn speed_range(v: &[f64]) -> (f64, f64) {
+    let lo = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let hi = v
+        .iter()
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(f64::NEG_INFINITY, f64::max);
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (0.0, 1.0);
+    }
+    let scale = lo.abs().max(hi.abs()).max(0.1);
+    if hi - lo < 1e-6 * scale {
+        let m = 0.5 * (lo + hi);
+        return (m - 0.01 * scale, m + 0.01 * scale);
+    }
+    padded(lo, hi, 0.1)
+}
+
 impl Figure for TimeHistory<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), DrawErr> {
-        let o = self.opts;
+    fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
         root.fill(&WHITE).map_err(de)?;
-        let root = match &o.title {
-            Some(t) => root.titled(t, o.font(1.2)).map_err(de)?,
-            None => root.clone(),
-        };
-        let panels = root.split_evenly((3, 1));
+        let area = style::titled(root, o, "roll, steer and speed after the inputs")?;
+        let panels = area.split_evenly((3, 1));
         let t = &self.sim.t;
-        let xr = (t[0], *t.last().expect("two samples"));
+        let xr = o.x_range.unwrap_or((t[0], *t.last().expect("two samples")));
         let series: [(&[f64], &str, RGBColor); 3] = [
-            (&self.roll, "roll theta (deg)", RGBColor(31, 119, 180)),
-            (&self.steer, "steer gamma (deg)", RGBColor(214, 39, 40)),
-            (&self.sim.speed, "speed (m/s)", RGBColor(44, 160, 44)),
+            (&self.roll, "roll (deg)", style::BLUE),
+            (&self.steer, "steer (deg)", style::VERMILION),
+            (&self.sim.speed, "speed (m/s)", style::GREEN),
         ];
-        for (k, (panel, (ys, label, color))) in panels.iter().zip(series).enumerate() {
-            let lo = ys.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let yr = if k == 2 {
-                padded(lo.min(0.0), hi.max(1e-3), 0.05)
-            } else {
+        let ranges: Vec<(f64, f64)> = series
+            .iter()
+            .enumerate()
+            .map(|(k, (ys, _, _))| {
+                if k == 2 {
+                    return speed_range(ys);
+                }
+                if let Some(r) = o.y_range {
+                    return r;
+                }
+                let lo = ys.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = ys.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 padded(lo.min(-1e-3), hi.max(1e-3), 0.05)
+            })
+            .collect();
+        let label_w = ranges
+            .iter()
+            .map(|r| label_area_width(root, o, *r, 8))
+            .max()
+            .unwrap_or(0);
+        // Inputs inside the time range.
+        let kicks: Vec<f64> = self
+            .inputs
+            .kicks
+            .iter()
+            .map(|k| k.time)
+            .filter(|t| *t >= xr.0 && *t <= xr.1)
+            .collect();
+        let pulses: Vec<(f64, f64, PulseTarget)> = self
+            .inputs
+            .pulses
+            .iter()
+            .map(|p| (p.start.max(xr.0), (p.start + p.duration).min(xr.1), p.target))
+            .filter(|(a, b, _)| b > a)
+            .collect();
+        let mut legend = Legend::default();
+        if !kicks.is_empty() {
+            legend.add("kick", Icon::Line(Stroke::dashed(style::MARK).width(0.5)));
+        }
+        for (target, name, color) in [
+            (PulseTarget::Roll, "roll torque pulse", style::PURPLE),
+            (PulseTarget::Steer, "steer torque pulse", style::ORANGE),
+        ] {
+            if pulses.iter().any(|p| p.2 == target) {
+                legend.add(name, Icon::Patch(color, 0.25));
+            }
+        }
+        for (k, (panel, ((ys, label, color), yr))) in panels.iter().zip(series.iter().zip(&ranges)).enumerate() {
+            let last = k == 2;
+            let frame = Frame {
+                x_desc: last,
+                y_label_width: Some(label_w),
+                ..Frame::default()
             };
-            let mut chart = ChartBuilder::on(panel)
-                .margin_top(o.pxu(10.0))
-                .margin_right(o.pxu(24.0))
-                .margin_left(o.pxu(10.0))
-                .x_label_area_size(o.pxu(o.font_size * 2.8))
-                .y_label_area_size(o.pxu(o.font_size * 4.5))
-                .build_cartesian_2d(xr.0..xr.1, yr.0..yr.1)
-                .map_err(de)?;
-            chart
-                .configure_mesh()
-                .bold_line_style(RGBColor(225, 225, 225).stroke_width(o.pxu(1.0)))
-                .light_line_style(TRANSPARENT)
-                .axis_style(BLACK.stroke_width(o.pxu(1.0)))
-                .x_labels(11)
-                .y_labels(6)
-                .x_label_formatter(&|v| tick(*v))
-                .y_label_formatter(&|v| tick(*v))
-                .label_style(o.font(0.85))
-                .axis_desc_style(o.font(0.95))
-                .x_desc("time t (s)")
-                .y_desc(label)
-                .draw()
-                .map_err(de)?;
-            if k < 2 {
+            let pts: Vec<(f64, f64)> = t.iter().copied().zip(ys.iter().copied()).collect();
+            let (mut chart, place) = if k == 0 {
+                let (c, p, _) = style::chart_with_legend(panel, o, xr, *yr, frame, &legend, &[&pts], &[])?;
+                (c, Some(p))
+            } else {
+                (style::chart(panel, o, xr, *yr, frame)?, None)
+            };
+            style::mesh(&mut chart, o, if last { "time t (s)" } else { "" }, label)?;
+            for (a, b, target) in &pulses {
+                let c = if *target == PulseTarget::Roll {
+                    style::PURPLE
+                } else {
+                    style::ORANGE
+                };
                 chart
-                    .draw_series(std::iter::once(PathElement::new(
-                        vec![(xr.0, 0.0), (xr.1, 0.0)],
-                        BLACK.stroke_width(o.pxu(1.0)),
+                    .draw_series(std::iter::once(Rectangle::new(
+                        [(*a, yr.0), (*b, yr.1)],
+                        c.mix(0.18).filled(),
                     )))
                     .map_err(de)?;
             }
-            chart
-                .draw_series(std::iter::once(PathElement::new(
-                    t.iter().copied().zip(ys.iter().copied()).collect::<Vec<_>>(),
-                    color.stroke_width(o.pxu(2.0)),
-                )))
-                .map_err(de)?;
+            for kt in &kicks {
+                style::vline(&mut chart, o, *kt, style::MARK)?;
+            }
+            if !last && yr.0 < 0.0 && yr.1 > 0.0 {
+                style::hline(&mut chart, o, 0.0)?;
+            }
+            style::curve(&mut chart, o, &pts, Stroke::solid(*color))?;
+            style::frame(&mut chart, o)?;
+            if let Some(p) = place {
+                legend.draw(root, &chart, o, p)?;
+            }
         }
+        let _ = tick;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn speed_axis_follows_the_variation() {
+        // A speed varying by 2 cm/s gets an axis about that wide, not 0-5.
+        let (lo, hi) = speed_range(&[4.99, 5.0, 5.01]);
+        assert!(lo > 4.98 && hi < 5.02, "{lo} {hi}");
+        // A constant speed: a narrow band around it.
+        let (lo, hi) = speed_range(&[4.0; 10]);
+        assert!(lo < 4.0 && hi > 4.0 && hi - lo < 0.1, "{lo} {hi}");
     }
 }
