@@ -64,11 +64,21 @@ pub use bikedyn_runtime::number_text::{format_fixed, format_significant};
 /// Boxed error of a writer callback.
 pub type BoxError = Box<dyn std::error::Error + Send + Sync + 'static>;
 
+/// Why `dir` cannot hold a new file: it is a file, or it does not exist.
+fn missing_directory(dir: &Path) -> String {
+    if dir.exists() {
+        format!("{} is a file, not a directory", dir.display())
+    } else {
+        format!("directory {} does not exist", dir.display())
+    }
+}
+
 /// Error writing an output file; always names the target path.
 #[derive(Debug, thiserror::Error)]
 pub enum OutputError {
-    /// The directory of the target does not exist (it is not created).
-    #[error("cannot write {}: directory {} does not exist", .path.display(), .dir.display())]
+    /// The directory of the target does not exist (it is not created), or
+    /// is a file.
+    #[error("cannot write {}: {}", .path.display(), missing_directory(.dir))]
     NoSuchDirectory {
         /// Target file.
         path: PathBuf,
@@ -1078,11 +1088,25 @@ fn summary_row(c: &CellResult) -> Vec<String> {
     }
 }
 
+/// A parameter column's header with its unit, `c (m)`, for the thesis and
+/// benchmark symbols (from their descriptions); other names as they are.
+fn parameter_header(symbol: &str) -> String {
+    use bikedyn_runtime::parameters::{BenchmarkParameters, ThesisParameters};
+    let unit = BenchmarkParameters::describe(symbol)
+        .or_else(|| ThesisParameters::describe(symbol))
+        .and_then(|d| d.strip_suffix(')'))
+        .and_then(|d| d.rsplit_once('(').map(|(_, u)| u));
+    match unit {
+        Some(u) => format!("{symbol} ({u})"),
+        None => symbol.to_string(),
+    }
+}
+
 const SUMMARY_HEADER: [&str; 4] = ["v_w (m/s)", "v_c (m/s)", "stable width (m/s)", "stable intervals (m/s)"];
 
 /// Aligned plain-text table of a parameter sweep (`+` marks a width cut off at `speed_max`).
 pub fn format_parameter_table(s: &ParameterSweep) -> String {
-    let header: Vec<String> = std::iter::once(s.param.name.clone())
+    let header: Vec<String> = std::iter::once(parameter_header(&s.param.name))
         .chain(SUMMARY_HEADER.iter().map(|h| h.to_string()))
         .collect();
     let rows: Vec<Vec<String>> = s
@@ -1101,7 +1125,7 @@ pub fn format_parameter_table(s: &ParameterSweep) -> String {
 
 /// Aligned plain-text table of a stability map, one line per cell (row-major).
 pub fn format_stability_map_table(m: &StabilityMap) -> String {
-    let header: Vec<String> = [m.x.name.clone(), m.y.name.clone()]
+    let header: Vec<String> = [parameter_header(&m.x.name), parameter_header(&m.y.name)]
         .into_iter()
         .chain(SUMMARY_HEADER.iter().map(|h| h.to_string()))
         .collect();

@@ -412,7 +412,10 @@ impl CharPoly {
         }
         let va = v.abs();
         let mut z = quartic_roots(&self.coeffs(va)).ok_or_else(|| EigenError::NoConvergence {
-            what: format!("quartic roots at v = {v}"),
+            what: format!(
+                "quartic roots at v = {} m/s",
+                crate::number_text::format_significant(v, 10)
+            ),
         })?;
         if v < 0.0 {
             for x in z.iter_mut() {

@@ -25,7 +25,7 @@ pub(super) struct Identify<'a, R: ModelRegistry> {
     pub(super) segments: &'a [Segment],
     pub(super) candidates: &'a [Candidate],
     pub(super) opts: &'a FitSettings,
-    pub(super) progress: &'a (dyn Fn(&str) + Sync),
+    pub(super) progress: &'a (dyn Fn(&str, Option<(usize, usize)>) + Sync),
 }
 
 impl<R: ModelRegistry> ModelVisitor for Identify<'_, R> {

@@ -264,13 +264,16 @@ pub fn run_plan<R: ModelRegistry>(
         folds: request.folds,
         ..FitSettings::default()
     };
-    // The runtime reports each candidate fitted by name, from the fitting threads.
+    // The runtime reports each stage by name, from the fitting threads, with
+    // how far the stage is where its size is known (a step's candidate fits,
+    // its cross-validations).
     let fitted = AtomicUsize::new(0);
-    let on_fit = |name: &str| {
+    let on_fit = |name: &str, count: Option<(usize, usize)>| {
+        let n = fitted.fetch_add(1, Ordering::Relaxed) + 1;
         progress(Progress {
             step: name,
-            done: fitted.fetch_add(1, Ordering::Relaxed) + 1,
-            total: None,
+            done: count.map_or(n, |c| c.0),
+            total: count.map(|c| c.1),
         })
     };
     let (id, run_plot) = R::with_model(

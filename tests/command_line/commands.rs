@@ -134,6 +134,28 @@ fn sweep_over_trail_and_a_stability_map() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert_eq!(&std::fs::read(&png).unwrap()[..4], b"\x89PNG");
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1 + 3 * 3);
+    // The tables' headers carry the units, parameter columns included.
+    let table = bikedyn(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0.04:0.08:0.04",
+        "--param2",
+        "lam",
+        "--values2",
+        "0.3:0.31:0.01",
+    ]);
+    let header = String::from_utf8_lossy(&table.stdout)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    for column in ["c (m)", "lam (rad)", "v_w (m/s)", "v_c (m/s)"] {
+        assert!(header.contains(column), "{header}");
+    }
 }
 
 #[test]

@@ -185,6 +185,29 @@ fn huge_and_tiny_values_name_file_and_field() {
     assert!(err.contains("found -1e-300") && err.len() < 300, "{err}");
 }
 
+/// Huge times and speeds on the command line come back in messages in
+/// scientific notation, not with 301 digits.
+#[test]
+fn huge_numbers_in_messages_are_short() {
+    let out = bikedyn(&[
+        "simulate",
+        "--bike",
+        "benchmark",
+        "--speed",
+        "5",
+        "--duration",
+        "1",
+        "--kick",
+        "1e300:1",
+    ]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.contains("1.000000000e300") && err.len() < 300, "{err}");
+    let out = bikedyn(&["eig", "--bike", "benchmark", "--speeds", "0:1e300:1e299"]);
+    let err = text(&out.stderr);
+    assert!(err.len() < 400 && !err.contains("0000000000000000000000"), "{err}");
+}
+
 /// A file missing several fields reports all of them.
 #[test]
 fn all_missing_fields_at_once() {

@@ -496,3 +496,18 @@ fn a_wrong_imu_rate_gives_a_few_gap_lines_and_the_cause() {
     assert!(gap_lines <= 6, "{gap_lines} gap lines: {stderr}");
     assert!(stderr.contains("more gaps") && stderr.contains("rate_hz"), "{stderr}");
 }
+
+/// A plot or output path under a file (not a directory) says so, before
+/// any computation, instead of the system's "File exists" or "does not
+/// exist".
+#[test]
+fn an_output_under_a_file_says_the_folder_is_a_file() {
+    let file = tmp("plain-file");
+    std::fs::write(&file, "not a folder").unwrap();
+    let plot = file.join("eig.svg");
+    let out = bikedyn(&["eig", "--bike", "benchmark", "--speeds", "0:1:0.5", "--plot", plot.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = text(&out.stderr);
+    assert!(err.contains("is a file, not a directory") && err.contains("plain-file"), "{err}");
+    assert!(text(&out.stdout).is_empty(), "computed before checking the output");
+}

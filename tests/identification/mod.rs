@@ -50,14 +50,33 @@ fn identify_with(dir: &Path, report: Option<&Path>, extra: &[&str]) -> Value {
         "identify: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    // Not a terminal: one progress line per step (issue 17, point 5).
+    // Not a terminal: one progress line per step with its count and, in a
+    // counted stage past its first step, the estimate of the time left
+    // (issue 17, point 5; issue 20, point 2).
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
-        err.contains("progress: runs processed (1 done of ")
-            && err.contains("progress: fitted base model (")
+        err.contains("progress: runs processed (1 of ")
+            && err.contains("progress: fitted base model (1 of 1, ")
             && err.contains("progress: score test of "),
         "{err}"
     );
+    let runs = err
+        .lines()
+        .filter(|l| l.starts_with("progress: runs processed"))
+        .count();
+    if runs >= 3 {
+        assert!(
+            err.lines()
+                .any(|l| l.starts_with("progress: runs processed (2 of ") && l.contains("left in this stage)")),
+            "{err}"
+        );
+    }
+    for l in err
+        .lines()
+        .filter(|l| l.starts_with("progress: fitted ") || l.starts_with("progress: cross-validated "))
+    {
+        assert!(l.contains(" of "), "a counted stage without its count: {l}");
+    }
     serde_json::from_slice(&out.stdout).expect("JSON output")
 }
 

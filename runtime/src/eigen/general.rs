@@ -165,7 +165,10 @@ impl Spectrum for General<'_> {
     }
     fn roots_at(&self, v: f64) -> Result<[C64; 4], EigenError> {
         quartic_roots(&self.checked(v)?).ok_or_else(|| EigenError::NoConvergence {
-            what: format!("quartic roots at v = {v}"),
+            what: format!(
+                "quartic roots at v = {} m/s",
+                crate::number_text::format_significant(v, 10)
+            ),
         })
     }
     fn scale(&self) -> f64 {

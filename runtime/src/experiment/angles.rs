@@ -68,6 +68,26 @@ pub struct Calibration {
     pub steer_axis: Option<Vector3<f64>>,
 }
 
+/// Motion of the bicycle during a calibration run ([`Calibration::motion`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CalibrationMotion {
+    /// Range of the block-averaged roll (rad).
+    pub roll_range: f64,
+    /// Range of the block-averaged steer (rad).
+    pub steer_range: f64,
+    /// Largest roll rate between neighbouring blocks (rad/s).
+    pub roll_rate: f64,
+    /// Largest steer rate between neighbouring blocks (rad/s).
+    pub steer_rate: f64,
+}
+
+impl CalibrationMotion {
+    /// Whether the bicycle stayed at rest ([`Calibration::AT_REST_LIMIT`]).
+    pub fn at_rest(&self) -> bool {
+        self.roll_range <= Calibration::AT_REST_LIMIT && self.steer_range <= Calibration::AT_REST_LIMIT
+    }
+}
+
 fn mat(q: &UnitQuaternion<f64>) -> Matrix3<f64> {
     *q.to_rotation_matrix().matrix()
 }
@@ -174,6 +194,63 @@ impl Calibration {
         c.finish(cal, k0);
         c
     }
+
+    /// How far the bicycle moved during the settled part of its
+    /// calibration run: the range of the direct roll and steer angles
+    /// averaged over blocks of [`Calibration::MOTION_BLOCK`] (rad), and the
+    /// largest rate between neighbouring blocks (rad/s). Averaging first
+    /// keeps the sensors' sample noise out; what remains is motion (or the
+    /// sensors' slow wander). `None` when the settled part holds fewer than
+    /// four blocks.
+    pub fn motion(&self, cal: &ThesisRun) -> Option<CalibrationMotion> {
+        let a = angles(cal, self, AngleMethod::Direct);
+        let k0 = a.t.partition_point(|&t| t < self.settled_from);
+        let t = &a.t[k0.min(a.t.len())..];
+        if t.len() < 2 {
+            return None;
+        }
+        let dt = (t[t.len() - 1] - t[0]) / (t.len() - 1) as f64;
+        let m = ((Self::MOTION_BLOCK / dt).round() as usize).max(1);
+        let blocks = t.len() / m;
+        if blocks < 4 || !dt.is_finite() || dt <= 0.0 {
+            return None;
+        }
+        let means = |x: &[f64]| -> Vec<f64> {
+            x[k0..k0 + blocks * m]
+                .chunks_exact(m)
+                .map(|c| c.iter().sum::<f64>() / m as f64)
+                .collect()
+        };
+        let spread = |x: &[f64]| {
+            let (lo, hi) = x
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+            hi - lo
+        };
+        let rate = |x: &[f64]| {
+            x.windows(2)
+                .map(|w| (w[1] - w[0]).abs() / (m as f64 * dt))
+                .fold(0.0, f64::max)
+        };
+        let (roll, steer) = (means(&a.roll), means(&a.steer));
+        Some(CalibrationMotion {
+            roll_range: spread(&roll),
+            steer_range: spread(&steer),
+            roll_rate: rate(&roll),
+            steer_rate: rate(&steer),
+        })
+    }
+
+    /// Block length of [`Calibration::motion`] (s): long against the
+    /// sensors' sample noise, short against a hand's sway.
+    pub const MOTION_BLOCK: f64 = 0.5;
+
+    /// The largest motion of a calibration run at rest (rad): 2 deg of
+    /// roll or steer between block means. The sensors' slow wander at rest
+    /// is a few tenths of a degree; a bicycle that moved more than this
+    /// while its mounting was being measured biases every angle by up to
+    /// that much.
+    pub const AT_REST_LIMIT: f64 = 2.0 * std::f64::consts::PI / 180.0;
 
     fn finish(&mut self, cal: &ThesisRun, k0: usize) {
         let direct = angles(cal, self, AngleMethod::Direct);

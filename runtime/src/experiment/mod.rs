@@ -147,6 +147,26 @@ pub enum RunError {
         /// Where it was looked for.
         expected: PathBuf,
     },
+    /// The calibration run's bicycle moved: its mounting misalignments
+    /// would carry the motion into every angle.
+    #[error(
+        "{}: the calibration run is not at rest: its roll moves by {:.2} deg and its steer by {:.2} deg \
+         between half-second averages over the settled record (rates up to {:.1} and {:.1} deg/s; a bicycle at rest \
+         stays within {:.0} deg, its sensors wander a few tenths); record it with the bicycle held still, or give \
+         another with --calibration",
+        run.display(),
+        motion.roll_range.to_degrees(),
+        motion.steer_range.to_degrees(),
+        motion.roll_rate.to_degrees(),
+        motion.steer_rate.to_degrees(),
+        Calibration::AT_REST_LIMIT.to_degrees()
+    )]
+    NotAtRest {
+        /// The calibration run.
+        run: PathBuf,
+        /// How it moved.
+        motion: angles::CalibrationMotion,
+    },
     /// The named path is neither a run, a set nor a log.
     #[error("{}: not a run folder (run.toml), a set of runs, or a log file", path.display())]
     NotARun {
@@ -515,6 +535,12 @@ pub fn process_set(
     let read: Vec<Result<ThesisRun, RunError>> =
         runs.iter().map(|r| read::read_run(r).map_err(RunError::from)).collect();
     let mut cal = Calibration::estimate(&cal_run, opt.frame_pitch);
+    if let Some(motion) = cal.motion(&cal_run).filter(|m| !m.at_rest()) {
+        return Err(RunError::NotAtRest {
+            run: calibration.to_path_buf(),
+            motion,
+        });
+    }
     let good: Vec<&ThesisRun> = read.iter().filter_map(|r| r.as_ref().ok()).collect();
     if let Some(axis) = cal.steer_axis(&good) {
         cal = cal.with_steer_axis(&cal_run, &axis);

@@ -1418,14 +1418,16 @@ pub fn folds_by_run(segments: &[Segment], folds: usize) -> (usize, Vec<usize>) {
 /// Identify which of `candidates` the data warrant, for the free-speed
 /// model `M` with base parameters `base` (no effect). `progress` is called
 /// after each stage (the base fit, a step's score test, each candidate's fit
-/// and cross-validation) with what was done.
+/// and cross-validation) with what was done and, where the stage's size is
+/// known, how far it is: `(done, total)` (the candidates a step fits after
+/// its score test; at most the candidates it cross-validates).
 pub fn identify<M: MultibodyModel>(
     base: &[f64],
     segments: &[Segment],
     candidates: &[Candidate],
     alternative: Option<&dyn ModelFactory>,
     opts: &IdentifyOptions,
-    progress: &(dyn Fn(&str) + Sync),
+    progress: &(dyn Fn(&str, Option<(usize, usize)>) + Sync),
 ) -> Result<Identification, IdentifyError> {
     if segments.is_empty() {
         return Err(IdentifyError::NoData);
@@ -1473,7 +1475,7 @@ pub fn identify<M: MultibodyModel>(
     let setup0 = Setup::new::<M>(base, segments, &weights, &[])?;
     let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts, None)?;
     before.bic = bic(&before, &before);
-    progress("fitted base model");
+    progress("fitted base model", Some((1, 1)));
     let mut simulations = first.simulations + before.simulations;
     let candidates = &with_priors_on_the_data_scale(candidates, &before);
 
@@ -1519,7 +1521,7 @@ pub fn identify<M: MultibodyModel>(
             current: &current,
         });
         simulations += screened.simulations;
-        progress(&format!("score test of {} candidates", remaining.len()));
+        progress(&format!("score test of {} candidates", remaining.len()), None);
         let reference_bic = screened.reference.map_or(base_bic, |r| r.min(base_bic));
         let best_gain = screened
             .predictions
@@ -1531,6 +1533,15 @@ pub fn identify<M: MultibodyModel>(
         let mut tried = Vec::new();
         let mut setups = Vec::new();
         let mut failed: Vec<(String, String)> = Vec::new();
+        // How many this step fits (for the progress of the step).
+        let passes = |predicted: &Option<f64>| {
+            predicted.is_none_or(|p| {
+                let gain = reference_bic - p;
+                gain > 0.0 && gain >= CONFOUNDED * CONFOUNDED * best_gain
+            })
+        };
+        let to_fit = screened.predictions.iter().filter(|p| passes(p)).count();
+        let mut fitted = 0;
         for (c, predicted) in remaining.iter().zip(&screened.predictions) {
             if let Some(p) = predicted {
                 let gain = reference_bic - p;
@@ -1566,7 +1577,8 @@ pub fn identify<M: MultibodyModel>(
                 }
                 Err(e) => failed.push((c.name.clone(), format!("fit failed: {e}"))),
             }
-            progress(&format!("fitted {}", c.name));
+            fitted += 1;
+            progress(&format!("fitted {}", c.name), Some((fitted, to_fit.max(fitted))));
         }
         // Cross-validation in the order of the criterion: the first
         // candidate that also generalises is added, and the ones behind it
@@ -1577,6 +1589,7 @@ pub fn identify<M: MultibodyModel>(
         order.sort_by(|&a, &b| tried[a].1.bic.total_cmp(&tried[b].1.bic));
         let mut best: Option<usize> = None;
         let mut held_verdict: Vec<Option<String>> = vec![None; tried.len()];
+        let mut validated = 0;
         for &i in &order {
             if best.is_some() {
                 held_verdict[i] = Some(format!(
@@ -1587,7 +1600,11 @@ pub fn identify<M: MultibodyModel>(
                 continue;
             }
             cross_validate(&setups[i], &mut tried[i].1, &fold_of, opts);
-            progress(&format!("cross-validated {}", tried[i].0));
+            validated += 1;
+            progress(
+                &format!("cross-validated {}", tried[i].0),
+                Some((validated, order.len())),
+            );
             let f = &tried[i].1;
             held_verdict[i] = Some(if !(f.cv < current.cv) {
                 format!(

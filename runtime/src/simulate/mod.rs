@@ -868,8 +868,9 @@ pub fn simulate<M: MultibodyModel>(
         }
         if !(k.time >= 0.0 && k.time < duration) {
             return Err(SimulateError::InvalidInput(format!(
-                "kick at t = {} s is outside the run [0, {duration}) s",
-                k.time
+                "kick at t = {} s is outside the run [0, {}) s",
+                crate::number_text::format_significant(k.time, 10),
+                crate::number_text::format_significant(duration, 10)
             )));
         }
     }
