@@ -17,6 +17,7 @@ use bikedyn::fit::{kick_json, plots, run_fit, FitOptions, FitOutcome};
 use bikedyn::identify::eigen_table::{identify_table, write_table_report, TableOutcome, TableRequest};
 use bikedyn::identify::{report as identify_report, run as identify_run, IdentifyRequest, Outcome};
 use bikedyn::report::output::{stability_json, write_atomic};
+use bikedyn::report::plot::PlotOptions;
 use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, eigenvalues_of, LinearBicycle};
 use bikedyn::runtime::experiment::angles::AngleMethod;
 use bikedyn::runtime::parameters::ParameterSet;
@@ -856,6 +857,8 @@ fn sim_failure(e: bikedyn::simulate::SimulationError) -> Failure {
 struct PyFitResult {
     outcome: FitOutcome,
     json: String,
+    /// The figures' subject (the bicycle), as the command line titles them.
+    subject: Option<String>,
 }
 
 #[pymethods]
@@ -875,7 +878,11 @@ impl PyFitResult {
                 .map_err(|e| Failure::new("OutputError", format!("{}: {e}", dir.display())))?;
             write_atomic(dir.join("kicks.json"), |w| w.write_all(json.as_bytes()))
                 .map_err(|e| Failure::new("OutputError", e))?;
-            plots(out, &dir).map_err(|e| Failure::new("OutputError", e))
+            let opts = PlotOptions {
+                subject: self.subject.clone(),
+                ..PlotOptions::default()
+            };
+            plots(out, &dir, &opts).map_err(|e| Failure::new("OutputError", e))
         })
     }
 }
@@ -902,6 +909,7 @@ fn fit(
                 ))
             }
         };
+        let subject = bike.as_deref().map(|b| bikedyn::report::plot::subject(b, None));
         let opts = FitOptions {
             inputs,
             calibration,
@@ -927,6 +935,7 @@ fn fit(
         Ok(PyFitResult {
             json: serde_json::to_string_pretty(&json).expect("JSON of plain values"),
             outcome,
+            subject,
         })
     })
 }
@@ -954,7 +963,7 @@ impl PyIdentifyResult {
     /// replacing a previous report as a whole.
     fn write_report(&self, py: Python<'_>, dir: PathBuf) -> PyResult<()> {
         let r = catch_unwind(AssertUnwindSafe(|| {
-            identify_report::write_report(&self.outcome, &self.request, &dir)
+            identify_report::write_report(&self.outcome, &self.request, &dir, &PlotOptions::default())
         }));
         match r {
             Ok(Ok(())) => Ok(()),
