@@ -1070,6 +1070,15 @@ fn models() -> String {
     serde_json::Value::Array(list).to_string()
 }
 
+/// Panic inside the guard every call runs in, for the test that a panic
+/// reaches Python as `bikedyn.InternalError` (not part of the API).
+#[pyfunction]
+fn _panic_for_tests(py: Python<'_>) -> PyResult<()> {
+    detached(py, || -> Result<(), Failure> {
+        panic!("a deliberate panic (test of the guard)")
+    })
+}
+
 /// Accept parameter files whose lengths look like millimetres.
 #[pyfunction]
 fn allow_implausible_units(allow: bool) {
@@ -1089,6 +1098,7 @@ fn _bikedyn(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(identify_eigenvalues, m)?)?;
     m.add_function(wrap_pyfunction!(models, m)?)?;
     m.add_function(wrap_pyfunction!(allow_implausible_units, m)?)?;
+    m.add_function(wrap_pyfunction!(_panic_for_tests, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

@@ -70,3 +70,13 @@ def test_bad_arguments():
 def test_sweep_errors_name_the_design():
     with pytest.raises(bikedyn.ParameterError, match="mB = -1"):
         bikedyn.sweep("benchmark", "mB", [85.0, -1.0], [5.0])
+
+
+def test_a_rust_panic_is_an_exception_with_its_message():
+    from bikedyn import _bikedyn
+
+    with pytest.raises(bikedyn.InternalError, match="deliberate panic") as e:
+        _bikedyn._panic_for_tests()
+    assert isinstance(e.value, bikedyn.Error) and isinstance(e.value, RuntimeError)
+    # The interpreter goes on.
+    assert bikedyn.Bicycle("benchmark").stability()["weave_speed"] > 4
