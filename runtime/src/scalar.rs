@@ -41,54 +41,54 @@ pub trait Scalar:
     fn powi(self, n: i32) -> Self;
     /// `(sin, cos)` in one call (generated code pairs them).
     fn sin_cos(self) -> (Self, Self);
-    #[inline(always)]
+    #[inline]
     fn zero() -> Self {
         Self::cst(0.0)
     }
-    #[inline(always)]
+    #[inline]
     fn one() -> Self {
         Self::cst(1.0)
     }
 }
 
 impl Scalar for f64 {
-    #[inline(always)]
+    #[inline]
     fn cst(x: f64) -> Self {
         x
     }
-    #[inline(always)]
+    #[inline]
     fn re(self) -> f64 {
         self
     }
-    #[inline(always)]
+    #[inline]
     fn sin(self) -> Self {
         f64::sin(self)
     }
-    #[inline(always)]
+    #[inline]
     fn cos(self) -> Self {
         f64::cos(self)
     }
-    #[inline(always)]
+    #[inline]
     fn sqrt(self) -> Self {
         f64::sqrt(self)
     }
-    #[inline(always)]
+    #[inline]
     fn exp(self) -> Self {
         f64::exp(self)
     }
-    #[inline(always)]
+    #[inline]
     fn acos(self) -> Self {
         f64::acos(self)
     }
-    #[inline(always)]
+    #[inline]
     fn atan(self) -> Self {
         f64::atan(self)
     }
-    #[inline(always)]
+    #[inline]
     fn powi(self, n: i32) -> Self {
         f64::powi(self, n)
     }
-    #[inline(always)]
+    #[inline]
     fn sin_cos(self) -> (Self, Self) {
         f64::sin_cos(self)
     }
@@ -111,7 +111,7 @@ impl<const N: usize> Dual<N> {
         eps[k] = 1.0;
         Dual { re, eps }
     }
-    #[inline(always)]
+    #[inline]
     fn chain(self, f: f64, df: f64) -> Self {
         let mut eps = self.eps;
         for e in eps.iter_mut() {
@@ -121,9 +121,15 @@ impl<const N: usize> Dual<N> {
     }
 }
 
+// The operations are `#[inline]`, not `#[inline(always)]`: LLVM's
+// always-inliner runs before each callee is simplified, so forced inlining
+// pasted the per-direction loops, not yet unrolled, into the generated
+// functions (tens of thousands of tiny loops in one function, which the loop
+// passes then took minutes over). Plain `#[inline]` lets the callee be
+// unrolled first; the generated code then inlines it all the same.
 impl<const N: usize> Add for Dual<N> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn add(mut self, o: Self) -> Self {
         self.re += o.re;
         for k in 0..N {
@@ -134,7 +140,7 @@ impl<const N: usize> Add for Dual<N> {
 }
 impl<const N: usize> Sub for Dual<N> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn sub(mut self, o: Self) -> Self {
         self.re -= o.re;
         for k in 0..N {
@@ -145,7 +151,7 @@ impl<const N: usize> Sub for Dual<N> {
 }
 impl<const N: usize> Mul for Dual<N> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn mul(self, o: Self) -> Self {
         let mut eps = [0.0; N];
         for k in 0..N {
@@ -159,7 +165,7 @@ impl<const N: usize> Mul for Dual<N> {
 }
 impl<const N: usize> Div for Dual<N> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn div(self, o: Self) -> Self {
         let inv = 1.0 / o.re;
         let re = self.re * inv;
@@ -172,73 +178,73 @@ impl<const N: usize> Div for Dual<N> {
 }
 impl<const N: usize> Neg for Dual<N> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn neg(self) -> Self {
         self.chain(-self.re, -1.0)
     }
 }
 impl<const N: usize> AddAssign for Dual<N> {
-    #[inline(always)]
+    #[inline]
     fn add_assign(&mut self, o: Self) {
         *self = *self + o;
     }
 }
 impl<const N: usize> SubAssign for Dual<N> {
-    #[inline(always)]
+    #[inline]
     fn sub_assign(&mut self, o: Self) {
         *self = *self - o;
     }
 }
 impl<const N: usize> MulAssign for Dual<N> {
-    #[inline(always)]
+    #[inline]
     fn mul_assign(&mut self, o: Self) {
         *self = *self * o;
     }
 }
 
 impl<const N: usize> Scalar for Dual<N> {
-    #[inline(always)]
+    #[inline]
     fn cst(x: f64) -> Self {
         Dual { re: x, eps: [0.0; N] }
     }
-    #[inline(always)]
+    #[inline]
     fn re(self) -> f64 {
         self.re
     }
-    #[inline(always)]
+    #[inline]
     fn sin(self) -> Self {
         let (s, c) = self.re.sin_cos();
         self.chain(s, c)
     }
-    #[inline(always)]
+    #[inline]
     fn cos(self) -> Self {
         let (s, c) = self.re.sin_cos();
         self.chain(c, -s)
     }
-    #[inline(always)]
+    #[inline]
     fn sqrt(self) -> Self {
         let r = self.re.sqrt();
         self.chain(r, 0.5 / r)
     }
-    #[inline(always)]
+    #[inline]
     fn exp(self) -> Self {
         let e = self.re.exp();
         self.chain(e, e)
     }
-    #[inline(always)]
+    #[inline]
     fn acos(self) -> Self {
         self.chain(self.re.acos(), -1.0 / (1.0 - self.re * self.re).sqrt())
     }
-    #[inline(always)]
+    #[inline]
     fn atan(self) -> Self {
         self.chain(self.re.atan(), 1.0 / (1.0 + self.re * self.re))
     }
-    #[inline(always)]
+    #[inline]
     fn powi(self, n: i32) -> Self {
         let p = self.re.powi(n - 1);
         self.chain(p * self.re, n as f64 * p)
     }
-    #[inline(always)]
+    #[inline]
     fn sin_cos(self) -> (Self, Self) {
         let (s, c) = self.re.sin_cos();
         (self.chain(s, c), self.chain(c, -s))
@@ -283,7 +289,7 @@ impl Counted {
     pub fn reset() {
         FLOPS.with(|c| c.set(0));
     }
-    #[inline(always)]
+    #[inline]
     fn tick(n: u64) {
         FLOPS.with(|c| c.set(c.get() + n));
     }
@@ -293,14 +299,14 @@ macro_rules! counted_binop {
     ($tr:ident, $m:ident, $atr:ident, $am:ident, $op:tt) => {
         impl $tr for Counted {
             type Output = Counted;
-            #[inline(always)]
+            #[inline]
             fn $m(self, o: Counted) -> Counted {
                 Counted::tick(1);
                 Counted(self.0 $op o.0)
             }
         }
         impl $atr for Counted {
-            #[inline(always)]
+            #[inline]
             fn $am(&mut self, o: Counted) {
                 *self = *self $op o;
             }
@@ -312,7 +318,7 @@ counted_binop!(Sub, sub, SubAssign, sub_assign, -);
 counted_binop!(Mul, mul, MulAssign, mul_assign, *);
 impl Div for Counted {
     type Output = Counted;
-    #[inline(always)]
+    #[inline]
     fn div(self, o: Counted) -> Counted {
         Counted::tick(1);
         Counted(self.0 / o.0)
@@ -320,7 +326,7 @@ impl Div for Counted {
 }
 impl Neg for Counted {
     type Output = Counted;
-    #[inline(always)]
+    #[inline]
     fn neg(self) -> Counted {
         Counted::tick(1);
         Counted(-self.0)

@@ -326,27 +326,25 @@ impl Simulation {
     }
 }
 
-/// The integrator's view of the model.
-struct Rhs<'e, 'a, M: MultibodyModel> {
-    eval: &'e Evaluator<'a, M>,
-    events: Events,
+/// The explicit integrator's view of a system: its right-hand side and its
+/// stop test behind references to closures, so that DOP853 is compiled once
+/// for every model and scalar type (a `System` generic over the model
+/// would be a copy of the whole solver per model, most of the library's
+/// compile time for nothing: one indirect call per right-hand side is
+/// nothing beside the model's evaluation).
+pub(crate) struct DynSystem<'f> {
+    /// `dy = f(y)`; the time is the state's clock component.
+    pub(crate) f: &'f dyn Fn(&[f64], &mut [f64]),
+    /// Ends the integration after the step that produced `y`.
+    pub(crate) stop: &'f dyn Fn(&[f64]) -> bool,
 }
 
-impl<M: MultibodyModel> System<f64, DVector<f64>> for Rhs<'_, '_, M> {
+impl System<f64, DVector<f64>> for DynSystem<'_> {
     fn system(&self, _x: f64, y: &DVector<f64>, dy: &mut DVector<f64>) {
-        // Time is the state's clock component (see `StateLayout`).
-        let t = y[self.eval.layout.time()];
-        if self.eval.error.borrow().is_some() {
-            dy.fill(f64::NAN);
-            return;
-        }
-        if let Err(e) = self.eval.derivative(t, y.as_slice(), dy.as_mut_slice()) {
-            *self.eval.error.borrow_mut() = Some(e);
-            dy.fill(f64::NAN);
-        }
+        (self.f)(y.as_slice(), dy.as_mut_slice())
     }
     fn solout(&mut self, _t: f64, y: &DVector<f64>, _dy: &DVector<f64>) -> bool {
-        self.eval.error.borrow().is_some() || event_value(self.eval, &self.events, y.as_slice()).0 <= 0.0
+        (self.stop)(y.as_slice())
     }
 }
 
@@ -562,6 +560,20 @@ fn integrate<M: MultibodyModel>(
         Sampling::End => (None, NO_EVENTS),
     };
     let dx = |n: usize| (t1 - t0) / n as f64;
+    // Time is the state's clock component (see `StateLayout`); the first
+    // error of the model's evaluation is kept and the integration driven to
+    // an end with NaN rates.
+    let f = |y: &[f64], dy: &mut [f64]| {
+        if eval.error.borrow().is_some() {
+            dy.fill(f64::NAN);
+            return;
+        }
+        if let Err(e) = eval.derivative(y[eval.layout.time()], y, dy) {
+            *eval.error.borrow_mut() = Some(e);
+            dy.fill(f64::NAN);
+        }
+    };
+    let stop = |y: &[f64]| eval.error.borrow().is_some() || event_value(eval, &events, y).0 <= 0.0;
     let samples = match opts.method {
         Method::Dop853 => {
             let (x_end, dx, output) = match grid {
@@ -574,7 +586,7 @@ fn integrate<M: MultibodyModel>(
                 None => (t1, t1 - t0, OutputType::Sparse),
             };
             let mut s = Dop853::new(
-                Rhs { eval, events },
+                DynSystem { f: &f, stop: &stop },
                 t0,
                 x_end,
                 dx,
@@ -617,17 +629,6 @@ fn integrate<M: MultibodyModel>(
                     .collect(),
                 None => vec![t1],
             };
-            let f = |y: &[f64], dy: &mut [f64]| {
-                if eval.error.borrow().is_some() {
-                    dy.fill(f64::NAN);
-                    return;
-                }
-                if let Err(e) = eval.derivative(y[eval.layout.time()], y, dy) {
-                    *eval.error.borrow_mut() = Some(e);
-                    dy.fill(f64::NAN);
-                }
-            };
-            let stop = |y: &[f64]| eval.error.borrow().is_some() || event_value(eval, &events, y).0 <= 0.0;
             // A few padded sizes (each is a monomorphisation of the solver).
             let r = match y0.len() {
                 0..=12 => radau_padded::<12>(&f, &stop, opts, t0, y0, times),

@@ -26,11 +26,11 @@
 //! The same code with plain `f64` (no direction) is the lean path for
 //! residuals alone: samples on a grid, no energies or constraint residuals.
 
-use ode_solvers::{DVector, Dop853, OutputType, System};
+use ode_solvers::{DVector, Dop853, OutputType};
 use std::cell::RefCell;
 
 use super::rhs::{evaluate_state, forward_speed, state_derivative, At, BicycleCoordinates, StateLayout, Workspace};
-use super::{imposed_speed_parameter, initial_state, Events, InitialConditions, Inputs, SimOptions, SimulateError};
+use super::{imposed_speed_parameter, DynSystem, initial_state, Events, InitialConditions, Inputs, SimOptions, SimulateError};
 use crate::model::MultibodyModel;
 use crate::scalar::{Dual, Scalar};
 
@@ -138,28 +138,15 @@ impl<M: MultibodyModel, T: Carried> Variational<'_, M, T> {
     }
 }
 
-/// The integrator borrows the system (its buffers and first error stay
-/// readable afterwards).
-struct Driver<'v, 'a, M: MultibodyModel, T: Carried>(&'v Variational<'a, M, T>);
-
-impl<M: MultibodyModel, T: Carried> System<f64, DVector<f64>> for Driver<'_, '_, M, T> {
-    fn system(&self, x: f64, big: &DVector<f64>, dbig: &mut DVector<f64>) {
-        self.0.rhs(x, big, dbig)
-    }
-    fn solout(&mut self, _t: f64, big: &DVector<f64>, _dy: &DVector<f64>) -> bool {
-        self.0.error.borrow().is_some() || self.0.stop(big.as_slice())
-    }
-}
-
 impl<M: MultibodyModel, T: Carried> Variational<'_, M, T> {
-    fn rhs(&self, _x: f64, big: &DVector<f64>, dbig: &mut DVector<f64>) {
+    fn rhs(&self, big: &[f64], dbig: &mut [f64]) {
         if self.error.borrow().is_some() {
             dbig.fill(f64::NAN);
             return;
         }
         let mut y = self.y.borrow_mut();
         let mut dy = self.dy.borrow_mut();
-        self.gather(big.as_slice(), &mut y);
+        self.gather(big, &mut y);
         let t = big[self.at.layout.time()];
         let mut pz = self.pz.borrow_mut();
         let mut w = self.ws.borrow_mut();
@@ -170,8 +157,7 @@ impl<M: MultibodyModel, T: Carried> Variational<'_, M, T> {
         }
         state_derivative::<M, T>(self.at.layout, t, &y, &pz, &w, &mut dy);
         let (nd, n) = (T::DIRECTIONS, self.n);
-        let out = dbig.as_mut_slice();
-        let (head, tail) = out.split_at_mut(n);
+        let (head, tail) = dbig.split_at_mut(n);
         for (i, v) in dy.iter().enumerate() {
             head[i] = v.scatter(&mut tail[i * nd..(i + 1) * nd]);
         }
@@ -282,8 +268,13 @@ pub fn response<M: MultibodyModel, T: Carried>(
     // Past the end, off the grid: see `integrate` (ode_solvers 0.6.2 pushes
     // an extrapolated sample at an end within 1e-9 of a grid time).
     let x_end = duration + (1e-6f64).min(0.01 * dx).max(1e-8);
+    // The integrator borrows the system through closures (its buffers and
+    // first error stay readable afterwards; DOP853 is compiled once, see
+    // `DynSystem`).
+    let f = |big: &[f64], dbig: &mut [f64]| sys.rhs(big, dbig);
+    let stop = |big: &[f64]| sys.error.borrow().is_some() || sys.stop(big);
     let mut solver = Dop853::new(
-        Driver(&sys),
+        DynSystem { f: &f, stop: &stop },
         0.0,
         x_end,
         dx,
