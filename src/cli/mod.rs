@@ -318,8 +318,9 @@ impl ProgressDisplay {
             match *stage {
                 Some((t, started)) if t == total && p.done > 1 => started,
                 _ => {
-                    // The first step of a stage took as long as the time since
-                    // the previous report: count the stage from there.
+                    // The stage's clock starts at its first report, so the
+                    // estimate uses the steps after the first (`time_left`
+                    // below is given `done - 1` of `total - 1`).
                     let started = std::time::Instant::now();
                     *stage = Some((total, started));
                     started

@@ -505,9 +505,20 @@ fn an_output_under_a_file_says_the_folder_is_a_file() {
     let file = tmp("plain-file");
     std::fs::write(&file, "not a folder").unwrap();
     let plot = file.join("eig.svg");
-    let out = bikedyn(&["eig", "--bike", "benchmark", "--speeds", "0:1:0.5", "--plot", plot.to_str().unwrap()]);
+    let out = bikedyn(&[
+        "eig",
+        "--bike",
+        "benchmark",
+        "--speeds",
+        "0:1:0.5",
+        "--plot",
+        plot.to_str().unwrap(),
+    ]);
     assert!(!out.status.success());
     let err = text(&out.stderr);
-    assert!(err.contains("is a file, not a directory") && err.contains("plain-file"), "{err}");
+    assert!(
+        err.contains("is a file, not a directory") && err.contains("plain-file"),
+        "{err}"
+    );
     assert!(text(&out.stdout).is_empty(), "computed before checking the output");
 }

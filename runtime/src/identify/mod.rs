@@ -1533,33 +1533,36 @@ pub fn identify<M: MultibodyModel>(
         let mut tried = Vec::new();
         let mut setups = Vec::new();
         let mut failed: Vec<(String, String)> = Vec::new();
-        // How many this step fits (for the progress of the step).
-        let passes = |predicted: &Option<f64>| {
-            predicted.is_none_or(|p| {
-                let gain = reference_bic - p;
-                gain > 0.0 && gain >= CONFOUNDED * CONFOUNDED * best_gain
-            })
-        };
-        let to_fit = screened.predictions.iter().filter(|p| passes(p)).count();
-        let mut fitted = 0;
-        for (c, predicted) in remaining.iter().zip(&screened.predictions) {
-            if let Some(p) = predicted {
-                let gain = reference_bic - p;
-                let why = if !(gain > 0.0) {
-                    format!("screened out: linearised at the current fit, its best BIC change is {:+.1} (score test; not fitted)", -gain)
-                } else if gain < CONFOUNDED * CONFOUNDED * best_gain {
+        // The score test's verdict on a candidate: why it is screened out
+        // (its BIC change and the reason), or `None` when it is fitted. The
+        // count of those fitted is the size of this step for its progress.
+        let screened_why = |predicted: &Option<f64>| -> Option<(f64, String)> {
+            let gain = reference_bic - (*predicted)?;
+            if !(gain > 0.0) {
+                Some((gain, format!("screened out: linearised at the current fit, its best BIC change is {:+.1} (score test; not fitted)", -gain)))
+            } else if gain < CONFOUNDED * CONFOUNDED * best_gain {
+                Some((
+                    gain,
                     format!(
                         "screened out: linearised, it gains {:.0} % of the criterion the best candidate gains (below {:.0} %: neither selected nor confounded with it; not fitted)",
                         100.0 * gain / best_gain,
                         100.0 * CONFOUNDED * CONFOUNDED
-                    )
-                } else {
-                    String::new()
-                };
-                if !why.is_empty() {
-                    screened_out.push((c.name.clone(), -gain, why));
-                    continue;
-                }
+                    ),
+                ))
+            } else {
+                None
+            }
+        };
+        let to_fit = screened
+            .predictions
+            .iter()
+            .filter(|p| screened_why(p).is_none())
+            .count();
+        let mut fitted = 0;
+        for (c, predicted) in remaining.iter().zip(&screened.predictions) {
+            if let Some((gain, why)) = screened_why(predicted) {
+                screened_out.push((c.name.clone(), -gain, why));
+                continue;
             }
             let mut active = selected.clone();
             active.push(c);

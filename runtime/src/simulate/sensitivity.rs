@@ -30,7 +30,9 @@ use ode_solvers::{DVector, Dop853, OutputType};
 use std::cell::RefCell;
 
 use super::rhs::{evaluate_state, forward_speed, state_derivative, At, BicycleCoordinates, StateLayout, Workspace};
-use super::{imposed_speed_parameter, DynSystem, initial_state, Events, InitialConditions, Inputs, SimOptions, SimulateError};
+use super::{
+    imposed_speed_parameter, initial_state, DynSystem, Events, InitialConditions, Inputs, SimOptions, SimulateError,
+};
 use crate::model::MultibodyModel;
 use crate::scalar::{Dual, Scalar};
 
