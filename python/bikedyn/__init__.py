@@ -25,7 +25,7 @@ import json
 import os
 import tempfile
 from collections.abc import Mapping
-from typing import Any, Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, Iterable, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -51,6 +51,7 @@ __all__ = [
     "Simulation",
     "FitResult",
     "IdentifyResult",
+    "ProgressCallback",
     "sweep",
     "simulate",
     "fit",
@@ -563,21 +564,34 @@ def _paths(paths: Union[PathLike, Iterable[PathLike]], what: str) -> List[str]:
     return out
 
 
+ProgressCallback = Callable[[str, int, Optional[int]], None]
+"""A progress callback of :func:`fit` and :func:`identify`:
+``progress(step, done, total)`` with ``step`` what was just done in words
+(``"runs"``, ``"fitted steer_damping"``, ``"score test of 30 candidates"``),
+``done`` the steps of that stage done so far and ``total`` their number when
+known in advance, else ``None``. It is called from the computation's worker
+threads (one call at a time); an exception it raises stops the reports and
+is raised when the computation has finished."""
+
+
 def fit(
     paths: Union[PathLike, Iterable[PathLike]],
     calibration: Optional[PathLike] = None,
     bike: Optional[BikeLike] = None,
     angles: str = "direct",
     nominal_clock: bool = False,
+    progress: Optional[ProgressCallback] = None,
 ) -> FitResult:
     """Measured weave eigenvalues from raw runs (``bikedyn fit``): run
     folders, set folders or TU Delft logs. ``calibration``: the calibration
     run (default: ``calibration/`` beside the runs). ``bike``: predict each
-    kick's weave with this bicycle. Returns a :class:`FitResult`."""
+    kick's weave with this bicycle. ``progress``: called as
+    ``progress(step, done, total)`` after each run or log (see
+    :data:`ProgressCallback`). Returns a :class:`FitResult`."""
     stack: List[Any] = []
     spec = None if bike is None else _bicycle(bike)._as_spec(stack)
     cal = None if calibration is None else _paths(calibration, "calibration")[0]
-    return FitResult(_bikedyn.fit(_paths(paths, "fit"), cal, spec, angles, nominal_clock))
+    return FitResult(_bikedyn.fit(_paths(paths, "fit"), cal, spec, angles, nominal_clock, progress))
 
 
 def identify(
@@ -587,6 +601,7 @@ def identify(
     folds: int = 4,
     corrections: Optional[int] = None,
     calibration: Optional[PathLike] = None,
+    progress: Optional[ProgressCallback] = None,
 ) -> IdentifyResult:
     """Close the loop (``bikedyn identify``): fit the base model to measured
     runs, diagnose the residual, select effects and parameter corrections
@@ -595,8 +610,10 @@ def identify(
     eigenvalue table form (``identify --eigenvalues``: speed, real part,
     imaginary part, optional standard errors). ``effects``: the candidate
     effects' symbols (default: all); ``corrections``: at most this many
-    parameter corrections (0: effects only). Returns an
-    :class:`IdentifyResult`."""
+    parameter corrections (0: effects only). ``progress``: called as
+    ``progress(step, done, total)`` after each step of the selection (see
+    :data:`ProgressCallback`; the eigenvalue table form takes seconds and
+    does not report). Returns an :class:`IdentifyResult`."""
     stack: List[Any] = []
     spec = _bicycle(bike)._as_spec(stack)
     single = isinstance(paths_or_eigen_table, (str, os.PathLike))
@@ -605,7 +622,9 @@ def identify(
         return IdentifyResult(_bikedyn.identify_eigenvalues(table, spec, list(effects), corrections))
     cal = None if calibration is None else _paths(calibration, "calibration")[0]
     return IdentifyResult(
-        _bikedyn.identify(_paths(paths_or_eigen_table, "identify"), cal, spec, list(effects), int(folds), corrections)
+        _bikedyn.identify(
+            _paths(paths_or_eigen_table, "identify"), cal, spec, list(effects), int(folds), corrections, progress
+        )
     )
 
 

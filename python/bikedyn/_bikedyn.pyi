@@ -2,7 +2,7 @@
 # Users call the package `bikedyn` (bikedyn/__init__.py), which views these
 # byte buffers (native-endian float64, or uint8 mode codes) as NumPy arrays.
 
-from typing import List, Optional, Tuple
+from typing import Callable, List, Optional, Tuple
 
 __version__: str
 
@@ -74,6 +74,7 @@ def fit(
     bike: Optional[str] = None,
     angles: str = "direct",
     nominal_clock: bool = False,
+    progress: Optional[Callable[[str, int, Optional[int]], None]] = None,
 ) -> _FitResult: ...
 def identify(
     inputs: List[str],
@@ -82,6 +83,7 @@ def identify(
     effects: List[str] = ...,
     folds: int = 4,
     corrections: Optional[int] = None,
+    progress: Optional[Callable[[str, int, Optional[int]], None]] = None,
 ) -> _IdentifyResult: ...
 def identify_eigenvalues(
     table: str, bike: str = "thesis", effects: List[str] = ..., corrections: Optional[int] = None

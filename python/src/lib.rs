@@ -89,6 +89,48 @@ fn detached<T: Send>(py: Python<'_>, f: impl FnOnce() -> Result<T, Failure> + Se
     r.map_err(|e| e.into_py(py))
 }
 
+/// Progress reports of a long call (`fit`, `identify`) passed to a Python
+/// callable `progress(step, done, total)`. The pipelines report from their
+/// worker threads, so each call takes the interpreter lock itself (the
+/// computation runs with it released); calls are serialised, and the first
+/// exception the callable raises stops further calls and is raised when
+/// the computation returns.
+struct PyProgress {
+    callback: Option<Py<PyAny>>,
+    error: std::sync::Mutex<Option<PyErr>>,
+}
+
+impl PyProgress {
+    fn new(callback: Option<Py<PyAny>>) -> Self {
+        PyProgress {
+            callback,
+            error: std::sync::Mutex::new(None),
+        }
+    }
+
+    fn report(&self, p: bikedyn::progress::Progress<'_>) {
+        let Some(callback) = &self.callback else { return };
+        // The lock is taken before the interpreter's, never the other way.
+        let mut error = self.error.lock().unwrap_or_else(|e| e.into_inner());
+        if error.is_some() {
+            return;
+        }
+        Python::attach(|py| {
+            if let Err(e) = callback.call1(py, (p.step, p.done, p.total)) {
+                *error = Some(e);
+            }
+        });
+    }
+
+    /// The callable's first exception, if it raised one.
+    fn raised(self) -> PyResult<()> {
+        match self.error.into_inner().unwrap_or_else(|e| e.into_inner()) {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+}
+
 fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
     let what = payload
         .downcast_ref::<&str>()
@@ -889,7 +931,7 @@ impl PyFitResult {
 
 /// Run `bikedyn fit` on run folders, set folders or logs.
 #[pyfunction]
-#[pyo3(signature = (inputs, calibration=None, bike=None, angles="direct".to_string(), nominal_clock=false))]
+#[pyo3(signature = (inputs, calibration=None, bike=None, angles="direct".to_string(), nominal_clock=false, progress=None))]
 fn fit(
     py: Python<'_>,
     inputs: Vec<PathBuf>,
@@ -897,8 +939,10 @@ fn fit(
     bike: Option<String>,
     angles: String,
     nominal_clock: bool,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<PyFitResult> {
-    detached(py, move || {
+    let progress = PyProgress::new(progress);
+    let result = detached(py, || {
         let angles = match angles.as_str() {
             "direct" => AngleMethod::Direct,
             "thesis" => AngleMethod::Thesis,
@@ -917,7 +961,7 @@ fn fit(
             angles,
             nominal_clock,
         };
-        let outcome = run_fit(&opts, &bikedyn::progress::ignore).map_err(|e| Failure::new("DataError", e))?;
+        let outcome = run_fit(&opts, &|p| progress.report(p)).map_err(|e| Failure::new("DataError", e))?;
         let linear = outcome.linear.as_ref().map(|l| l as &dyn LinearBicycle);
         let kicks: Vec<serde_json::Value> = outcome
             .reports
@@ -937,7 +981,9 @@ fn fit(
             outcome,
             subject,
         })
-    })
+    });
+    progress.raised()?;
+    result
 }
 
 /// What identification found (`bikedyn identify`).
@@ -975,7 +1021,7 @@ impl PyIdentifyResult {
 
 /// Run `bikedyn identify` on run folders, set folders or logs.
 #[pyfunction]
-#[pyo3(signature = (inputs, calibration=None, bike="thesis".to_string(), effects=Vec::new(), folds=4, corrections=None))]
+#[pyo3(signature = (inputs, calibration=None, bike="thesis".to_string(), effects=Vec::new(), folds=4, corrections=None, progress=None))]
 fn identify(
     py: Python<'_>,
     inputs: Vec<PathBuf>,
@@ -984,6 +1030,7 @@ fn identify(
     effects: Vec<String>,
     folds: usize,
     corrections: Option<usize>,
+    progress: Option<Py<PyAny>>,
 ) -> PyResult<PyIdentifyResult> {
     if !(2..=1000).contains(&folds) {
         return Err(Failure::new("InvalidArgumentError", format!("folds = {folds}: expected 2 to 1000")).into_py(py));
@@ -996,13 +1043,12 @@ fn identify(
         folds,
         corrections,
     };
-    // The outcome holds the models' plot data, which stays on this thread.
-    let r = catch_unwind(AssertUnwindSafe(|| identify_run(&request, &bikedyn::progress::ignore)));
-    let outcome = match r {
-        Ok(Ok(o)) => o,
-        Ok(Err(e)) => return Err(Failure::new("DataError", e).into_py(py)),
-        Err(p) => return Err(Failure::new("InternalError", panic_message(p)).into_py(py)),
-    };
+    let progress = PyProgress::new(progress);
+    let outcome = detached(py, || {
+        identify_run(&request, &|p| progress.report(p)).map_err(|e| Failure::new("DataError", e))
+    });
+    progress.raised()?;
+    let outcome = outcome?;
     let json = serde_json::to_string_pretty(&identify_report::outcome_json(&outcome)).expect("JSON of plain values");
     let summary = identify_report::summary(&outcome);
     Ok(PyIdentifyResult {

@@ -30,9 +30,38 @@ def test_fit_returns_the_kicks_and_writes_plots(tmp_path):
     assert any(p.suffix == ".svg" for p in (tmp_path / "fit").iterdir())
 
 
+def test_fit_reports_progress_and_raises_the_callbacks_exception():
+    seen = []
+    bikedyn.fit(SET, progress=lambda step, done, total: seen.append((step, done, total)))
+    runs = len([p for p in SET.iterdir() if p.name.startswith("run")])
+    # Runs are processed in parallel: the counts arrive in any order.
+    assert sorted(d for _, d, _ in seen) == list(range(1, runs + 1)), seen
+    assert all(t == runs for _, _, t in seen), seen
+
+    calls = []
+
+    def failing(step, done, total):
+        calls.append(done)
+        raise KeyError("stop")
+
+    with pytest.raises(KeyError):
+        bikedyn.fit(SET, progress=failing)
+    assert len(calls) == 1, "no call after the exception"
+
+
 def test_identify_finds_the_hidden_steer_damping(tmp_path):
-    r = bikedyn.identify(SET, bike="thesis", effects=["steer_damping"], corrections=0)
+    seen = []
+    r = bikedyn.identify(
+        SET,
+        bike="thesis",
+        effects=["steer_damping"],
+        corrections=0,
+        progress=lambda step, done, total: seen.append((step, done, total)),
+    )
     assert r.selected_effects == ["steer_damping"], r.summary()
+    # Each stage counts from 1; the fitted candidate is among the steps.
+    assert seen and all(isinstance(s, str) and d >= 1 for s, d, _ in seen), seen
+    assert any("steer_damping" in s for s, _, _ in seen), seen
     assert "steer_damping" in r.summary()
     r.write_report(tmp_path / "report")
     assert (tmp_path / "report/report.md").is_file()

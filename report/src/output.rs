@@ -1088,12 +1088,14 @@ fn summary_row(c: &CellResult) -> Vec<String> {
     }
 }
 
-/// A parameter column's header with its unit, `c (m)`, for the thesis and
-/// benchmark symbols (from their descriptions); other names as they are.
-fn parameter_header(symbol: &str) -> String {
-    use bikedyn_runtime::parameters::{BenchmarkParameters, ThesisParameters};
-    let unit = BenchmarkParameters::describe(symbol)
-        .or_else(|| ThesisParameters::describe(symbol))
+/// A parameter column's header with its unit, `c (m)`, from the symbol's
+/// description (`describe`: the model's parameter docs, which end in the
+/// unit, as `"steer-axis viscous damping coefficient (N m s/rad)"`, or the
+/// thesis and benchmark descriptions); a name with no description as it is.
+fn parameter_header(symbol: &str, describe: &dyn Fn(&str) -> Option<String>) -> String {
+    let unit = describe(symbol);
+    let unit = unit
+        .as_deref()
         .and_then(|d| d.strip_suffix(')'))
         .and_then(|d| d.rsplit_once('(').map(|(_, u)| u));
     match unit {
@@ -1102,11 +1104,24 @@ fn parameter_header(symbol: &str) -> String {
     }
 }
 
+/// The description of a parameter symbol: the thesis and benchmark sets'
+/// descriptions, else the doc of the parameter in `model` (effect
+/// parameters such as `c_steer`). Each ends in its unit in parentheses.
+pub fn describe_parameter(symbol: &str, model: Option<&bikedyn_runtime::registry::ModelInfo>) -> Option<String> {
+    use bikedyn_runtime::parameters::{BenchmarkParameters, ThesisParameters};
+    BenchmarkParameters::describe(symbol)
+        .or_else(|| ThesisParameters::describe(symbol))
+        .or_else(|| model?.parameter(symbol).map(|p| p.doc))
+        .map(str::to_string)
+}
+
 const SUMMARY_HEADER: [&str; 4] = ["v_w (m/s)", "v_c (m/s)", "stable width (m/s)", "stable intervals (m/s)"];
 
-/// Aligned plain-text table of a parameter sweep (`+` marks a width cut off at `speed_max`).
-pub fn format_parameter_table(s: &ParameterSweep) -> String {
-    let header: Vec<String> = std::iter::once(parameter_header(&s.param.name))
+/// Aligned plain-text table of a parameter sweep (`+` marks a width cut off
+/// at `speed_max`). `describe` gives a parameter's description ending in its
+/// unit in parentheses, for the header (see [`describe_parameter`]).
+pub fn format_parameter_table(s: &ParameterSweep, describe: &dyn Fn(&str) -> Option<String>) -> String {
+    let header: Vec<String> = std::iter::once(parameter_header(&s.param.name, describe))
         .chain(SUMMARY_HEADER.iter().map(|h| h.to_string()))
         .collect();
     let rows: Vec<Vec<String>> = s
@@ -1123,12 +1138,16 @@ pub fn format_parameter_table(s: &ParameterSweep) -> String {
     format_table(&header, &rows)
 }
 
-/// Aligned plain-text table of a stability map, one line per cell (row-major).
-pub fn format_stability_map_table(m: &StabilityMap) -> String {
-    let header: Vec<String> = [parameter_header(&m.x.name), parameter_header(&m.y.name)]
-        .into_iter()
-        .chain(SUMMARY_HEADER.iter().map(|h| h.to_string()))
-        .collect();
+/// Aligned plain-text table of a stability map, one line per cell
+/// (row-major); `describe` as in [`format_parameter_table`].
+pub fn format_stability_map_table(m: &StabilityMap, describe: &dyn Fn(&str) -> Option<String>) -> String {
+    let header: Vec<String> = [
+        parameter_header(&m.x.name, describe),
+        parameter_header(&m.y.name, describe),
+    ]
+    .into_iter()
+    .chain(SUMMARY_HEADER.iter().map(|h| h.to_string()))
+    .collect();
     let (nx, ny) = m.shape();
     let mut rows = Vec::with_capacity(nx * ny);
     for i in 0..nx {

@@ -153,15 +153,16 @@ pub enum LegendPosition {
     Hidden,
 }
 
-/// Plot options. `PlotOptions::default()` gives an 800x600 figure (8 x 6
-/// inches at 100 dpi) with automatic ranges, each figure's default title,
+/// Plot options. `PlotOptions::default()` gives each figure its own size
+/// (800x600, 8 x 6 inches at 100 dpi, for one panel) with automatic ranges, each figure's default title,
 /// 18 px text and a legend placed where it covers no data.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlotOptions {
-    /// Width in pixels at `scale = 1` (default 800).
-    pub width: u32,
-    /// Height in pixels at `scale = 1` (default 600).
-    pub height: u32,
+    /// Width and height in pixels at `scale = 1`. `None`: the figure's own
+    /// size ([`DEFAULT_SIZE`] for one panel; figures with several panels
+    /// are taller). A size that is given is always kept, even when it equals
+    /// the default.
+    pub size: Option<(u32, u32)>,
     /// Multiplies the pixel size, fonts and line widths (default 1; use 2-3
     /// for print-resolution PNG). SVG output is resolution independent anyway.
     pub scale: f64,
@@ -195,11 +196,14 @@ pub struct PlotOptions {
     pub font_path: Option<PathBuf>,
 }
 
+/// Size in pixels at `scale = 1` of a one-panel figure when none is given
+/// (8 x 6 inches at 100 dpi).
+pub const DEFAULT_SIZE: (u32, u32) = (800, 600);
+
 impl Default for PlotOptions {
     fn default() -> Self {
         Self {
-            width: 800,
-            height: 600,
+            size: None,
             scale: 1.0,
             title: None,
             subject: None,
@@ -275,10 +279,19 @@ impl PlotOptions {
 
     /// Image size in pixels.
     pub fn pixel_size(&self) -> (u32, u32) {
+        let (w, h) = self.size.unwrap_or(DEFAULT_SIZE);
         (
-            (self.width as f64 * self.scale).round() as u32,
-            (self.height as f64 * self.scale).round() as u32,
+            (w as f64 * self.scale).round() as u32,
+            (h as f64 * self.scale).round() as u32,
         )
+    }
+
+    /// These options with `size` as the figure's own size when none is given.
+    pub fn sized_by_default(&self, size: (u32, u32)) -> PlotOptions {
+        PlotOptions {
+            size: Some(self.size.unwrap_or(size)),
+            ..self.clone()
+        }
     }
 
     pub(crate) fn px(&self, x: f64) -> f64 {
@@ -1578,8 +1591,7 @@ mod tests {
         }
         let path = std::env::temp_dir().join(format!("bikedyn-smooth-{}.png", std::process::id()));
         let opts = PlotOptions {
-            width: 300,
-            height: 200,
+            size: Some((300, 200)),
             ..PlotOptions::default()
         };
         render(&path, &opts, &Diagonal).unwrap();

@@ -263,7 +263,7 @@ fn sweep_grid_parallel_and_deterministic() {
     save_stability_map_csv(dir.join("map.csv"), &a).unwrap();
     save_stability_map_json(dir.join("map.json"), &a).unwrap();
     assert_eq!(entries(&dir), ["map.csv", "map.json"]);
-    assert_eq!(format_stability_map_table(&a).lines().count(), 63 + 2);
+    assert_eq!(format_stability_map_table(&a, &|_| None).lines().count(), 63 + 2);
 }
 
 #[test]
@@ -343,7 +343,7 @@ fn sweep_parameter_sweep_outputs() {
          n_stable_intervals,stable_intervals,open_ended,error"
     );
     assert_eq!(lines.count(), 17);
-    let table = format_parameter_table(&p);
+    let table = format_parameter_table(&p, &|_| None);
     assert_eq!(table.lines().count(), 19);
     println!("{table}");
 }
@@ -621,8 +621,7 @@ fn issue_20_png_size_and_dpi() {
     let sweep = speed_sweep(&benchmark(), &linspace(0.0, 10.0, 101)).unwrap();
     let dir = test_dir("dpi");
     let opts = PlotOptions {
-        width: 600,
-        height: 400,
+        size: Some((600, 400)),
         scale: 2.0,
         ..PlotOptions::default()
     };

@@ -74,8 +74,10 @@ pub struct OutputArgs {
 /// Size, resolution and axis limits of the figures a command draws.
 #[derive(Args, Clone, Debug, Default)]
 pub struct PlotArgs {
-    /// Figure size WIDTHxHEIGHT in inches (default 8x6; e.g. 3.5x2.6 for a
-    /// journal column), or with a unit: 16x12cm, 800x600px (pixels at 100 dpi).
+    /// Figure size WIDTHxHEIGHT in inches (default 8x6 for one panel, taller
+    /// for stacked panels and 9x6.2 for fit and identify figures; e.g.
+    /// 3.5x2.6 for a journal column), or with a unit: 16x12cm, 800x600px
+    /// (pixels at 100 dpi). A size given is kept, even 8x6.
     #[arg(long, value_name = "WxH")]
     pub plot_size: Option<String>,
     /// Resolution of PNG figures in dots per inch (default 100; 300 for

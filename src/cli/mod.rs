@@ -203,9 +203,9 @@ pub fn plot_options(a: &args::PlotArgs, subject: Option<String>) -> Result<biked
         if !(w.is_finite() && h.is_finite() && w > 0.0 && h > 0.0) {
             bail!("--plot-size `{spec}`: width and height must be positive");
         }
-        o.width = (w * 100.0).round() as u32;
-        o.height = (h * 100.0).round() as u32;
-        if o.width < 200 || o.height < 150 {
+        let size = ((w * 100.0).round() as u32, (h * 100.0).round() as u32);
+        o.size = Some(size);
+        if size.0 < 200 || size.1 < 150 {
             bail!("--plot-size `{spec}`: too small for a figure with axes and labels (at least 2x1.5 inches)");
         }
     }

@@ -61,6 +61,12 @@ pub fn run(a: SweepArgs) -> Result<bool> {
         }
     };
     eprintln!("model: {}", model.as_deref().unwrap_or_default());
+    let info = model.as_deref().and_then(bikedyn::models::model_info);
+    let describe = |symbol: &str| output::describe_parameter(symbol, info);
+    let axis_label = |symbol: &str| match describe(symbol) {
+        Some(d) => format!("{d} [{symbol}]"),
+        None => symbol.to_string(),
+    };
     let opts = SweepOptions {
         probe_speed: at_speed,
         ..SweepOptions::with_speed_range(0.0, speed_max)
@@ -152,7 +158,7 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                 eprintln!("wrote {}", p.display());
             }
             match format {
-                Format::Table => output::format_stability_map_table(&map),
+                Format::Table => output::format_stability_map_table(&map, &describe),
                 Format::Json => serde_json::to_string_pretty(&output::stability_map_json(&map))? + "\n",
                 Format::Csv => {
                     let mut buf = Vec::new();
@@ -190,7 +196,7 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                 eprintln!("wrote {}", p.display());
             }
             match format {
-                Format::Table => output::format_parameter_table(&s),
+                Format::Table => output::format_parameter_table(&s, &describe),
                 Format::Json => serde_json::to_string_pretty(&output::parameter_sweep_json(&s))? + "\n",
                 Format::Csv => {
                     let mut buf = Vec::new();
@@ -206,14 +212,6 @@ pub fn run(a: SweepArgs) -> Result<bool> {
 }
 
 /// "c: trail (m)" from a parameter symbol, for plot axes.
-fn axis_label(symbol: &str) -> String {
-    use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
-    match BenchmarkParameters::describe(symbol).or_else(|| ThesisParameters::describe(symbol)) {
-        Some(d) => format!("{d} [{symbol}]"),
-        None => symbol.to_string(),
-    }
-}
-
 /// A sweep with failed cells is an error listing them (at most ten), never
 /// a table with messages in it.
 fn refuse_failed_cells<'a>(

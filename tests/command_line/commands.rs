@@ -156,6 +156,15 @@ fn sweep_over_trail_and_a_stability_map() {
     for column in ["c (m)", "lam (rad)", "v_w (m/s)", "v_c (m/s)"] {
         assert!(header.contains(column), "{header}");
     }
+    // An effect parameter's column carries the unit of its declaration.
+    let table = bikedyn(&["sweep", "--param", "c_steer", "--values", "0:0.2:0.1"]);
+    assert!(table.status.success(), "{}", String::from_utf8_lossy(&table.stderr));
+    let header = String::from_utf8_lossy(&table.stdout)
+        .lines()
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    assert!(header.contains("c_steer (N m s/rad)"), "{header}");
 }
 
 #[test]

@@ -304,3 +304,30 @@ fn issue_20_simulation_plot() {
     assert!(!speed_ticks.is_empty());
     assert!(speed_ticks.iter().all(|v| (3.9..=4.1).contains(v)), "{speed_ticks:?}");
 }
+
+/// A size given is kept even when it is the one-panel default: the
+/// simulation's three stacked panels are 800x900 by default, and
+/// `--plot-size 8x6` makes them 800x600.
+#[test]
+fn issue_20_an_explicit_plot_size_is_kept() {
+    for (name, extra, size) in [
+        ("sim-default.png", vec![], (800, 900)),
+        ("sim-8x6.png", vec!["--plot-size", "8x6"], (800, 600)),
+    ] {
+        let png = tmp(name);
+        let mut args = vec![
+            "simulate",
+            "--speed",
+            "4",
+            "--duration",
+            "1",
+            "--plot",
+            png.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let out = bikedyn(&args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let (w, h, _) = png_header(&png);
+        assert_eq!((w, h), size, "{name}");
+    }
+}

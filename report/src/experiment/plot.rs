@@ -28,17 +28,14 @@ pub(crate) fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
 
 /// Measured roll (deg) or roll rate (deg/s, for roll-rate fits) with the
 /// reported fit, over the window, and the speed below. The default size
-/// (when `opts` has the 800x600 default) is 900x620.
+/// (when `opts` gives none) is 900x620.
 pub fn plot_response(path: &Path, k: &KickFit, opts: &PlotOptions) -> Result<(), PlotError> {
     if k.samples.t.is_empty() {
         return Err(PlotError::NoData {
             path: path.to_path_buf(),
         });
     }
-    let mut o = opts.clone();
-    if o.width == 800 && o.height == 600 {
-        (o.width, o.height) = (900, 620);
-    }
+    let o = opts.sized_by_default((900, 620));
     render(path, &o, &Response { k })
 }
 
@@ -147,7 +144,7 @@ impl Figure for Response<'_> {
 /// The model's weave eigenvalue (real part solid, imaginary part dashed)
 /// over speed, and each measured eigenvalue at its mean speed with error
 /// bars (one standard error) and its speed interval. The default size
-/// (when `opts` has the 800x600 default) is 900x620.
+/// (when `opts` gives none) is 900x620.
 pub fn plot_measured_continuation(
     path: &Path,
     c: &dyn LinearBicycle,
@@ -184,10 +181,7 @@ pub fn plot_measured_continuation(
             })
         })
         .collect();
-    let mut o = opts.clone();
-    if o.width == 800 && o.height == 600 {
-        (o.width, o.height) = (900, 620);
-    }
+    let o = opts.sized_by_default((900, 620));
     render(path, &o, &MeasuredContinuation { model, measured, vmax })
 }
 
@@ -220,9 +214,12 @@ impl Figure for MeasuredContinuation {
         if !self.measured.is_empty() {
             legend.add(
                 "measured real part (bar: 1 s.e.)",
-                Icon::Point(Marker::filled(style::DATA)),
+                Icon::PointWithError(Marker::filled(style::DATA)),
             );
-            legend.add("measured imaginary part", Icon::Point(Marker::open(style::DATA)));
+            legend.add(
+                "measured imaginary part",
+                Icon::PointWithError(Marker::open(style::DATA)),
+            );
         }
         let points: Vec<(f64, f64)> = mre.iter().chain(&mim).map(|m| (m.x, m.y)).collect();
         let (mut ch, place, _) =

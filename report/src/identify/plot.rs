@@ -24,8 +24,8 @@ pub struct MeasuredWeave {
 }
 
 /// Weave eigenvalue curves `(speed, re, im)` of the model before and after,
-/// and the measured eigenvalues. The default size (when `opts` has the
-/// 800x600 default) is 900x620.
+/// and the measured eigenvalues. The default size (when `opts` gives none)
+/// is 900x620.
 pub fn plot_continuation(
     path: &Path,
     before: &[(f64, f64, f64)],
@@ -34,10 +34,7 @@ pub fn plot_continuation(
     measured: &[MeasuredWeave],
     opts: &PlotOptions,
 ) -> Result<(), PlotError> {
-    let mut o = opts.clone();
-    if o.width == 800 && o.height == 600 {
-        (o.width, o.height) = (900, 620);
-    }
+    let o = opts.sized_by_default((900, 620));
     render(
         path,
         &o,
@@ -112,9 +109,9 @@ impl Figure for Continuation<'_> {
         if !measured.is_empty() {
             legend.add(
                 "measured real part (bar: 1 s.e.)",
-                Icon::Point(Marker::filled(MEASURED)),
+                Icon::PointWithError(Marker::filled(MEASURED)),
             );
-            legend.add("measured imaginary part", Icon::Point(Marker::open(MEASURED)));
+            legend.add("measured imaginary part", Icon::PointWithError(Marker::open(MEASURED)));
         }
         let points: Vec<(f64, f64)> = re.iter().chain(&im).map(|m| (m.x, m.y)).collect();
         let mut data: Vec<&[(f64, f64)]> = curves.iter().map(|c| c.0.as_slice()).collect();
@@ -148,12 +145,9 @@ pub struct Channel<'a> {
 
 /// Measured and simulated roll, steer and speed of one run, before and
 /// after, in stacked panels sharing the time axis. The default size (when
-/// `opts` has the 800x600 default) is 900 wide and 260 per channel.
+/// `opts` gives none) is 900 wide and 260 per channel.
 pub fn plot_run(path: &Path, title: &str, channels: &[Channel<'_>], opts: &PlotOptions) -> Result<(), PlotError> {
-    let mut o = opts.clone();
-    if o.width == 800 && o.height == 600 {
-        (o.width, o.height) = (900, 260 * channels.len() as u32 + 40);
-    }
+    let o = opts.sized_by_default((900, 260 * channels.len() as u32 + 40));
     render(path, &o, &RunFigure { title, channels })
 }
 

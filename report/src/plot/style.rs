@@ -404,8 +404,10 @@ pub(crate) fn lighten(c: RGBColor, t: f64) -> RGBColor {
 pub(crate) enum Icon {
     /// A line (solid or dashed).
     Line(Stroke),
-    /// A measured point with its error bar.
+    /// A measured sample: the marker alone.
     Point(Marker),
+    /// A measured point with its error bar.
+    PointWithError(Marker),
     /// A filled patch (a shaded band).
     Patch(RGBColor, f64),
 }
@@ -563,7 +565,8 @@ impl Legend {
                 Icon::Line(s) => {
                     root.draw(&s.line(o, vec![(ix, cy), (ix + iw, cy)])).map_err(de)?;
                 }
-                Icon::Point(mk) => {
+                Icon::Point(mk) => mk.draw_at(root, o, (ix + iw / 2, cy))?,
+                Icon::PointWithError(mk) => {
                     let e = o.pxi(o.font_size * 0.45);
                     let mid = ix + iw / 2;
                     root.draw(&Line {

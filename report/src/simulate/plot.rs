@@ -8,7 +8,7 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use crate::plot::style::{self, Area, Frame, Icon, Legend, Stroke};
-use crate::plot::{de, label_area_width, padded, render, tick, DrawErr, Figure, PlotError, PlotOptions};
+use crate::plot::{de, label_area_width, padded, render, tick, DrawErr, Figure, PlotError, PlotOptions, DEFAULT_SIZE};
 
 use bikedyn_runtime::simulate::{Inputs, PulseTarget, Simulation};
 
@@ -20,8 +20,8 @@ struct TimeHistory<'a> {
 }
 
 /// Plot roll, steer and speed of `sim` against time to `path`, marking the
-/// kicks and torque pulses of `inputs`. The default size (when `opts` has
-/// the 800x600 default) is 800x900. The speed axis spans the speed's own
+/// kicks and torque pulses of `inputs`. The default size (when `opts` gives
+/// none) is 800x900. The speed axis spans the speed's own
 /// variation (a constant speed is drawn in a narrow band around its value).
 pub fn plot_simulation(
     path: impl AsRef<Path>,
@@ -41,10 +41,7 @@ pub fn plot_simulation(
             })
         }
     };
-    let mut o = opts.clone();
-    if o.width == 800 && o.height == 600 {
-        o.height = 900;
-    }
+    let o = opts.sized_by_default((DEFAULT_SIZE.0, 900));
     render(
         path,
         &o,
