@@ -522,3 +522,54 @@ fn an_output_under_a_file_says_the_folder_is_a_file() {
     );
     assert!(text(&out.stdout).is_empty(), "computed before checking the output");
 }
+
+/// `[speed_switch] magnets = 1e9` in one run.toml drove the process to
+/// 23 GB and the whole batch was killed: every count read from a file is
+/// bounded, and the run is refused with its file and field while the other
+/// runs of the set are still fitted.
+#[test]
+fn a_huge_count_in_a_run_file_is_refused_not_allocated() {
+    let set = tmp("magnets");
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping");
+    for run in ["calibration", "run01", "run02"] {
+        copy_dir(&examples.join(run), &set.join(run));
+    }
+    let toml = set.join("run02/run.toml");
+    let meta = std::fs::read_to_string(&toml).unwrap();
+    assert!(meta.contains("magnets = 9"));
+    std::fs::write(&toml, meta.replace("magnets = 9", "magnets = 1e9")).unwrap();
+    let out = bikedyn(&["fit", set.to_str().unwrap(), "--json"]);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "a run failed: exit 1; {err}");
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let skipped = json["skipped"].to_string();
+    assert!(
+        skipped.contains("run02") && skipped.contains("magnets = 1000000000"),
+        "{skipped}"
+    );
+    assert!(!json["kicks"].as_array().unwrap().is_empty(), "run01 still fitted");
+}
+
+/// `--bike /dev/zero` grew to 2 GB: every input file is read through a
+/// size cap, so an endless device is an error naming the file at once.
+#[cfg(unix)]
+#[test]
+fn an_endless_input_file_is_refused_at_its_cap() {
+    let out = bikedyn(&["params", "show", "--bike", "/dev/zero"]);
+    let err = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("/dev/zero") && err.contains("larger than 16 MiB"), "{err}");
+    // A run's data file likewise (a sensor log cannot be endless).
+    let set = tmp("endless");
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping");
+    for run in ["calibration", "run01"] {
+        copy_dir(&examples.join(run), &set.join(run));
+    }
+    let csv = set.join("run01/speed_switch.csv");
+    std::fs::remove_file(&csv).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &csv).unwrap();
+    let out = bikedyn(&["fit", set.join("run01").to_str().unwrap()]);
+    let err = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("speed_switch.csv") && err.contains("larger than 512 MiB"), "{err}");
+}
