@@ -53,7 +53,11 @@ pub fn input_files(m: &Model) -> Vec<(String, u64)> {
     m.sources
         .iter()
         .filter_map(|s| Some((s.path.clone(), s.text_hash?)))
-        .chain(DERIVATION_CODE.iter().map(|(p, t)| (p.to_string(), fnv1a(t.as_bytes()))))
+        .chain(
+            DERIVATION_CODE
+                .iter()
+                .map(|(p, t)| (p.to_string(), fnv1a(t.as_bytes()))),
+        )
         .collect()
 }
 
@@ -316,7 +320,9 @@ mod tests {
         // file is stale, and the message names that file and no other.
         let after = model("// second version\n");
         let e = from_snapshots(std::slice::from_ref(&after), &snap, &out).unwrap_err();
-        let SnapshotError::Stale(ref stale) = e else { panic!("{e}") };
+        let SnapshotError::Stale(ref stale) = e else {
+            panic!("{e}")
+        };
         assert_eq!(stale[0].changed, vec!["modeler/src/models/pendulum.rs".to_string()]);
         let msg = e.to_string();
         assert!(

@@ -542,9 +542,8 @@ fn a_huge_count_in_a_run_file_is_refused_not_allocated() {
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "a run failed: exit 1; {err}");
     assert!(
-        err.lines().any(|l| l.starts_with("skipped:")
-            && l.contains("run02/run.toml")
-            && l.contains("magnets = 1000000000")),
+        err.lines()
+            .any(|l| l.starts_with("skipped:") && l.contains("run02/run.toml") && l.contains("magnets = 1000000000")),
         "{err}"
     );
     let kicks: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -572,5 +571,8 @@ fn an_endless_input_file_is_refused_at_its_cap() {
     let out = bikedyn(&["fit", set.join("run01").to_str().unwrap()]);
     let err = text(&out.stderr);
     assert!(!out.status.success());
-    assert!(err.contains("speed_switch.csv") && err.contains("larger than 512 MiB"), "{err}");
+    assert!(
+        err.contains("speed_switch.csv") && err.contains("larger than 512 MiB"),
+        "{err}"
+    );
 }
