@@ -217,3 +217,44 @@ fn every_real_parameter_set_gives_its_stability_interval() {
     }
     assert!(stable >= 20, "{stable}");
 }
+
+/// Every command that computes with a model names it (issue 20), on
+/// standard output as part of its result or on standard error beside it.
+#[test]
+fn every_command_names_the_model_it_used() {
+    let set = example_set();
+    let run = set.join("run01");
+    let synth = tmp("named-model-synth");
+    let _ = std::fs::remove_dir_all(&synth);
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["canonical"], "model: thesis_whipple"),
+        (vec!["stability", "--bike", "benchmark"], "model: whipple_offset"),
+        (vec!["eig", "--speeds", "1:2:1"], "model: thesis_whipple"),
+        (
+            vec!["sweep", "--param", "c_steer", "--values", "0.1:0.2:0.1"],
+            "model: extended",
+        ),
+        (
+            vec!["simulate", "--speed", "4", "--duration", "0.2"],
+            "model thesis_whipple",
+        ),
+        (
+            vec!["verify", "--model", "thesis_whipple", "--states", "1"],
+            "model thesis_whipple",
+        ),
+        (
+            vec!["fit", run.to_str().unwrap(), "--bike", "thesis"],
+            "model thesis_whipple",
+        ),
+        (
+            vec!["synth", "--runs", "1", "--seed", "3", "--out", synth.to_str().unwrap()],
+            "model: thesis_whipple",
+        ),
+    ];
+    for (args, named) in cases {
+        let out = bikedyn(&args);
+        let all = text(&out.stdout) + &text(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {all}");
+        assert!(all.contains(named), "{args:?} does not say `{named}`:\n{all}");
+    }
+}
