@@ -354,6 +354,52 @@ fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
         );
         assert!(ha <= 0.5 * hb, "held-out {key} {hb} -> {ha}");
     }
+    // Issue 17, point 6: the weave eigenvalue error, weighted by each
+    // fit's standard error, at least halves on fitted and held-out runs.
+    // The plain RMS cannot halve on this set: the fitted eigenvalues
+    // scatter about the truth's (the frozen-speed weave of the simulated
+    // model, in synth's truth files) by about 0.38 1/s, so the plain RMS
+    // is held to that floor instead.
+    for part in [&j["error_before"], &j["error_after"]] {
+        assert!(part["eigen_weighted_rms"].is_number() && part["held_out"]["eigen_weighted_rms"].is_number());
+    }
+    let (wb, wa) = (
+        f(&j["error_before"]["eigen_weighted_rms"]),
+        f(&j["error_after"]["eigen_weighted_rms"]),
+    );
+    assert!(wa <= 0.5 * wb, "weighted weave RMS {wb} -> {wa}");
+    let (hb, ha) = (
+        f(&j["error_before"]["held_out"]["eigen_weighted_rms"]),
+        f(&j["error_after"]["held_out"]["eigen_weighted_rms"]),
+    );
+    assert!(ha <= 0.5 * hb, "held-out weighted weave RMS {hb} -> {ha}");
+    let kicks = ok_json(&["fit", dir.to_str().unwrap(), "--json"]);
+    let mut ss = Vec::new();
+    for k in kicks.as_array().unwrap() {
+        let run = std::path::Path::new(k["run"].as_str().unwrap())
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        let truth: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("truth/{run}_truth.json"))).unwrap())
+                .unwrap();
+        let weave = truth["frozen_speed_eigenvalues"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|z| [f(&z[0]), f(&z[1])])
+            .max_by(|a, b| a[1].total_cmp(&b[1]))
+            .unwrap();
+        let m = [f(&k["weave"][0]), f(&k["weave"][1])];
+        ss.push((m[0] - weave[0]).powi(2) + (m[1] - weave[1]).powi(2));
+    }
+    let floor = (ss.iter().sum::<f64>() / ss.len() as f64).sqrt();
+    let (before, after) = (f(&j["error_before"]["eigen_rms"]), f(&j["error_after"]["eigen_rms"]));
+    assert!(
+        after <= 1.15 * floor && after < before,
+        "weave RMS {before} -> {after}, the truth's own {floor}"
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 
