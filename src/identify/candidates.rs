@@ -135,6 +135,7 @@ pub fn candidates<R: ModelRegistry>(
                 .map(|f| EffectParameter {
                     symbol: f.symbol.to_string(),
                     tied: f.tied.iter().map(|t| t.to_string()).collect(),
+                    moves: Vec::new(),
                     scale: f.scale,
                     dissipative: f.dissipative,
                     unit: unit(f.symbol),

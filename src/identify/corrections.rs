@@ -16,13 +16,55 @@
 //! falls by at most `(s_j . r)^2 / (s_j . s_j + 1)` when only `j` moves (the
 //! `+1` is the prior). The corrections that explain most of the misfit this
 //! way are the candidates.
+//!
+//! Besides the model's own parameters, the quantities of the bicycle file
+//! that the model holds in several parameters are corrected as a whole
+//! ([`FILE_QUANTITIES`]): the front assembly's mass centre. The thesis
+//! model splits it between the steer-axis point `(x4, z4)`, the front
+//! wheel centre from that point `(x5, z5)` and the offset from the axis
+//! `d4`, so a correction of `z4` alone would also move the steering
+//! geometry. A correction of `zH` moves those parameters together along the
+//! tangent of the file's conversion (the steer axis and the wheels stay
+//! where they are), and the predictions and `fitted.toml` apply it through
+//! the exact conversion.
 
 use super::error::IdentifyError;
 use super::predict::predict;
 use crate::bicycle::Bicycle;
 use bikedyn_runtime::identify::{Candidate, EffectParameter, Segment};
+use bikedyn_runtime::parameters::ThesisParameters;
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 use std::collections::BTreeMap;
+
+/// Quantities of the bicycle file (benchmark symbols; x forward, z down,
+/// from the rear contact point) corrected as a whole: the handlebar and
+/// fork assembly's mass centre, with the models' default uncertainty of a
+/// mass-centre coordinate unless the file gives one.
+pub const FILE_QUANTITIES: [&str; 2] = ["xH", "zH"];
+
+/// Standard deviation of a mass-centre coordinate when the file gives none
+/// (m), as the models declare for theirs.
+const MASS_CENTRE_SD: f64 = 0.02;
+
+/// The model parameters that a file quantity moves, with the coefficients
+/// of the tangent of the file's conversion (central differences of 0.1 mm),
+/// when the model has all of them and they are more than one (a quantity
+/// held in one parameter is that parameter's own correction).
+pub fn moves_of<R: ModelRegistry>(free: &ModelInfo, bike: &Bicycle<R>, symbol: &str) -> Option<Vec<(String, f64)>> {
+    const H: f64 = 1e-4;
+    let v0 = bike.value(symbol)?;
+    let up = bike.with_parameter(symbol, v0 + H).ok()?.thesis().ok()?;
+    let down = bike.with_parameter(symbol, v0 - H).ok()?.thesis().ok()?;
+    let mut out = Vec::new();
+    for s in ThesisParameters::SYMBOLS {
+        let c = (up.get(s)? - down.get(s)?) / (2.0 * H);
+        if c.abs() > 1e-9 {
+            free.parameter(s)?;
+            out.push((s.to_string(), c));
+        }
+    }
+    (out.len() > 1).then_some(out)
+}
 
 /// A parameter correction that passed the screen.
 #[derive(Clone, Debug)]
@@ -37,6 +79,10 @@ pub struct Screened {
     pub from_file: bool,
     /// Largest fall of the weighted eigenvalue misfit (chi^2) it can give.
     pub reduction: f64,
+    /// For a quantity of the file ([`FILE_QUANTITIES`]), the model
+    /// parameters it moves and their coefficients; empty for a model
+    /// parameter.
+    pub moves: Vec<(String, f64)>,
 }
 
 /// The candidate name of a correction of parameter `symbol`.
@@ -110,6 +156,8 @@ pub fn screen_points<R: ModelRegistry>(
         .flat_map(|&(_, m, se, p)| [(m[0] - p[0]) / se[0], (m[1] - p[1]) / se[1]])
         .collect();
     let mut out = Vec::new();
+    // (symbol, value, prior sd, whether the file gave it, moved parameters)
+    let mut quantities: Vec<(String, f64, f64, bool, Vec<(String, f64)>)> = Vec::new();
     for info in free.parameters.iter().filter(|p| p.effect.is_none()) {
         let (Some(u), Some(value)) = (info.uncertainty, bike.value(info.name)) else {
             continue;
@@ -119,12 +167,26 @@ pub fn screen_points<R: ModelRegistry>(
         if !(sd > 0.0) || driven.parameter(info.name).is_none() {
             continue;
         }
-        let moved = predict(
-            driven,
-            bike,
-            &BTreeMap::from([(info.name.to_string(), value + sd)]),
-            &speeds,
-        )?;
+        quantities.push((info.name.to_string(), value, sd, file_sd.is_some(), Vec::new()));
+    }
+    for symbol in FILE_QUANTITIES {
+        let (Some(value), Some(moves)) = (bike.value(symbol), moves_of(free, bike, symbol)) else {
+            continue;
+        };
+        if moves.iter().any(|(s, _)| driven.parameter(s).is_none()) {
+            continue;
+        }
+        let file_sd = bike.file_uncertainty(symbol);
+        quantities.push((
+            symbol.to_string(),
+            value,
+            file_sd.unwrap_or(MASS_CENTRE_SD),
+            file_sd.is_some(),
+            moves,
+        ));
+    }
+    for (symbol, value, sd, from_file, moves) in quantities {
+        let moved = predict(driven, bike, &BTreeMap::from([(symbol.clone(), value + sd)]), &speeds)?;
         let mut s = Vec::with_capacity(r.len());
         for (k, &(_, _, se, p)) in used.iter().enumerate() {
             match moved[k] {
@@ -137,11 +199,12 @@ pub fn screen_points<R: ModelRegistry>(
         let reduction = sr * sr / (ss + 1.0);
         if reduction >= 1.0 {
             out.push(Screened {
-                symbol: info.name.to_string(),
+                symbol,
                 value,
                 sd,
-                from_file: file_sd.is_some(),
+                from_file,
                 reduction,
+                moves,
             });
         }
     }
@@ -153,16 +216,20 @@ pub fn screen_points<R: ModelRegistry>(
 /// The candidate of a screened correction.
 pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
     let doc = free.parameter(&c.symbol).map_or("", |p| p.doc);
-    let unit = doc
-        .rsplit_once('(')
-        .map_or("", |(_, u)| u.trim_end_matches(')'))
-        .to_string();
+    let unit = if c.moves.is_empty() {
+        doc.rsplit_once('(')
+            .map_or("", |(_, u)| u.trim_end_matches(')'))
+            .to_string()
+    } else {
+        "m".to_string()
+    };
     Candidate {
         name: correction_name(&c.symbol),
         effects: Vec::new(),
         parameters: vec![EffectParameter {
             symbol: c.symbol.clone(),
             tied: Vec::new(),
+            moves: c.moves.clone(),
             scale: c.sd,
             dissipative: false,
             unit: unit.clone(),
@@ -173,8 +240,17 @@ pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
         fixed: Vec::new(),
         speed_decay: false,
         reason: format!(
-            "{} = {:.4} {unit}, known to +/- {:.3} {unit} ({}): within that, it could explain a \
+            "{}{} = {:.4} {unit}, known to +/- {:.3} {unit} ({}): within that, it could explain a \
              weighted weave-eigenvalue misfit of {:.1}",
+            if c.moves.is_empty() {
+                String::new()
+            } else {
+                let moved: Vec<&str> = c.moves.iter().map(|(s, _)| s.as_str()).collect();
+                format!(
+                    "the front assembly's mass centre (moving {} together, the steer axis kept): ",
+                    moved.join(", ")
+                )
+            },
             c.symbol,
             c.value,
             c.sd,

@@ -8,6 +8,7 @@ use super::error::IdentifyError;
 use crate::bicycle::Bicycle;
 use bikedyn_runtime::linearize::{lateral_block, linearize_at_speed, parameter_vector, state_space_at_speed};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
+use bikedyn_runtime::parameters::BenchmarkParameters;
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
 use bikedyn_runtime::MultibodyModel;
 use std::collections::BTreeMap;
@@ -66,6 +67,31 @@ pub fn predict<R: ModelRegistry>(
     values: &BTreeMap<String, f64>,
     speeds: &[f64],
 ) -> Result<Vec<Option<[f64; 2]>>, IdentifyError> {
+    // A corrected quantity of the bicycle file that the model holds in
+    // several parameters (the front assembly's mass centre) goes through
+    // the file's exact conversion; the rest overlays the model's values.
+    let file_quantities: Vec<(&String, f64)> = values
+        .iter()
+        .filter(|(k, _)| driven.parameter(k).is_none() && BenchmarkParameters::SYMBOLS.contains(&k.as_str()))
+        .map(|(k, v)| (k, *v))
+        .collect();
+    let corrected;
+    let bike = if file_quantities.is_empty() {
+        bike
+    } else {
+        let mut b = bike.clone();
+        for (k, v) in &file_quantities {
+            b = b.with_parameter(k, *v)?;
+        }
+        corrected = b;
+        &corrected
+    };
+    let values: BTreeMap<String, f64> = values
+        .iter()
+        .filter(|(k, _)| !file_quantities.iter().any(|(q, _)| q == k))
+        .map(|(k, v)| (k.clone(), *v))
+        .collect();
+    let values = &values;
     let base = bike.lookup()?;
     let lookup = |s: &str| values.get(s).copied().or_else(|| base(s));
     let guide = R::with_model(

@@ -388,7 +388,7 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
             parameters: free
                 .iter()
                 .enumerate()
-                .map(|(d, s)| (M::parameter_index(s).unwrap(), d))
+                .map(|(d, s)| (M::parameter_index(s).unwrap(), d, 1.0))
                 .collect(),
             initial: [None; 5],
         };
@@ -468,4 +468,77 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
     check::<ExtendedFree>(&effects, &["c_steer"], &all);
     check::<ExtendedFree>(&effects, &["CdA", "I3x", "T_steer"], &[2, 4]);
     check::<TyreFree>(&[("c_steer", 0.2)], &["c_steer", "sigma_front"], &[0, 3, 4]);
+}
+
+/// A sensitivity direction that moves several parameters with weights (a
+/// correction of the front assembly's mass-centre height moves the
+/// steer-axis point, the wheel centre from it and the offset from the axis
+/// together) equals the central difference of simulations moved along that
+/// combination.
+#[test]
+fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
+    use bikedyn::generated::ExtendedFree;
+    use bikedyn::runtime::linearize::parameter_vector;
+    use bikedyn::runtime::parameters::ThesisParameters;
+    use bikedyn::runtime::scalar::Dual;
+    use bikedyn::runtime::simulate::sensitivity::{response, Carried, Directions, Response};
+    use bikedyn::runtime::simulate::{Events, InitialConditions, SimOptions};
+    use bikedyn::runtime::MultibodyModel;
+    type M = ExtendedFree;
+
+    let thesis = ThesisParameters::thesis_bicycle();
+    let param = parameter_vector::<M>(|s| thesis.get(s), 5.0).unwrap();
+    let weights = [("z4", 0.95), ("z5", -0.95), ("d4", 0.31)];
+    let dirs = Directions {
+        parameters: weights
+            .iter()
+            .map(|(s, w)| (M::parameter_index(s).unwrap(), 0, *w))
+            .collect(),
+        initial: [None; 5],
+    };
+    let ic = InitialConditions {
+        roll: 0.02,
+        steer: -0.01,
+        roll_rate: 0.3,
+        steer_rate: 0.2,
+        speed: 5.0,
+        yaw: 0.0,
+    };
+    let opts = SimOptions {
+        rtol: 1e-12,
+        atol: 1e-14,
+        output_interval: 0.01,
+        events: Events {
+            roll_limit: Some(1.2),
+            steer_limit: Some(1.45),
+        },
+        ..SimOptions::default()
+    };
+    let exact: Response<Dual<6>> = response::<M, Dual<6>>(&param, &ic, &dirs, 2.0, &opts, true).unwrap();
+    let moved = |h: f64| -> Response<f64> {
+        let mut p = param.clone();
+        for (s, w) in weights {
+            p[M::parameter_index(s).unwrap()] += w * h;
+        }
+        response::<M, f64>(&p, &ic, &Directions::default(), 2.0, &opts, true).unwrap()
+    };
+    let h = 1e-5;
+    let (a, b) = (moved(h), moved(-h));
+    for (name, e, a, b) in [
+        ("roll", &exact.roll, &a.roll, &b.roll),
+        ("steer", &exact.steer, &a.steer, &b.steer),
+        ("speed", &exact.speed, &a.speed, &b.speed),
+    ] {
+        let fd: Vec<f64> = a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * h)).collect();
+        let scale = fd.iter().fold(1e-3f64, |m, x| m.max(x.abs()));
+        let worst = e
+            .iter()
+            .zip(&fd)
+            .map(|(x, f)| (x.derivative(0) - f).abs())
+            .fold(0.0f64, f64::max);
+        assert!(
+            worst <= 1e-5 * scale,
+            "d {name} along the combination: exact and central differences differ by {worst:.3e} (scale {scale:.3e})"
+        );
+    }
 }

@@ -403,6 +403,131 @@ fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Issue 17, point 6(b): the front assembly (handlebar and fork) has its
+/// mass centre 3 cm higher than the bicycle file says. The model holds that
+/// point in the steer-axis point, the wheel centre from it and the offset
+/// from the axis, so no single parameter's correction is it; the file's own
+/// quantity `zH` is corrected as a whole (the steer axis kept) and found
+/// within 20 % of the hidden shift. Its effect on the weave is a few
+/// hundredths of 1/s, below the scatter of the fitted eigenvalues about the
+/// truth's, so the eigenvalue check is against the truth itself: the
+/// corrected bicycle's weave is at least twice as close to the simulated
+/// model's as the file's. The held-out errors fall.
+#[test]
+fn a_higher_front_mass_centre_is_corrected_as_a_whole() {
+    let dir = scratch("identify").join("front_mass_centre");
+    let rep = scratch("identify").join("front_mass_centre_report");
+    for d in [&dir, &rep] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+    let benchmark = bikedyn(&["params", "convert", "--to", "benchmark", "thesis"]);
+    assert!(benchmark.status.success(), "{}", text(&benchmark.stderr));
+    let zh = |toml: &str| -> f64 {
+        toml.lines()
+            .find_map(|l| l.strip_prefix("zH = "))
+            .and_then(|v| v.split_whitespace().next()?.parse().ok())
+            .unwrap_or_else(|| panic!("no zH in\n{toml}"))
+    };
+    let zh0 = zh(&text(&benchmark.stdout));
+    let shift = -0.03; // z points down: 3 cm higher
+    let effects = format!("zH={}", zh0 + shift);
+    let out = bikedyn(&[
+        "synth",
+        "--bike",
+        "thesis",
+        "--runs",
+        "12",
+        "--seed",
+        "41",
+        "--effects",
+        &effects,
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "synth: {}", text(&out.stderr));
+    let out = bikedyn(&[
+        "identify",
+        dir.to_str().unwrap(),
+        "--json",
+        "--report",
+        rep.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "identify: {}", text(&out.stderr));
+    let j = stdout_json(&out);
+    let selected: Vec<&str> = j["selected_effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect();
+    let confounded = j["confounded"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|c| c["confounded"] == true && (c["chosen"] == "correct zH" || c["rival"] == "correct zH"));
+    assert!(selected.contains(&"correct zH") || confounded, "{j:#}");
+    if selected.contains(&"correct zH") {
+        let fitted = f(&j["parameters"]["zH"]["value"]) - zh0;
+        assert!(
+            ((fitted - shift) / shift).abs() < 0.2,
+            "zH moved {fitted} m, hidden {shift} m"
+        );
+    }
+    for key in ["roll_rms", "steer_rms"] {
+        let (hb, ha) = (
+            f(&j["error_before"]["held_out"][key]),
+            f(&j["error_after"]["held_out"][key]),
+        );
+        assert!(ha < hb, "held-out {key} {hb} -> {ha}");
+    }
+    // The weave of the file's bicycle and of the corrected one (the
+    // report's fitted.toml) against the simulated model's, at each run's
+    // speed (synth's truth files).
+    let fitted_bike = rep.join("fitted.toml");
+    let weave = |bike: &str, v: f64| -> [f64; 2] {
+        let speeds = format!("{v}:{v}:1");
+        let e = ok_json(&["eig", "--bike", bike, "--speeds", &speeds, "--format", "json"]);
+        let p = &e[0];
+        let k = p["modes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .zip(p["eigenvalues"].as_array().unwrap())
+            .filter(|(m, z)| m.as_str().unwrap().starts_with("weave") && f(&z[1]) > 0.0)
+            .map(|(_, z)| [f(&z[0]), f(&z[1])])
+            .next();
+        k.unwrap_or_else(|| panic!("no weave at {v} m/s for {bike}: {e:#}"))
+    };
+    let (mut before, mut after) = (0.0, 0.0);
+    for entry in std::fs::read_dir(dir.join("truth")).unwrap() {
+        let path = entry.unwrap().path();
+        if !path.to_string_lossy().ends_with("_truth.json") {
+            continue;
+        }
+        let t: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+        let v = f(&t["mean_speed_after_release"]);
+        let truth = t["frozen_speed_eigenvalues"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|z| [f(&z[0]), f(&z[1])])
+            .max_by(|a, b| a[1].total_cmp(&b[1]))
+            .unwrap();
+        let d2 = |w: [f64; 2]| (w[0] - truth[0]).powi(2) + (w[1] - truth[1]).powi(2);
+        before += d2(weave("thesis", v));
+        after += d2(weave(fitted_bike.to_str().unwrap(), v));
+    }
+    assert!(
+        after.sqrt() <= 0.5 * before.sqrt(),
+        "weave distance to the truth {} -> {}",
+        before.sqrt(),
+        after.sqrt()
+    );
+    for d in [&dir, &rep] {
+        let _ = std::fs::remove_dir_all(d);
+    }
+}
+
 /// The TU Delft steer-by-wire logs (`../shared/realdata/tudelft_sbw_kicks`,
 /// four logs, about a hundred kicks) with their bicycle file, whose assist
 /// is a declared input: identify reads them with the roll rate and the

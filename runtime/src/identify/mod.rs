@@ -242,6 +242,16 @@ pub struct EffectParameter {
     /// Other symbols set to the same value (e.g. front and rear rolling
     /// resistance coefficients).
     pub tied: Vec<String>,
+    /// Model parameters this one moves, when `symbol` is not one of the
+    /// model's own but a quantity of the bicycle file that the model holds
+    /// in several parameters (the front assembly's mass-centre height
+    /// `zH`: the steer-axis point, the front wheel centre from it and the
+    /// offset from the axis). Each `(model symbol, coefficient)` is
+    /// simulated at its base value plus the coefficient times this value's
+    /// change from `initial` (the tangent of the file's conversion to the
+    /// model's parameters). Empty: `symbol` and `tied` are model parameters
+    /// set to the value.
+    pub moves: Vec<(String, f64)>,
     /// Typical magnitude (difference step and LM scaling).
     pub scale: f64,
     /// Physical only when positive (dissipation).
@@ -345,8 +355,10 @@ pub struct Setup<'a> {
     /// Channel scales of each segment.
     pub weights: Vec<Weights>,
     pub options: SimOptions,
-    /// Active effect parameters: index lists into `base` (primary + tied).
-    slots: Vec<Vec<usize>>,
+    /// Active effect parameters: the entries of `base` each sets, as
+    /// `(index, coefficient, offset)`: entry = offset + coefficient x value
+    /// (primary and tied symbols: coefficient 1, offset 0).
+    slots: Vec<Vec<(usize, f64, f64)>>,
     pub parameters: Vec<EffectParameter>,
     simulate: fn(&[f64], &Segment, &[f64; NUISANCE], &SimOptions) -> Result<Sim, String>,
     sensitivities: SensitivityFn,
@@ -519,7 +531,7 @@ fn segment_sensitivities<M: MultibodyModel>(
             parameters: dirs
                 .parameters
                 .iter()
-                .filter_map(|&(i, d)| Some((i, inside(d)?)))
+                .filter_map(|&(i, d, c)| Some((i, inside(d)?, c)))
                 .collect(),
             initial: dirs.initial.map(|d| d.and_then(inside)),
         };
@@ -556,11 +568,22 @@ impl<'a> Setup<'a> {
                 base[index(s)?] = *v;
             }
             for p in &c.parameters {
-                let mut idx = vec![index(&p.symbol)?];
-                for t in &p.tied {
-                    idx.push(index(t)?);
-                }
-                slots.push(idx);
+                let slot = if p.moves.is_empty() {
+                    let mut idx = vec![(index(&p.symbol)?, 1.0, 0.0)];
+                    for t in &p.tied {
+                        idx.push((index(t)?, 1.0, 0.0));
+                    }
+                    idx
+                } else {
+                    let origin = p.initial.unwrap_or(0.0);
+                    let mut idx = Vec::with_capacity(p.moves.len());
+                    for (s, c) in &p.moves {
+                        let i = index(s)?;
+                        idx.push((i, *c, base[i] - c * origin));
+                    }
+                    idx
+                };
+                slots.push(slot);
                 parameters.push(p.clone());
             }
         }
@@ -598,11 +621,19 @@ impl<'a> Setup<'a> {
         let mut p = self.base.clone();
         for ((slot, &v), info) in self.slots.iter().zip(g).zip(&self.parameters) {
             let v = info.lower.map_or(v, |lo| v.max(lo));
-            for &i in slot {
-                p[i] = v;
+            for &(i, c, offset) in slot {
+                p[i] = offset + c * v;
             }
         }
         p
+    }
+
+    /// The value of effect parameter `j` at which the model is the base
+    /// one (the base vector's value of its symbol; a derived correction's
+    /// starting value).
+    pub fn base_value(&self, j: usize) -> f64 {
+        let (i, c, offset) = self.slots[j][0];
+        (self.base[i] - offset) / c
     }
 
     /// Weighted residuals of one segment (roll, steer, speed blocks).
@@ -645,7 +676,7 @@ impl<'a> Setup<'a> {
                 if info.lower.is_some_and(|lo| g[j] < lo) {
                     continue;
                 }
-                dirs.parameters.extend(slot.iter().map(|&p| (p, j)));
+                dirs.parameters.extend(slot.iter().map(|&(p, c, _)| (p, j, c)));
             }
         }
         if nuisance {

@@ -134,7 +134,11 @@ pub(super) fn screen(s: &Screen<'_>) -> Screened {
     let symbols = |c: &Candidate| -> Vec<String> {
         c.parameters
             .iter()
-            .flat_map(|p| std::iter::once(p.symbol.clone()).chain(p.tied.iter().cloned()))
+            .flat_map(|p| {
+                std::iter::once(p.symbol.clone())
+                    .chain(p.tied.iter().cloned())
+                    .chain(p.moves.iter().map(|(s, _)| s.clone()))
+            })
             .collect()
     };
     let mut seen: BTreeSet<String> = s.selected.iter().flat_map(|c| symbols(c)).collect();
@@ -172,7 +176,7 @@ pub(super) fn screen(s: &Screen<'_>) -> Screened {
     for &i in &group {
         let mut nested = true;
         for p in &s.remaining[i].parameters {
-            let v = setup.base[setup.slots[j][0]];
+            let v = setup.base_value(j);
             nested &= !p.lower.is_some_and(|lo| v < lo);
             j += 1;
         }
@@ -195,7 +199,7 @@ pub(super) fn screen(s: &Screen<'_>) -> Screened {
         let mut cols = Vec::new();
         for _ in &s.remaining[i].parameters {
             let j = g.len();
-            g.push(setup.base[setup.slots[j][0]]);
+            g.push(setup.base_value(j));
             cols.push(j);
         }
         columns.push(cols);

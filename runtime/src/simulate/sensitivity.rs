@@ -87,8 +87,11 @@ impl<const N: usize> Carried for Dual<N> {
 /// other move along the same one).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Directions {
-    /// `(parameter index, direction)`.
-    pub parameters: Vec<(usize, usize)>,
+    /// `(parameter index, direction, weight)`: the parameter moves by
+    /// `weight` per unit along the direction (1 for a parameter itself; a
+    /// combination of parameters, such as a correction of a quantity the
+    /// model holds in several, gives each its coefficient).
+    pub parameters: Vec<(usize, usize, f64)>,
     /// The direction of the initial roll, steer, roll rate, steer rate and
     /// speed (rad, rad, rad/s, rad/s, m/s), if they have one.
     pub initial: [Option<usize>; 5],
@@ -192,7 +195,10 @@ pub fn response<M: MultibodyModel, T: Carried>(
     let np = M::PARAMETERS.len();
     // Without derivatives (`f64`) the directions are not used.
     let out_of_range = nd > 0
-        && (directions.parameters.iter().any(|&(i, d)| i >= np || d >= nd)
+        && (directions
+            .parameters
+            .iter()
+            .any(|&(i, d, w)| i >= np || d >= nd || !w.is_finite())
             || directions.initial.iter().flatten().any(|&d| d >= nd));
     if out_of_range {
         return Err(SimulateError::InvalidInput(format!(
@@ -216,8 +222,8 @@ pub fn response<M: MultibodyModel, T: Carried>(
     // Parameters with their seeds; a driven model's speed parameter moves
     // with the initial speed (`initial_state` sets it from there).
     let mut seeds = vec![vec![0.0; nd]; param.len()];
-    for &(i, d) in directions.parameters.iter().filter(|_| nd > 0) {
-        seeds[i][d] = 1.0;
+    for &(i, d, w) in directions.parameters.iter().filter(|_| nd > 0) {
+        seeds[i][d] += w;
     }
     if let (Some(k), Some(d), true) = (imposed_speed_parameter::<M>(), directions.initial[4], nd > 0) {
         seeds[k] = vec![0.0; nd];
