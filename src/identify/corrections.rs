@@ -186,7 +186,13 @@ pub fn screen_points<R: ModelRegistry>(
         ));
     }
     for (symbol, value, sd, from_file, moves) in quantities {
-        let moved = predict(driven, bike, &BTreeMap::from([(symbol.clone(), value + sd)]), &speeds)?;
+        let moved = match predict(driven, bike, &BTreeMap::from([(symbol.clone(), value + sd)]), &speeds) {
+            Ok(m) => m,
+            // A file quantity one deviation away may not convert (a mass
+            // centre below the ground): it is then no candidate.
+            Err(_) if !moves.is_empty() => continue,
+            Err(e) => return Err(e),
+        };
         let mut s = Vec::with_capacity(r.len());
         for (k, &(_, _, se, p)) in used.iter().enumerate() {
             match moved[k] {
