@@ -80,6 +80,21 @@ fn identify_with(dir: &Path, report: Option<&Path>, extra: &[&str]) -> Value {
     serde_json::from_slice(&out.stdout).expect("JSON output")
 }
 
+/// A synthetic run's truth (synth's `truth/<run>_truth.json`): the mean
+/// speed after the release (m/s) and the weave eigenvalue `[re, im]` (1/s)
+/// of the simulated model's linear equations at that speed.
+fn truth_weave(path: &std::path::Path) -> (f64, [f64; 2]) {
+    let t: Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let weave = t["frozen_speed_eigenvalues"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|z| [f(&z[0]), f(&z[1])])
+        .max_by(|a, b| a[1].total_cmp(&b[1]))
+        .unwrap();
+    (f(&t["mean_speed_after_release"]), weave)
+}
+
 fn f(v: &Value) -> f64 {
     v.as_f64().unwrap_or(f64::NAN)
 }
@@ -381,16 +396,7 @@ fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
             .unwrap()
             .to_string_lossy()
             .into_owned();
-        let truth: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("truth/{run}_truth.json"))).unwrap())
-                .unwrap();
-        let weave = truth["frozen_speed_eigenvalues"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|z| [f(&z[0]), f(&z[1])])
-            .max_by(|a, b| a[1].total_cmp(&b[1]))
-            .unwrap();
+        let (_, weave) = truth_weave(&dir.join(format!("truth/{run}_truth.json")));
         let m = [f(&k["weave"][0]), f(&k["weave"][1])];
         ss.push((m[0] - weave[0]).powi(2) + (m[1] - weave[1]).powi(2));
     }
@@ -504,15 +510,7 @@ fn a_higher_front_mass_centre_is_corrected_as_a_whole() {
         if !path.to_string_lossy().ends_with("_truth.json") {
             continue;
         }
-        let t: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-        let v = f(&t["mean_speed_after_release"]);
-        let truth = t["frozen_speed_eigenvalues"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|z| [f(&z[0]), f(&z[1])])
-            .max_by(|a, b| a[1].total_cmp(&b[1]))
-            .unwrap();
+        let (v, truth) = truth_weave(&path);
         let d2 = |w: [f64; 2]| (w[0] - truth[0]).powi(2) + (w[1] - truth[1]).powi(2);
         before += d2(weave("thesis", v));
         after += d2(weave(fitted_bike.to_str().unwrap(), v));
