@@ -355,7 +355,7 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
     use bikedyn::runtime::parameters::ThesisParameters;
     use bikedyn::runtime::scalar::Dual;
     use bikedyn::runtime::simulate::sensitivity::{response, Carried, Directions, Response};
-    use bikedyn::runtime::simulate::{simulate, Events, InitialConditions, Inputs, SimOptions};
+    use bikedyn::runtime::simulate::{simulate, Inputs};
     use bikedyn::runtime::MultibodyModel;
 
     // Up to six directions: the dual width identification uses.
@@ -365,24 +365,7 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
         for (s, v) in set {
             param[M::parameter_index(s).unwrap()] = *v;
         }
-        let ic = InitialConditions {
-            roll: 0.02,
-            steer: -0.01,
-            roll_rate: 0.3,
-            steer_rate: 0.2,
-            speed: 5.0,
-            yaw: 0.0,
-        };
-        let opts = SimOptions {
-            rtol: 1e-12,
-            atol: 1e-14,
-            output_interval: 0.01,
-            events: Events {
-                roll_limit: Some(1.2),
-                steer_limit: Some(1.45),
-            },
-            ..SimOptions::default()
-        };
+        let (ic, opts) = kick_and_tight_options();
         let k = free.len();
         let mut dirs = Directions {
             parameters: free
@@ -482,7 +465,6 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
     use bikedyn::runtime::parameters::ThesisParameters;
     use bikedyn::runtime::scalar::Dual;
     use bikedyn::runtime::simulate::sensitivity::{response, Carried, Directions, Response};
-    use bikedyn::runtime::simulate::{Events, InitialConditions, SimOptions};
     use bikedyn::runtime::MultibodyModel;
     type M = ExtendedFree;
 
@@ -496,24 +478,7 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
             .collect(),
         initial: [None; 5],
     };
-    let ic = InitialConditions {
-        roll: 0.02,
-        steer: -0.01,
-        roll_rate: 0.3,
-        steer_rate: 0.2,
-        speed: 5.0,
-        yaw: 0.0,
-    };
-    let opts = SimOptions {
-        rtol: 1e-12,
-        atol: 1e-14,
-        output_interval: 0.01,
-        events: Events {
-            roll_limit: Some(1.2),
-            steer_limit: Some(1.45),
-        },
-        ..SimOptions::default()
-    };
+    let (ic, opts) = kick_and_tight_options();
     let exact: Response<Dual<6>> = response::<M, Dual<6>>(&param, &ic, &dirs, 2.0, &opts, true).unwrap();
     let moved = |h: f64| -> Response<f64> {
         let mut p = param.clone();
@@ -541,4 +506,32 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
             "d {name} along the combination: exact and central differences differ by {worst:.3e} (scale {scale:.3e})"
         );
     }
+}
+
+/// The state just after a kick at 5 m/s, and integration tolerances far
+/// below the differences' step, for the sensitivity checks.
+fn kick_and_tight_options() -> (
+    bikedyn::runtime::simulate::InitialConditions,
+    bikedyn::runtime::simulate::SimOptions,
+) {
+    use bikedyn::runtime::simulate::{Events, InitialConditions, SimOptions};
+    let ic = InitialConditions {
+        roll: 0.02,
+        steer: -0.01,
+        roll_rate: 0.3,
+        steer_rate: 0.2,
+        speed: 5.0,
+        yaw: 0.0,
+    };
+    let opts = SimOptions {
+        rtol: 1e-12,
+        atol: 1e-14,
+        output_interval: 0.01,
+        events: Events {
+            roll_limit: Some(1.2),
+            steer_limit: Some(1.45),
+        },
+        ..SimOptions::default()
+    };
+    (ic, opts)
 }
