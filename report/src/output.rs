@@ -1093,12 +1093,8 @@ fn summary_row(c: &CellResult) -> Vec<String> {
 /// unit, as `"steer-axis viscous damping coefficient (N m s/rad)"`, or the
 /// thesis and benchmark descriptions); a name with no description as it is.
 fn parameter_header(symbol: &str, describe: &dyn Fn(&str) -> Option<String>) -> String {
-    let unit = describe(symbol);
-    let unit = unit
-        .as_deref()
-        .and_then(|d| d.strip_suffix(')'))
-        .and_then(|d| d.rsplit_once('(').map(|(_, u)| u));
-    match unit {
+    let doc = describe(symbol);
+    match doc.as_deref().and_then(bikedyn_runtime::model::unit_of) {
         Some(u) => format!("{symbol} ({u})"),
         None => symbol.to_string(),
     }

@@ -33,6 +33,13 @@ pub struct ParameterInfo {
     pub uncertainty: Option<Uncertainty>,
 }
 
+/// The unit at the end of a parameter's description, as in `"trail (m)"`
+/// or `"steer-axis viscous damping coefficient (N m s/rad)"`; `None` when
+/// the description does not end in one.
+pub fn unit_of(doc: &str) -> Option<&str> {
+    doc.strip_suffix(')')?.rsplit_once('(').map(|(_, u)| u)
+}
+
 /// A parameter's measurement uncertainty, one standard deviation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Uncertainty {

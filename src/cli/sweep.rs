@@ -63,6 +63,7 @@ pub fn run(a: SweepArgs) -> Result<bool> {
     eprintln!("model: {}", model.as_deref().unwrap_or_default());
     let info = model.as_deref().and_then(bikedyn::models::model_info);
     let describe = |symbol: &str| output::describe_parameter(symbol, info);
+    // "trail (m) [c]" from a parameter symbol, for plot axes.
     let axis_label = |symbol: &str| match describe(symbol) {
         Some(d) => format!("{d} [{symbol}]"),
         None => symbol.to_string(),
@@ -211,7 +212,6 @@ pub fn run(a: SweepArgs) -> Result<bool> {
     Ok(true)
 }
 
-/// "c: trail (m)" from a parameter symbol, for plot axes.
 /// A sweep with failed cells is an error listing them (at most ten), never
 /// a table with messages in it.
 fn refuse_failed_cells<'a>(

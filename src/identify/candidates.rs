@@ -5,7 +5,7 @@
 use super::error::IdentifyError;
 use crate::bicycle::Bicycle;
 use bikedyn_runtime::identify::{Candidate, EffectParameter};
-use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification};
+use bikedyn_runtime::model::{unit_of, CandidateDeclaration, EffectIdentification};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 
 /// The identification model, its driven twin, and the alternative model
@@ -118,13 +118,9 @@ pub fn candidates<R: ModelRegistry>(
         }
         let unit = |sym: &str| {
             info.parameter(sym)
-                .map(|p| {
-                    p.doc
-                        .rsplit_once('(')
-                        .map_or("", |(_, u)| u.trim_end_matches(')'))
-                        .to_string()
-                })
+                .and_then(|p| unit_of(p.doc))
                 .unwrap_or_default()
+                .to_string()
         };
         out.push(Candidate {
             name: effect.to_string(),

@@ -32,7 +32,8 @@ use super::error::IdentifyError;
 use super::predict::predict;
 use crate::bicycle::Bicycle;
 use bikedyn_runtime::identify::{Candidate, EffectParameter, Segment};
-use bikedyn_runtime::parameters::ThesisParameters;
+use bikedyn_runtime::model::unit_of;
+use bikedyn_runtime::parameters::{BenchmarkParameters, ThesisParameters};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 use std::collections::BTreeMap;
 
@@ -221,14 +222,13 @@ pub fn screen_points<R: ModelRegistry>(
 
 /// The candidate of a screened correction.
 pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
-    let doc = free.parameter(&c.symbol).map_or("", |p| p.doc);
-    let unit = if c.moves.is_empty() {
-        doc.rsplit_once('(')
-            .map_or("", |(_, u)| u.trim_end_matches(')'))
-            .to_string()
-    } else {
-        "m".to_string()
-    };
+    // A model parameter's doc, or the file quantity's description.
+    let doc = free
+        .parameter(&c.symbol)
+        .map(|p| p.doc)
+        .or_else(|| BenchmarkParameters::describe(&c.symbol))
+        .unwrap_or("");
+    let unit = unit_of(doc).unwrap_or_default().to_string();
     Candidate {
         name: correction_name(&c.symbol),
         effects: Vec::new(),
@@ -252,8 +252,9 @@ pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
                 String::new()
             } else {
                 let moved: Vec<&str> = c.moves.iter().map(|(s, _)| s.as_str()).collect();
+                let what = doc.rsplit_once(" (").map_or(doc, |(w, _)| w);
                 format!(
-                    "the front assembly's mass centre (moving {} together, the steer axis kept): ",
+                    "the file's {what} (moving {} together, the steer axis kept): ",
                     moved.join(", ")
                 )
             },
