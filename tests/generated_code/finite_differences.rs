@@ -381,8 +381,9 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
         let nd = k + initial.len();
         assert!(nd <= 6);
         let duration = 2.0;
-        let exact: Response<Dual<6>> = response::<M, Dual<6>>(&param, &ic, &dirs, duration, &opts, true).unwrap();
-        let plain: Response<f64> = response::<M, f64>(&param, &ic, &dirs, duration, &opts, true).unwrap();
+        let speed_at = wheel_sensor_times(duration);
+        let exact: Response<Dual<6>> = response::<M, Dual<6>>(&param, &ic, &dirs, duration, &opts, &speed_at).unwrap();
+        let plain: Response<f64> = response::<M, f64>(&param, &ic, &dirs, duration, &opts, &speed_at).unwrap();
         // The lean response is the simulation's.
         let sim = simulate::<M>(&param, &ic, &Inputs::default(), duration, &opts).unwrap();
         let roll = sim.coordinate("theta").unwrap();
@@ -394,6 +395,21 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
                 M::NAME
             );
             assert!((a - exact.roll[i].re).abs() < 1e-9);
+        }
+        // The speed, from the velocities alone at the samples around each
+        // time asked for, is the simulation's (a full evaluation at every
+        // sample), interpolated alike.
+        assert_eq!(plain.speed.len(), speed_at.len());
+        for (&t, (a, e)) in speed_at.iter().zip(plain.speed.iter().zip(&exact.speed)) {
+            let k = sim.t.partition_point(|&x| x <= t).clamp(1, sim.t.len() - 1);
+            let w = ((t - sim.t[k - 1]) / (sim.t[k] - sim.t[k - 1])).min(1.0);
+            let b = sim.speed[k - 1] + (sim.speed[k] - sim.speed[k - 1]) * w;
+            assert!(
+                (a - b).abs() < 1e-10 && (a - e.re).abs() < 1e-9,
+                "{}: speed at {t} s: lean {a}, dual {}, simulate {b}",
+                M::NAME,
+                e.re
+            );
         }
         let moved = |d: usize, h: f64| -> Response<f64> {
             let mut p = param.clone();
@@ -409,7 +425,7 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
                     _ => c.speed += h,
                 }
             }
-            response::<M, f64>(&p, &c, &Directions::default(), duration, &opts, true).unwrap()
+            response::<M, f64>(&p, &c, &Directions::default(), duration, &opts, &speed_at).unwrap()
         };
         for d in 0..nd {
             let size = if d < k {
@@ -479,13 +495,14 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
         initial: [None; 5],
     };
     let (ic, opts) = kick_and_tight_options();
-    let exact: Response<Dual<6>> = response::<M, Dual<6>>(&param, &ic, &dirs, 2.0, &opts, true).unwrap();
+    let speed_at = wheel_sensor_times(2.0);
+    let exact: Response<Dual<6>> = response::<M, Dual<6>>(&param, &ic, &dirs, 2.0, &opts, &speed_at).unwrap();
     let moved = |h: f64| -> Response<f64> {
         let mut p = param.clone();
         for (s, w) in weights {
             p[M::parameter_index(s).unwrap()] += w * h;
         }
-        response::<M, f64>(&p, &ic, &Directions::default(), 2.0, &opts, true).unwrap()
+        response::<M, f64>(&p, &ic, &Directions::default(), 2.0, &opts, &speed_at).unwrap()
     };
     let h = 1e-5;
     let (a, b) = (moved(h), moved(-h));
@@ -510,6 +527,15 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
 
 /// The state just after a kick at 5 m/s, and integration tolerances far
 /// below the differences' step, for the sensitivity checks.
+/// Times at which the speed is asked for, as a wheel sensor gives them:
+/// off the output grid, from the start to past the end (held there).
+fn wheel_sensor_times(duration: f64) -> Vec<f64> {
+    (0..)
+        .map(|i| 0.037 * i as f64)
+        .take_while(|&t| t < duration + 0.1)
+        .collect()
+}
+
 fn kick_and_tight_options() -> (
     bikedyn::runtime::simulate::InitialConditions,
     bikedyn::runtime::simulate::SimOptions,

@@ -475,7 +475,7 @@ fn sampled<M: MultibodyModel, T: Carried>(
         ..*opts
     };
     let ic = initial_conditions(x0);
-    let r = response::<M, T>(param, &ic, dirs, seg.duration() + dt, &opts, !seg.speed_t.is_empty()).ok()?;
+    let r = response::<M, T>(param, &ic, dirs, seg.duration() + dt, &opts, &seg.speed_t).ok()?;
     let roll = match seg.roll_channel {
         RollChannel::Angle => &r.roll,
         RollChannel::Rate => &r.roll_rate,
@@ -483,11 +483,7 @@ fn sampled<M: MultibodyModel, T: Carried>(
     let at = |xs: &[T], ts: &[f64]| -> Vec<T> { ts.iter().map(|&t| interp(&r.t, xs, t)).collect() };
     let roll = at(roll, &seg.t);
     let steer = at(&r.steer, &seg.t);
-    let speed = if seg.speed_t.is_empty() {
-        Vec::new()
-    } else {
-        at(&r.speed, &seg.speed_t)
-    };
+    let speed = r.speed;
     let columns: Vec<Vec<f64>> = (0..T::DIRECTIONS)
         .map(|d| {
             roll.iter()
@@ -685,7 +681,8 @@ impl<'a> Setup<'a> {
             }
         }
         self.simulations.fetch_add(1, Ordering::Relaxed);
-        let (_, columns) = (self.sensitivities)(&self.param(g), seg, x0, &self.options, &dirs, k + nn)?;
+        let opts = self.sensitivity_options();
+        let (_, columns) = (self.sensitivities)(&self.param(g), seg, x0, &opts, &dirs, k + nn)?;
         let w = self.weights[i];
         let (nr, ns) = (seg.roll.len(), seg.steer.len());
         let scale = |row: usize| {
@@ -709,6 +706,23 @@ impl<'a> Setup<'a> {
         }
         let finite = a.iter().chain(b.iter()).all(|x| x.is_finite());
         finite.then_some(SegmentJacobian { a, b })
+    }
+
+    /// The integrator's options for the sensitivities: ten times the
+    /// residuals' tolerances. The residuals define the objective, whose
+    /// changes a fit compares to a part in a million, and keep the tight
+    /// ones. The Jacobian only steers the steps and gives the standard
+    /// errors and the score test, which need a few digits, not eight; and
+    /// its simulation carries six derivative directions beside the state in
+    /// the integrator's error control, which at the residuals' tolerance
+    /// took more steps than the response needs (`bench --identify`: 6.1 s,
+    /// 4.3 s at this one, with the same selection and digits).
+    fn sensitivity_options(&self) -> SimOptions {
+        SimOptions {
+            rtol: 10.0 * self.options.rtol,
+            atol: 10.0 * self.options.atol,
+            ..self.options
+        }
     }
 
     /// Simulated channels of one segment (for plots).

@@ -543,6 +543,21 @@ pub(crate) fn evaluate_state<M: MultibodyModel, T: Scalar>(
     pz: &mut [T],
     w: &mut Workspace<T>,
 ) -> Result<(), SimulateError> {
+    evaluate_kinematics::<M, T>(at, t, y, pz, w)?;
+    evaluate_dynamics::<M, T>(at, t, pz, w)
+}
+
+/// The first half of [`evaluate_state`]: the full coordinates `w.p` and
+/// velocities `w.dp` from the state, without the dynamics. What a sample
+/// of an output that depends on the motion alone (the forward speed)
+/// needs: the mass matrix and forces are most of an evaluation's cost.
+pub(crate) fn evaluate_kinematics<M: MultibodyModel, T: Scalar>(
+    at: &At<'_>,
+    t: f64,
+    y: &[T],
+    pz: &mut [T],
+    w: &mut Workspace<T>,
+) -> Result<(), SimulateError> {
     let l = at.layout;
     let ni = l.ni();
     let nq = M::nq();
@@ -630,6 +645,25 @@ pub(crate) fn evaluate_state<M: MultibodyModel, T: Scalar>(
         }
         w.dp[w.depv[r]] = v;
     }
+    Ok(())
+}
+
+/// The second half of [`evaluate_state`], after [`evaluate_kinematics`]
+/// at the same `(t, y)`: the independent accelerations `w.ddq`.
+fn evaluate_dynamics<M: MultibodyModel, T: Scalar>(
+    at: &At<'_>,
+    t: f64,
+    pz: &mut [T],
+    w: &mut Workspace<T>,
+) -> Result<(), SimulateError> {
+    let l = at.layout;
+    let ni = l.ni();
+    let nq = M::nq();
+    let nh = M::HOLONOMIC.len();
+    let nc = nh + M::NONHOLONOMIC.len();
+    let nd = w.depv.len();
+    let param = &*pz;
+    let tt = T::cst(t);
     // Everything that needs the full velocities in one call (shared
     // common subexpressions).
     M::all_quantities(param, tt, &w.p, &w.dp, &mut w.all);

@@ -29,7 +29,10 @@
 use ode_solvers::{DVector, Dop853, OutputType};
 use std::cell::RefCell;
 
-use super::rhs::{evaluate_state, forward_speed, state_derivative, At, BicycleCoordinates, StateLayout, Workspace};
+use super::rhs::{
+    evaluate_kinematics, evaluate_state, forward_speed, state_derivative, At, BicycleCoordinates, StateLayout,
+    Workspace,
+};
 use super::{
     imposed_speed_parameter, initial_state, DynSystem, Events, InitialConditions, Inputs, SimOptions, SimulateError,
 };
@@ -108,7 +111,8 @@ pub struct Response<T> {
     pub roll_rate: Vec<T>,
     /// Steer angle (rad).
     pub steer: Vec<T>,
-    /// Forward speed (m/s), when asked for.
+    /// Forward speed (m/s) at the times asked for, linear between the
+    /// grid's samples (the last value held after a stop).
     pub speed: Vec<T>,
     /// Time (s) of the step at whose end a fall or steer-stop event fired:
     /// the samples end there.
@@ -181,7 +185,7 @@ pub fn response<M: MultibodyModel, T: Carried>(
     directions: &Directions,
     duration: f64,
     opts: &SimOptions,
-    speed: bool,
+    speed_at: &[f64],
 ) -> Result<Response<T>, SimulateError> {
     let nd = T::DIRECTIONS;
     if !(duration > 0.0 && duration.is_finite()) {
@@ -323,18 +327,43 @@ pub fn response<M: MultibodyModel, T: Carried>(
         out.roll.push(y[c.roll_ind]);
         out.roll_rate.push(y[rates + c.roll_ind]);
         out.steer.push(y[c.steer_ind]);
-        if speed {
-            let mut pz = sys.pz.borrow_mut();
-            let mut w = sys.ws.borrow_mut();
-            evaluate_state::<M, T>(&sys.at, b[layout.time()], &y, &mut pz, &mut w)?;
-            out.speed.push(forward_speed(&coords, &w.p, &w.dp));
-        }
     }
     if out.t.is_empty() {
         return Err(SimulateError::Integrator {
             t: 0.0,
             message: "DOP853 returned no sample".into(),
         });
+    }
+    // The speed is a function of the full velocities, which take a
+    // constraint solve: it is evaluated only at the grid samples that the
+    // times asked for fall between (a wheel sensor gives a few a second,
+    // the grid a hundred).
+    let mut at_sample: Vec<Option<T>> = vec![None; out.t.len()];
+    let mut speed_of = |k: usize| -> Result<T, SimulateError> {
+        if let Some(v) = at_sample[k] {
+            return Ok(v);
+        }
+        sys.gather(ys[k].as_slice(), &mut y);
+        let mut pz = sys.pz.borrow_mut();
+        let mut w = sys.ws.borrow_mut();
+        evaluate_kinematics::<M, T>(&sys.at, ys[k][layout.time()], &y, &mut pz, &mut w)?;
+        let v = forward_speed(&coords, &w.p, &w.dp);
+        at_sample[k] = Some(v);
+        Ok(v)
+    };
+    let last = out.t.len() - 1;
+    for &t in speed_at {
+        let v = if !(t > out.t[0]) {
+            speed_of(0)?
+        } else if t >= out.t[last] {
+            speed_of(last)?
+        } else {
+            let k = out.t.partition_point(|&x| x <= t);
+            let w = (t - out.t[k - 1]) / (out.t[k] - out.t[k - 1]);
+            let (a, b) = (speed_of(k - 1)?, speed_of(k)?);
+            a + (b - a) * T::cst(w)
+        };
+        out.speed.push(v);
     }
     Ok(out)
 }
