@@ -19,7 +19,7 @@
 //! design whose correlation is well below the data's would tell the
 //! candidates apart.
 
-use super::{Candidate, ModelFactory, Normal, Segment, SegmentJacobian, Setup, NUISANCE};
+use super::{at_rest, Candidate, ModelFactory, Normal, Segment, SegmentJacobian, Setup, NUISANCE};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -117,15 +117,15 @@ pub fn confounding(
     let rate = x[2].abs().max(x[3].abs()).max(0.2);
     let mut kicks: Vec<(String, [f64; NUISANCE])> = speeds
         .iter()
-        .map(|&v| (format!("kicks at {v:.1} m/s"), [x[0], x[1], x[2], x[3], v]))
+        .map(|&v| (format!("kicks at {v:.1} m/s"), at_rest([x[0], x[1], x[2], x[3], v])))
         .collect();
     kicks.push((
         format!("three times the amplitude (at {:.1} m/s)", x[4]),
-        [3.0 * x[0], 3.0 * x[1], 3.0 * x[2], 3.0 * x[3], x[4]],
+        at_rest([3.0 * x[0], 3.0 * x[1], 3.0 * x[2], 3.0 * x[3], x[4]]),
     ));
     kicks.push((
         format!("a steer-torque kick (steer rate {rate:.2} rad/s at {:.1} m/s)", x[4]),
-        [0.0, 0.0, 0.0, rate, x[4]],
+        at_rest([0.0, 0.0, 0.0, rate, x[4]]),
     ));
     let segments: Vec<Segment> = kicks
         .iter()

@@ -71,11 +71,27 @@ pub mod confounding;
 mod screen;
 pub use confounding::{Confounding, Design, CONFOUNDED};
 
-/// Number of per-segment nuisance parameters: initial roll, steer (rad),
-/// roll rate, steer rate (rad/s) and forward speed (m/s).
-pub const NUISANCE: usize = 5;
+/// Room for the per-segment nuisance parameters, the state at the window
+/// start: the initial motion ([`INITIAL_MOTION`]: roll, steer (rad), roll
+/// rate, steer rate (rad/s), forward speed (m/s)), then the model's extra
+/// first-order states (`M::STATES`, at most [`EXTRA_STATES`]: a tyre
+/// model's lagged lateral forces, N). A window starts after a kick, when
+/// those states are away from rest as much as the motion is; a model
+/// without them leaves their entries at zero.
+pub const NUISANCE: usize = INITIAL_MOTION + EXTRA_STATES;
+/// Number of initial-motion nuisances (roll, steer, their rates, speed).
+pub const INITIAL_MOTION: usize = 5;
+/// Most extra first-order states a model may have for identification.
+pub const EXTRA_STATES: usize = 2;
 /// Scales of the nuisance parameters (difference steps and LM scaling).
-const NUISANCE_SCALE: [f64; NUISANCE] = [0.01, 0.01, 0.1, 0.1, 0.1];
+const NUISANCE_SCALE: [f64; NUISANCE] = [0.01, 0.01, 0.1, 0.1, 0.1, 10.0, 10.0];
+
+/// A window-start state from the initial motion, the extra states at rest.
+pub fn at_rest(motion: [f64; INITIAL_MOTION]) -> [f64; NUISANCE] {
+    let mut x = [0.0; NUISANCE];
+    x[..INITIAL_MOTION].copy_from_slice(&motion);
+    x
+}
 
 /// What the roll channel of a segment measures: the roll angle (the
 /// thesis's IMU orientation) or the roll rate (a gyro, as on the TU Delft
@@ -172,7 +188,7 @@ impl Segment {
         let mean_speed = speed.iter().sum::<f64>() / speed.len() as f64;
         let lo = speed.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = speed.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let initial = [r0, s0, dr0, ds0, v0];
+        let initial = at_rest([r0, s0, dr0, ds0, v0]);
         if initial.iter().any(|x| !x.is_finite()) || !(v0 > 0.0) {
             return None;
         }
@@ -345,6 +361,8 @@ pub enum IdentifyError {
     NoData,
     #[error("the simulation of {run} failed at the initial state: {message}")]
     Simulation { run: String, message: String },
+    #[error("model `{model}` has {states} extra first-order states; identification fits at most {EXTRA_STATES} at each window start")]
+    TooManyStates { model: &'static str, states: usize },
 }
 
 /// The fitting problem: a base parameter vector of `M`, the segments, and
@@ -362,6 +380,12 @@ pub struct Setup<'a> {
     pub parameters: Vec<EffectParameter>,
     simulate: fn(&[f64], &Segment, &[f64; NUISANCE], &SimOptions) -> Result<Sim, String>,
     sensitivities: SensitivityFn,
+    /// Nuisances per segment: the initial motion and the model's extra
+    /// states.
+    nuisance: usize,
+    /// Number of the model's parameters (the extra states' initial values
+    /// follow them in a simulation's parameter vector).
+    model_parameters: usize,
     /// Simulations run so far (a simulation in dual numbers counts as one).
     simulations: AtomicUsize,
 }
@@ -404,6 +428,7 @@ fn simulate_segment<M: MultibodyModel>(
     x0: &[f64; NUISANCE],
     opts: &SimOptions,
 ) -> Result<Sim, String> {
+    let param = &with_extra_states::<M>(param, x0);
     let ic = initial_conditions(x0);
     let dt = sample_interval(seg);
     let opts = SimOptions {
@@ -448,6 +473,15 @@ fn sample_interval(seg: &Segment) -> f64 {
     (seg.t.get(1).copied().unwrap_or(0.01) - seg.t[0]).max(1e-3)
 }
 
+/// The parameter vector with the extra states at the window start in its
+/// tail (where the simulation reads their initial values).
+fn with_extra_states<M: MultibodyModel>(param: &[f64], x0: &[f64; NUISANCE]) -> Vec<f64> {
+    let np = M::PARAMETERS.len();
+    let mut p = param[..np.min(param.len())].to_vec();
+    p.extend_from_slice(&x0[INITIAL_MOTION..INITIAL_MOTION + M::STATES.len().min(EXTRA_STATES)]);
+    p
+}
+
 fn initial_conditions(x0: &[f64; NUISANCE]) -> InitialConditions {
     InitialConditions {
         roll: x0[0],
@@ -475,6 +509,7 @@ fn sampled<M: MultibodyModel, T: Carried>(
         ..*opts
     };
     let ic = initial_conditions(x0);
+    let param = &with_extra_states::<M>(param, x0);
     let r = response::<M, T>(param, &ic, dirs, seg.duration() + dt, &opts, &seg.speed_t).ok()?;
     let roll = match seg.roll_channel {
         RollChannel::Angle => &r.roll,
@@ -547,6 +582,12 @@ impl<'a> Setup<'a> {
         weights: &[Weights],
         candidates: &[&Candidate],
     ) -> Result<Self, IdentifyError> {
+        if M::STATES.len() > EXTRA_STATES {
+            return Err(IdentifyError::TooManyStates {
+                model: M::NAME,
+                states: M::STATES.len(),
+            });
+        }
         let index = |s: &str| {
             M::PARAMETERS
                 .iter()
@@ -603,6 +644,8 @@ impl<'a> Setup<'a> {
             parameters,
             simulate: simulate_segment::<M>,
             sensitivities: segment_sensitivities::<M>,
+            nuisance: INITIAL_MOTION + M::STATES.len(),
+            model_parameters: M::PARAMETERS.len(),
             simulations: AtomicUsize::new(0),
         })
     }
@@ -663,7 +706,7 @@ impl<'a> Setup<'a> {
     ) -> Option<SegmentJacobian> {
         let seg = &self.segments[i];
         let k = if shared { self.k() } else { 0 };
-        let nn = if nuisance { NUISANCE } else { 0 };
+        let nn = if nuisance { self.nuisance } else { 0 };
         let mut dirs = Directions::default();
         if shared {
             for (j, (slot, info)) in self.slots.iter().zip(&self.parameters).enumerate() {
@@ -678,6 +721,12 @@ impl<'a> Setup<'a> {
         if nuisance {
             for (d, dir) in dirs.initial.iter_mut().enumerate() {
                 *dir = Some(k + d);
+            }
+            // The extra states' initial values sit in the parameter
+            // vector's tail.
+            for e in 0..self.nuisance - INITIAL_MOTION {
+                dirs.parameters
+                    .push((self.model_parameters + e, k + INITIAL_MOTION + e, 1.0));
             }
         }
         self.simulations.fetch_add(1, Ordering::Relaxed);
@@ -756,9 +805,9 @@ struct Problem<'s, 'a> {
 impl Problem<'_, '_> {
     fn n_free(&self) -> usize {
         match self.free {
-            Free::All => self.setup.k() + NUISANCE * self.segs.len(),
+            Free::All => self.setup.k() + self.setup.nuisance * self.segs.len(),
             Free::Shared => self.setup.k(),
-            Free::Nuisance => NUISANCE * self.segs.len(),
+            Free::Nuisance => self.setup.nuisance * self.segs.len(),
         }
     }
     fn pack(&self) -> Vec<f64> {
@@ -768,7 +817,7 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for &s in &self.segs {
-                x.extend(&self.x0[s]);
+                x.extend(&self.x0[s][..self.setup.nuisance]);
             }
         }
         x
@@ -782,8 +831,9 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for &s in &self.segs {
-                self.x0[s].copy_from_slice(&x[i..i + NUISANCE]);
-                i += NUISANCE;
+                let nn = self.setup.nuisance;
+                self.x0[s][..nn].copy_from_slice(&x[i..i + nn]);
+                i += nn;
             }
         }
     }
@@ -844,7 +894,11 @@ impl Problem<'_, '_> {
     fn jacobian_blocks(&self) -> Option<Vec<SegmentJacobian>> {
         let base = self.all_residuals()?;
         let k = if self.free == Free::Nuisance { 0 } else { self.setup.k() };
-        let nn = if self.free == Free::Shared { 0 } else { NUISANCE };
+        let nn = if self.free == Free::Shared {
+            0
+        } else {
+            self.setup.nuisance
+        };
         let (shared, nuisance) = (k > 0, nn > 0);
         let exact: Vec<Option<SegmentJacobian>> = self
             .segs
@@ -913,7 +967,7 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for _ in &self.segs {
-                x.extend(NUISANCE_SCALE);
+                x.extend(&NUISANCE_SCALE[..self.setup.nuisance]);
             }
         }
         x
@@ -1129,7 +1183,7 @@ fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
     };
     let Some(mut c) = cost(&p) else { return p };
     let scales = p.scales();
-    let budget = patience.max(1) * (k + NUISANCE + 1) * 4;
+    let budget = patience.max(1) * (k + p.setup.nuisance + 1) * 4;
 
     let mut evals = 1;
     let mut lambda = 1e-3;

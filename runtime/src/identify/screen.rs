@@ -21,9 +21,7 @@
 //! (the tyre model) or not nested are not screened: they are fitted.
 
 use super::Candidate;
-use super::{
-    bic, CandidateFit, Free, ModelFactory, Normal, Problem, Segment, SegmentError, SegmentJacobian, Weights, NUISANCE,
-};
+use super::{bic, CandidateFit, Free, ModelFactory, Normal, Problem, Segment, SegmentError, SegmentJacobian, Weights};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeSet;
 use std::sync::atomic::Ordering;
@@ -95,7 +93,8 @@ fn predict(
         .zip(res)
         .enumerate()
         .map(|(m, (b, r))| {
-            let di = DVector::from_column_slice(&dx[k + m * NUISANCE..k + (m + 1) * NUISANCE]);
+            let nn = setup.nuisance;
+            let di = DVector::from_column_slice(&dx[k + m * nn..k + (m + 1) * nn]);
             let moved = &b.a * &dg + &b.b * di;
             let r: Vec<f64> = r.iter().zip(moved.iter()).map(|(a, d)| a + d).collect();
             SegmentError::of(&r, &s.segments[m], s.weights[m])

@@ -93,7 +93,9 @@ pub struct Directions {
     /// `(parameter index, direction, weight)`: the parameter moves by
     /// `weight` per unit along the direction (1 for a parameter itself; a
     /// combination of parameters, such as a correction of a quantity the
-    /// model holds in several, gives each its coefficient).
+    /// model holds in several, gives each its coefficient). Indices past
+    /// the model's parameters are the extra states' initial values (the
+    /// parameter vector's tail).
     pub parameters: Vec<(usize, usize, f64)>,
     /// The direction of the initial roll, steer, roll rate, steer rate and
     /// speed (rad, rad, rad/s, rad/s, m/s), if they have one.
@@ -177,8 +179,9 @@ impl<M: MultibodyModel, T: Carried> Variational<'_, M, T> {
 /// sampled every `opts.output_interval` seconds (DOP853 with `opts`'s
 /// tolerances and events), with the derivatives of every sample along
 /// `directions` when `T` is a dual number (`f64`: the response alone).
-/// `speed` asks for the forward speed channel (one more evaluation per
-/// sample).
+/// `param` may carry the extra states' initial values in its tail (zero
+/// without), and a direction may move them (indices past the parameters).
+/// `speed_at` lists the times (s) at which the forward speed is wanted.
 pub fn response<M: MultibodyModel, T: Carried>(
     param: &[f64],
     ic: &InitialConditions,
@@ -196,7 +199,8 @@ pub fn response<M: MultibodyModel, T: Carried>(
     if !(opts.output_interval > 0.0 && duration / opts.output_interval <= 1e7) {
         return Err(SimulateError::InvalidInput("output interval must be positive".into()));
     }
-    let np = M::PARAMETERS.len();
+    // Parameters, and the extra states' initial values in the tail.
+    let np = M::PARAMETERS.len() + M::STATES.len();
     // Without derivatives (`f64`) the directions are not used.
     let out_of_range = nd > 0
         && (directions
