@@ -799,6 +799,7 @@ fn simulate<'py>(
             steer_rate,
             speed,
             yaw,
+            ..InitialConditions::default()
         };
         let inputs = Inputs {
             kicks: kick_list,

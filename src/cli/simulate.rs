@@ -96,6 +96,7 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
         steer_rate: a.steer_rate.to_radians(),
         speed: a.speed,
         yaw: a.yaw.to_radians(),
+        ..InitialConditions::default()
     };
     let inputs = Inputs {
         kicks: a.kick.iter().map(|k| parse_kick(k)).collect::<Result<_>>()?,

@@ -37,7 +37,7 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     } else {
         let _ = writeln!(s, "1. The measured-run pipeline (`bikedyn fit`) found every kick and its free-response window, and estimated mounting misalignments (calibration run) and clock offsets: these sensor effects are nuisances, never reported as mechanics.");
     }
-    let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed, and a tyre model's lagged lateral forces; fitted per kick as nuisance parameters), and compared with the measured {roll}, steer and speed.");
+    let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed, and a tyre model's lagged lateral forces and their rates; fitted per kick as nuisance parameters), and compared with the measured {roll}, steer and speed.");
     let _ = writeln!(s, "3. The residual pattern of the model without any added effect was related to the effects of the library (below).");
     let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all kicks (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run: each run's or log's kicks are predicted with the values fitted to the others), and its dissipative parameters are positive. The search stops when no candidate passes.\n", id.folds);
     let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| median(id.weights.iter().map(f));

@@ -365,7 +365,12 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
         for (s, v) in set {
             param[M::parameter_index(s).unwrap()] = *v;
         }
-        let (ic, opts) = kick_and_tight_options();
+        let (mut ic, opts) = kick_and_tight_options();
+        // A model with extra states (the lagged tyre forces) starts with
+        // them changing, as just after a kick.
+        if !M::STATES.is_empty() {
+            ic.state_rates = [150.0, -80.0];
+        }
         let k = free.len();
         let mut dirs = Directions {
             parameters: free
@@ -373,10 +378,16 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
                 .enumerate()
                 .map(|(d, s)| (M::parameter_index(s).unwrap(), d, 1.0))
                 .collect(),
-            initial: [None; 5],
+            ..Directions::default()
         };
+        // 0-4: roll, steer, their rates, speed; 5, 6: the extra states'
+        // initial rates.
         for (d, &which) in initial.iter().enumerate() {
-            dirs.initial[which] = Some(k + d);
+            if which < 5 {
+                dirs.initial[which] = Some(k + d);
+            } else {
+                dirs.state_rates[which - 5] = Some(k + d);
+            }
         }
         let nd = k + initial.len();
         assert!(nd <= 6);
@@ -422,7 +433,8 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
                     1 => c.steer += h,
                     2 => c.roll_rate += h,
                     3 => c.steer_rate += h,
-                    _ => c.speed += h,
+                    4 => c.speed += h,
+                    j => c.state_rates[j - 5] += h,
                 }
             }
             response::<M, f64>(&p, &c, &Directions::default(), duration, &opts, &speed_at).unwrap()
@@ -430,6 +442,8 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
         for d in 0..nd {
             let size = if d < k {
                 param[M::parameter_index(free[d]).unwrap()].abs().max(0.1)
+            } else if initial[d - k] >= 5 {
+                100.0 // N/s
             } else {
                 0.1
             };
@@ -467,6 +481,7 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
     check::<ExtendedFree>(&effects, &["c_steer"], &all);
     check::<ExtendedFree>(&effects, &["CdA", "I3x", "T_steer"], &[2, 4]);
     check::<TyreFree>(&[("c_steer", 0.2)], &["c_steer", "sigma_front"], &[0, 3, 4]);
+    check::<TyreFree>(&[("c_steer", 0.2)], &["sigma_rear"], &[2, 4, 5, 6]);
 }
 
 /// A sensitivity direction that moves several parameters with weights (a
@@ -492,7 +507,7 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
             .iter()
             .map(|(s, w)| (M::parameter_index(s).unwrap(), 0, *w))
             .collect(),
-        initial: [None; 5],
+        ..Directions::default()
     };
     let (ic, opts) = kick_and_tight_options();
     let speed_at = wheel_sensor_times(2.0);
@@ -548,6 +563,7 @@ fn kick_and_tight_options() -> (
         steer_rate: 0.2,
         speed: 5.0,
         yaw: 0.0,
+        ..InitialConditions::default()
     };
     let opts = SimOptions {
         rtol: 1e-12,

@@ -73,18 +73,23 @@ pub use confounding::{Confounding, Design, CONFOUNDED};
 
 /// Room for the per-segment nuisance parameters, the state at the window
 /// start: the initial motion ([`INITIAL_MOTION`]: roll, steer (rad), roll
-/// rate, steer rate (rad/s), forward speed (m/s)), then the model's extra
-/// first-order states (`M::STATES`, at most [`EXTRA_STATES`]: a tyre
-/// model's lagged lateral forces, N). A window starts after a kick, when
-/// those states are away from rest as much as the motion is; a model
-/// without them leaves their entries at zero.
-pub const NUISANCE: usize = INITIAL_MOTION + EXTRA_STATES;
+/// rate, steer rate (rad/s), forward speed (m/s)), then, for a model with
+/// `e` extra first-order states (`M::STATES`, at most [`EXTRA_STATES`]: a
+/// tyre model's lagged lateral forces, N), their values (`e` entries) and
+/// their rates (`e` entries, N/s). A window starts just after a kick,
+/// while the forces still lag behind the slip the kick gave the wheels:
+/// neither is at rest, and the rates set the slip (the free lateral
+/// velocities are solved from them). A model without extra states leaves
+/// those entries at zero.
+pub const NUISANCE: usize = INITIAL_MOTION + 2 * EXTRA_STATES;
 /// Number of initial-motion nuisances (roll, steer, their rates, speed).
 pub const INITIAL_MOTION: usize = 5;
 /// Most extra first-order states a model may have for identification.
-pub const EXTRA_STATES: usize = 2;
-/// Scales of the nuisance parameters (difference steps and LM scaling).
-const NUISANCE_SCALE: [f64; NUISANCE] = [0.01, 0.01, 0.1, 0.1, 0.1, 10.0, 10.0];
+pub const EXTRA_STATES: usize = crate::simulate::MAX_STATE_RATES;
+/// Scales of the initial-motion nuisances (difference steps and LM scaling).
+const MOTION_SCALE: [f64; INITIAL_MOTION] = [0.01, 0.01, 0.1, 0.1, 0.1];
+/// Scales of an extra state (a tyre force, N) and of its rate (N/s).
+const STATE_SCALE: [f64; 2] = [10.0, 100.0];
 
 /// A window-start state from the initial motion, the extra states at rest.
 pub fn at_rest(motion: [f64; INITIAL_MOTION]) -> [f64; NUISANCE] {
@@ -429,7 +434,7 @@ fn simulate_segment<M: MultibodyModel>(
     opts: &SimOptions,
 ) -> Result<Sim, String> {
     let param = &with_extra_states::<M>(param, x0);
-    let ic = initial_conditions(x0);
+    let ic = initial_conditions(x0, M::STATES.len());
     let dt = sample_interval(seg);
     let opts = SimOptions {
         output_interval: dt,
@@ -482,7 +487,12 @@ fn with_extra_states<M: MultibodyModel>(param: &[f64], x0: &[f64; NUISANCE]) -> 
     p
 }
 
-fn initial_conditions(x0: &[f64; NUISANCE]) -> InitialConditions {
+/// The initial motion of a window start, with the rates of the model's
+/// `extra` states.
+fn initial_conditions(x0: &[f64; NUISANCE], extra: usize) -> InitialConditions {
+    let mut state_rates = [0.0; EXTRA_STATES];
+    let e = extra.min(EXTRA_STATES);
+    state_rates[..e].copy_from_slice(&x0[INITIAL_MOTION + e..INITIAL_MOTION + 2 * e]);
     InitialConditions {
         roll: x0[0],
         steer: x0[1],
@@ -490,6 +500,18 @@ fn initial_conditions(x0: &[f64; NUISANCE]) -> InitialConditions {
         steer_rate: x0[3],
         speed: x0[4],
         yaw: 0.0,
+        state_rates,
+    }
+}
+
+/// The scale of nuisance `j` of a model with `extra` extra states.
+fn nuisance_scale(j: usize, extra: usize) -> f64 {
+    if j < INITIAL_MOTION {
+        MOTION_SCALE[j]
+    } else if j < INITIAL_MOTION + extra {
+        STATE_SCALE[0]
+    } else {
+        STATE_SCALE[1]
     }
 }
 
@@ -508,7 +530,7 @@ fn sampled<M: MultibodyModel, T: Carried>(
         output_interval: dt,
         ..*opts
     };
-    let ic = initial_conditions(x0);
+    let ic = initial_conditions(x0, M::STATES.len());
     let param = &with_extra_states::<M>(param, x0);
     let r = response::<M, T>(param, &ic, dirs, seg.duration() + dt, &opts, &seg.speed_t).ok()?;
     let roll = match seg.roll_channel {
@@ -565,6 +587,7 @@ fn segment_sensitivities<M: MultibodyModel>(
                 .filter_map(|&(i, d, c)| Some((i, inside(d)?, c)))
                 .collect(),
             initial: dirs.initial.map(|d| d.and_then(inside)),
+            state_rates: dirs.state_rates.map(|d| d.and_then(inside)),
         };
         let (s, c) = sampled::<M, Dual<WIDTH>>(param, seg, x0, opts, &pass)?;
         columns.extend(c.into_iter().take(nd - first));
@@ -644,10 +667,15 @@ impl<'a> Setup<'a> {
             parameters,
             simulate: simulate_segment::<M>,
             sensitivities: segment_sensitivities::<M>,
-            nuisance: INITIAL_MOTION + M::STATES.len(),
+            nuisance: INITIAL_MOTION + 2 * M::STATES.len(),
             model_parameters: M::PARAMETERS.len(),
             simulations: AtomicUsize::new(0),
         })
+    }
+
+    /// Number of the model's extra first-order states.
+    fn extra_states(&self) -> usize {
+        (self.nuisance - INITIAL_MOTION) / 2
     }
 
     /// Number of shared (effect) parameters.
@@ -724,9 +752,11 @@ impl<'a> Setup<'a> {
             }
             // The extra states' initial values sit in the parameter
             // vector's tail.
-            for e in 0..self.nuisance - INITIAL_MOTION {
+            let extra = self.extra_states();
+            for e in 0..extra {
                 dirs.parameters
                     .push((self.model_parameters + e, k + INITIAL_MOTION + e, 1.0));
+                dirs.state_rates[e] = Some(k + INITIAL_MOTION + extra + e);
             }
         }
         self.simulations.fetch_add(1, Ordering::Relaxed);
@@ -924,7 +954,7 @@ impl Problem<'_, '_> {
                 let mut g = self.g.clone();
                 let mut x0 = self.x0[s];
                 let h = if nuisance {
-                    let h = 1e-3 * NUISANCE_SCALE[j].max(x0[j].abs());
+                    let h = 1e-3 * nuisance_scale(j, self.setup.extra_states()).max(x0[j].abs());
                     x0[j] += h;
                     h
                 } else {
@@ -967,7 +997,7 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for _ in &self.segs {
-                x.extend(&NUISANCE_SCALE[..self.setup.nuisance]);
+                x.extend((0..self.setup.nuisance).map(|j| nuisance_scale(j, self.setup.extra_states())));
             }
         }
         x

@@ -20,6 +20,22 @@ pub struct InitialConditions {
     pub speed: f64,
     /// Yaw angle phi (rad).
     pub yaw: f64,
+    /// Rates of the model's extra first-order states at the start (`M::STATES`
+    /// in order, at most [`MAX_STATE_RATES`]; a tyre model's lagged lateral
+    /// forces, N/s). The states' values are in the parameter vector's tail;
+    /// the free independent rates (with tyre slip, the lateral ones) are
+    /// solved so that the states change at these rates. Zero (the default):
+    /// the states at rest relative to the motion, as in steady running; a
+    /// start just after a kick has forces lagging behind the slip.
+    #[serde(default, skip_serializing_if = "all_zero")]
+    pub state_rates: [f64; MAX_STATE_RATES],
+}
+
+/// Most extra states whose initial rates [`InitialConditions`] can set.
+pub const MAX_STATE_RATES: usize = 2;
+
+fn all_zero(x: &[f64; MAX_STATE_RATES]) -> bool {
+    x.iter().all(|v| *v == 0.0)
 }
 
 impl Default for InitialConditions {
@@ -32,6 +48,7 @@ impl Default for InitialConditions {
             steer_rate: 0.0,
             speed: 4.5,
             yaw: 0.0,
+            state_rates: [0.0; MAX_STATE_RATES],
         }
     }
 }

@@ -85,7 +85,9 @@ pub mod sensitivity;
 pub mod fit;
 pub mod trajectory;
 
-pub use inputs::{Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, StopReason, TorquePulse};
+pub use inputs::{
+    Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, StopReason, TorquePulse, MAX_STATE_RATES,
+};
 pub use rhs::{forward_speed, BicycleCoordinates, Evaluator, StateLayout};
 
 use differential_equations::prelude::{
@@ -749,8 +751,9 @@ pub fn initial_state<M: MultibodyModel>(
     // The independent rates besides roll and steer: the rate that carries
     // the forward speed (the rear wheel's, in a free-speed model) and, with
     // tyre slip, the lateral ones (yc, phi). They solve `speed = ic.speed`
-    // and `z' = 0` (the extra states start at rest; upright, that is rolling
-    // without lateral slip), one equation per extra state.
+    // and `z' = ic.state_rates` (by default zero: the extra states at rest;
+    // upright, that is rolling without lateral slip), one equation per
+    // extra state.
     let others: Vec<usize> = (0..l.ni()).filter(|&k| k != c.roll_ind && k != c.steer_ind).collect();
     if !others.is_empty() {
         if others.len() != 1 + l.extra {
@@ -761,7 +764,16 @@ pub fn initial_state<M: MultibodyModel>(
                 l.extra
             )));
         }
-        solve_free_rates(&eval, &mut y, &others, ic.speed)?;
+        if l.extra > MAX_STATE_RATES && ic.state_rates.iter().any(|r| *r != 0.0) {
+            return Err(SimulateError::InvalidInput(format!(
+                "model `{}` has {} extra states; initial rates can be set for at most {MAX_STATE_RATES}",
+                M::NAME,
+                l.extra
+            )));
+        }
+        let mut rates = ic.state_rates.to_vec();
+        rates.resize(l.extra, 0.0);
+        solve_free_rates(&eval, &mut y, &others, ic.speed, &rates)?;
     }
     // Check that the configuration exists.
     eval.full_state(0.0, &y)?;
@@ -769,14 +781,15 @@ pub fn initial_state<M: MultibodyModel>(
 }
 
 /// Set the rates `y[rates + k]`, `k` in `others`, so that the forward speed
-/// is `speed` and the extra states' rates vanish: Newton's method with a
-/// finite-difference Jacobian (the conditions are affine in the rates except
-/// through the regularised contact speeds of effects like tyre slip).
+/// is `speed` and the extra states change at `state_rates`: Newton's method
+/// with a finite-difference Jacobian (the conditions are affine in the rates
+/// except through the regularised contact speeds of effects like tyre slip).
 fn solve_free_rates<M: MultibodyModel>(
     eval: &Evaluator<'_, M>,
     y: &mut [f64],
     others: &[usize],
     speed: f64,
+    state_rates: &[f64],
 ) -> Result<(), SimulateError> {
     let l = eval.layout.clone();
     let m = others.len();
@@ -786,7 +799,7 @@ fn solve_free_rates<M: MultibodyModel>(
         let mut r = vec![forward_speed(&eval.coords, &p, &dp) - speed];
         if l.extra > 0 {
             eval.derivative(0.0, y, &mut dy)?;
-            r.extend_from_slice(&dy[l.extras()..]);
+            r.extend(dy[l.extras()..].iter().zip(state_rates).map(|(a, b)| a - b));
         }
         Ok(r)
     };
@@ -826,7 +839,7 @@ fn solve_free_rates<M: MultibodyModel>(
     }
     let r = residual(y)?;
     Err(SimulateError::InvalidInput(format!(
-        "no initial rates give forward speed {speed} m/s with the extra states at rest (residual {r:?})"
+        "no initial rates give forward speed {speed} m/s with the extra states changing at {state_rates:?} (residual {r:?})"
     )))
 }
 

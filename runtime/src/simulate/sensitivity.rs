@@ -35,6 +35,7 @@ use super::rhs::{
 };
 use super::{
     imposed_speed_parameter, initial_state, DynSystem, Events, InitialConditions, Inputs, SimOptions, SimulateError,
+    MAX_STATE_RATES,
 };
 use crate::model::MultibodyModel;
 use crate::scalar::{Dual, Scalar};
@@ -100,6 +101,9 @@ pub struct Directions {
     /// The direction of the initial roll, steer, roll rate, steer rate and
     /// speed (rad, rad, rad/s, rad/s, m/s), if they have one.
     pub initial: [Option<usize>; 5],
+    /// The direction of the extra states' initial rates
+    /// ([`InitialConditions::state_rates`]), if they have one.
+    pub state_rates: [Option<usize>; MAX_STATE_RATES],
 }
 
 /// A response sampled on a uniform grid, with derivatives along the
@@ -207,7 +211,12 @@ pub fn response<M: MultibodyModel, T: Carried>(
             .parameters
             .iter()
             .any(|&(i, d, w)| i >= np || d >= nd || !w.is_finite())
-            || directions.initial.iter().flatten().any(|&d| d >= nd));
+            || directions
+                .initial
+                .iter()
+                .chain(&directions.state_rates)
+                .flatten()
+                .any(|&d| d >= nd));
     if out_of_range {
         return Err(SimulateError::InvalidInput(format!(
             "sensitivity directions {directions:?} outside {np} parameters and {nd} directions"
@@ -394,6 +403,12 @@ fn initial_sensitivities<M: MultibodyModel>(
                 v[k] += h;
             }
         }
+        let mut state_rates = ic.state_rates;
+        for (k, dir) in directions.state_rates.iter().enumerate() {
+            if *dir == Some(d) {
+                state_rates[k] += h;
+            }
+        }
         let moved_ic = InitialConditions {
             roll: v[0],
             steer: v[1],
@@ -401,6 +416,7 @@ fn initial_sensitivities<M: MultibodyModel>(
             steer_rate: v[3],
             speed: v[4],
             yaw: ic.yaw,
+            state_rates,
         };
         Ok(initial_state::<M>(&p, &moved_ic)?.0)
     };
@@ -415,6 +431,11 @@ fn initial_sensitivities<M: MultibodyModel>(
         for (k, dir) in directions.initial.iter().enumerate() {
             if *dir == Some(d) {
                 size = size.max(ic_values[k].abs());
+            }
+        }
+        for (k, dir) in directions.state_rates.iter().enumerate() {
+            if *dir == Some(d) {
+                size = size.max(ic.state_rates[k].abs());
             }
         }
         let h = 1e-6 * size;

@@ -260,6 +260,7 @@ pub fn trajectory_for_run<M: crate::model::MultibodyModel>(
         steer_rate: at_release.3,
         speed: plan.speed,
         yaw,
+        ..InitialConditions::default()
     };
     let inputs = Inputs {
         kicks: vec![Kick::at_saddle(plan.kick_delay, plan.kick_impulse)],
