@@ -66,3 +66,32 @@ pub fn shared(sub: &str) -> Option<PathBuf> {
 pub fn example_set() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping")
 }
+
+/// A kick's state (roll 0.02 rad, steer -0.01 rad, rates 0.3 and 0.2 rad/s,
+/// 5 m/s) and tight tolerances, for checks of simulated responses.
+pub fn kick_and_tight_options() -> (
+    bikedyn::runtime::simulate::InitialConditions,
+    bikedyn::runtime::simulate::SimOptions,
+) {
+    use bikedyn::runtime::simulate::{Events, InitialConditions, SimOptions};
+    let ic = InitialConditions {
+        roll: 0.02,
+        steer: -0.01,
+        roll_rate: 0.3,
+        steer_rate: 0.2,
+        speed: 5.0,
+        yaw: 0.0,
+        ..InitialConditions::default()
+    };
+    let opts = SimOptions {
+        rtol: 1e-12,
+        atol: 1e-14,
+        output_interval: 0.01,
+        events: Events {
+            roll_limit: Some(1.2),
+            steer_limit: Some(1.45),
+        },
+        ..SimOptions::default()
+    };
+    (ic, opts)
+}

@@ -550,30 +550,3 @@ fn wheel_sensor_times(duration: f64) -> Vec<f64> {
         .take_while(|&t| t < duration + 0.1)
         .collect()
 }
-
-fn kick_and_tight_options() -> (
-    bikedyn::runtime::simulate::InitialConditions,
-    bikedyn::runtime::simulate::SimOptions,
-) {
-    use bikedyn::runtime::simulate::{Events, InitialConditions, SimOptions};
-    let ic = InitialConditions {
-        roll: 0.02,
-        steer: -0.01,
-        roll_rate: 0.3,
-        steer_rate: 0.2,
-        speed: 5.0,
-        yaw: 0.0,
-        ..InitialConditions::default()
-    };
-    let opts = SimOptions {
-        rtol: 1e-12,
-        atol: 1e-14,
-        output_interval: 0.01,
-        events: Events {
-            roll_limit: Some(1.2),
-            steer_limit: Some(1.45),
-        },
-        ..SimOptions::default()
-    };
-    (ic, opts)
-}

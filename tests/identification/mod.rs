@@ -648,7 +648,7 @@ fn tyre_forces_at_the_window_start_are_fitted_per_kick() {
     use bikedyn::runtime::linearize::parameter_vector;
     use bikedyn::runtime::model::CoordinateRole as R;
     use bikedyn::runtime::parameters::ThesisParameters;
-    use bikedyn::runtime::simulate::{simulate, InitialConditions, Inputs, SimOptions};
+    use bikedyn::runtime::simulate::{simulate, Inputs};
     use bikedyn::runtime::MultibodyModel;
     type M = TyreFree;
 
@@ -665,21 +665,8 @@ fn tyre_forces_at_the_window_start_are_fitted_per_kick() {
     assert_eq!(param.len(), np + 2);
     let mut with_forces = param.clone();
     with_forces[np..].copy_from_slice(&forces);
-    let ic = InitialConditions {
-        roll: 0.02,
-        steer: -0.01,
-        roll_rate: 0.3,
-        steer_rate: 0.2,
-        speed: 5.0,
-        yaw: 0.0,
-        state_rates: rates,
-    };
-    let opts = SimOptions {
-        rtol: 1e-10,
-        atol: 1e-12,
-        output_interval: 0.01,
-        ..SimOptions::default()
-    };
+    let (mut ic, opts) = kick_and_tight_options();
+    ic.state_rates = rates;
     let sim = simulate::<M>(&with_forces, &ic, &Inputs::default(), 3.0, &opts).unwrap();
     let roll = sim.require_coordinate(R::Roll, "test").unwrap();
     let steer = sim.require_coordinate(R::Steer, "test").unwrap();
