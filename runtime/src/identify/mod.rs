@@ -385,8 +385,8 @@ pub struct Setup<'a> {
     pub parameters: Vec<EffectParameter>,
     simulate: fn(&[f64], &Segment, &[f64; NUISANCE], &SimOptions) -> Result<Sim, String>,
     sensitivities: SensitivityFn,
-    /// Nuisances per segment: the initial motion and the model's extra
-    /// states.
+    /// Nuisances per segment: the initial motion, the model's extra states
+    /// and their rates.
     nuisance: usize,
     /// Number of the model's parameters (the extra states' initial values
     /// follow them in a simulation's parameter vector).
@@ -751,7 +751,7 @@ impl<'a> Setup<'a> {
                 *dir = Some(k + d);
             }
             // The extra states' initial values sit in the parameter
-            // vector's tail.
+            // vector's tail; their rates are initial conditions.
             let extra = self.extra_states();
             for e in 0..extra {
                 dirs.parameters
