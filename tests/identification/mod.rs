@@ -34,6 +34,39 @@ fn synth_with(name: &str, model: Option<&str>, effects: &str, seed: u64) -> Path
     dir
 }
 
+/// A 12-run set of the thesis bicycle at synth's default speeds (3-7 m/s),
+/// with `effects` hidden.
+fn synth_twelve(name: &str, effects: &str, seed: u64) -> PathBuf {
+    let dir = scratch("identify").join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    let seed = seed.to_string();
+    let out = bikedyn(&[
+        "synth",
+        "--bike",
+        "thesis",
+        "--runs",
+        "12",
+        "--seed",
+        &seed,
+        "--effects",
+        effects,
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "synth: {}", text(&out.stderr));
+    dir
+}
+
+/// The effects (and corrections) an identify report selected, in order.
+fn selected_effects(j: &Value) -> Vec<&str> {
+    j["selected_effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_str().unwrap())
+        .collect()
+}
+
 fn identify(dir: &Path, report: Option<&Path>) -> Value {
     identify_with(dir, report, &[])
 }
@@ -120,12 +153,7 @@ fn recovers_with_args(
 ) {
     let dir = synth_with(name, model, effects, seed);
     let j = identify_with(&dir, None, args);
-    let sel: Vec<&str> = j["selected_effects"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_str().unwrap())
-        .collect();
+    let sel = selected_effects(&j);
     assert_eq!(sel, vec![selected], "{name}: selected {sel:?}\n{j:#}");
     let v = f(&j["parameters"][symbol]["value"]);
     assert!(
@@ -311,33 +339,12 @@ fn bad_inputs_are_clear_errors() {
 #[test]
 fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
     let i3x = 0.3295 * 1.25;
-    let dir = scratch("identify").join("inertia");
-    let _ = std::fs::remove_dir_all(&dir);
-    let effects = format!("I3x={i3x},c_steer=0.1");
-    let out = bikedyn(&[
-        "synth",
-        "--bike",
-        "thesis",
-        "--runs",
-        "12",
-        "--seed",
-        "31",
-        "--effects",
-        &effects,
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "synth: {}", text(&out.stderr));
+    let dir = synth_twelve("inertia", &format!("I3x={i3x},c_steer=0.1"), 31);
     // Corrections are candidates by default (issue 17, point 1).
     let out = bikedyn(&["identify", dir.to_str().unwrap(), "--json"]);
     assert!(out.status.success(), "identify: {}", text(&out.stderr));
     let j = stdout_json(&out);
-    let mut sel: Vec<&str> = j["selected_effects"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_str().unwrap())
-        .collect();
+    let mut sel = selected_effects(&j);
     sel.sort();
     assert_eq!(sel, vec!["correct I3x", "steer_damping"], "{j:#}");
     // Issue 17, point 1: on kicks at 3-7 m/s, steer damping and a larger
@@ -421,11 +428,8 @@ fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
 /// model's as the file's. The held-out errors fall.
 #[test]
 fn a_higher_front_mass_centre_is_corrected_as_a_whole() {
-    let dir = scratch("identify").join("front_mass_centre");
     let rep = scratch("identify").join("front_mass_centre_report");
-    for d in [&dir, &rep] {
-        let _ = std::fs::remove_dir_all(d);
-    }
+    let _ = std::fs::remove_dir_all(&rep);
     let benchmark = bikedyn(&["params", "convert", "--to", "benchmark", "thesis"]);
     assert!(benchmark.status.success(), "{}", text(&benchmark.stderr));
     let zh = |toml: &str| -> f64 {
@@ -436,21 +440,7 @@ fn a_higher_front_mass_centre_is_corrected_as_a_whole() {
     };
     let zh0 = zh(&text(&benchmark.stdout));
     let shift = -0.03; // z points down: 3 cm higher
-    let effects = format!("zH={}", zh0 + shift);
-    let out = bikedyn(&[
-        "synth",
-        "--bike",
-        "thesis",
-        "--runs",
-        "12",
-        "--seed",
-        "41",
-        "--effects",
-        &effects,
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    assert!(out.status.success(), "synth: {}", text(&out.stderr));
+    let dir = synth_twelve("front_mass_centre", &format!("zH={}", zh0 + shift), 41);
     let out = bikedyn(&[
         "identify",
         dir.to_str().unwrap(),
@@ -460,12 +450,7 @@ fn a_higher_front_mass_centre_is_corrected_as_a_whole() {
     ]);
     assert!(out.status.success(), "identify: {}", text(&out.stderr));
     let j = stdout_json(&out);
-    let selected: Vec<&str> = j["selected_effects"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_str().unwrap())
-        .collect();
+    let selected = selected_effects(&j);
     let confounded = j["confounded"]
         .as_array()
         .unwrap()

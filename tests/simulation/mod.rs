@@ -1007,3 +1007,34 @@ fn trajectory_times_stay_strictly_increasing() {
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
 }
+
+/// Initial rates of extra states are a tyre model's (its lagged forces);
+/// given to a model without such states, or not finite, they are refused
+/// rather than dropped.
+#[test]
+fn initial_rates_of_states_the_model_lacks_are_refused() {
+    use bikedyn::generated::TyreFree;
+    use bikedyn_runtime::simulate::SimulateError;
+    let opts = SimOptions::default();
+    let ic = InitialConditions {
+        state_rates: [100.0, 0.0],
+        ..InitialConditions::default()
+    };
+    let e = simulate::<M>(&default_parameters::<M>(), &ic, &Inputs::default(), 0.5, &opts).unwrap_err();
+    assert!(
+        matches!(&e, SimulateError::InvalidInput(m) if m.contains("thesis_whipple") && m.contains("has 0")),
+        "{e}"
+    );
+    let ic = InitialConditions {
+        state_rates: [f64::NAN, 0.0],
+        ..InitialConditions::default()
+    };
+    let e = simulate::<TyreFree>(&default_parameters::<TyreFree>(), &ic, &Inputs::default(), 0.5, &opts).unwrap_err();
+    assert!(matches!(e, SimulateError::NotFinite { .. }), "{e}");
+    // The tyre model takes them.
+    let ic = InitialConditions {
+        state_rates: [100.0, -50.0],
+        ..InitialConditions::default()
+    };
+    simulate::<TyreFree>(&default_parameters::<TyreFree>(), &ic, &Inputs::default(), 0.5, &opts).unwrap();
+}

@@ -59,7 +59,7 @@
 
 use crate::model::MultibodyModel;
 use crate::scalar::Dual;
-use crate::simulate::sensitivity::{response, Carried, Directions};
+use crate::simulate::sensitivity::{interpolate, response, Carried, Directions};
 use crate::simulate::{simulate, Events, InitialConditions, Inputs, Method, SimOptions};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -385,9 +385,9 @@ pub struct Setup<'a> {
     pub parameters: Vec<EffectParameter>,
     simulate: fn(&[f64], &Segment, &[f64; NUISANCE], &SimOptions) -> Result<Sim, String>,
     sensitivities: SensitivityFn,
-    /// Nuisances per segment: the initial motion, the model's extra states
-    /// and their rates.
-    nuisance: usize,
+    /// Number of the model's extra first-order states (each kick's window
+    /// start fits their values and rates beside its motion).
+    extra_states: usize,
     /// Number of the model's parameters (the extra states' initial values
     /// follow them in a simulation's parameter vector).
     model_parameters: usize,
@@ -412,19 +412,11 @@ pub struct Sim {
 /// interpolated alike), holding the last value after a stop (a fall ends
 /// the simulation).
 fn interp<T: Carried>(ts: &[f64], xs: &[T], t: f64) -> T {
-    let n = ts.len();
-    if n == 0 {
+    if ts.is_empty() {
         return T::cst(f64::NAN);
     }
-    if t <= ts[0] {
-        return xs[0];
-    }
-    if t >= ts[n - 1] {
-        return xs[n - 1];
-    }
-    let k = ts.partition_point(|&x| x <= t);
-    let w = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
-    xs[k - 1] + (xs[k] - xs[k - 1]) * T::cst(w)
+    let Ok(v) = interpolate(ts, t, |k| Ok::<T, std::convert::Infallible>(xs[k]));
+    v
 }
 
 fn simulate_segment<M: MultibodyModel>(
@@ -433,8 +425,6 @@ fn simulate_segment<M: MultibodyModel>(
     x0: &[f64; NUISANCE],
     opts: &SimOptions,
 ) -> Result<Sim, String> {
-    let param = &with_extra_states::<M>(param, x0);
-    let ic = initial_conditions(x0, M::STATES.len());
     let dt = sample_interval(seg);
     let opts = SimOptions {
         output_interval: dt,
@@ -451,7 +441,9 @@ fn simulate_segment<M: MultibodyModel>(
         method: Method::Radau5,
         ..opts
     };
-    let sim = simulate::<M>(param, &ic, &Inputs::default(), seg.duration() + dt, &stiff).map_err(|e| e.to_string())?;
+    let ic = initial_conditions(x0, M::STATES.len());
+    let param = with_extra_states::<M>(param, x0);
+    let sim = simulate::<M>(&param, &ic, &Inputs::default(), seg.duration() + dt, &stiff).map_err(|e| e.to_string())?;
     use crate::model::CoordinateRole as R;
     let roll = match seg.roll_channel {
         RollChannel::Angle => sim.require_coordinate(R::Roll, "identification residuals"),
@@ -667,15 +659,16 @@ impl<'a> Setup<'a> {
             parameters,
             simulate: simulate_segment::<M>,
             sensitivities: segment_sensitivities::<M>,
-            nuisance: INITIAL_MOTION + 2 * M::STATES.len(),
+            extra_states: M::STATES.len(),
             model_parameters: M::PARAMETERS.len(),
             simulations: AtomicUsize::new(0),
         })
     }
 
-    /// Number of the model's extra first-order states.
-    fn extra_states(&self) -> usize {
-        (self.nuisance - INITIAL_MOTION) / 2
+    /// Nuisances per segment: the initial motion, the model's extra states
+    /// and their rates (the first entries of a `[f64; NUISANCE]`).
+    fn nuisance(&self) -> usize {
+        INITIAL_MOTION + 2 * self.extra_states
     }
 
     /// Number of shared (effect) parameters.
@@ -734,7 +727,7 @@ impl<'a> Setup<'a> {
     ) -> Option<SegmentJacobian> {
         let seg = &self.segments[i];
         let k = if shared { self.k() } else { 0 };
-        let nn = if nuisance { self.nuisance } else { 0 };
+        let nn = if nuisance { self.nuisance() } else { 0 };
         let mut dirs = Directions::default();
         if shared {
             for (j, (slot, info)) in self.slots.iter().zip(&self.parameters).enumerate() {
@@ -752,7 +745,7 @@ impl<'a> Setup<'a> {
             }
             // The extra states' initial values sit in the parameter
             // vector's tail; their rates are initial conditions.
-            let extra = self.extra_states();
+            let extra = self.extra_states;
             for e in 0..extra {
                 dirs.parameters
                     .push((self.model_parameters + e, k + INITIAL_MOTION + e, 1.0));
@@ -835,9 +828,9 @@ struct Problem<'s, 'a> {
 impl Problem<'_, '_> {
     fn n_free(&self) -> usize {
         match self.free {
-            Free::All => self.setup.k() + self.setup.nuisance * self.segs.len(),
+            Free::All => self.setup.k() + self.setup.nuisance() * self.segs.len(),
             Free::Shared => self.setup.k(),
-            Free::Nuisance => self.setup.nuisance * self.segs.len(),
+            Free::Nuisance => self.setup.nuisance() * self.segs.len(),
         }
     }
     fn pack(&self) -> Vec<f64> {
@@ -847,7 +840,7 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for &s in &self.segs {
-                x.extend(&self.x0[s][..self.setup.nuisance]);
+                x.extend(&self.x0[s][..self.setup.nuisance()]);
             }
         }
         x
@@ -861,7 +854,7 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for &s in &self.segs {
-                let nn = self.setup.nuisance;
+                let nn = self.setup.nuisance();
                 self.x0[s][..nn].copy_from_slice(&x[i..i + nn]);
                 i += nn;
             }
@@ -927,7 +920,7 @@ impl Problem<'_, '_> {
         let nn = if self.free == Free::Shared {
             0
         } else {
-            self.setup.nuisance
+            self.setup.nuisance()
         };
         let (shared, nuisance) = (k > 0, nn > 0);
         let exact: Vec<Option<SegmentJacobian>> = self
@@ -954,7 +947,7 @@ impl Problem<'_, '_> {
                 let mut g = self.g.clone();
                 let mut x0 = self.x0[s];
                 let h = if nuisance {
-                    let h = 1e-3 * nuisance_scale(j, self.setup.extra_states()).max(x0[j].abs());
+                    let h = 1e-3 * nuisance_scale(j, self.setup.extra_states).max(x0[j].abs());
                     x0[j] += h;
                     h
                 } else {
@@ -997,7 +990,7 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for _ in &self.segs {
-                x.extend((0..self.setup.nuisance).map(|j| nuisance_scale(j, self.setup.extra_states())));
+                x.extend((0..self.setup.nuisance()).map(|j| nuisance_scale(j, self.setup.extra_states)));
             }
         }
         x
@@ -1213,7 +1206,7 @@ fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
     };
     let Some(mut c) = cost(&p) else { return p };
     let scales = p.scales();
-    let budget = patience.max(1) * (k + p.setup.nuisance + 1) * 4;
+    let budget = patience.max(1) * (k + p.setup.nuisance() + 1) * 4;
 
     let mut evals = 1;
     let mut lambda = 1e-3;

@@ -93,7 +93,7 @@ fn predict(
         .zip(res)
         .enumerate()
         .map(|(m, (b, r))| {
-            let nn = setup.nuisance;
+            let nn = setup.nuisance();
             let di = DVector::from_column_slice(&dx[k + m * nn..k + (m + 1) * nn]);
             let moved = &b.a * &dg + &b.b * di;
             let r: Vec<f64> = r.iter().zip(moved.iter()).map(|(a, d)| a + d).collect();

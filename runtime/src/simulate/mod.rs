@@ -718,6 +718,21 @@ pub fn initial_state<M: MultibodyModel>(
             });
         }
     }
+    if ic.state_rates.iter().any(|r| !r.is_finite()) {
+        return Err(SimulateError::NotFinite {
+            what: "initial rate of an extra state".into(),
+        });
+    }
+    // A rate for a state the model does not have would be dropped.
+    if ic.state_rates.iter().skip(M::STATES.len()).any(|r| *r != 0.0) {
+        return Err(SimulateError::InvalidInput(format!(
+            "initial rates {:?} of extra states, but model `{}` has {} ({:?})",
+            ic.state_rates,
+            M::NAME,
+            M::STATES.len(),
+            M::STATES
+        )));
+    }
     let mut param = rhs::with_state_tail::<M>(param)?;
     if let Some(k) = imposed_speed_parameter::<M>() {
         if k < param.len() {
@@ -761,13 +776,6 @@ pub fn initial_state<M: MultibodyModel>(
                 "model `{}` has {} independent coordinates besides roll and steer and {} extra states (expected one more coordinate than states)",
                 M::NAME,
                 others.len(),
-                l.extra
-            )));
-        }
-        if l.extra > MAX_STATE_RATES && ic.state_rates.iter().any(|r| *r != 0.0) {
-            return Err(SimulateError::InvalidInput(format!(
-                "model `{}` has {} extra states; initial rates can be set for at most {MAX_STATE_RATES}",
-                M::NAME,
                 l.extra
             )));
         }

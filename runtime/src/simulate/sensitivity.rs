@@ -364,21 +364,28 @@ pub fn response<M: MultibodyModel, T: Carried>(
         at_sample[k] = Some(v);
         Ok(v)
     };
-    let last = out.t.len() - 1;
     for &t in speed_at {
-        let v = if !(t > out.t[0]) {
-            speed_of(0)?
-        } else if t >= out.t[last] {
-            speed_of(last)?
-        } else {
-            let k = out.t.partition_point(|&x| x <= t);
-            let w = (t - out.t[k - 1]) / (out.t[k] - out.t[k - 1]);
-            let (a, b) = (speed_of(k - 1)?, speed_of(k)?);
-            a + (b - a) * T::cst(w)
-        };
-        out.speed.push(v);
+        out.speed.push(interpolate(&out.t, t, &mut speed_of)?);
     }
     Ok(out)
+}
+
+/// The value at `t` of samples taken at the times `ts` (not empty, in
+/// increasing order): linear between the two samples around `t`, the first
+/// or last held outside them (a fall ends a simulation early). `value(k)`
+/// gives sample `k`; only the samples used are asked for.
+pub fn interpolate<T: Scalar, E>(ts: &[f64], t: f64, mut value: impl FnMut(usize) -> Result<T, E>) -> Result<T, E> {
+    let last = ts.len() - 1;
+    if !(t > ts[0]) {
+        return value(0);
+    }
+    if t >= ts[last] {
+        return value(last);
+    }
+    let k = ts.partition_point(|&x| x <= t);
+    let w = (t - ts[k - 1]) / (ts[k] - ts[k - 1]);
+    let (a, b) = (value(k - 1)?, value(k)?);
+    Ok(a + (b - a) * T::cst(w))
 }
 
 /// The initial state's derivatives along each direction, `[component][direction]`,
