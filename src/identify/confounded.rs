@@ -13,10 +13,11 @@ pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
     for step in &id.steps {
         for c in step.confounded.iter().filter(|c| c.correlation >= CONFOUNDED) {
             let values = |name: &str| {
-                step.tried
+                step.trials
                     .iter()
-                    .find(|(n, _)| n == name)
-                    .map(|(_, f)| {
+                    .find(|t| t.name == name)
+                    .and_then(|t| t.fit.as_ref())
+                    .map(|f| {
                         let own = f.parameters.len().saturating_sub(
                             o.candidates
                                 .iter()

@@ -2,9 +2,10 @@
 //! the fits, the errors before and after, the diagnosis and the plots.
 
 use super::candidates::not_candidates;
-use super::report::{errors_json, fmt_c, median, summary};
+use super::report::{errors_json, fmt_c, median, summary, verdict_text};
 use super::{IdentifyRequest, Outcome};
 use bikedyn_runtime::identify::confounding::CONFOUNDED;
+use bikedyn_runtime::identify::Trial;
 use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::Value;
 use std::fmt::Write as _;
@@ -96,35 +97,49 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
             s,
             "| candidate | fitted values | BIC change | held-out error | verdict |\n|---|---|---|---|---|"
         );
-        let mut rows: Vec<usize> = (0..step.tried.len()).collect();
-        rows.sort_by(|&x, &y| step.tried[x].1.bic.total_cmp(&step.tried[y].1.bic));
-        for r in rows {
-            let (name, f) = &step.tried[r];
-            let vals: Vec<String> = f
-                .parameters
-                .iter()
-                .zip(f.values.iter().zip(&f.stderr))
-                .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4}", p.symbol, v, se))
-                .collect();
-            let cv = if f.cv.is_finite() {
-                format!("{:.4}", f.cv)
-            } else {
-                "-".into()
-            };
-            let _ = writeln!(
-                s,
-                "| `{name}` | {} | {:+.1} | {cv} | {} |",
-                vals.join(", "),
-                f.bic - step.base_bic,
-                step.verdicts[r].1
-            );
-        }
-        for (name, why) in &step.failed {
-            let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
-        }
-        let screened = step.verdicts.iter().skip(step.tried.len());
-        for ((name, predicted), (_, why)) in step.screened_out.iter().zip(screened) {
-            let _ = writeln!(s, "| `{name}` | not fitted | {predicted:+.1} (predicted) | - | {why} |");
+        // Fitted trials by their criterion, then those not fitted by their
+        // predicted change.
+        let key = |t: &Trial| match &t.fit {
+            Some(f) => (0, f.bic - step.base_bic),
+            None => (1, t.predicted_bic_change.unwrap_or(f64::INFINITY)),
+        };
+        let mut rows: Vec<&Trial> = step.trials.iter().collect();
+        rows.sort_by(|x, y| {
+            let (a, b) = (key(x), key(y));
+            a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
+        });
+        for t in rows {
+            let name = &t.name;
+            let why = verdict_text(&t.verdict);
+            match &t.fit {
+                Some(f) => {
+                    let vals: Vec<String> = f
+                        .parameters
+                        .iter()
+                        .zip(f.values.iter().zip(&f.stderr))
+                        .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4}", p.symbol, v, se))
+                        .collect();
+                    let cv = if f.cv.is_finite() {
+                        format!("{:.4}", f.cv)
+                    } else {
+                        "-".into()
+                    };
+                    let _ = writeln!(
+                        s,
+                        "| `{name}` | {} | {:+.1} | {cv} | {why} |",
+                        vals.join(", "),
+                        f.bic - step.base_bic
+                    );
+                }
+                None => match t.predicted_bic_change {
+                    Some(p) => {
+                        let _ = writeln!(s, "| `{name}` | not fitted | {p:+.1} (predicted) | - | {why} |");
+                    }
+                    None => {
+                        let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
+                    }
+                },
+            }
         }
         let _ = writeln!(s);
         if !step.confounded.is_empty() {

@@ -12,7 +12,7 @@ use crate::bicycle::Bicycle;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic, StagedDir};
 use bikedyn_runtime::identify::confounding::CONFOUNDED;
-use bikedyn_runtime::identify::{pooled_rms, Candidate};
+use bikedyn_runtime::identify::{pooled_rms, Candidate, Verdict};
 use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
@@ -88,44 +88,21 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
     }
     let mut cands = Vec::new();
     for (k, step) in id.steps.iter().enumerate() {
-        for ((name, f), (_, verdict)) in step.tried.iter().zip(&step.verdicts) {
+        for t in &step.trials {
+            let fitted = t.fit.as_ref();
             cands.push(json!({
                 "step": k + 1,
-                "name": name,
+                "name": t.name,
+                "members": t.members,
                 "extends": step.base,
-                "score": f.bic - step.base_bic,
-                "cv": f.cv,
+                "score": fitted.map(|f| f.bic - step.base_bic),
+                "predicted_score": t.predicted_bic_change,
+                "cv": fitted.map(|f| f.cv).filter(|cv| cv.is_finite()),
                 "base_cv": step.base_cv,
-                "values": f.values,
-                "selected": step.added.as_deref() == Some(name.as_str()),
-                "verdict": verdict,
-            }));
-        }
-        for (name, why) in &step.failed {
-            cands.push(json!({
-                "step": k + 1,
-                "name": name,
-                "extends": step.base,
-                "score": Value::Null,
-                "cv": Value::Null,
-                "selected": false,
-                "verdict": why,
-            }));
-        }
-        for ((name, predicted), (_, verdict)) in step
-            .screened_out
-            .iter()
-            .zip(step.verdicts.iter().skip(step.tried.len()))
-        {
-            cands.push(json!({
-                "step": k + 1,
-                "name": name,
-                "extends": step.base,
-                "score": Value::Null,
-                "predicted_score": predicted,
-                "cv": Value::Null,
-                "selected": false,
-                "verdict": verdict,
+                "values": fitted.map(|f| f.values.clone()),
+                "selected": t.verdict.added(),
+                "outcome": t.verdict,
+                "verdict": verdict_text(&t.verdict),
             }));
         }
     }
@@ -435,4 +412,34 @@ pub fn write_report<R: ModelRegistry>(
     write_string_atomic(out.join("report.md"), &report_markdown(o, a, dir))?;
     staged.commit()?;
     Ok(())
+}
+
+/// A candidate's verdict in words, with its numbers (changes of the
+/// criterion against the step's base; negative is better).
+pub fn verdict_text(v: &Verdict) -> String {
+    match v {
+        Verdict::Added { bic_change, cv, base_cv } => {
+            format!("warranted: BIC {bic_change:+.1}, held-out error {cv:.4} (was {base_cv:.4})")
+        }
+        Verdict::NoPredictedGain { predicted_bic_change } => format!(
+            "not fitted: linearised at the current fit (score test), its best BIC change is {predicted_bic_change:+.1}, no gain"
+        ),
+        Verdict::BehindAdded { predicted_bic_change, added } => format!(
+            "not fitted: predicted BIC change {predicted_bic_change:+.1}, and {added}, predicted to gain more, passed first (tried again in the next step)"
+        ),
+        Verdict::CriterionAboveAdded { bic_change, added } => {
+            format!("not added: BIC {bic_change:+.1}, above that of {added} (not cross-validated)")
+        }
+        Verdict::FitFailed { reason } => format!("fit failed: {reason}"),
+        Verdict::NotPhysical => "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".into(),
+        Verdict::NoCriterionGain { bic_change } => {
+            format!("rejected: BIC {bic_change:+.1} (no gain beyond its added parameters; not cross-validated)")
+        }
+        Verdict::HeldOutNotLower { cv, base_cv } => {
+            format!("rejected: held-out error {cv:.4} not below {base_cv:.4} (does not generalise)")
+        }
+        Verdict::HeldOutGainNotConsistent { gain, stderr } => format!(
+            "rejected: held-out gain per run {gain:.4} within two standard errors ({stderr:.4}) of zero (not a consistent improvement)"
+        ),
+    }
 }

@@ -40,20 +40,17 @@
 //!   the residual variance, inflated by `(1 + rho) / (1 - rho)` for the lag-1
 //!   autocorrelation `rho` of the residuals: 120 Hz samples of a smooth
 //!   model error are not independent.
-//! * **Selection.** Forward stepwise: starting from no effect, each remaining
-//!   candidate is added and fitted; the best is kept only if it lowers the
-//!   Bayesian information criterion computed with the effective sample size
-//!   (`n (1 - rho) / (1 + rho)` per channel, from the current model's
-//!   residuals) *and* lowers the cross-validated error over held-out runs
-//!   (k-fold by run or log, the effect fitted on the other runs and only the
-//!   held-out run's initial state fitted to it), *and* its dissipative
-//!   parameters are positive (a negative damper is not physics). Each step
-//!   first screens its candidates by the score test ([`screen`]: one
-//!   simulation per kick in dual numbers linearises every candidate at
-//!   once); only those the linearisation says could lower the criterion
-//!   by at least `CONFOUNDED^2` of the best one's predicted gain are
-//!   fitted, and the fits are cross-validated in the order of the
-//!   criterion until one generalises. Sensor
+//! * **Selection** ([`selection`]). Forward stepwise: a candidate is added
+//!   only if it lowers the Bayesian information criterion computed with the
+//!   effective sample size (`n (1 - rho) / (1 + rho)` per channel, from the
+//!   base model's residuals) *and* lowers the cross-validated error over
+//!   held-out runs (k-fold by run or log, the effect fitted on the other
+//!   runs and only the held-out run's initial state fitted to it), *and*
+//!   its dissipative parameters are positive (a negative damper is not
+//!   physics). The score test ([`screen`]: one simulation per kick in dual
+//!   numbers linearises every candidate at once) orders the candidates and
+//!   skips those that cannot lower the criterion; when the best fails, the
+//!   next is tried, and pairs when no single candidate passes. Sensor
 //!   nuisances (mounting misalignment, clock offset) are estimated per set by
 //!   the measured-run pipeline before, and are never candidates.
 
@@ -69,7 +66,11 @@ use std::sync::Mutex;
 
 pub mod confounding;
 mod screen;
+pub mod selection;
 pub use confounding::{Confounding, Design, CONFOUNDED};
+pub use selection::{
+    bic, folds_by_run, identify, paired_gain, Identification, Step, Trial, Verdict, PLAUSIBLE_PRIOR_SDS,
+};
 
 /// Room for the per-segment nuisance parameters, the state at the window
 /// start: the initial motion ([`INITIAL_MOTION`]: roll, steer (rad), roll
@@ -80,8 +81,23 @@ pub use confounding::{Confounding, Design, CONFOUNDED};
 /// while the forces still lag behind the slip the kick gave the wheels:
 /// neither is at rest, and the rates set the slip (the free lateral
 /// velocities are solved from them). A model without extra states leaves
-/// those entries at zero.
-pub const NUISANCE: usize = INITIAL_MOTION + 2 * EXTRA_STATES;
+/// those entries at zero. The last entry ([`STEER_BIAS`]) is a sensor
+/// nuisance, not a state: the measured steer's offset over the window.
+pub const NUISANCE: usize = INITIAL_MOTION + 2 * EXTRA_STATES + 1;
+/// Where a kick's steer bias (rad) sits in its nuisances: the offset of the
+/// measured steer angle over the window, fitted per kick. A steer angle
+/// taken from two orientation sensors (frame and handlebar) inherits the
+/// difference of their heading references, which drift and carry errors of
+/// a degree or more that the calibration at rest cannot fix (each run's
+/// heading fusion settles anew), and an encoder's zero is set by hand; a
+/// mechanical candidate asked to explain such an offset would take up a
+/// sensor error (a few degrees of steer is what a lateral mass offset of
+/// centimetres gives). It is held at the same index in every model, so a
+/// fit's nuisances carry over between models with and without extra
+/// states.
+pub const STEER_BIAS: usize = NUISANCE - 1;
+/// Scale of the steer bias (rad).
+const STEER_BIAS_SCALE: f64 = 0.01;
 /// Number of initial-motion nuisances (roll, steer, their rates, speed).
 pub const INITIAL_MOTION: usize = 5;
 /// Most extra first-order states a model may have for identification.
@@ -498,7 +514,9 @@ fn initial_conditions(x0: &[f64; NUISANCE], extra: usize) -> InitialConditions {
 
 /// The scale of nuisance `j` of a model with `extra` extra states.
 fn nuisance_scale(j: usize, extra: usize) -> f64 {
-    if j < INITIAL_MOTION {
+    if j == STEER_BIAS {
+        STEER_BIAS_SCALE
+    } else if j < INITIAL_MOTION {
         MOTION_SCALE[j]
     } else if j < INITIAL_MOTION + extra {
         STATE_SCALE[0]
@@ -666,9 +684,20 @@ impl<'a> Setup<'a> {
     }
 
     /// Nuisances per segment: the initial motion, the model's extra states
-    /// and their rates (the first entries of a `[f64; NUISANCE]`).
+    /// and their rates, and the steer bias.
     fn nuisance(&self) -> usize {
-        INITIAL_MOTION + 2 * self.extra_states
+        INITIAL_MOTION + 2 * self.extra_states + 1
+    }
+
+    /// Where the segment's nuisances sit in a `[f64; NUISANCE]`, in the
+    /// order of the Jacobian's columns: the initial motion, the extra
+    /// states and their rates, then the steer bias ([`STEER_BIAS`]).
+    fn nuisance_index(&self, j: usize) -> usize {
+        if j < INITIAL_MOTION + 2 * self.extra_states {
+            j
+        } else {
+            STEER_BIAS
+        }
     }
 
     /// Number of shared (effect) parameters.
@@ -704,7 +733,8 @@ impl<'a> Setup<'a> {
         let w = self.weights[i];
         let mut r = Vec::with_capacity(seg.len());
         r.extend(seg.roll.iter().zip(&s.roll).map(|(m, p)| (m - p) / w.roll));
-        r.extend(seg.steer.iter().zip(&s.steer).map(|(m, p)| (m - p) / w.steer));
+        let bias = x0[STEER_BIAS];
+        r.extend(seg.steer.iter().zip(&s.steer).map(|(m, p)| (m - p - bias) / w.steer));
         r.extend(seg.speed.iter().zip(&s.speed).map(|(m, p)| (m - p) / w.speed));
         if r.iter().any(|x| !x.is_finite()) {
             return Err("non-finite residual".into());
@@ -754,7 +784,10 @@ impl<'a> Setup<'a> {
         }
         self.simulations.fetch_add(1, Ordering::Relaxed);
         let opts = self.sensitivity_options();
-        let (_, columns) = (self.sensitivities)(&self.param(g), seg, x0, &opts, &dirs, k + nn)?;
+        // The steer bias is no simulation direction: its column is set
+        // below.
+        let simulated = k + nn.saturating_sub(1);
+        let (_, columns) = (self.sensitivities)(&self.param(g), seg, x0, &opts, &dirs, simulated)?;
         let w = self.weights[i];
         let (nr, ns) = (seg.roll.len(), seg.steer.len());
         let scale = |row: usize| {
@@ -773,8 +806,16 @@ impl<'a> Setup<'a> {
         for d in 0..k {
             a.set_column(d, &column(d));
         }
-        for d in 0..nn {
+        for d in 0..nn.saturating_sub(1) {
             b.set_column(d, &column(k + d));
+        }
+        if nuisance {
+            // d r / d bias = -1 / w_steer on the steer rows.
+            let mut bias = DVector::zeros(rows);
+            for r in nr..(nr + ns).min(rows) {
+                bias[r] = -1.0 / w.steer;
+            }
+            b.set_column(nn - 1, &bias);
         }
         let finite = a.iter().chain(b.iter()).all(|x| x.is_finite());
         finite.then_some(SegmentJacobian { a, b })
@@ -797,9 +838,14 @@ impl<'a> Setup<'a> {
         }
     }
 
-    /// Simulated channels of one segment (for plots).
+    /// Simulated channels of one segment as the sensors read them (the
+    /// steer with the kick's bias), for plots.
     pub fn simulated(&self, g: &[f64], seg: &Segment, x0: &[f64; NUISANCE]) -> Result<Sim, String> {
-        (self.simulate)(&self.param(g), seg, x0, &self.options)
+        let mut sim = (self.simulate)(&self.param(g), seg, x0, &self.options)?;
+        for s in &mut sim.steer {
+            *s += x0[STEER_BIAS];
+        }
+        Ok(sim)
     }
 }
 
@@ -840,7 +886,7 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for &s in &self.segs {
-                x.extend(&self.x0[s][..self.setup.nuisance()]);
+                x.extend((0..self.setup.nuisance()).map(|j| self.x0[s][self.setup.nuisance_index(j)]));
             }
         }
         x
@@ -855,7 +901,9 @@ impl Problem<'_, '_> {
         if self.free != Free::Shared {
             for &s in &self.segs {
                 let nn = self.setup.nuisance();
-                self.x0[s][..nn].copy_from_slice(&x[i..i + nn]);
+                for j in 0..nn {
+                    self.x0[s][self.setup.nuisance_index(j)] = x[i + j];
+                }
                 i += nn;
             }
         }
@@ -947,8 +995,9 @@ impl Problem<'_, '_> {
                 let mut g = self.g.clone();
                 let mut x0 = self.x0[s];
                 let h = if nuisance {
-                    let h = 1e-3 * nuisance_scale(j, self.setup.extra_states).max(x0[j].abs());
-                    x0[j] += h;
+                    let at = self.setup.nuisance_index(j);
+                    let h = 1e-3 * nuisance_scale(at, self.setup.extra_states).max(x0[at].abs());
+                    x0[at] += h;
                     h
                 } else {
                     let h = 1e-3 * self.setup.parameters[j].scale.max(g[j].abs());
@@ -990,7 +1039,10 @@ impl Problem<'_, '_> {
         }
         if self.free != Free::Shared {
             for _ in &self.segs {
-                x.extend((0..self.setup.nuisance()).map(|j| nuisance_scale(j, self.setup.extra_states)));
+                x.extend(
+                    (0..self.setup.nuisance())
+                        .map(|j| nuisance_scale(self.setup.nuisance_index(j), self.setup.extra_states)),
+                );
             }
         }
         x
@@ -1418,506 +1470,6 @@ pub fn cross_validate(setup: &Setup<'_>, fit: &mut CandidateFit, fold_of: &[usiz
     fit.held_out = held_out;
     fit.fold_values = fold_values;
     fit.simulations += setup.simulations.load(Ordering::Relaxed) - sims_before;
-}
-
-/// The candidates with their priors put on the scale of the weighted data.
-/// The weighted sum of squares counts every sample as independent with
-/// variance one, but the residuals of a smooth response are strongly
-/// autocorrelated and their level is not the weight: the information the
-/// data carry is that sum divided by `s2 = chi2 / n (1 + rho) / (1 - rho)`
-/// (the inflation the standard errors use). A prior `sd` is therefore
-/// applied as `sd / sqrt(s2)`, measured on the base model's fit, never
-/// weaker than as stated; without this a correction would move several
-/// prior deviations for a small gain in a sum that overstates the data.
-fn with_priors_on_the_data_scale(candidates: &[Candidate], base: &CandidateFit) -> Vec<Candidate> {
-    let n: usize = base.errors.iter().flat_map(|e| e.channel_n).sum();
-    let rho = base.errors.iter().map(|e| e.rho).sum::<f64>() / base.errors.len().max(1) as f64;
-    let s2 = base.chi2 / n.max(1) as f64 * (1.0 + rho) / (1.0 - rho);
-    let scale = if s2.is_finite() { s2.max(1.0).sqrt() } else { 1.0 };
-    candidates
-        .iter()
-        .map(|c| {
-            let mut c = c.clone();
-            for p in &mut c.parameters {
-                p.prior = p.prior.map(|(mean, sd)| (mean, sd / scale));
-            }
-            c
-        })
-        .collect()
-}
-
-/// Bayesian information criterion of `fit` with the effective sample size
-/// of each channel taken from `reference` (the model being extended): the
-/// profile likelihood of Gaussian residuals with one unknown variance per
-/// channel of each segment (a run that the model follows badly, e.g. one
-/// that diverges toward a fall, then counts by the log of its misfit and
-/// cannot outweigh the others): `sum n_eff ln(SS / n) + k ln(n_eff)`.
-pub fn bic(fit: &CandidateFit, reference: &CandidateFit) -> f64 {
-    let mut total = 0.0;
-    let mut n_eff_all = 0.0;
-    for (e, r) in fit.errors.iter().zip(&reference.errors) {
-        for c in 0..3 {
-            let n = e.channel_n[c];
-            if n == 0 || !(e.channel_ss[c] > 0.0) {
-                continue;
-            }
-            // Speed samples are sparse (one per magnet): about independent.
-            let rho = if c == 2 { 0.0 } else { r.rho };
-            let n_eff = n as f64 * (1.0 - rho) / (1.0 + rho);
-            total += n_eff * (e.channel_ss[c] / n as f64).ln();
-            n_eff_all += n_eff;
-        }
-    }
-    total + fit.values.len() as f64 * n_eff_all.max(1.0).ln()
-}
-
-/// One step of the stepwise selection: every candidate tried on top of the
-/// current model.
-#[derive(Clone, Debug, Serialize)]
-pub struct Step {
-    /// Effects of the model this step extends.
-    pub base: Vec<String>,
-    pub base_bic: f64,
-    pub base_cv: f64,
-    /// Candidates tried, with their fits.
-    pub tried: Vec<(String, CandidateFit)>,
-    /// The candidate added (if any) and why the others were not.
-    pub added: Option<String>,
-    pub verdicts: Vec<(String, String)>,
-    /// Candidates whose fit failed, with the reason.
-    pub failed: Vec<(String, String)>,
-    /// Candidates not fitted because the score test predicted no gain,
-    /// with the predicted change of the criterion ([`screen`]).
-    pub screened_out: Vec<(String, f64)>,
-    /// The candidate added against each rival that also explained the
-    /// data: how far the data tell them apart ([`confounding`]).
-    pub confounded: Vec<Confounding>,
-}
-
-/// Outcome of identification.
-#[derive(Clone, Debug, Serialize)]
-pub struct Identification {
-    /// Channel scales of each segment.
-    pub weights: Vec<Weights>,
-    /// The base model's fit (no effect added).
-    pub before: CandidateFit,
-    /// The selected model's fit (equal to `before` when nothing is warranted).
-    pub after: CandidateFit,
-    /// Selected candidates in order.
-    pub selected: Vec<String>,
-    pub steps: Vec<Step>,
-    /// Folds of the cross-validation.
-    pub folds: usize,
-    /// Fold of each segment (all kicks of a run in one fold).
-    pub fold_of: Vec<usize>,
-    /// Simulations run in all.
-    pub simulations: usize,
-}
-
-/// The folds of the cross-validation: by run, so that a held-out error is
-/// that of runs (or logs, with many kicks each) the fit never saw; runs are
-/// dealt to `folds` folds in their order. With a single run the folds are
-/// by kick.
-pub fn folds_by_run(segments: &[Segment], folds: usize) -> (usize, Vec<usize>) {
-    let mut runs: Vec<&str> = Vec::new();
-    for s in segments {
-        if !runs.contains(&s.run.as_str()) {
-            runs.push(&s.run);
-        }
-    }
-    if runs.len() < 2 {
-        let folds = folds.clamp(2, segments.len().max(2));
-        return (folds, (0..segments.len()).map(|s| s % folds).collect());
-    }
-    let folds = folds.clamp(2, runs.len());
-    let fold_of = segments
-        .iter()
-        .map(|s| runs.iter().position(|r| *r == s.run).unwrap_or(0) % folds)
-        .collect();
-    (folds, fold_of)
-}
-
-/// Identify which of `candidates` the data warrant, for the free-speed
-/// model `M` with base parameters `base` (no effect). `progress` is called
-/// after each stage (the base fit, a step's score test, each candidate's fit
-/// and cross-validation) with what was done and, where the stage's size is
-/// known, how far it is: `(done, total)` (the candidates a step fits after
-/// its score test; at most the candidates it cross-validates).
-pub fn identify<M: MultibodyModel>(
-    base: &[f64],
-    segments: &[Segment],
-    candidates: &[Candidate],
-    alternative: Option<&dyn ModelFactory>,
-    opts: &IdentifyOptions,
-    progress: &(dyn Fn(&str, Option<(usize, usize)>) + Sync),
-) -> Result<Identification, IdentifyError> {
-    if segments.is_empty() {
-        return Err(IdentifyError::NoData);
-    }
-    let (folds, fold_of) = folds_by_run(segments, opts.folds);
-    let x0: Vec<[f64; NUISANCE]> = segments.iter().map(|s| s.initial).collect();
-    // Channel scales: first a sensor-level guess, then each segment's own
-    // residual level per channel under the base model (at least the best
-    // segment's, which is about the noise), so that each segment and
-    // channel weighs by how well the base model describes it: roll and
-    // steer (rad) and speed (m/s) are otherwise incommensurable, and a run
-    // that diverges toward a fall would otherwise dominate the fit.
-    let guess = |s: &Segment| Weights {
-        roll: match s.roll_channel {
-            RollChannel::Angle => 0.005,
-            RollChannel::Rate => 0.05,
-        },
-        steer: 0.01,
-        speed: 0.05,
-    };
-    let guesses: Vec<Weights> = segments.iter().map(guess).collect();
-    let setup0 = Setup::new::<M>(base, segments, &guesses, &[])?;
-    // (No folds: this fit only sets the channel scales.)
-    let first = fit_candidate(&setup0, vec![], &[], &x0, &[], opts, None)?;
-    let rms = |e: &SegmentError, c: usize| (e.channel_ss[c] / e.channel_n[c].max(1) as f64).sqrt();
-    let floor = |c: usize, min: f64| {
-        first
-            .errors
-            .iter()
-            .map(|e| rms(e, c))
-            .filter(|x| x.is_finite() && *x > 0.0)
-            .fold(f64::INFINITY, f64::min)
-            .max(min)
-    };
-    let floors = [floor(0, 1e-4), floor(1, 1e-4), floor(2, 1e-3)];
-    let weights: Vec<Weights> = first
-        .errors
-        .iter()
-        .map(|e| Weights {
-            roll: rms(e, 0).max(floors[0]),
-            steer: rms(e, 1).max(floors[1]),
-            speed: rms(e, 2).max(floors[2]),
-        })
-        .collect();
-    let setup0 = Setup::new::<M>(base, segments, &weights, &[])?;
-    let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts, None)?;
-    before.bic = bic(&before, &before);
-    progress("fitted base model", Some((1, 1)));
-    let mut simulations = first.simulations + before.simulations;
-    let candidates = &with_priors_on_the_data_scale(candidates, &before);
-
-    let main = Factory::<M>::new(base.to_vec());
-    let mut current = before.clone();
-    let mut selected: Vec<&Candidate> = Vec::new();
-    let mut steps = Vec::new();
-    while selected.len() < opts.max_effects {
-        // After the first step, only candidates that improved the criterion
-        // on their own (fitted, or predicted by the score test) are
-        // combined: one that explained nothing alone is not revived by a
-        // partner (and each try costs a full fit).
-        let remaining: Vec<&Candidate> = candidates
-            .iter()
-            .filter(|c| !selected.iter().any(|s| s.name == c.name))
-            .filter(|c| !c.alternative_model || alternative.is_some())
-            .filter(|c| {
-                steps.first().is_none_or(|s: &Step| {
-                    s.tried.iter().any(|(n, f)| n == &c.name && f.bic < s.base_bic)
-                        || s.screened_out.iter().any(|(n, d)| n == &c.name && *d < 0.0)
-                })
-            })
-            .collect();
-        if remaining.is_empty() {
-            break;
-        }
-        let base_bic = bic(&current, &current);
-        // The score test first (see [`screen`]): a candidate is fitted when
-        // its linearised best fit lowers the criterion below the current
-        // model's (itself linearised one step further), by at least
-        // CONFOUNDED^2 of the best candidate's predicted gain. One that
-        // explains less cannot be a rival the data fail to tell from the
-        // best (two candidates at that correlation explain the same misfit
-        // to within that factor) and is not the one a fit would select
-        // unless the linearisation is far off.
-        let screened = screen::screen(&screen::Screen {
-            main: &main,
-            alternative,
-            segments,
-            weights: &weights,
-            selected: &selected,
-            remaining: &remaining,
-            current: &current,
-        });
-        simulations += screened.simulations;
-        progress(&format!("score test of {} candidates", remaining.len()), None);
-        let reference_bic = screened.reference.map_or(base_bic, |r| r.min(base_bic));
-        let best_gain = screened
-            .predictions
-            .iter()
-            .flatten()
-            .map(|p| reference_bic - p)
-            .fold(0.0, f64::max);
-        let mut screened_out = Vec::new();
-        let mut tried = Vec::new();
-        let mut setups = Vec::new();
-        let mut failed: Vec<(String, String)> = Vec::new();
-        // The score test's verdict on a candidate: why it is screened out
-        // (its BIC change and the reason), or `None` when it is fitted. The
-        // count of those fitted is the size of this step for its progress.
-        let screened_why = |predicted: &Option<f64>| -> Option<(f64, String)> {
-            let gain = reference_bic - (*predicted)?;
-            if !(gain > 0.0) {
-                Some((gain, format!("screened out: linearised at the current fit, its best BIC change is {:+.1} (score test; not fitted)", -gain)))
-            } else if gain < CONFOUNDED * CONFOUNDED * best_gain {
-                Some((
-                    gain,
-                    format!(
-                        "screened out: linearised, it gains {:.0} % of the criterion the best candidate gains (below {:.0} %: neither selected nor confounded with it; not fitted)",
-                        100.0 * gain / best_gain,
-                        100.0 * CONFOUNDED * CONFOUNDED
-                    ),
-                ))
-            } else {
-                None
-            }
-        };
-        let to_fit = screened
-            .predictions
-            .iter()
-            .filter(|p| screened_why(p).is_none())
-            .count();
-        let mut fitted = 0;
-        for (c, predicted) in remaining.iter().zip(&screened.predictions) {
-            if let Some((gain, why)) = screened_why(predicted) {
-                screened_out.push((c.name.clone(), -gain, why));
-                continue;
-            }
-            let mut active = selected.clone();
-            active.push(c);
-            let setup = match alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
-                Some(f) => f.setup(segments, &weights, &active)?,
-                None => Setup::new::<M>(base, segments, &weights, &active)?,
-            };
-            let mut g0 = current.values.clone();
-            g0.extend(c.parameters.iter().map(|p| p.initial.unwrap_or(0.1 * p.scale)));
-            let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
-            match fit_candidate(&setup, effects, &g0, &current.nuisance, &fold_of, opts, Some(&current)) {
-                Ok(f) => {
-                    tried.push((c.name.clone(), f));
-                    setups.push(setup);
-                }
-                Err(e) => failed.push((c.name.clone(), format!("fit failed: {e}"))),
-            }
-            fitted += 1;
-            progress(&format!("fitted {}", c.name), Some((fitted, to_fit.max(fitted))));
-        }
-        // Cross-validation in the order of the criterion: the first
-        // candidate that also generalises is added, and the ones behind it
-        // need no held-out error.
-        let mut order: Vec<usize> = (0..tried.len())
-            .filter(|&i| tried[i].1.physical && tried[i].1.bic < base_bic)
-            .collect();
-        order.sort_by(|&a, &b| tried[a].1.bic.total_cmp(&tried[b].1.bic));
-        let mut best: Option<usize> = None;
-        let mut held_verdict: Vec<Option<String>> = vec![None; tried.len()];
-        let mut validated = 0;
-        for &i in &order {
-            if best.is_some() {
-                held_verdict[i] = Some(format!(
-                    "not added: BIC {:+.1}, above that of {} (not cross-validated)",
-                    tried[i].1.bic - base_bic,
-                    best.map_or("", |b| tried[b].0.as_str())
-                ));
-                continue;
-            }
-            cross_validate(&setups[i], &mut tried[i].1, &fold_of, opts);
-            validated += 1;
-            progress(
-                &format!("cross-validated {}", tried[i].0),
-                Some((validated, order.len())),
-            );
-            let f = &tried[i].1;
-            held_verdict[i] = Some(if !(f.cv < current.cv) {
-                format!(
-                    "rejected: held-out error {:.4} not below {:.4} (does not generalise)",
-                    f.cv, current.cv
-                )
-            } else if let Some((d, se)) = paired_gain(&current, f, &weights).filter(|(d, se)| !(*d > 2.0 * se)) {
-                format!(
-                    "rejected: held-out gain per run {d:.4} within two standard errors ({se:.4}) of zero (not a consistent improvement)"
-                )
-            } else {
-                best = Some(i);
-                format!(
-                    "warranted: BIC {:+.1}, held-out error {:.4} (was {:.4})",
-                    f.bic - base_bic,
-                    f.cv,
-                    current.cv
-                )
-            });
-        }
-        for (i, (_, f)) in tried.iter_mut().enumerate() {
-            f.simulations = setups[i].simulations.load(Ordering::Relaxed);
-            simulations += f.simulations;
-        }
-        let mut verdicts = Vec::new();
-        for (i, (name, f)) in tried.iter().enumerate() {
-            let verdict = if !f.physical {
-                "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".to_string()
-            } else if !(f.bic < base_bic) {
-                format!(
-                    "rejected: BIC {:+.1} (no gain beyond its added parameters; not cross-validated)",
-                    f.bic - base_bic
-                )
-            } else {
-                held_verdict[i].clone().unwrap_or_default()
-            };
-            verdicts.push((name.clone(), verdict));
-        }
-        for (name, _, why) in &screened_out {
-            verdicts.push((name.clone(), why.clone()));
-        }
-        let screened_out: Vec<(String, f64)> = screened_out.into_iter().map(|(n, d, _)| (n, d)).collect();
-        let added = best.map(|b| tried[b].0.clone());
-        let failed_names = failed.clone();
-        let confounded = match best {
-            Some(b) => rivals(&Rivals {
-                main: &main,
-                alternative,
-                segments,
-                weights: &weights,
-                selected: &selected,
-                candidates,
-                tried: &tried,
-                best: b,
-                base_bic,
-            }),
-            None => Vec::new(),
-        };
-        let step = Step {
-            base: current.effects.clone(),
-            base_bic,
-            base_cv: current.cv,
-            tried: tried.clone(),
-            added: added.clone(),
-            verdicts,
-            failed: failed_names,
-            screened_out,
-            confounded,
-        };
-        steps.push(step);
-        match best {
-            Some(b) => {
-                let name = &tried[b].0;
-                selected.push(candidates.iter().find(|c| &c.name == name).expect("tried candidate"));
-                current = tried[b].1.clone();
-            }
-            None => break,
-        }
-    }
-    Ok(Identification {
-        weights,
-        before,
-        after: current,
-        selected: selected.iter().map(|c| c.name.clone()).collect(),
-        steps,
-        folds,
-        fold_of,
-        simulations,
-    })
-}
-
-/// What [`rivals`] looks at: a step's fits and what made them.
-struct Rivals<'r> {
-    main: &'r dyn ModelFactory,
-    alternative: Option<&'r dyn ModelFactory>,
-    segments: &'r [Segment],
-    weights: &'r [Weights],
-    selected: &'r [&'r Candidate],
-    candidates: &'r [Candidate],
-    tried: &'r [(String, CandidateFit)],
-    best: usize,
-    base_bic: f64,
-}
-
-/// The candidate a step adds against each rival that also lowered the
-/// information criterion: their correlation on the measured kicks, and for
-/// a confounded pair the designs of kicks that would separate them (at
-/// speeds from 1.5 m/s below the slowest kick to 1.5 m/s above the fastest).
-fn rivals(r: &Rivals<'_>) -> Vec<Confounding> {
-    let (name, fit) = &r.tried[r.best];
-    let find = |n: &str| r.candidates.iter().find(|c| c.name == n);
-    let Some(chosen) = find(name) else { return Vec::new() };
-    let speeds: Vec<f64> = {
-        let v = r.segments.iter().map(|s| s.mean_speed).filter(|v| v.is_finite());
-        let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
-        if lo.is_finite() {
-            let (lo, hi) = ((lo - 1.5).max(1.0), hi + 1.5);
-            (0..6).map(|i| lo + (hi - lo) * i as f64 / 5.0).collect()
-        } else {
-            Vec::new()
-        }
-    };
-    let ks: usize = r.selected.iter().map(|c| c.parameters.len()).sum();
-    let kc = chosen.parameters.len();
-    let mut out = Vec::new();
-    for (i, (rival_name, rival_fit)) in r.tried.iter().enumerate() {
-        if i == r.best || !rival_fit.physical || !(rival_fit.bic < r.base_bic) {
-            continue;
-        }
-        let Some(rival) = find(rival_name) else { continue };
-        let mut active: Vec<&Candidate> = r.selected.to_vec();
-        active.push(chosen);
-        active.push(rival);
-        let factory = match r.alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
-            Some(f) => f,
-            None if active.iter().any(|a| a.alternative_model) => continue,
-            None => r.main,
-        };
-        let Ok(setup) = factory.setup(r.segments, r.weights, &active) else {
-            continue;
-        };
-        let mut g = fit.values.clone();
-        g.extend(rival_fit.values.iter().skip(ks));
-        if g.len() != setup.k() {
-            continue;
-        }
-        let a: Vec<usize> = (ks..ks + kc).collect();
-        let b: Vec<usize> = (ks + kc..setup.k()).collect();
-        if let Some((correlation, designs)) =
-            confounding::confounding(&setup, factory, &active, &g, &fit.nuisance, &a, &b, &speeds)
-        {
-            out.push(Confounding {
-                chosen: name.clone(),
-                rival: rival_name.clone(),
-                correlation,
-                designs,
-            });
-        }
-    }
-    out
-}
-
-/// Paired comparison of the held-out errors of two models, run by run:
-/// mean gain (weighted mean square, `base - candidate`) and its standard
-/// error. Selection asks the gain to exceed two standard errors, so an
-/// effect that improves the held-out error only on average over a few runs
-/// (an artefact of one run, noise) is not added.
-pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> Option<(f64, f64)> {
-    let mse = |e: &SegmentError, w: &Weights| {
-        let ss = e.channel_ss[0] / (w.roll * w.roll)
-            + e.channel_ss[1] / (w.steer * w.steer)
-            + e.channel_ss[2] / (w.speed * w.speed);
-        ss / (e.channel_n.iter().sum::<usize>().max(1) as f64)
-    };
-    let d: Vec<f64> = base
-        .held_out
-        .iter()
-        .zip(&cand.held_out)
-        .zip(w)
-        .map(|((a, b), w)| mse(a, w) - mse(b, w))
-        .collect();
-    let n = d.len() as f64;
-    if n < 2.0 {
-        return None;
-    }
-    let m = d.iter().sum::<f64>() / n;
-    let var = d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    Some((m, (var / n).sqrt()))
 }
 
 /// Overall RMS of a channel over segments (rad or m/s).

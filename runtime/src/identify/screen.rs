@@ -41,6 +41,9 @@ pub(super) struct Screen<'s> {
     pub remaining: &'s [&'s Candidate],
     /// The current model's fit.
     pub current: &'s CandidateFit,
+    /// The fit whose residuals give the criterion's effective sample sizes
+    /// (the base model of the search).
+    pub reference: &'s CandidateFit,
 }
 
 /// The screen of a step.
@@ -52,6 +55,12 @@ pub(super) struct Screened {
     /// Each remaining candidate's predicted information criterion (in
     /// order); `None` where the screen does not apply (it is fitted).
     pub predictions: Vec<Option<f64>>,
+    /// The predicted criterion of pairs of nested candidates (indices into
+    /// the remaining ones, the smaller first) whose joint linearised fit
+    /// beats each member's alone: two effects that each explain part of a
+    /// misfit the other cannot (a damper beside an inertia error) may pass
+    /// together where neither passes alone.
+    pub pairs: Vec<((usize, usize), f64)>,
     /// Simulations run.
     pub simulations: usize,
 }
@@ -105,7 +114,7 @@ fn predict(
         values: vec![0.0; k],
         ..s.current.clone()
     };
-    let bic = bic(&predicted, s.current);
+    let bic = bic(&predicted, s.reference);
     // A prediction that is not finite says nothing: the candidate is fitted.
     bic.is_finite().then_some(bic)
 }
@@ -118,6 +127,7 @@ pub(super) fn screen(s: &Screen<'_>) -> Screened {
     let mut out = Screened {
         reference: None,
         predictions: vec![None; s.remaining.len()],
+        pairs: Vec::new(),
         simulations: 0,
     };
     let in_alternative = s.selected.iter().any(|c| c.alternative_model);
@@ -217,6 +227,19 @@ pub(super) fn screen(s: &Screen<'_>) -> Screened {
         for (n, &i) in group.iter().enumerate() {
             let cols: Vec<usize> = base.iter().chain(&columns[n]).copied().collect();
             out.predictions[i] = predict(s, &setup, &blocks, &res, &g, &cols);
+        }
+        // Pairs: the same linearisation with both members' columns free.
+        for a in 0..group.len() {
+            for b in a + 1..group.len() {
+                let (ia, ib) = (group[a], group[b]);
+                let (Some(pa), Some(pb)) = (out.predictions[ia], out.predictions[ib]) else {
+                    continue;
+                };
+                let cols: Vec<usize> = base.iter().chain(&columns[a]).chain(&columns[b]).copied().collect();
+                if let Some(p) = predict(s, &setup, &blocks, &res, &g, &cols).filter(|p| *p < pa.min(pb)) {
+                    out.pairs.push(((ia.min(ib), ia.max(ib)), p));
+                }
+            }
         }
     }
     out.simulations += setup.simulations.load(Ordering::Relaxed);

@@ -1,0 +1,720 @@
+//! Forward stepwise selection of the candidates: which effects and
+//! corrections the data warrant, step by step, with every candidate's
+//! outcome as a typed [`Verdict`].
+//!
+//! Each step extends the current model by the candidate that (a) lowers the
+//! information criterion ([`bic`]), (b) lowers the held-out error of the
+//! cross-validation by run, by more than two standard errors of the
+//! run-by-run gain ([`paired_gain`]), and (c) keeps its dissipative
+//! parameters positive. The score test ([`super::screen`]) orders the
+//! candidates and skips those whose linearised fit cannot lower the
+//! criterion, but it never discards one because of another: the
+//! candidates it ranks close to the best are fitted together (they are the
+//! rivals the report compares), and when none of them passes, the next
+//! ones are fitted in the order of their predicted gain until one passes
+//! or none is left. When no single candidate passes, pairs whose joint
+//! linearised fit beats each member's alone are fitted and validated the
+//! same way (a damper and an inertia error may each explain only part of
+//! a misfit). The search ends when a step adds nothing, or after
+//! [`IdentifyOptions::max_effects`] additions.
+//!
+//! The criterion of every fit, at every step, is computed with the
+//! effective sample sizes of the base model's residuals (one reference for
+//! the whole search), so the steps' figures add up: a step's base is the
+//! previous step's base plus the change it selected.
+
+use super::confounding::{self, Confounding};
+use super::screen;
+use super::{
+    cross_validate, fit_candidate, Candidate, CandidateFit, Factory, IdentifyError, IdentifyOptions, ModelFactory,
+    RollChannel, Segment, SegmentError, Setup, Weights, NUISANCE,
+};
+use crate::model::MultibodyModel;
+use serde::Serialize;
+use std::sync::atomic::Ordering;
+
+/// The candidates with their priors put on the scale of the weighted data.
+/// The weighted sum of squares counts every sample as independent with
+/// variance one, but the residuals of a smooth response are strongly
+/// autocorrelated and their level is not the weight: the information the
+/// data carry is that sum divided by `s2 = chi2 / n (1 + rho) / (1 - rho)`
+/// (the inflation the standard errors use). A prior `sd` is therefore
+/// applied as `sd / sqrt(s2)`, measured on the base model's fit, never
+/// weaker than as stated; without this a correction would move several
+/// prior deviations for a small gain in a sum that overstates the data.
+fn with_priors_on_the_data_scale(candidates: &[Candidate], base: &CandidateFit) -> Vec<Candidate> {
+    let n: usize = base.errors.iter().flat_map(|e| e.channel_n).sum();
+    let rho = base.errors.iter().map(|e| e.rho).sum::<f64>() / base.errors.len().max(1) as f64;
+    let s2 = base.chi2 / n.max(1) as f64 * (1.0 + rho) / (1.0 - rho);
+    let scale = if s2.is_finite() { s2.max(1.0).sqrt() } else { 1.0 };
+    candidates
+        .iter()
+        .map(|c| {
+            let mut c = c.clone();
+            for p in &mut c.parameters {
+                p.prior = p.prior.map(|(mean, sd)| (mean, sd / scale));
+            }
+            c
+        })
+        .collect()
+}
+
+/// Bayesian information criterion of `fit` with the effective sample size
+/// of each channel taken from `reference` (the base model of the search):
+/// the profile likelihood of Gaussian residuals with one unknown variance
+/// per channel of each segment (a run that the model follows badly, e.g.
+/// one that diverges toward a fall, then counts by the log of its misfit
+/// and cannot outweigh the others): `sum n_eff ln(SS / n) + k ln(n_eff)`.
+pub fn bic(fit: &CandidateFit, reference: &CandidateFit) -> f64 {
+    let mut total = 0.0;
+    let mut n_eff_all = 0.0;
+    for (e, r) in fit.errors.iter().zip(&reference.errors) {
+        for c in 0..3 {
+            let n = e.channel_n[c];
+            if n == 0 || !(e.channel_ss[c] > 0.0) {
+                continue;
+            }
+            // Speed samples are sparse (one per magnet): about independent.
+            let rho = if c == 2 { 0.0 } else { r.rho };
+            let n_eff = n as f64 * (1.0 - rho) / (1.0 + rho);
+            total += n_eff * (e.channel_ss[c] / n as f64).ln();
+            n_eff_all += n_eff;
+        }
+    }
+    total + fit.values.len() as f64 * n_eff_all.max(1.0).ln()
+}
+
+/// Why a candidate of a step was or was not added, with the numbers behind
+/// it. Changes of the criterion are against the step's base model
+/// (negative: better).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Verdict {
+    /// Added: it lowers the criterion and the held-out error, consistently
+    /// over the runs.
+    Added { bic_change: f64, cv: f64, base_cv: f64 },
+    /// The score test's linearised fit does not lower the criterion: it
+    /// cannot win this step (not fitted).
+    NoPredictedGain { predicted_bic_change: f64 },
+    /// Not fitted: a candidate predicted to gain more passed first.
+    BehindAdded { predicted_bic_change: f64, added: String },
+    /// Fitted, with a criterion above the added candidate's: not
+    /// cross-validated.
+    CriterionAboveAdded { bic_change: f64, added: String },
+    /// The fit failed.
+    FitFailed { reason: String },
+    /// A dissipative parameter fitted at or below zero, or at its floor
+    /// (not physics; not cross-validated).
+    NotPhysical,
+    /// The fit does not lower the criterion beyond its added parameters
+    /// (not cross-validated).
+    NoCriterionGain { bic_change: f64 },
+    /// The held-out error does not fall: it does not generalise.
+    HeldOutNotLower { cv: f64, base_cv: f64 },
+    /// The held-out gain per run is within two standard errors of zero:
+    /// not a consistent improvement.
+    HeldOutGainNotConsistent { gain: f64, stderr: f64 },
+}
+
+impl Verdict {
+    /// The candidate was added.
+    pub fn added(&self) -> bool {
+        matches!(self, Verdict::Added { .. })
+    }
+}
+
+/// One candidate (or a pair of candidates) of a step and its outcome.
+#[derive(Clone, Debug, Serialize)]
+pub struct Trial {
+    /// The candidate's name; a pair is `a + b`.
+    pub name: String,
+    /// The candidates it adds (one, or two for a pair).
+    pub members: Vec<String>,
+    /// The score test's predicted change of the criterion, where it applies
+    /// (`None`: not screened, e.g. the tyre candidate's other model).
+    pub predicted_bic_change: Option<f64>,
+    /// The fit, when it was fitted.
+    pub fit: Option<CandidateFit>,
+    pub verdict: Verdict,
+}
+
+/// One step of the stepwise selection: the candidates tried on top of the
+/// current model, in the order they were considered.
+#[derive(Clone, Debug, Serialize)]
+pub struct Step {
+    /// Effects of the model this step extends.
+    pub base: Vec<String>,
+    /// Its criterion and held-out error.
+    pub base_bic: f64,
+    pub base_cv: f64,
+    /// Every candidate of the step with its outcome.
+    pub trials: Vec<Trial>,
+    /// The candidates added (empty: the search ends here; two for a pair).
+    pub added: Vec<String>,
+    /// The candidate added against each rival that also explained the
+    /// data: how far the data tell them apart ([`confounding`]).
+    pub confounded: Vec<Confounding>,
+}
+
+impl Step {
+    /// The trial that was added, if any.
+    pub fn added_trial(&self) -> Option<&Trial> {
+        self.trials.iter().find(|t| t.verdict.added())
+    }
+}
+
+/// Outcome of identification.
+#[derive(Clone, Debug, Serialize)]
+pub struct Identification {
+    /// Channel scales of each segment.
+    pub weights: Vec<Weights>,
+    /// The base model's fit (no effect added).
+    pub before: CandidateFit,
+    /// The selected model's fit (equal to `before` when nothing is warranted).
+    pub after: CandidateFit,
+    /// Selected candidates in order.
+    pub selected: Vec<String>,
+    pub steps: Vec<Step>,
+    /// Folds of the cross-validation.
+    pub folds: usize,
+    /// Fold of each segment (all kicks of a run in one fold).
+    pub fold_of: Vec<usize>,
+    /// Simulations run in all.
+    pub simulations: usize,
+}
+
+/// The folds of the cross-validation: by run, so that a held-out error is
+/// that of runs (or logs, with many kicks each) the fit never saw; runs are
+/// dealt to `folds` folds in their order. With a single run the folds are
+/// by kick.
+pub fn folds_by_run(segments: &[Segment], folds: usize) -> (usize, Vec<usize>) {
+    let mut runs: Vec<&str> = Vec::new();
+    for s in segments {
+        if !runs.contains(&s.run.as_str()) {
+            runs.push(&s.run);
+        }
+    }
+    if runs.len() < 2 {
+        let folds = folds.clamp(2, segments.len().max(2));
+        return (folds, (0..segments.len()).map(|s| s % folds).collect());
+    }
+    let folds = folds.clamp(2, runs.len());
+    let fold_of = segments
+        .iter()
+        .map(|s| runs.iter().position(|r| *r == s.run).unwrap_or(0) % folds)
+        .collect();
+    (folds, fold_of)
+}
+
+/// The largest number of pairs fitted in a step whose single candidates all
+/// failed, best predicted first (each costs a fit and a cross-validation).
+const MAX_PAIRS: usize = 3;
+
+/// Identify which of `candidates` the data warrant, for the free-speed
+/// model `M` with base parameters `base` (no effect). `progress` is called
+/// after each stage (the base fit, a step's score test, each candidate's fit
+/// and cross-validation) with what was done and, where the stage's size is
+/// known, how far it is: `(done, total)`.
+pub fn identify<M: MultibodyModel>(
+    base: &[f64],
+    segments: &[Segment],
+    candidates: &[Candidate],
+    alternative: Option<&dyn ModelFactory>,
+    opts: &IdentifyOptions,
+    progress: &(dyn Fn(&str, Option<(usize, usize)>) + Sync),
+) -> Result<Identification, IdentifyError> {
+    if segments.is_empty() {
+        return Err(IdentifyError::NoData);
+    }
+    let (folds, fold_of) = folds_by_run(segments, opts.folds);
+    let x0: Vec<[f64; NUISANCE]> = segments.iter().map(|s| s.initial).collect();
+    // Channel scales: first a sensor-level guess, then each segment's own
+    // residual level per channel under the base model (at least the best
+    // segment's, which is about the noise), so that each segment and
+    // channel weighs by how well the base model describes it: roll and
+    // steer (rad) and speed (m/s) are otherwise incommensurable, and a run
+    // that diverges toward a fall would otherwise dominate the fit.
+    let guess = |s: &Segment| Weights {
+        roll: match s.roll_channel {
+            RollChannel::Angle => 0.005,
+            RollChannel::Rate => 0.05,
+        },
+        steer: 0.01,
+        speed: 0.05,
+    };
+    let guesses: Vec<Weights> = segments.iter().map(guess).collect();
+    let setup0 = Setup::new::<M>(base, segments, &guesses, &[])?;
+    // (No folds: this fit only sets the channel scales.)
+    let first = fit_candidate(&setup0, vec![], &[], &x0, &[], opts, None)?;
+    let rms = |e: &SegmentError, c: usize| (e.channel_ss[c] / e.channel_n[c].max(1) as f64).sqrt();
+    let floor = |c: usize, min: f64| {
+        first
+            .errors
+            .iter()
+            .map(|e| rms(e, c))
+            .filter(|x| x.is_finite() && *x > 0.0)
+            .fold(f64::INFINITY, f64::min)
+            .max(min)
+    };
+    let floors = [floor(0, 1e-4), floor(1, 1e-4), floor(2, 1e-3)];
+    let weights: Vec<Weights> = first
+        .errors
+        .iter()
+        .map(|e| Weights {
+            roll: rms(e, 0).max(floors[0]),
+            steer: rms(e, 1).max(floors[1]),
+            speed: rms(e, 2).max(floors[2]),
+        })
+        .collect();
+    let setup0 = Setup::new::<M>(base, segments, &weights, &[])?;
+    let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts, None)?;
+    before.bic = bic(&before, &before);
+    progress("fitted base model", Some((1, 1)));
+    let mut simulations = first.simulations + before.simulations;
+    let scaled = with_priors_on_the_data_scale(candidates, &before);
+    let search = Search {
+        main: &Factory::<M>::new(base.to_vec()),
+        alternative,
+        segments,
+        weights: &weights,
+        fold_of: &fold_of,
+        opts,
+        reference: &before,
+        stated: candidates,
+        progress,
+    };
+
+    let mut current = before.clone();
+    let mut selected: Vec<&Candidate> = Vec::new();
+    let mut steps: Vec<Step> = Vec::new();
+    while selected.len() < opts.max_effects {
+        let remaining: Vec<&Candidate> = scaled
+            .iter()
+            .filter(|c| !selected.iter().any(|s| s.name == c.name))
+            .filter(|c| !c.alternative_model || alternative.is_some())
+            .collect();
+        if remaining.is_empty() {
+            break;
+        }
+        let (step, fit, sims) = search.step(&current, &selected, &remaining)?;
+        simulations += sims;
+        let added = step.added.clone();
+        steps.push(step);
+        let Some(fit) = fit else { break };
+        for name in &added {
+            selected.push(scaled.iter().find(|c| &c.name == name).expect("added candidate"));
+        }
+        current = fit;
+    }
+    Ok(Identification {
+        weights,
+        before,
+        after: current,
+        selected: selected.iter().map(|c| c.name.clone()).collect(),
+        steps,
+        folds,
+        fold_of,
+        simulations,
+    })
+}
+
+/// What every step of one search shares.
+struct Search<'s> {
+    main: &'s dyn ModelFactory,
+    alternative: Option<&'s dyn ModelFactory>,
+    segments: &'s [Segment],
+    weights: &'s [Weights],
+    fold_of: &'s [usize],
+    opts: &'s IdentifyOptions,
+    /// The base model's fit: the effective sample sizes of every criterion.
+    reference: &'s CandidateFit,
+    /// The candidates with their priors as stated (the plausibility of a
+    /// rival; the fits use them on the data's scale).
+    stated: &'s [Candidate],
+    progress: &'s (dyn Fn(&str, Option<(usize, usize)>) + Sync),
+}
+
+/// A trial being considered: its members (indices into the step's
+/// remaining candidates) and what the step knows of it so far.
+struct Pending<'c> {
+    members: Vec<&'c Candidate>,
+    predicted: Option<f64>,
+    fit: Option<(CandidateFit, Setup<'c>)>,
+    verdict: Option<Verdict>,
+}
+
+impl<'c> Pending<'c> {
+    fn name(&self) -> String {
+        self.members
+            .iter()
+            .map(|c| c.name.as_str())
+            .collect::<Vec<_>>()
+            .join(" + ")
+    }
+}
+
+impl<'s> Search<'s> {
+    /// One step on top of `current` (with the candidates `selected`): the
+    /// step's record, the fit of the extended model when something was
+    /// added, and the simulations run.
+    fn step(
+        &self,
+        current: &CandidateFit,
+        selected: &[&'s Candidate],
+        remaining: &[&'s Candidate],
+    ) -> Result<(Step, Option<CandidateFit>, usize), IdentifyError> {
+        let base_bic = bic(current, self.reference);
+        let screened = screen::screen(&screen::Screen {
+            main: self.main,
+            alternative: self.alternative,
+            segments: self.segments,
+            weights: self.weights,
+            selected,
+            remaining,
+            current,
+            reference: self.reference,
+        });
+        let mut simulations = screened.simulations;
+        (self.progress)(&format!("score test of {} candidates", remaining.len()), None);
+        // Predicted changes against the step's base: the screen's reference
+        // is the current fit one Gauss-Newton step further, never above it.
+        let reference_bic = screened.reference.map_or(base_bic, |r| r.min(base_bic));
+        let change = |p: Option<f64>| p.map(|p| p - reference_bic);
+        let mut pending: Vec<Pending<'s>> = remaining
+            .iter()
+            .zip(&screened.predictions)
+            .map(|(c, p)| Pending {
+                members: vec![*c],
+                predicted: change(*p),
+                fit: None,
+                verdict: None,
+            })
+            .collect();
+        for p in &mut pending {
+            if let Some(d) = p.predicted.filter(|d| !(*d < 0.0)) {
+                p.verdict = Some(Verdict::NoPredictedGain {
+                    predicted_bic_change: d,
+                });
+            }
+        }
+        // The order of the search: candidates the screen could not judge
+        // first (they were always fitted), then by predicted gain.
+        let mut order: Vec<usize> = (0..pending.len()).filter(|&i| pending[i].verdict.is_none()).collect();
+        order.sort_by(|&a, &b| {
+            let key = |i: usize| pending[i].predicted.unwrap_or(f64::NEG_INFINITY);
+            key(a).total_cmp(&key(b))
+        });
+        // The contenders: every candidate the screen ranks within
+        // CONFOUNDED^2 of the best one's predicted gain is fitted before any
+        // is cross-validated, since two candidates at that correlation
+        // explain the same misfit to within that factor: the report
+        // compares them as rivals.
+        let best_gain = order
+            .iter()
+            .filter_map(|&i| pending[i].predicted)
+            .fold(0.0, |m: f64, d| m.max(-d));
+        let contenders = order
+            .iter()
+            .take_while(|&&i| {
+                pending[i]
+                    .predicted
+                    .is_none_or(|d| -d >= confounding::CONFOUNDED * confounding::CONFOUNDED * best_gain)
+            })
+            .count();
+        let mut next = 0;
+        let mut winner: Option<usize> = None;
+        let mut fitted = 0;
+        while winner.is_none() && next < order.len() {
+            let batch = if next == 0 { contenders.max(1) } else { 1 };
+            for &i in &order[next..(next + batch).min(order.len())] {
+                self.fit(&mut pending[i], current, selected, base_bic)?;
+                fitted += 1;
+                (self.progress)(
+                    &format!("fitted {}", pending[i].name()),
+                    Some((fitted, order.len().max(fitted))),
+                );
+            }
+            next += batch;
+            winner = self.validate(&mut pending, current)?;
+        }
+        // No single candidate passed: pairs whose joint linearised fit
+        // beats each member's alone, best predicted first.
+        let single = pending.len();
+        if winner.is_none() {
+            let mut pairs = screened.pairs.clone();
+            pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
+            for ((a, b), p) in pairs.into_iter().filter(|(_, p)| *p < reference_bic).take(MAX_PAIRS) {
+                let mut pair = Pending {
+                    members: vec![remaining[a], remaining[b]],
+                    predicted: change(Some(p)),
+                    fit: None,
+                    verdict: None,
+                };
+                self.fit(&mut pair, current, selected, base_bic)?;
+                pending.push(pair);
+                winner = self.validate(&mut pending, current)?;
+                if winner.is_some() {
+                    break;
+                }
+            }
+        }
+        // Those behind the winner.
+        if let Some(w) = winner {
+            let added = pending[w].name();
+            for p in pending.iter_mut().filter(|p| p.verdict.is_none()) {
+                // A fitted one left without a verdict comes after the
+                // winner in the order of the criterion (see `validate`).
+                p.verdict = Some(match &p.fit {
+                    Some((f, _)) => Verdict::CriterionAboveAdded {
+                        bic_change: f.bic - base_bic,
+                        added: added.clone(),
+                    },
+                    None => Verdict::BehindAdded {
+                        predicted_bic_change: p.predicted.unwrap_or(f64::NAN),
+                        added: added.clone(),
+                    },
+                });
+            }
+        }
+        let confounded = match winner.filter(|&w| w < single) {
+            Some(w) => self.rivals(&pending, w, selected, base_bic),
+            None => Vec::new(),
+        };
+        let mut trials = Vec::with_capacity(pending.len());
+        let mut added_fit = None;
+        let mut added = Vec::new();
+        for (i, p) in pending.into_iter().enumerate() {
+            let name = p.name();
+            let members: Vec<String> = p.members.iter().map(|c| c.name.clone()).collect();
+            let fit = p.fit.map(|(mut f, setup)| {
+                f.simulations = setup.simulations.load(Ordering::Relaxed);
+                simulations += f.simulations;
+                f
+            });
+            if Some(i) == winner {
+                added_fit = fit.clone();
+                added = members.clone();
+            }
+            trials.push(Trial {
+                name,
+                members,
+                predicted_bic_change: p.predicted,
+                fit,
+                verdict: p.verdict.expect("every trial has a verdict"),
+            });
+        }
+        let step = Step {
+            base: current.effects.clone(),
+            base_bic,
+            base_cv: current.cv,
+            trials,
+            added,
+            confounded,
+        };
+        Ok((step, added_fit, simulations))
+    }
+
+    /// Fit a pending trial on top of `current`; a failed fit gets its
+    /// verdict, and so does a fit that is not physical or does not lower
+    /// the criterion.
+    fn fit(
+        &self,
+        p: &mut Pending<'s>,
+        current: &CandidateFit,
+        selected: &[&'s Candidate],
+        base_bic: f64,
+    ) -> Result<(), IdentifyError> {
+        let mut active: Vec<&Candidate> = selected.to_vec();
+        active.extend(p.members.iter().copied());
+        let setup = match self.alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
+            Some(f) => f.setup(self.segments, self.weights, &active)?,
+            None => self.main.setup(self.segments, self.weights, &active)?,
+        };
+        let mut g0 = current.values.clone();
+        for c in &p.members {
+            g0.extend(c.parameters.iter().map(|q| q.initial.unwrap_or(0.1 * q.scale)));
+        }
+        let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
+        match fit_candidate(
+            &setup,
+            effects,
+            &g0,
+            &current.nuisance,
+            self.fold_of,
+            self.opts,
+            Some(self.reference),
+        ) {
+            Ok(f) => {
+                if !f.physical {
+                    p.verdict = Some(Verdict::NotPhysical);
+                } else if !(f.bic < base_bic) {
+                    p.verdict = Some(Verdict::NoCriterionGain {
+                        bic_change: f.bic - base_bic,
+                    });
+                }
+                p.fit = Some((f, setup));
+            }
+            Err(e) => p.verdict = Some(Verdict::FitFailed { reason: e.to_string() }),
+        }
+        Ok(())
+    }
+
+    /// Cross-validate the fitted trials without a verdict, in the order of
+    /// the criterion, until one passes: its index.
+    fn validate(&self, pending: &mut [Pending<'s>], current: &CandidateFit) -> Result<Option<usize>, IdentifyError> {
+        let mut order: Vec<usize> = (0..pending.len())
+            .filter(|&i| pending[i].verdict.is_none() && pending[i].fit.is_some())
+            .collect();
+        order.sort_by(|&a, &b| {
+            let bic = |i: usize| pending[i].fit.as_ref().map_or(f64::INFINITY, |f| f.0.bic);
+            bic(a).total_cmp(&bic(b))
+        });
+        for i in order {
+            let name = pending[i].name();
+            let Some((fit, setup)) = pending[i].fit.as_mut() else {
+                continue;
+            };
+            cross_validate(setup, fit, self.fold_of, self.opts);
+            (self.progress)(&format!("cross-validated {name}"), None);
+            let verdict = if !(fit.cv < current.cv) {
+                Verdict::HeldOutNotLower {
+                    cv: fit.cv,
+                    base_cv: current.cv,
+                }
+            } else if let Some((gain, stderr)) =
+                paired_gain(current, fit, self.weights).filter(|(d, se)| !(*d > 2.0 * se))
+            {
+                Verdict::HeldOutGainNotConsistent { gain, stderr }
+            } else {
+                Verdict::Added {
+                    bic_change: fit.bic - bic(current, self.reference),
+                    cv: fit.cv,
+                    base_cv: current.cv,
+                }
+            };
+            let added = verdict.added();
+            pending[i].verdict = Some(verdict);
+            if added {
+                return Ok(Some(i));
+            }
+        }
+        Ok(None)
+    }
+
+    /// The candidate a step adds against each fitted rival that also
+    /// lowered the information criterion and is plausible under its
+    /// prior: their correlation on the measured kicks, and for a
+    /// confounded pair the designs of kicks that would separate them (at
+    /// speeds from 1.5 m/s below the slowest kick to 1.5 m/s above the
+    /// fastest).
+    fn rivals(
+        &self,
+        pending: &[Pending<'s>],
+        best: usize,
+        selected: &[&'s Candidate],
+        base_bic: f64,
+    ) -> Vec<Confounding> {
+        let chosen = pending[best].members[0];
+        let Some((fit, _)) = &pending[best].fit else {
+            return Vec::new();
+        };
+        let speeds: Vec<f64> = {
+            let v = self.segments.iter().map(|s| s.mean_speed).filter(|v| v.is_finite());
+            let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+            if lo.is_finite() {
+                let (lo, hi) = ((lo - 1.5).max(1.0), hi + 1.5);
+                (0..6).map(|i| lo + (hi - lo) * i as f64 / 5.0).collect()
+            } else {
+                Vec::new()
+            }
+        };
+        let ks: usize = selected.iter().map(|c| c.parameters.len()).sum();
+        let kc = chosen.parameters.len();
+        let mut out = Vec::new();
+        for (i, p) in pending.iter().enumerate() {
+            let Some((rival_fit, _)) = &p.fit else { continue };
+            if i == best || p.members.len() != 1 || !rival_fit.physical || !(rival_fit.bic < base_bic) {
+                continue;
+            }
+            let rival = p.members[0];
+            if !self.plausible(rival, &rival_fit.values[ks..]) {
+                continue;
+            }
+            let mut active: Vec<&Candidate> = selected.to_vec();
+            active.push(chosen);
+            active.push(rival);
+            let factory = match self.alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
+                Some(f) => f,
+                None if active.iter().any(|a| a.alternative_model) => continue,
+                None => self.main,
+            };
+            let Ok(setup) = factory.setup(self.segments, self.weights, &active) else {
+                continue;
+            };
+            let mut g = fit.values.clone();
+            g.extend(rival_fit.values.iter().skip(ks));
+            if g.len() != setup.k() {
+                continue;
+            }
+            let a: Vec<usize> = (ks..ks + kc).collect();
+            let b: Vec<usize> = (ks + kc..setup.k()).collect();
+            if let Some((correlation, designs)) =
+                confounding::confounding(&setup, factory, &active, &g, &fit.nuisance, &a, &b, &speeds)
+            {
+                out.push(Confounding {
+                    chosen: chosen.name.clone(),
+                    rival: rival.name.clone(),
+                    correlation,
+                    designs,
+                });
+            }
+        }
+        out
+    }
+
+    /// Whether a candidate's fitted values are plausible under its stated
+    /// prior: within [`PLAUSIBLE_PRIOR_SDS`] prior standard deviations of the
+    /// measured value (a candidate without a prior, an effect, always is).
+    fn plausible(&self, candidate: &Candidate, values: &[f64]) -> bool {
+        let Some(stated) = self.stated.iter().find(|c| c.name == candidate.name) else {
+            return true;
+        };
+        stated.parameters.iter().zip(values).all(|(p, v)| {
+            p.prior
+                .is_none_or(|(mean, sd)| ((v - mean) / sd).abs() <= PLAUSIBLE_PRIOR_SDS)
+        })
+    }
+}
+
+/// A correction further than this many prior standard deviations from its
+/// measured value is no plausible rival explanation (beyond three, a
+/// Gaussian prior gives it odds below 1 in 370).
+pub const PLAUSIBLE_PRIOR_SDS: f64 = 3.0;
+
+/// Paired comparison of the held-out errors of two models, run by run:
+/// mean gain (weighted mean square, `base - candidate`) and its standard
+/// error. Selection asks the gain to exceed two standard errors, so an
+/// effect that improves the held-out error only on average over a few runs
+/// (an artefact of one run, noise) is not added.
+pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> Option<(f64, f64)> {
+    let mse = |e: &SegmentError, w: &Weights| {
+        let ss = e.channel_ss[0] / (w.roll * w.roll)
+            + e.channel_ss[1] / (w.steer * w.steer)
+            + e.channel_ss[2] / (w.speed * w.speed);
+        ss / (e.channel_n.iter().sum::<usize>().max(1) as f64)
+    };
+    let d: Vec<f64> = base
+        .held_out
+        .iter()
+        .zip(&cand.held_out)
+        .zip(w)
+        .map(|((a, b), w)| mse(a, w) - mse(b, w))
+        .collect();
+    let n = d.len() as f64;
+    if n < 2.0 {
+        return None;
+    }
+    let m = d.iter().sum::<f64>() / n;
+    let var = d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
+    Some((m, (var / n).sqrt()))
+}

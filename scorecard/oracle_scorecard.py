@@ -1,0 +1,300 @@
+#!/usr/bin/env python3
+"""Score `bikedyn identify` on sets it did not make.
+
+The sets come from ../shared/oracle-sim (sympy.physics.mechanics equations,
+SciPy integration, its own IMU, reed-switch and clock models; no code shared
+with bikedyn). For every row of `matrix.toml` the set is generated (once;
+kept under --work), `bikedyn identify` runs on its data folder, and the
+outcome is scored against the truth the oracle wrote apart:
+
+* right cause: every cause in the set is selected, or reported as not
+  separable from a selected candidate (the report's `confounded` list);
+* false causes: selected candidates that are neither a cause nor speed decay
+  (rolling resistance and drag are in every set);
+* parameter error: for an effect, |fitted - true| / |true|; for a
+  correction, the error of the fitted shift from the nominal value relative
+  to the true shift;
+* errors before and after on the fitted and on the held-out runs: the weave
+  eigenvalue RMS (1/s) and the median run's roll RMS (deg);
+* time of the identification (s).
+
+Targets (issue 33): the right cause on at least 90 % of the sets with a
+cause, nothing but speed decay on the controls, parameters within 25 %, and
+the weave eigenvalue or the median run's roll error at least halved on the
+held-out runs where there is a cause.
+
+Usage:
+    python3 scorecard/oracle_scorecard.py [--subset ci] [--sets A,B] [--work DIR]
+        [--oracle DIR] [--python PY] [--bikedyn BIN] [--seed-base N] [--json FILE]
+
+The oracle needs numpy and scipy in --python (default: this interpreter).
+The exit status is 0 when the scorecard was made (whatever it scores), 1 when
+a set could not be made or identified, or with --require-targets when a
+target is missed.
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+import time
+import tomllib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+
+# Oracle effects -> (bikedyn candidate, symbol, how the true value follows
+# from the oracle's value and the nominal thesis parameters).
+EFFECT_CAUSES = {
+    "c_steer": ("steer_damping", "c_steer", lambda v, nom: v),
+    "T_coul": ("steer_friction", "T_steer", lambda v, nom: v),
+    # The oracle's yB is positive to the right; bikedyn's y3 to the left.
+    "yB": ("lateral_mass_offset", "y3", lambda v, nom: -v),
+    "dI3x_rel": ("correct I3x", "I3x", lambda v, nom: nom["I3x"] * (1.0 + v)),
+    # The front assembly's inertia about its local z axis is the thesis's I4z.
+    "dIE33_rel": ("correct I4z", "I4z", lambda v, nom: nom["I4z"] * (1.0 + v)),
+    "dbz": ("correct z3", "z3", lambda v, nom: nom["z3"] + v),
+}
+SPEED_DECAY = {"rolling_resistance", "aero_drag"}
+TARGET_RIGHT = 0.90
+TARGET_PARAMETER = 0.25
+
+
+def pairs(text: str) -> dict[str, float]:
+    out = {}
+    for item in filter(None, (text or "").split(",")):
+        key, value = item.split("=")
+        out[key.strip()] = float(value)
+    return out
+
+
+def seed_of(name: str, base: int) -> int:
+    """A seed nobody picked: a hash of the set's name and the base."""
+    return int(hashlib.sha256(f"{base}:{name}".encode()).hexdigest()[:8], 16) % 1_000_000
+
+
+def make_set(row, decay, args, seed):
+    data = os.path.join(args.work, "data", row["name"])
+    stamp = os.path.join(args.work, "stamps", row["name"] + ".json")
+    want = {"effects": row.get("effects", ""), "thesis": row.get("thesis", ""), "decay": decay, "seed": seed}
+    if os.path.isdir(data) and os.path.exists(stamp):
+        with open(stamp) as fh:
+            if json.load(fh) == want:
+                return
+    effects = ",".join(filter(None, [decay, row.get("effects", "")]))
+    cmd = [args.python, os.path.join(args.oracle, "make_runs.py"), "--out", args.work,
+           "--name", row["name"], "--seed", str(seed), "--effects", effects]
+    if row.get("thesis"):
+        cmd += ["--thesis", row["thesis"]]
+    for sub in ("data", "truth"):
+        shutil.rmtree(os.path.join(args.work, sub, row["name"]), ignore_errors=True)
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
+    os.makedirs(os.path.dirname(stamp), exist_ok=True)
+    with open(stamp, "w") as fh:
+        json.dump(want, fh)
+
+
+def causes_of(row, truth):
+    """The set's causes: (candidate, symbol, nominal, true value)."""
+    nom = truth["nominal_thesis_parameters"]
+    out = []
+    for key, value in pairs(row.get("effects", "")).items():
+        cand, symbol, true_of = EFFECT_CAUSES[key]
+        nominal = nom.get(symbol, 0.0)
+        out.append((cand, symbol, nominal, true_of(value, nom)))
+    for key, value in pairs(row.get("thesis", "")).items():
+        out.append((f"correct {key}", key, nom[key], value))
+    return out
+
+
+def base_name(selected: str) -> str:
+    return selected.split(" (")[0]
+
+
+def score(row, truth, report, seconds):
+    causes = causes_of(row, truth)
+    selected = [base_name(s) for s in report["selected_effects"]]
+    confounded = [(c["chosen"], c["rival"]) for c in report.get("confounded", []) if c.get("confounded")]
+    cause_names = {c[0] for c in causes}
+    found = []
+    param_errors = []
+    for cand, symbol, nominal, true in causes:
+        hit = cand in selected
+        via = None
+        if not hit:
+            via = next((ch for ch, rv in confounded if rv == cand and ch in selected), None)
+        found.append(hit or via is not None)
+        p = report["parameters"].get(symbol)
+        if hit and p is not None:
+            if cand.startswith("correct "):
+                shift_true = true - nominal
+                err = abs((p["value"] - nominal) - shift_true) / abs(shift_true)
+            else:
+                err = abs(p["value"] - true) / abs(true)
+            param_errors.append((symbol, p["value"], true, err))
+    false = [s for s in selected if s not in cause_names and s not in SPEED_DECAY
+             and not any(rv in cause_names for ch, rv in confounded if ch == s)]
+    before, after = report["error_before"], report["error_after"]
+    ho_b, ho_a = before["held_out"], after["held_out"]
+
+    def ratio(a, b):
+        return a / b if b and math.isfinite(a) and math.isfinite(b) else float("nan")
+
+    # Held-out figures: the weave eigenvalue RMS, and the median run's roll
+    # RMS from the per-run held-out values.
+    def median_held_roll(err):
+        xs = sorted(r["held_out_roll_rms"] for r in err["per_run"] if r.get("held_out_roll_rms") is not None)
+        return xs[len(xs) // 2] if xs else float("nan")
+
+    figures = {
+        "eigen_rms": (before["eigen_rms"], after["eigen_rms"]),
+        "eigen_rms_held_out": (ho_b["eigen_rms"], ho_a["eigen_rms"]),
+        "median_run_roll_deg": (math.degrees(before["median_run_roll_rms"]), math.degrees(after["median_run_roll_rms"])),
+        "median_run_roll_held_out_deg": (math.degrees(median_held_roll(before)), math.degrees(median_held_roll(after))),
+    }
+    halved = (ratio(*figures["eigen_rms_held_out"][::-1]) <= 0.5
+              or ratio(*figures["median_run_roll_held_out_deg"][::-1]) <= 0.5)
+    return {
+        "set": row["name"],
+        "causes": [f"{c[0]}" for c in causes],
+        "selected": report["selected_effects"],
+        "right": all(found) if causes else None,
+        "control_clean": (not false) if not causes else None,
+        "false": false,
+        "parameters": [{"symbol": s, "fitted": v, "true": t, "relative_error": e} for s, v, t, e in param_errors],
+        "parameters_within": all(e <= TARGET_PARAMETER for *_, e in param_errors) if param_errors else None,
+        "figures": figures,
+        "halved": halved if causes else None,
+        "seconds": seconds,
+    }
+
+
+def fmt(x, digits=3):
+    return "-" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.{digits}f}"
+
+
+def print_table(rows, out=sys.stdout):
+    print("| set | causes | selected | right | false | parameter error | eigen RMS held-out (1/s) | median-run roll held-out (deg) | s |", file=out)
+    print("|---|---|---|---|---|---|---|---|---|", file=out)
+    for r in rows:
+        if "error" in r:
+            print(f"| {r['set']} | | error: {r['error']} | no | | | | | |", file=out)
+            continue
+        causes = ", ".join(r["causes"]) or "none (control)"
+        sel = ", ".join(r["selected"]) or "nothing"
+        right = "yes" if r["right"] else ("no" if r["right"] is False else ("clean" if r["control_clean"] else "no"))
+        perr = ", ".join(f"{p['symbol']} {100 * p['relative_error']:.0f} %" for p in r["parameters"]) or "-"
+        e, m = r["figures"]["eigen_rms_held_out"], r["figures"]["median_run_roll_held_out_deg"]
+        print(f"| {r['set']} | {causes} | {sel} | {right} | {', '.join(r['false']) or '-'} | {perr} | "
+              f"{fmt(e[0])} -> {fmt(e[1])} | {fmt(m[0])} -> {fmt(m[1])} | {r['seconds']:.0f} |", file=out)
+
+
+def summary(rows):
+    with_cause = [r for r in rows if r.get("right") is not None or ("error" in r and r.get("has_cause"))]
+    controls = [r for r in rows if r.get("control_clean") is not None or ("error" in r and not r.get("has_cause"))]
+    right = sum(1 for r in with_cause if r.get("right"))
+    clean = sum(1 for r in controls if r.get("control_clean"))
+    params = [p for r in rows for p in r.get("parameters", [])]
+    within = sum(1 for p in params if p["relative_error"] <= TARGET_PARAMETER)
+    halved = sum(1 for r in with_cause if r.get("halved"))
+    false = sum(len(r.get("false", [])) for r in with_cause)
+    return {
+        "sets": len(rows),
+        "right_causes": right, "sets_with_cause": len(with_cause),
+        "clean_controls": clean, "controls": len(controls),
+        "false_causes_on_sets_with_cause": false,
+        "parameters_within_25pct": within, "parameters_scored": len(params),
+        "errors_halved": halved,
+        "seconds": sum(r.get("seconds", 0.0) for r in rows),
+        "targets_met": (len(with_cause) == 0 or right >= TARGET_RIGHT * len(with_cause)) and clean == len(controls),
+    }
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--matrix", default=os.path.join(HERE, "matrix.toml"))
+    ap.add_argument("--oracle", default=os.path.join(ROOT, "..", "shared", "oracle-sim"))
+    ap.add_argument("--work", default=os.path.join(ROOT, "target", "scorecard"))
+    ap.add_argument("--python", default=sys.executable, help="interpreter with numpy and scipy for the oracle")
+    ap.add_argument("--bikedyn", default=os.path.join(ROOT, "target", "release", "bikedyn"))
+    ap.add_argument("--subset", choices=["all", "ci"], default="all")
+    ap.add_argument("--sets", default="", help="comma-separated set names (default: the subset)")
+    ap.add_argument("--seed-base", type=int, default=0, help="another base draws other seeds for every set")
+    ap.add_argument("--identify-args", default="", help="extra arguments for bikedyn identify")
+    ap.add_argument("--json", help="write the scorecard as JSON here")
+    ap.add_argument("--markdown", help="write the table and summary as Markdown here")
+    ap.add_argument("--require-targets", action="store_true", help="exit 1 when a target is missed")
+    args = ap.parse_args()
+
+    if not os.path.isfile(os.path.join(args.oracle, "make_runs.py")):
+        sys.exit(f"error: no oracle simulator at {args.oracle} (--oracle names the folder with make_runs.py)")
+    if not os.access(args.bikedyn, os.X_OK):
+        sys.exit(f"error: no bikedyn binary at {args.bikedyn} (build it with `cargo build --release`, or pass --bikedyn)")
+    with open(args.matrix, "rb") as fh:
+        matrix = tomllib.load(fh)
+    decay = matrix.get("decay", "")
+    rows = matrix["set"]
+    if args.sets:
+        names = args.sets.split(",")
+        unknown = [n for n in names if n not in {r["name"] for r in rows}]
+        if unknown:
+            sys.exit(f"error: --sets names sets not in {args.matrix}: {', '.join(unknown)}")
+        rows = [r for r in rows if r["name"] in names]
+    elif args.subset == "ci":
+        rows = [r for r in rows if r.get("ci")]
+    os.makedirs(args.work, exist_ok=True)
+
+    results = []
+    failed = False
+    for i, row in enumerate(rows, 1):
+        seed = seed_of(row["name"], args.seed_base)
+        print(f"[{i}/{len(rows)}] {row['name']} (seed {seed})", file=sys.stderr, flush=True)
+        has_cause = bool(row.get("effects") or row.get("thesis"))
+        try:
+            make_set(row, decay, args, seed)
+            with open(os.path.join(args.work, "truth", row["name"], "set_truth.json")) as fh:
+                truth = json.load(fh)
+            report_dir = os.path.join(args.work, "reports", row["name"])
+            os.makedirs(os.path.dirname(report_dir), exist_ok=True)
+            t0 = time.time()
+            cmd = [args.bikedyn, "identify", os.path.join(args.work, "data", row["name"]),
+                   "--report", report_dir] + args.identify_args.split()
+            done = subprocess.run(cmd, capture_output=True, text=True)
+            seconds = time.time() - t0
+            if done.returncode not in (0, 1) or not os.path.exists(os.path.join(report_dir, "report.json")):
+                raise RuntimeError(f"identify exited {done.returncode}: {done.stderr.strip().splitlines()[-1:]}")
+            with open(os.path.join(report_dir, "report.json")) as fh:
+                report = json.load(fh)
+            results.append(score(row, truth, report, seconds))
+            r = results[-1]
+            print(f"    selected {', '.join(r['selected']) or 'nothing'}; right {r['right']}; false {r['false']}; "
+                  f"{seconds:.0f} s", file=sys.stderr, flush=True)
+        except (subprocess.CalledProcessError, RuntimeError, OSError, KeyError) as e:
+            failed = True
+            results.append({"set": row["name"], "error": str(e), "has_cause": has_cause})
+            print(f"    error: {e}", file=sys.stderr, flush=True)
+    print_table(results)
+    s = summary(results)
+    print(f"\nright cause: {s['right_causes']} of {s['sets_with_cause']} sets with a cause; "
+          f"clean controls: {s['clean_controls']} of {s['controls']}; "
+          f"false causes beside them: {s['false_causes_on_sets_with_cause']}; "
+          f"parameters within 25 %: {s['parameters_within_25pct']} of {s['parameters_scored']}; "
+          f"held-out error halved: {s['errors_halved']} of {s['sets_with_cause']}; "
+          f"identify time {s['seconds']:.0f} s")
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump({"summary": s, "sets": results, "seed_base": args.seed_base}, fh, indent=1)
+    if args.markdown:
+        with open(args.markdown, "w") as fh:
+            print_table(results, fh)
+    if failed or (args.require_targets and not s["targets_met"]):
+        sys.exit(1)
+
+
+if __name__ == "__main__":
+    main()
