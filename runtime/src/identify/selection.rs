@@ -397,46 +397,32 @@ impl<'s> Search<'s> {
                 });
             }
         }
-        // The order of the search: candidates the screen could not judge
-        // first (they were always fitted), then by predicted gain.
-        let mut order: Vec<usize> = (0..pending.len()).filter(|&i| pending[i].verdict.is_none()).collect();
-        order.sort_by(|&a, &b| {
-            let key = |i: usize| pending[i].predicted.unwrap_or(f64::NEG_INFINITY);
-            key(a).total_cmp(&key(b))
-        });
-        // The contenders: every candidate the screen ranks within
-        // CONFOUNDED^2 of the best one's predicted gain is fitted before any
-        // is cross-validated, since two candidates at that correlation
-        // explain the same misfit to within that factor: the report
-        // compares them as rivals.
-        let best_gain = order
+        let predicted: Vec<Option<f64>> = pending
             .iter()
-            .filter_map(|&i| pending[i].predicted)
-            .fold(0.0, |m: f64, d| m.max(-d));
-        let contenders = order
-            .iter()
-            .take_while(|&&i| {
-                pending[i]
-                    .predicted
-                    .is_none_or(|d| -d >= confounding::CONFOUNDED * confounding::CONFOUNDED * best_gain)
+            .map(|p| {
+                if p.verdict.is_some() {
+                    Some(f64::INFINITY)
+                } else {
+                    p.predicted
+                }
             })
-            .count();
-        let mut next = 0;
-        let mut winner: Option<usize> = None;
+            .collect();
+        let plan = SearchOrder::of(&predicted);
         let mut fitted = 0;
-        while winner.is_none() && next < order.len() {
-            let batch = if next == 0 { contenders.max(1) } else { 1 };
-            for &i in &order[next..(next + batch).min(order.len())] {
+        let mut winner = first_passing(
+            &mut pending,
+            &plan,
+            |pending, i| {
                 self.fit(&mut pending[i], current, selected, base_bic)?;
                 fitted += 1;
                 (self.progress)(
                     &format!("fitted {}", pending[i].name()),
-                    Some((fitted, order.len().max(fitted))),
+                    Some((fitted, plan.order.len().max(fitted))),
                 );
-            }
-            next += batch;
-            winner = self.validate(&mut pending, current)?;
-        }
+                Ok(())
+            },
+            |pending| self.validate(pending, current),
+        )?;
         // No single candidate passed: pairs whose joint linearised fit
         // beats each member's alone, best predicted first.
         let single = pending.len();
@@ -686,6 +672,65 @@ impl<'s> Search<'s> {
     }
 }
 
+/// The order in which a step fits its candidates, from the score test's
+/// predicted change of the criterion of each (`None`: not screened; a
+/// change at or above zero: it cannot lower the criterion, never fitted).
+#[derive(Clone, Debug, PartialEq)]
+struct SearchOrder {
+    /// The candidates to fit: those not screened first (they were always
+    /// fitted), then by predicted gain, best first.
+    order: Vec<usize>,
+    /// How many of `order` are fitted before any is cross-validated: the
+    /// candidates ranked within `CONFOUNDED^2` of the best one's predicted
+    /// gain (two candidates at that correlation explain the same misfit to
+    /// within that factor, so the report compares them as rivals).
+    contenders: usize,
+}
+
+impl SearchOrder {
+    fn of(predicted: &[Option<f64>]) -> SearchOrder {
+        let mut order: Vec<usize> = (0..predicted.len())
+            .filter(|&i| predicted[i].is_none_or(|d| d < 0.0))
+            .collect();
+        let key = |i: usize| predicted[i].unwrap_or(f64::NEG_INFINITY);
+        order.sort_by(|&a, &b| key(a).total_cmp(&key(b)));
+        let best_gain = order
+            .iter()
+            .filter_map(|&i| predicted[i])
+            .fold(0.0, |m: f64, d| m.max(-d));
+        let near = confounding::CONFOUNDED * confounding::CONFOUNDED * best_gain;
+        let contenders = order
+            .iter()
+            .take_while(|&&i| predicted[i].is_none_or(|d| -d >= near))
+            .count();
+        SearchOrder { order, contenders }
+    }
+}
+
+/// The search of one step: fit the contenders, cross-validate, and while
+/// nothing has passed, fit the next candidate in the order and
+/// cross-validate again, until one passes (its index) or none is left. A
+/// candidate is never skipped because another one failed.
+fn first_passing<S, E>(
+    state: &mut S,
+    plan: &SearchOrder,
+    mut fit: impl FnMut(&mut S, usize) -> Result<(), E>,
+    mut validate: impl FnMut(&mut S) -> Result<Option<usize>, E>,
+) -> Result<Option<usize>, E> {
+    let mut next = 0;
+    while next < plan.order.len() {
+        let batch = if next == 0 { plan.contenders.max(1) } else { 1 };
+        for &i in &plan.order[next..(next + batch).min(plan.order.len())] {
+            fit(state, i)?;
+        }
+        next += batch;
+        if let Some(w) = validate(state)? {
+            return Ok(Some(w));
+        }
+    }
+    Ok(None)
+}
+
 /// A correction further than this many prior standard deviations from its
 /// measured value is no plausible rival explanation (beyond three, a
 /// Gaussian prior gives it odds below 1 in 370).
@@ -717,4 +762,88 @@ pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> O
     let m = d.iter().sum::<f64>() / n;
     let var = d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
     Some((m, (var / n).sqrt()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn candidates_are_fitted_best_predicted_first_and_none_that_cannot_gain() {
+        // Predicted changes: c0 -100, c1 not screened, c2 +5 (no gain),
+        // c3 -400, c4 -350 (within 81 % of c3), c5 -10.
+        let plan = SearchOrder::of(&[Some(-100.0), None, Some(5.0), Some(-400.0), Some(-350.0), Some(-10.0)]);
+        assert_eq!(plan.order, vec![1, 3, 4, 0, 5]);
+        assert_eq!(
+            plan.contenders, 3,
+            "the unscreened one and the two within 81 % of the best"
+        );
+    }
+
+    /// A mock step: which candidates pass cross-validation, and the log of
+    /// what was fitted and validated.
+    struct Mock {
+        passes: Vec<bool>,
+        fitted: Vec<usize>,
+        validated: Vec<usize>,
+    }
+
+    impl Mock {
+        fn validate(&mut self) -> Result<Option<usize>, ()> {
+            // Cross-validate every fitted one not yet validated, in the
+            // order fitted, until one passes.
+            for &i in &self.fitted.clone() {
+                if self.validated.contains(&i) {
+                    continue;
+                }
+                self.validated.push(i);
+                if self.passes[i] {
+                    return Ok(Some(i));
+                }
+            }
+            Ok(None)
+        }
+    }
+
+    fn run(predicted: &[Option<f64>], passes: Vec<bool>) -> (Option<usize>, Mock) {
+        let mut m = Mock {
+            passes,
+            fitted: Vec::new(),
+            validated: Vec::new(),
+        };
+        let plan = SearchOrder::of(predicted);
+        let w = first_passing(
+            &mut m,
+            &plan,
+            |m, i| {
+                m.fitted.push(i);
+                Ok(())
+            },
+            Mock::validate,
+        )
+        .unwrap();
+        (w, m)
+    }
+
+    #[test]
+    fn a_candidate_far_behind_the_best_is_tried_when_the_best_fails() {
+        // The best-predicted candidate (drag, -450) fails cross-validation;
+        // the right one is predicted to gain only 29 % of it (-130), below
+        // the contenders' mark. It is fitted and added all the same.
+        let (w, m) = run(&[Some(-450.0), Some(-130.0), Some(-20.0)], vec![false, true, true]);
+        assert_eq!(w, Some(1));
+        assert_eq!(m.fitted, vec![0, 1], "the third is not fitted once the second passed");
+    }
+
+    #[test]
+    fn the_search_ends_only_when_every_candidate_that_could_gain_failed() {
+        let (w, m) = run(&[Some(-450.0), Some(-130.0), Some(3.0), Some(-20.0)], vec![false; 4]);
+        assert_eq!(w, None);
+        assert_eq!(
+            m.fitted,
+            vec![0, 1, 3],
+            "every candidate with a predicted gain, best first"
+        );
+        assert_eq!(m.validated, vec![0, 1, 3]);
+    }
 }
