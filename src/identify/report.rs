@@ -12,7 +12,7 @@ use crate::bicycle::Bicycle;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic, StagedDir};
 use bikedyn_runtime::identify::confounding::CONFOUNDED;
-use bikedyn_runtime::identify::{pooled_rms, Candidate, Verdict};
+use bikedyn_runtime::identify::{pooled_rms, Candidate, Verdict, PLAUSIBLE_PRIOR_SDS};
 use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::{json, Value};
 use std::collections::BTreeMap;
@@ -431,6 +431,9 @@ pub fn verdict_text(v: &Verdict) -> String {
             format!("not added: BIC {bic_change:+.1}, above that of {added} (not cross-validated)")
         }
         Verdict::FitFailed { reason } => format!("fit failed: {reason}"),
+        Verdict::ImplausibleUnderPrior { symbol, value, prior_sds } => format!(
+            "rejected: {symbol} = {value:.4} lies {prior_sds:.1} prior standard deviations from its measured value (beyond {PLAUSIBLE_PRIOR_SDS}: implausible under the measurement; more likely it absorbs a missing effect; not cross-validated)"
+        ),
         Verdict::NotPhysical => "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".into(),
         Verdict::NoCriterionGain { bic_change } => {
             format!("rejected: BIC {bic_change:+.1} (no gain beyond its added parameters; not cross-validated)")

@@ -106,6 +106,12 @@ pub enum Verdict {
     /// A dissipative parameter fitted at or below zero, or at its floor
     /// (not physics; not cross-validated).
     NotPhysical,
+    /// A correction fitted further from its measured value than
+    /// [`PLAUSIBLE_PRIOR_SDS`] standard deviations of its stated
+    /// uncertainty: the data ask for a value the measurement makes
+    /// implausible, so the correction more likely absorbs a missing effect
+    /// (not cross-validated).
+    ImplausibleUnderPrior { symbol: String, value: f64, prior_sds: f64 },
     /// The fit does not lower the criterion beyond its added parameters
     /// (not cross-validated).
     NoCriterionGain { bic_change: f64 },
@@ -531,8 +537,18 @@ impl<'s> Search<'s> {
             Some(self.reference),
         ) {
             Ok(f) => {
+                let ks = current.values.len();
+                let farthest = self.farthest_from_prior(&p.members, &f.values[ks.min(f.values.len())..]);
                 if !f.physical {
                     p.verdict = Some(Verdict::NotPhysical);
+                } else if let Some((symbol, value, prior_sds)) =
+                    farthest.filter(|(_, _, sds)| *sds > PLAUSIBLE_PRIOR_SDS)
+                {
+                    p.verdict = Some(Verdict::ImplausibleUnderPrior {
+                        symbol,
+                        value,
+                        prior_sds,
+                    });
                 } else if !(f.bic < base_bic) {
                     p.verdict = Some(Verdict::NoCriterionGain {
                         bic_change: f.bic - base_bic,
@@ -662,13 +678,28 @@ impl<'s> Search<'s> {
     /// prior: within [`PLAUSIBLE_PRIOR_SDS`] prior standard deviations of the
     /// measured value (a candidate without a prior, an effect, always is).
     fn plausible(&self, candidate: &Candidate, values: &[f64]) -> bool {
-        let Some(stated) = self.stated.iter().find(|c| c.name == candidate.name) else {
-            return true;
-        };
-        stated.parameters.iter().zip(values).all(|(p, v)| {
-            p.prior
-                .is_none_or(|(mean, sd)| ((v - mean) / sd).abs() <= PLAUSIBLE_PRIOR_SDS)
-        })
+        self.farthest_from_prior(&[candidate], values)
+            .is_none_or(|(_, _, sds)| sds <= PLAUSIBLE_PRIOR_SDS)
+    }
+
+    /// Of the fitted `values` of `members` (their parameters in order), the
+    /// one farthest from its stated prior: symbol, value and distance in
+    /// prior standard deviations (`None`: no parameter has a prior).
+    fn farthest_from_prior(&self, members: &[&Candidate], values: &[f64]) -> Option<(String, f64, f64)> {
+        let mut out: Option<(String, f64, f64)> = None;
+        let params = members.iter().flat_map(|m| {
+            let stated = self.stated.iter().find(|c| c.name == m.name).unwrap_or(m);
+            stated.parameters.iter()
+        });
+        for (p, &v) in params.zip(values) {
+            if let Some((mean, sd)) = p.prior {
+                let d = ((v - mean) / sd).abs();
+                if out.as_ref().is_none_or(|o| d > o.2) {
+                    out = Some((p.symbol.clone(), v, d));
+                }
+            }
+        }
+        out
     }
 }
 
