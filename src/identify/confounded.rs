@@ -28,7 +28,9 @@ pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
                             .iter()
                             .zip(f.values.iter().zip(&f.stderr))
                             .skip(own)
-                            .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4} {}", p.symbol, v, 1.96 * se, p.unit))
+                            .map(|(p, (v, se))| {
+                                format!("{} = {:.4} +- {:.4} {} (95 %)", p.symbol, v, 1.96 * se, p.unit)
+                            })
                             .collect::<Vec<_>>()
                             .join(", ")
                     })

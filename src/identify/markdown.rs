@@ -95,7 +95,7 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
         );
         let _ = writeln!(
             s,
-            "| candidate | fitted values | BIC change | held-out error | verdict |\n|---|---|---|---|---|"
+            "| candidate | fitted values (+- one standard error) | BIC change | held-out error | verdict |\n|---|---|---|---|---|"
         );
         // Fitted trials by their criterion, then those not fitted by their
         // predicted change.

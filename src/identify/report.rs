@@ -83,7 +83,11 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
     {
         params.insert(
             p.symbol.clone(),
-            json!({"value": v, "low": v - 1.96 * se, "high": v + 1.96 * se, "stderr": se, "unit": p.unit, "tied": p.tied}),
+            json!({
+                "value": v, "low": v - 1.96 * se, "high": v + 1.96 * se, "stderr": se, "unit": p.unit, "tied": p.tied,
+                "prior": stated_prior(o, &p.symbol).map(|(mean, sd)| json!({"mean": mean, "sd": sd})),
+                "prior_sds": stated_prior(o, &p.symbol).map(|(mean, sd)| (v - mean) / sd),
+            }),
         );
     }
     let mut cands = Vec::new();
@@ -200,11 +204,16 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
         .parameters
         .iter()
         .zip(id.after.values.iter().zip(&id.after.stderr))
-        .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4} {}", p.symbol, v, 1.96 * se, p.unit))
+        .map(|(p, (v, se))| {
+            let prior = stated_prior(o, &p.symbol)
+                .map(|(mean, sd)| format!(" ({:+.1} prior sd from the measured {mean:.4})", (v - mean) / sd))
+                .unwrap_or_default();
+            format!("{} = {:.4} +- {:.4} {}{prior}", p.symbol, v, 1.96 * se, p.unit)
+        })
         .collect();
     let _ = writeln!(
         s,
-        "parameters (95 %): {}",
+        "parameters (+- 95 % interval): {}",
         if vals.is_empty() { "-".into() } else { vals.join(", ") }
     );
     let _ = writeln!(
@@ -432,7 +441,7 @@ pub fn verdict_text(v: &Verdict) -> String {
         }
         Verdict::FitFailed { reason } => format!("fit failed: {reason}"),
         Verdict::ImplausibleUnderPrior { symbol, value, prior_sds } => format!(
-            "rejected: {symbol} = {value:.4} lies {prior_sds:.1} prior standard deviations from its measured value (beyond {PLAUSIBLE_PRIOR_SDS}: implausible under the measurement; more likely it absorbs a missing effect; not cross-validated)"
+            "rejected: {symbol} = {value:.4} lies {prior_sds:.1} prior standard deviations from its measured value (beyond {PLAUSIBLE_PRIOR_SDS}: implausible under the measurement, more likely it absorbs a missing effect; tried only when no plausible candidate passes)"
         ),
         Verdict::NotPhysical => "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".into(),
         Verdict::NoCriterionGain { bic_change } => {
@@ -445,4 +454,15 @@ pub fn verdict_text(v: &Verdict) -> String {
             "rejected: held-out gain per run {gain:.4} within two standard errors ({stderr:.4}) of zero (not a consistent improvement)"
         ),
     }
+}
+
+/// The stated prior `(measured value, standard deviation)` of a corrected
+/// parameter (the bicycle file's `+/-`, or the model's default for its
+/// kind), as the plan's candidates declare it.
+pub fn stated_prior<R: ModelRegistry>(o: &Outcome<R>, symbol: &str) -> Option<(f64, f64)> {
+    o.candidates
+        .iter()
+        .flat_map(|c| &c.parameters)
+        .find(|p| p.symbol == symbol)
+        .and_then(|p| p.prior)
 }

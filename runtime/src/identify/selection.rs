@@ -109,8 +109,8 @@ pub enum Verdict {
     /// A correction fitted further from its measured value than
     /// [`PLAUSIBLE_PRIOR_SDS`] standard deviations of its stated
     /// uncertainty: the data ask for a value the measurement makes
-    /// implausible, so the correction more likely absorbs a missing effect
-    /// (not cross-validated).
+    /// implausible, so the correction more likely absorbs a missing effect.
+    /// It is cross-validated only when no plausible candidate passes.
     ImplausibleUnderPrior { symbol: String, value: f64, prior_sds: f64 },
     /// The fit does not lower the criterion beyond its added parameters
     /// (not cross-validated).
@@ -450,6 +450,23 @@ impl<'s> Search<'s> {
                 }
             }
         }
+        // Nothing plausible passed: the corrections the data pull beyond
+        // their stated uncertainty are cross-validated last (a measurement
+        // can be wrong by more than its stated uncertainty, a forgotten lamp
+        // on the handlebar; the report gives the distance). Those not
+        // reached keep their verdict.
+        if winner.is_none() {
+            let far: Vec<usize> = (0..pending.len())
+                .filter(|&i| matches!(pending[i].verdict, Some(Verdict::ImplausibleUnderPrior { .. })))
+                .collect();
+            let kept: Vec<Option<Verdict>> = far.iter().map(|&i| pending[i].verdict.take()).collect();
+            winner = self.validate(&mut pending, current)?;
+            for (&i, v) in far.iter().zip(kept) {
+                if pending[i].verdict.is_none() {
+                    pending[i].verdict = v;
+                }
+            }
+        }
         // Those behind the winner.
         if let Some(w) = winner {
             let added = pending[w].name();
@@ -541,6 +558,10 @@ impl<'s> Search<'s> {
                 let farthest = self.farthest_from_prior(&p.members, &f.values[ks.min(f.values.len())..]);
                 if !f.physical {
                     p.verdict = Some(Verdict::NotPhysical);
+                } else if !(f.bic < base_bic) {
+                    p.verdict = Some(Verdict::NoCriterionGain {
+                        bic_change: f.bic - base_bic,
+                    });
                 } else if let Some((symbol, value, prior_sds)) =
                     farthest.filter(|(_, _, sds)| *sds > PLAUSIBLE_PRIOR_SDS)
                 {
@@ -548,10 +569,6 @@ impl<'s> Search<'s> {
                         symbol,
                         value,
                         prior_sds,
-                    });
-                } else if !(f.bic < base_bic) {
-                    p.verdict = Some(Verdict::NoCriterionGain {
-                        bic_change: f.bic - base_bic,
                     });
                 }
                 p.fit = Some((f, setup));

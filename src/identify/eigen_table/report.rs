@@ -26,7 +26,7 @@ pub fn table_summary(o: &TableOutcome) -> String {
         .map(|(k, (v, se))| format!("{k} = {v:.4} +- {:.4}", 1.96 * se))
         .collect();
     s += &format!(
-        "parameters (95 %): {}\n",
+        "parameters (+- 95 % interval): {}\n",
         if vals.is_empty() { "-".into() } else { vals.join(", ") }
     );
     s += &format!(
