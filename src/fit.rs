@@ -580,7 +580,7 @@ pub fn speed_form_text(out: &FitOutcome) -> String {
     if refused > 0 {
         let list: Vec<String> = by.iter().map(|(l, n)| format!("{l}: {n}")).collect();
         s += &format!(
-            "; refused for {refused} (constant form chosen; {}; reasons in --json, speed_varying_refused)",
+            "; refused for {refused} ({}; reasons in --json, speed_varying_refused)",
             list.join(", ")
         );
     }
