@@ -1,6 +1,8 @@
 //! `bikedyn fit`: measured weave eigenvalues from raw logs (thesis-style run
-//! sets and TU Delft kick logs), with the model's prediction when a bicycle
-//! is given.
+//! sets and TU Delft kick logs), with the bicycle model's prediction. Which
+//! fitted eigenvalues are measured ones is judged against that model
+//! (`bikedyn_runtime::experiment::accept`), once, here: `identify` uses
+//! these verdicts.
 
 use crate::bicycle::{Bicycle, BicycleError, Linear};
 use crate::progress::{OnProgress, Progress};
@@ -8,7 +10,7 @@ use crate::registry::BuiltIn;
 use bikedyn_report::plot::PlotError;
 use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::experiment::{
-    self,
+    self, accept,
     angles::{AngleMethod, Calibration},
     compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
 };
@@ -26,9 +28,10 @@ pub struct FitOptions {
     pub inputs: Vec<PathBuf>,
     /// Calibration run (default: `calibration/` beside the runs).
     pub calibration: Option<PathBuf>,
-    /// Bicycle for the prediction and the frame pitch at rest (built-in name
-    /// or parameter file). Without it the thesis bicycle's frame pitch is used
-    /// and no prediction is made.
+    /// Bicycle (built-in name or parameter file): the frame pitch at rest,
+    /// the predicted weave and the bounds of the acceptance tests. `None`:
+    /// the built-in thesis bicycle for thesis-format runs; TU Delft logs
+    /// need one ([`BikeRequired`]).
     pub bike: Option<String>,
     /// How roll and steer are computed from the orientations (default: direct).
     pub angles: AngleMethod,
@@ -36,10 +39,47 @@ pub struct FitOptions {
     pub nominal_clock: bool,
 }
 
+/// Inputs that are not thesis-format runs (TU Delft logs, an eigenvalue
+/// table) and no bicycle: the built-in thesis bicycle is the default of
+/// thesis-format runs only, since these came from another bicycle.
+#[derive(Debug, Error)]
+#[error(
+    "give the bicycle with --bike FILE (Python: bike=): the built-in thesis bicycle is the default of thesis-format runs only, and these are not: {}",
+    inputs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+)]
+pub struct BikeRequired {
+    /// The inputs that need it.
+    pub inputs: Vec<PathBuf>,
+}
+
+/// The bicycle of a fit or an identification on `inputs`: the one given,
+/// else the built-in thesis bicycle when every input is a set of
+/// thesis-format runs; TU Delft logs need one.
+pub fn bicycle_for<'a>(bike: Option<&'a str>, inputs: &[Input]) -> Result<&'a str, BikeRequired> {
+    if let Some(b) = bike {
+        return Ok(b);
+    }
+    let logs: Vec<PathBuf> = inputs
+        .iter()
+        .filter_map(|i| match i {
+            Input::Log(p) => Some(p.clone()),
+            Input::Set { .. } => None,
+        })
+        .collect();
+    if logs.is_empty() {
+        Ok("thesis")
+    } else {
+        Err(BikeRequired { inputs: logs })
+    }
+}
+
 /// Why `fit` could not run. A run that cannot be processed is not an error
 /// of the whole: it is listed in [`FitOutcome::errors`].
 #[derive(Debug, Error)]
 pub enum FitError {
+    /// Logs without a bicycle.
+    #[error(transparent)]
+    BikeRequired(#[from] BikeRequired),
     /// The bicycle could not be resolved or has no canonical form it should have.
     #[error(transparent)]
     Bicycle(#[from] BicycleError),
@@ -154,9 +194,12 @@ pub struct FitOutcome {
     pub reports: Vec<RunReport>,
     /// Skipped runs with the reason.
     pub errors: Vec<String>,
-    /// The bicycle's linear equations through its model (any effects), for
-    /// the predicted weave, when a bicycle is given.
-    pub linear: Option<Linear>,
+    /// The bicycle (as given, or `thesis`, the default for thesis-format runs).
+    pub bike: String,
+    /// The bicycle's linear equations through its model (any effects): the
+    /// predicted weave, and the model the fitted eigenvalues are judged
+    /// against.
+    pub linear: Linear,
     /// Calibration of each set (folder and estimate).
     pub calibrations: Vec<(PathBuf, Calibration)>,
 }
@@ -170,27 +213,6 @@ pub fn run_fit(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome
 /// [`run_fit`] with the bicycle resolved against the models of registry `R`
 /// (its prediction runs through one of them).
 pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome, FitError> {
-    let bike = opts.bike.as_deref().map(Bicycle::<R>::resolve_in).transpose()?;
-    // The prediction runs through the bicycle's own model, effects (damping,
-    // an assist controller) included.
-    let linear = bike.as_ref().map(|b| b.linear_with(None)).transpose()?;
-    let pitch_bike = match &bike {
-        Some(b) => b.clone(),
-        None => Bicycle::<R>::resolve_in("thesis")?,
-    };
-    let frame_pitch = pitch_bike
-        .thesis()?
-        .frame_pitch()
-        .map_err(|source| FitError::FramePitch {
-            bicycle: pitch_bike.name.clone(),
-            source,
-        })?;
-    let opt = PipelineOptions {
-        angle_method: opts.angles,
-        frame_pitch,
-        refine_clock: !opts.nominal_clock,
-        ..PipelineOptions::default()
-    };
     let mut inputs = Vec::new();
     let mut errors = Vec::new();
     for p in &opts.inputs {
@@ -199,6 +221,21 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
             Err(e) => errors.push(e.to_string()),
         }
     }
+    let spec = bicycle_for(opts.bike.as_deref(), &inputs)?;
+    let bike = Bicycle::<R>::resolve_in(spec)?;
+    // The prediction runs through the bicycle's own model, effects (damping,
+    // an assist controller) included.
+    let linear = bike.linear_with(None)?;
+    let frame_pitch = bike.thesis()?.frame_pitch().map_err(|source| FitError::FramePitch {
+        bicycle: bike.name.clone(),
+        source,
+    })?;
+    let opt = PipelineOptions {
+        angle_method: opts.angles,
+        frame_pitch,
+        refine_clock: !opts.nominal_clock,
+        ..PipelineOptions::default()
+    };
     check_duplicates(&inputs, opts.calibration.as_ref())?;
     let total: usize = inputs
         .iter()
@@ -276,6 +313,10 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
             }
         }
     }
+    // Which fitted eigenvalues are measured weave eigenvalues, and which
+    // form is reported, judged against the bicycle's model (the outlier
+    // test over every kick of the inputs).
+    accept::judge(reports.iter_mut().flat_map(|r| r.kicks.iter_mut()), Some(&linear));
     // A kick without a speed is fitted but cannot be compared with any
     // model: say so (and the exit status says something was left out).
     for r in &reports {
@@ -286,6 +327,7 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
     Ok(FitOutcome {
         reports,
         errors,
+        bike: spec.to_string(),
         linear,
         calibrations,
     })
@@ -298,8 +340,18 @@ fn pair(x: [f64; 2]) -> Value {
     json!([x[0], x[1]])
 }
 
-/// JSON entry of one kick (schema in README, "Measured runs").
-pub fn kick_json(k: &KickFit, linear: Option<&dyn LinearBicycle>) -> Value {
+/// The fields of a verdict (its test and numbers) and its sentence.
+fn verdict_json<T: serde::Serialize>(verdict: &T, reason: String) -> Value {
+    let mut v = serde_json::to_value(verdict).expect("JSON of plain values");
+    v["reason"] = json!(reason);
+    v
+}
+
+/// JSON entry of one kick (schema in README, "Measured runs"): `weave`,
+/// its standard errors, r² and form only for a measured weave eigenvalue;
+/// a refused fit under `refused`, with the test it failed.
+pub fn kick_json(k: &KickFit, linear: &dyn LinearBicycle) -> Value {
+    use bikedyn_report::experiment::accept::{rejected_text, speed_form_text};
     let mut v = json!({
         "run": k.run.display().to_string(),
         "kick_time": k.kick_time,
@@ -317,7 +369,7 @@ pub fn kick_json(k: &KickFit, linear: Option<&dyn LinearBicycle>) -> Value {
         })).collect::<Vec<_>>(),
         "failed_fits": k.failed.iter().map(|(f, e)| json!({"form": f.name(), "error": e})).collect::<Vec<_>>(),
     });
-    if let Some(f) = k.chosen_fit() {
+    if let Some(f) = k.measured_weave() {
         v["weave"] = pair(f.eigenvalue);
         v["weave_stderr"] = pair(f.eigenvalue_stderr);
         v["r2"] = json!(f.r2);
@@ -328,15 +380,34 @@ pub fn kick_json(k: &KickFit, linear: Option<&dyn LinearBicycle>) -> Value {
         v["r2"] = Value::Null;
         v["form"] = Value::Null;
     }
+    v["refused"] = match &k.rejected {
+        Some(r) => {
+            let mut e = verdict_json(r, rejected_text(r));
+            if let Some(f) = k.chosen_fit() {
+                e["fit"] = json!({
+                    "form": f.form.name(),
+                    "eigenvalue": pair(f.eigenvalue),
+                    "stderr": pair(f.eigenvalue_stderr),
+                    "r2": f.r2,
+                });
+            }
+            e
+        }
+        None => Value::Null,
+    };
+    v["speed_varying_refused"] = match &k.speed_form {
+        Some(r) => verdict_json(r, speed_form_text(r)),
+        None => Value::Null,
+    };
     if let Some(o) = k.clock_offset {
         v["clock_offset"] = json!({"value": o.value, "stderr": o.stderr, "from_data": o.from_data});
     }
     if !k.mean_speed.is_finite() {
         v["predicted_weave"] = Value::Null;
         v["no_prediction"] = json!(NO_SPEED);
-    } else if let Some(c) = linear {
+    } else {
         let [lo, hi] = k.speed_interval;
-        v["predicted_weave"] = match compare::predict(c, k.mean_speed, lo, hi) {
+        v["predicted_weave"] = match compare::predict(linear, k.mean_speed, lo, hi) {
             Some(p) => json!({
                 "at_mean_speed": pair(p.at_mean_speed),
                 "real_range": pair(p.real_range),
@@ -348,16 +419,17 @@ pub fn kick_json(k: &KickFit, linear: Option<&dyn LinearBicycle>) -> Value {
     v
 }
 
-/// Residual rows (measured against predicted at the mean speed).
+/// Residual rows (measured against predicted at the mean speed), of the
+/// measured weave eigenvalues.
 pub fn residuals(out: &FitOutcome) -> Vec<compare::Residual> {
-    let Some(c) = &out.linear else { return Vec::new() };
+    let c = &out.linear;
     let mut rows = Vec::new();
     for r in &out.reports {
         for k in &r.kicks {
             if !k.mean_speed.is_finite() {
                 continue;
             }
-            let (Some(f), Some(p)) = (k.chosen_fit(), compare::predicted_weave(c, k.mean_speed)) else {
+            let (Some(f), Some(p)) = (k.measured_weave(), compare::predicted_weave(c, k.mean_speed)) else {
                 continue;
             };
             rows.push(compare::Residual {
@@ -409,8 +481,10 @@ pub fn calibration_text(out: &FitOutcome) -> String {
     s
 }
 
-/// Text table of the kicks.
+/// Text table of the kicks: the measured weave eigenvalues, and for the
+/// others the test they failed ([`refused_text`] says why in full).
 pub fn kicks_table(out: &FitOutcome) -> String {
+    use bikedyn_report::experiment::accept::rejected_label;
     let header: Vec<String> = [
         "run",
         "kick t (s)",
@@ -421,6 +495,7 @@ pub fn kicks_table(out: &FitOutcome) -> String {
         "r2",
         "form",
         "clock offset (s)",
+        "verdict",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -428,14 +503,18 @@ pub fn kicks_table(out: &FitOutcome) -> String {
     let mut rows = Vec::new();
     for r in &out.reports {
         for k in &r.kicks {
-            let (ev, se, r2, form) = match k.chosen_fit() {
+            let (ev, se, r2, form) = match k.measured_weave() {
                 Some(f) => (
                     format!("{:.3}{:+.3}i", f.eigenvalue[0], f.eigenvalue[1]),
                     format!("{:.3}, {:.3}", f.eigenvalue_stderr[0], f.eigenvalue_stderr[1]),
                     format!("{:.3}", f.r2),
                     f.form.name().to_string(),
                 ),
-                None => ("-".into(), "-".into(), "-".into(), "no fit".into()),
+                None => ("-".into(), "-".into(), "-".into(), "-".into()),
+            };
+            let verdict = match &k.rejected {
+                None => "accepted".to_string(),
+                Some(r) => format!("refused: {}", rejected_label(r)),
             };
             rows.push(vec![
                 k.run
@@ -452,16 +531,66 @@ pub fn kicks_table(out: &FitOutcome) -> String {
                 k.clock_offset
                     .map(|o| format!("{:.3} +- {:.3}", o.value, o.stderr))
                     .unwrap_or_default(),
+                verdict,
             ]);
         }
     }
     bikedyn_report::output::format_table(&header, &rows)
 }
 
-/// Response plots (one per kick) and, with a bicycle, the continuation
-/// diagram with the measured eigenvalues, in `dir` (created), each as SVG
-/// and PNG. The axis limits of `opts` apply to the continuation diagram
-/// only; its subject gets the model's name there.
+/// One line per kick whose fitted eigenvalue is not a measured weave
+/// eigenvalue, with the test it failed and its numbers.
+pub fn refused_text(out: &FitOutcome) -> String {
+    use bikedyn_report::experiment::accept::rejected_text;
+    let mut s = String::new();
+    for k in out.reports.iter().flat_map(|r| &r.kicks) {
+        let Some(r) = &k.rejected else { continue };
+        let fit = k
+            .chosen_fit()
+            .map(|f| format!(" (fit {:.3}{:+.3}i, r2 {:.3})", f.eigenvalue[0], f.eigenvalue[1], f.r2))
+            .unwrap_or_default();
+        s += &format!(
+            "refused: {} kick at {:.2} s{fit}: {}\n",
+            k.run.display(),
+            k.kick_time,
+            rejected_text(r)
+        );
+    }
+    s
+}
+
+/// For how many kicks the speed-varying form is the chosen one, and how
+/// many had a speed-varying fit that failed its tests, by test.
+pub fn speed_form_text(out: &FitOutcome) -> String {
+    use bikedyn_report::experiment::accept::speed_form_label;
+    let kicks: Vec<&KickFit> = out.reports.iter().flat_map(|r| &r.kicks).collect();
+    let kept = kicks
+        .iter()
+        .filter(|k| k.chosen_fit().is_some_and(|f| f.form.speed_varying()))
+        .count();
+    let mut by: Vec<(&str, usize)> = Vec::new();
+    for r in kicks.iter().filter_map(|k| k.speed_form.as_ref()) {
+        match by.iter_mut().find(|(l, _)| *l == speed_form_label(r)) {
+            Some((_, n)) => *n += 1,
+            None => by.push((speed_form_label(r), 1)),
+        }
+    }
+    let refused: usize = by.iter().map(|(_, n)| n).sum();
+    let mut s = format!("speed-varying form chosen for {kept} of {} kicks", kicks.len());
+    if refused > 0 {
+        let list: Vec<String> = by.iter().map(|(l, n)| format!("{l}: {n}")).collect();
+        s += &format!(
+            "; refused for {refused} ({}; reasons in --json, speed_varying_refused)",
+            list.join(", ")
+        );
+    }
+    s + "\n"
+}
+
+/// Response plots (one per kick) and the continuation diagram with the
+/// measured eigenvalues, in `dir` (created), each as SVG and PNG. The axis
+/// limits of `opts` apply to the continuation diagram only; its subject
+/// gets the model's name there.
 pub fn plots(out: &FitOutcome, dir: &Path, opts: &bikedyn_report::plot::PlotOptions) -> Result<(), FitError> {
     use bikedyn_report::experiment::plot as xplot;
     use bikedyn_report::plot::PlotOptions;
@@ -488,14 +617,13 @@ pub fn plots(out: &FitOutcome, dir: &Path, opts: &bikedyn_report::plot::PlotOpti
         }
     }
     let kicks: Vec<&KickFit> = out.reports.iter().flat_map(|r| r.kicks.iter()).collect();
-    if let Some(c) = &out.linear {
-        let o = PlotOptions {
-            subject: opts.subject.as_ref().map(|s| format!("{s}, model {}", c.model)),
-            ..opts.clone()
-        };
-        for ext in ["svg", "png"] {
-            xplot::plot_measured_continuation(&dir.join(format!("continuation_measured.{ext}")), c, &kicks, &o)?;
-        }
+    let c = &out.linear;
+    let o = PlotOptions {
+        subject: opts.subject.as_ref().map(|s| format!("{s}, model {}", c.model)),
+        ..opts.clone()
+    };
+    for ext in ["svg", "png"] {
+        xplot::plot_measured_continuation(&dir.join(format!("continuation_measured.{ext}")), c, &kicks, &o)?;
     }
     Ok(())
 }

@@ -584,8 +584,10 @@ def fit(
 ) -> FitResult:
     """Measured weave eigenvalues from raw runs (``bikedyn fit``): run
     folders, set folders or TU Delft logs. ``calibration``: the calibration
-    run (default: ``calibration/`` beside the runs). ``bike``: predict each
-    kick's weave with this bicycle. ``progress``: called as
+    run (default: ``calibration/`` beside the runs). ``bike``: the bicycle whose
+    model predicts each kick's weave and judges the fitted eigenvalues
+    (default: the built-in thesis bicycle for thesis-format runs; TU Delft
+    logs need theirs). ``progress``: called as
     ``progress(step, done, total)`` after each run or log (see
     :data:`ProgressCallback`). Returns a :class:`FitResult`."""
     stack: List[Any] = []
@@ -596,7 +598,7 @@ def fit(
 
 def identify(
     paths_or_eigen_table: Union[PathLike, Iterable[PathLike]],
-    bike: BikeLike = "thesis",
+    bike: Optional[BikeLike] = None,
     effects: Sequence[str] = (),
     folds: int = 4,
     corrections: Optional[int] = None,
@@ -608,14 +610,16 @@ def identify(
     (information criterion and cross-validation by run) and report the
     error before and after. Given one ``.csv`` file, the measured
     eigenvalue table form (``identify --eigenvalues``: speed, real part,
-    imaginary part, optional standard errors). ``effects``: the candidate
+    imaginary part, optional standard errors). ``bike``: the bicycle
+    (default: the built-in thesis bicycle for thesis-format runs; TU Delft
+    logs and a table need theirs). ``effects``: the candidate
     effects' symbols (default: all); ``corrections``: at most this many
     parameter corrections (0: effects only). ``progress``: called as
     ``progress(step, done, total)`` after each step of the selection (see
     :data:`ProgressCallback`; the eigenvalue table form takes seconds and
     does not report). Returns an :class:`IdentifyResult`."""
     stack: List[Any] = []
-    spec = _bicycle(bike)._as_spec(stack)
+    spec = None if bike is None else _bicycle(bike)._as_spec(stack)
     single = isinstance(paths_or_eigen_table, (str, os.PathLike))
     if single and os.fspath(paths_or_eigen_table).lower().endswith(".csv"):
         table = _paths(paths_or_eigen_table, "identify")[0]

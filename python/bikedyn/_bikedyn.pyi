@@ -79,14 +79,14 @@ def fit(
 def identify(
     inputs: List[str],
     calibration: Optional[str] = None,
-    bike: str = "thesis",
+    bike: Optional[str] = None,
     effects: List[str] = ...,
     folds: int = 4,
     corrections: Optional[int] = None,
     progress: Optional[Callable[[str, int, Optional[int]], None]] = None,
 ) -> _IdentifyResult: ...
 def identify_eigenvalues(
-    table: str, bike: str = "thesis", effects: List[str] = ..., corrections: Optional[int] = None
+    table: str, bike: Optional[str] = None, effects: List[str] = ..., corrections: Optional[int] = None
 ) -> _TableResult: ...
 def models() -> str: ...
 def allow_implausible_units(allow: bool) -> None: ...

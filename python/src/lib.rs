@@ -954,7 +954,6 @@ fn fit(
                 ))
             }
         };
-        let subject = bike.as_deref().map(|b| bikedyn::report::plot::subject(b, None));
         let opts = FitOptions {
             inputs,
             calibration,
@@ -963,7 +962,9 @@ fn fit(
             nominal_clock,
         };
         let outcome = run_fit(&opts, &|p| progress.report(p)).map_err(|e| Failure::new("DataError", e))?;
-        let linear = outcome.linear.as_ref().map(|l| l as &dyn LinearBicycle);
+        // The figures name the bicycle (given, or the thesis default).
+        let subject = Some(bikedyn::report::plot::subject(&outcome.bike, None));
+        let linear = &outcome.linear as &dyn LinearBicycle;
         let kicks: Vec<serde_json::Value> = outcome
             .reports
             .iter()
@@ -975,7 +976,7 @@ fn fit(
             "skipped": outcome.errors,
             "notes": outcome.reports.iter().flat_map(|r| r.notes.iter().map(move |n| format!("{}: {n}", r.run.display()))).collect::<Vec<_>>(),
             "calibration": bikedyn::fit::calibration_text(&outcome),
-            "prediction_model": outcome.linear.as_ref().map(|l| l.model),
+            "prediction_model": outcome.linear.model,
         });
         Ok(PyFitResult {
             json: serde_json::to_string_pretty(&json).expect("JSON of plain values"),
@@ -1022,12 +1023,12 @@ impl PyIdentifyResult {
 
 /// Run `bikedyn identify` on run folders, set folders or logs.
 #[pyfunction]
-#[pyo3(signature = (inputs, calibration=None, bike="thesis".to_string(), effects=Vec::new(), folds=4, corrections=None, progress=None))]
+#[pyo3(signature = (inputs, calibration=None, bike=None, effects=Vec::new(), folds=4, corrections=None, progress=None))]
 fn identify(
     py: Python<'_>,
     inputs: Vec<PathBuf>,
     calibration: Option<PathBuf>,
-    bike: String,
+    bike: Option<String>,
     effects: Vec<String>,
     folds: usize,
     corrections: Option<usize>,
@@ -1087,15 +1088,24 @@ impl PyTableResult {
 
 /// Run `bikedyn identify --eigenvalues TABLE`.
 #[pyfunction]
-#[pyo3(signature = (table, bike="thesis".to_string(), effects=Vec::new(), corrections=None))]
+#[pyo3(signature = (table, bike=None, effects=Vec::new(), corrections=None))]
 fn identify_eigenvalues(
     py: Python<'_>,
     table: PathBuf,
-    bike: String,
+    bike: Option<String>,
     effects: Vec<String>,
     corrections: Option<usize>,
 ) -> PyResult<PyTableResult> {
     detached(py, move || {
+        // A table is no thesis-format run: its bicycle must be named.
+        let bike = bike.ok_or_else(|| {
+            Failure::new(
+                "InvalidArgumentError",
+                bikedyn::fit::BikeRequired {
+                    inputs: vec![table.clone()],
+                },
+            )
+        })?;
         let outcome = identify_table(&TableRequest {
             path: table,
             bike,

@@ -231,9 +231,10 @@ pub struct FitArgs {
     /// Calibration run (default: `calibration/` beside the runs).
     #[arg(long)]
     pub calibration: Option<PathBuf>,
-    /// Bicycle for the prediction and the frame pitch at rest (built-in name
-    /// or parameter file). Without it the thesis bicycle's frame pitch is used
-    /// and no prediction is made.
+    /// Bicycle (built-in name or parameter file): the frame pitch at rest,
+    /// the predicted weave and the model the fitted eigenvalues are judged
+    /// against. Default: the built-in thesis bicycle for thesis-format runs;
+    /// TU Delft logs need their own.
     #[arg(long)]
     pub bike: Option<String>,
     /// JSON output (one entry per kick).
@@ -271,9 +272,11 @@ pub struct IdentifyArgs {
     #[arg(long)]
     pub calibration: Option<PathBuf>,
     /// Bicycle (built-in name or parameter file); its effect parameters, if
-    /// any, are part of the model before identification.
-    #[arg(long, default_value = "thesis")]
-    pub bike: String,
+    /// any, are part of the model before identification. Default: the
+    /// built-in thesis bicycle for thesis-format runs; TU Delft logs and an
+    /// eigenvalue table need their own.
+    #[arg(long)]
+    pub bike: Option<String>,
     /// Candidate effects to consider (comma-separated; default: every
     /// effect of the library that identification supports).
     #[arg(long, value_delimiter = ',')]

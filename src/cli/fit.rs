@@ -4,7 +4,9 @@
 use super::args::FitArgs;
 use super::ProgressDisplay;
 use anyhow::{bail, Result};
-use bikedyn::fit::{calibration_text, kick_json, kicks_table, plots, residuals, run_fit, FitOptions};
+use bikedyn::fit::{
+    calibration_text, kick_json, kicks_table, plots, refused_text, residuals, run_fit, speed_form_text, FitOptions,
+};
 use bikedyn::report::experiment::compare;
 use bikedyn::runtime::eigen::LinearBicycle;
 use bikedyn::runtime::experiment::angles::AngleMethod;
@@ -29,14 +31,15 @@ pub fn options(args: &FitArgs) -> Result<FitOptions> {
 /// Run `bikedyn fit`: `Ok(false)` when some run was skipped (its error is
 /// on stderr; the others are output).
 pub fn run(args: &FitArgs) -> Result<bool> {
-    let subject = args.bike.as_deref().map(|b| bikedyn::report::plot::subject(b, None));
-    let plot_opts = super::plot_options(&args.plot_args, subject)?;
+    let mut plot_opts = super::plot_options(&args.plot_args, None)?;
     let opts = options(args)?;
     let out = {
         // The bar is cleared before anything is printed.
         let display = ProgressDisplay::new();
         run_fit(&opts, &|p| display.show(p))?
     };
+    // The figures name the bicycle (given, or the thesis default).
+    plot_opts.subject = Some(bikedyn::report::plot::subject(&out.bike, None));
     for e in &out.errors {
         eprintln!("skipped: {e}");
     }
@@ -56,22 +59,23 @@ pub fn run(args: &FitArgs) -> Result<bool> {
     }
     if args.json {
         eprint!("{}", calibration_text(&out));
-        if let Some(l) = &out.linear {
-            eprintln!("prediction model: {}", l.model);
-        }
+        eprintln!("prediction model: {}", out.linear.model);
         let list: Vec<Value> = out
             .reports
             .iter()
             .flat_map(|r| r.kicks.iter())
-            .map(|k| kick_json(k, out.linear.as_ref().map(|l| l as &dyn LinearBicycle)))
+            .map(|k| kick_json(k, &out.linear as &dyn LinearBicycle))
             .collect();
         outln!("{}", serde_json::to_string_pretty(&list)?);
     } else {
         out!("{}", calibration_text(&out));
         out!("{}", kicks_table(&out));
+        // The fits that are no measured weave eigenvalue, and why.
+        out!("{}", refused_text(&out));
+        out!("{}", speed_form_text(&out));
         let rows = residuals(&out);
         if !rows.is_empty() {
-            let model = out.linear.as_ref().map_or("", |l| l.model);
+            let model = out.linear.model;
             outln!("\nmeasured against predicted weave eigenvalue (model {model}; z = difference / standard error)");
             out!("{}", compare::format_residuals(&rows));
         }

@@ -4,6 +4,7 @@
 use super::args::IdentifyArgs;
 use super::ProgressDisplay;
 use anyhow::Result;
+use bikedyn::fit::BikeRequired;
 use bikedyn::identify::{eigen_table, plan, report, run_builtin_plan, IdentifyRequest, Outcome};
 
 /// The library's request from the command line.
@@ -38,9 +39,14 @@ pub fn run(a: &IdentifyArgs) -> Result<bool> {
         bikedyn::report::output::StagedDir::check(dir, "report.json")?;
     }
     if let Some(table) = &a.eigenvalues {
+        // A table of someone's measured eigenvalues is no thesis-format run:
+        // its bicycle must be named.
+        let bike = a.bike.clone().ok_or_else(|| BikeRequired {
+            inputs: vec![table.clone()],
+        })?;
         let o = eigen_table::identify_table(&eigen_table::TableRequest {
             path: table.clone(),
-            bike: a.bike.clone(),
+            bike,
             effects: a.effects.clone(),
             corrections: a.corrections,
         })?;

@@ -27,7 +27,7 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
         "Data: {} ({} kicks). Bicycle: `{}`. Model: `{}` (nonlinear, {speed}, every effect of the library absent unless fitted); weave predictions from its driven-speed twin `{}`.\n",
         inputs.join(", "),
         o.segments.len(),
-        a.bike,
+        o.bike,
         o.model,
         o.driven_model
     );
@@ -279,7 +279,13 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     if !o.eigen_excluded.is_empty() {
         let _ = writeln!(s, "\nKicks kept out of the eigenvalue figures:\n");
         for e in &o.eigen_excluded {
-            let _ = writeln!(s, "* {} at {:.2} s: {}", e.run, e.window_start, e.reason);
+            let _ = writeln!(
+                s,
+                "* {} at {:.2} s: {}",
+                e.run,
+                e.window_start,
+                bikedyn_report::experiment::accept::rejected_text(&e.rejected)
+            );
         }
     }
     let _ = writeln!(s, "\n## Plots\n\n* `continuation.svg`: weave eigenvalue over speed, model before (thin) and after (thick), with each measured eigenvalue on its speed interval.\n* `run_residuals.svg`: measured and simulated {roll}, steer and speed of a typical kick (median error), before and after.\n");

@@ -25,7 +25,7 @@ pub mod weave_errors;
 pub use error::IdentifyError;
 
 use crate::bicycle::Bicycle;
-use crate::fit::{run_fit_in, FitOptions};
+use crate::fit::{bicycle_for, run_fit_in, FitError, FitOptions};
 use crate::progress::{OnProgress, Progress};
 use crate::registry::BuiltIn;
 use bikedyn_runtime::identify::{Candidate, Identification, IdentifyOptions as FitSettings, RollChannel, Segment};
@@ -52,8 +52,10 @@ pub struct IdentifyRequest {
     /// Calibration run (default: `calibration/` beside the runs).
     pub calibration: Option<PathBuf>,
     /// Bicycle (built-in name or parameter file); its effect parameters, if
-    /// any, are part of the model before identification. Default `thesis`.
-    pub bike: String,
+    /// any, are part of the model before identification. `None`, the
+    /// default: the built-in thesis bicycle for thesis-format runs; TU Delft
+    /// logs need one ([`IdentifyRequest::bicycle`]).
+    pub bike: Option<String>,
     /// Candidate effects to consider (empty, the default: every effect of
     /// the library that identification supports).
     pub effects: Vec<String>,
@@ -71,11 +73,26 @@ impl Default for IdentifyRequest {
         Self {
             inputs: Vec::new(),
             calibration: None,
-            bike: "thesis".into(),
+            bike: None,
             effects: Vec::new(),
             folds: 4,
             corrections: None,
         }
+    }
+}
+
+impl IdentifyRequest {
+    /// The bicycle: as given, or the built-in thesis bicycle when the
+    /// inputs are thesis-format runs ([`crate::fit::bicycle_for`]; logs
+    /// need one).
+    pub fn bicycle(&self) -> Result<&str, IdentifyError> {
+        let inputs: Vec<_> = self
+            .inputs
+            .iter()
+            .filter_map(|p| bikedyn_runtime::experiment::classify(p).ok())
+            .flatten()
+            .collect();
+        Ok(bicycle_for(self.bike.as_deref(), &inputs).map_err(FitError::from)?)
     }
 }
 
@@ -102,6 +119,8 @@ pub struct Plan<R: ModelRegistry = BuiltIn> {
 /// Everything identification found, and what the report needs; its models
 /// are those of registry `R`.
 pub struct Outcome<R: ModelRegistry = BuiltIn> {
+    /// The bicycle (as given, or `thesis`, the default for thesis-format runs).
+    pub bike: String,
     /// The stepwise selection: fits before and after, each step's verdicts.
     pub identification: Identification,
     /// The measured segments fitted (one per kick).
@@ -160,8 +179,8 @@ pub fn plan(request: &IdentifyRequest) -> Result<Plan, IdentifyError> {
 /// against them, and the candidates are the effects their files declare
 /// (e.g. an effect of a user's own build script).
 pub fn plan_in<R: ModelRegistry>(request: &IdentifyRequest) -> Result<Plan<R>, IdentifyError> {
-    let bike = Bicycle::<R>::resolve_in(&request.bike)?;
     let speed_imposed = segments::speed_imposed(&request.inputs)?;
+    let bike = Bicycle::<R>::resolve_in(request.bicycle()?)?;
     let (model, driven_model, alternative_model) = identification_models(&bike, speed_imposed)?;
     let candidates = candidates(model, alternative_model, &bike, &request.effects, speed_imposed)?;
     // A conclusion ("no effect warranted") means something only when
@@ -230,11 +249,16 @@ pub fn run_plan<R: ModelRegistry>(
     let fit_options = FitOptions {
         inputs: request.inputs.clone(),
         calibration: request.calibration.clone(),
-        bike: Some(request.bike.clone()),
+        bike: Some(request.bicycle()?.to_string()),
         ..FitOptions::default()
     };
+    // The measured eigenvalues and their verdicts (`fit` judges them).
     let out = run_fit_in::<R>(&fit_options, progress)?;
-    let (segs, mut skipped) = segments(&out);
+    let segments::Segments {
+        segments: segs,
+        rejected,
+        mut skipped,
+    } = segments(&out);
     skipped.extend(out.errors.iter().cloned());
     let failed_inputs = out.errors.clone();
     if segs.len() < 2 {
@@ -249,7 +273,7 @@ pub fn run_plan<R: ModelRegistry>(
     let predicted_before = predict(driven, bike, &BTreeMap::new(), &speeds)?;
     // Only the kicks whose measured eigenvalue is a weave count in the
     // eigenvalue figures and the screening of corrections.
-    let (weave_kicks, eigen_excluded) = weave_errors::weave_kicks(&segs, &predicted_before);
+    let (weave_kicks, eigen_excluded) = weave_errors::weave_kicks(&segs, &rejected, &predicted_before);
     let weave_predictions: Vec<Option<[f64; 2]>> = predicted_before
         .iter()
         .zip(&weave_kicks)
@@ -349,6 +373,7 @@ pub fn run_plan<R: ModelRegistry>(
         plan.speed_imposed,
     );
     Ok(Outcome {
+        bike: out.bike.clone(),
         identification: id,
         segments: segs,
         skipped,

@@ -6,9 +6,10 @@ use super::candidates::identification_models;
 use super::confounded::confounding_lines;
 use super::markdown::report_markdown;
 use super::predict::{linear_equivalent, predict};
-use super::weave_errors::{eigen_rms, eigen_weighted_rms};
+use super::weave_errors::{eigen_rms, eigen_weighted_rms, Excluded};
 use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
+use bikedyn_report::experiment::accept::rejected_text;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic, StagedDir};
 use bikedyn_runtime::identify::confounding::CONFOUNDED;
@@ -140,12 +141,24 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
         "speed_imposed": o.speed_imposed,
         "kicks": o.segments.len(),
         "skipped": o.skipped,
-        "eigen_excluded": o.eigen_excluded,
+        "eigen_excluded": o.eigen_excluded.iter().map(excluded_json).collect::<Vec<_>>(),
         "findings": o.findings,
         "weights": id.weights,
         "folds": id.folds,
         "simulations": id.simulations,
         "seconds": o.seconds,
+    })
+}
+
+/// A kick kept out of the eigenvalue figures: where, the test it failed
+/// with its numbers (`rejected`), and why in words (`reason`).
+fn excluded_json(e: &Excluded) -> Value {
+    json!({
+        "kick": e.kick,
+        "run": e.run,
+        "window_start": e.window_start,
+        "rejected": e.rejected,
+        "reason": rejected_text(&e.rejected),
     })
 }
 
@@ -187,7 +200,9 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
         let _ = writeln!(
             s,
             "not a weave (kept out of the eigenvalue figures): {} at {:.2} s: {}",
-            e.run, e.window_start, e.reason
+            e.run,
+            e.window_start,
+            rejected_text(&e.rejected)
         );
     }
     let sel = if id.selected.is_empty() {
@@ -293,7 +308,7 @@ pub fn write_report<R: ModelRegistry>(
     // new ones.
     let staged = StagedDir::new(dir, "report.json")?;
     let out = staged.path();
-    let bike = Bicycle::<R>::resolve_in(&a.bike)?;
+    let bike = Bicycle::<R>::resolve_in(&o.bike)?;
     save_json(out.join("report.json"), &outcome_json(o))?;
     write_string_atomic(out.join("fitted.toml"), &fitted_toml(&bike, &o.values_after, o)?)?;
     // Continuation diagram before and after.
@@ -323,10 +338,13 @@ pub fn write_report<R: ModelRegistry>(
         }
         Ok(pts[start..].to_vec())
     };
+    // The measured weave eigenvalues that count in the figures.
     let measured: Vec<MeasuredWeave> = o
         .segments
         .iter()
-        .filter_map(|s| {
+        .zip(&o.weave_kicks)
+        .filter(|(_, &counted)| counted)
+        .filter_map(|(s, _)| {
             let (w, se) = s.weave?;
             Some(MeasuredWeave {
                 speed_interval: s.speed_interval,
@@ -350,7 +368,7 @@ pub fn write_report<R: ModelRegistry>(
         .expect("the identification's driven model is registered");
     let plot = bikedyn_report::plot::PlotOptions {
         subject: Some(bikedyn_report::plot::subject(
-            &a.bike,
+            &o.bike,
             Some(&o.driven_model.to_string()),
         )),
         ..plot.clone()

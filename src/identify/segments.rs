@@ -3,22 +3,38 @@
 //! motion.
 
 use crate::fit::FitOutcome;
-use bikedyn_runtime::experiment::{kicks::WindowEnd, PipelineOptions};
+use bikedyn_runtime::experiment::{accept::Rejected, kicks::WindowEnd, PipelineOptions};
 use bikedyn_runtime::identify::Segment;
+
+/// The measured segments and what was left out.
+pub struct Segments {
+    /// One per kick with a usable window. A segment's `weave` is the kick's
+    /// measured weave eigenvalue: `None` where `fit` refused the fit.
+    pub segments: Vec<Segment>,
+    /// Why each segment's fitted eigenvalue was refused (`None`: it is a
+    /// measured weave eigenvalue), as `fit` judged it.
+    pub rejected: Vec<Option<Rejected>>,
+    /// Runs and kicks without a usable window, with the reason.
+    pub skipped: Vec<String>,
+}
 
 /// The measured segments of a processed set: every kick with a free
 /// response window, roll and steer from the pipeline's angles (IMU clock),
 /// speed from the reed switch moved onto the IMU clock.
-pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
-    let mut segs = Vec::new();
-    let mut skipped = Vec::new();
+pub fn segments(out: &FitOutcome) -> Segments {
+    let mut segs = Segments {
+        segments: Vec::new(),
+        rejected: Vec::new(),
+        skipped: Vec::new(),
+    };
     for r in &out.reports {
         if let Some(log) = &r.log {
-            log_segments(r, log, &mut segs, &mut skipped);
+            log_segments(r, log, &mut segs);
             continue;
         }
         let (Some(ang), Some(sp)) = (&r.angles, &r.speed) else {
-            skipped.push(format!("{}: no angle and speed record", r.run.display()));
+            segs.skipped
+                .push(format!("{}: no angle and speed record", r.run.display()));
             continue;
         };
         let offset = r.clock_offset.map_or(0.0, |c| c.value);
@@ -53,7 +69,7 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
             let speed_idx: Vec<usize> = (0..sp.t.len())
                 .filter(|&i| sp.t[i] + offset >= w0 && sp.t[i] + offset <= w1 && sp.v[i].is_finite())
                 .collect();
-            let weave = k.chosen_fit().map(|f| (f.eigenvalue, f.eigenvalue_stderr));
+            let weave = k.measured_weave().map(|f| (f.eigenvalue, f.eigenvalue_stderr));
             let seg = Segment::new(
                 r.run.display().to_string(),
                 w0,
@@ -64,13 +80,13 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
                 speed_idx.iter().map(|&i| sp.v[i]).collect(),
                 weave,
             );
-            keep(seg, 0.5, r, k, [w0, w1], &mut segs, &mut skipped);
+            keep(seg, 0.5, r, k, [w0, w1], &mut segs);
         }
         if r.kicks.is_empty() {
-            skipped.push(format!("{}: no kick found", r.run.display()));
+            segs.skipped.push(format!("{}: no kick found", r.run.display()));
         }
     }
-    (segs, skipped)
+    segs
 }
 
 /// The segments of a TU Delft log: each kick's free-response window as the
@@ -90,8 +106,7 @@ pub fn segments(out: &FitOutcome) -> (Vec<Segment>, Vec<String>) {
 fn log_segments(
     r: &bikedyn_runtime::experiment::RunReport,
     log: &bikedyn_runtime::experiment::read::TudelftLog,
-    segs: &mut Vec<Segment>,
-    skipped: &mut Vec<String>,
+    segs: &mut Segments,
 ) {
     for k in &r.kicks {
         let [w0, w1] = k.window;
@@ -99,7 +114,7 @@ fn log_segments(
         let pick = |x: &[f64]| idx.iter().map(|&i| x[i]).collect::<Vec<f64>>();
         let t: Vec<f64> = idx.iter().map(|&i| log.t[i] - w0).collect();
         let steer: Vec<f64> = idx.iter().map(|&i| -log.fork[i]).collect();
-        let weave = k.chosen_fit().map(|f| (f.eigenvalue, f.eigenvalue_stderr));
+        let weave = k.measured_weave().map(|f| (f.eigenvalue, f.eigenvalue_stderr));
         let seg = Segment::with_roll_rate(
             r.run.display().to_string(),
             w0,
@@ -111,23 +126,23 @@ fn log_segments(
             pick(&log.speed),
             weave,
         );
-        keep(seg, MIN_LOG_WINDOW, r, k, [w0, w1], segs, skipped);
+        keep(seg, MIN_LOG_WINDOW, r, k, [w0, w1], segs);
     }
     if r.kicks.is_empty() {
-        skipped.push(format!("{}: no kick found", r.run.display()));
+        segs.skipped.push(format!("{}: no kick found", r.run.display()));
     }
 }
 
 /// Keep a kick's segment if it is at least `min_len` s long, with the
-/// eigenvalue fit's speeds and quality; else say why it was skipped.
+/// eigenvalue fit's speeds, quality and verdict; else say why it was
+/// skipped.
 fn keep(
     seg: Option<Segment>,
     min_len: f64,
     r: &bikedyn_runtime::experiment::RunReport,
     k: &bikedyn_runtime::experiment::KickFit,
     [w0, w1]: [f64; 2],
-    segs: &mut Vec<Segment>,
-    skipped: &mut Vec<String>,
+    segs: &mut Segments,
 ) {
     match seg {
         Some(mut s) if s.duration() >= min_len => {
@@ -137,10 +152,11 @@ fn keep(
                 s.mean_speed = k.mean_speed;
                 s.speed_interval = k.speed_interval;
             }
-            s.weave_r2 = k.chosen_fit().map(|f| f.r2);
-            segs.push(s)
+            s.weave_r2 = k.measured_weave().map(|f| f.r2);
+            segs.segments.push(s);
+            segs.rejected.push(k.rejected);
         }
-        _ => skipped.push(format!(
+        _ => segs.skipped.push(format!(
             "{}: kick at {:.2} s has no usable window ({w0:.2}-{w1:.2} s)",
             r.run.display(),
             k.kick_time,

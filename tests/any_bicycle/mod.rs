@@ -359,7 +359,7 @@ fn no_job_names_a_thesis_symbol() {
 /// The TU Delft steer-by-wire bicycle with its declared assist against its
 /// measured kicks (`../shared/realdata/tudelft_sbw_kicks`): the Whipple
 /// model plus the assist predicts the median measured weave at 1.5-4.7 m/s
-/// within about 20 %, with the predicted frequency 1.1-1.6 rad/s above the
+/// within about 20 %, with the predicted frequency 0.9-1.5 rad/s above the
 /// measured one at the two higher speeds (an independent evaluation of this
 /// bicycle and law, quoted in the project's issue on real bicycles).
 #[test]

@@ -258,3 +258,35 @@ fn every_command_names_the_model_it_used() {
         assert!(all.contains(named), "{args:?} does not say `{named}`:\n{all}");
     }
 }
+
+/// The built-in thesis bicycle is the default of thesis-format runs only:
+/// `fit` and `identify` on a TU Delft log, and `identify --eigenvalues` on
+/// a table, without `--bike` are errors that name the flag (they used to
+/// compare the logs' bicycle with the thesis bicycle and say nothing). The
+/// committed thesis-format set still needs none.
+#[test]
+fn logs_and_tables_without_a_bicycle_are_errors_naming_bike() {
+    let d = tmp("no-bike");
+    std::fs::create_dir_all(&d).unwrap();
+    let log = d.join("kicks.log");
+    std::fs::write(&log, "not read: the bicycle is asked for first\n").unwrap();
+    let table = d.join("table.csv");
+    std::fs::write(&table, "v,re,im\n5,-1,7\n6,-1.5,8\n").unwrap();
+    let (log, table) = (log.to_str().unwrap(), table.to_str().unwrap());
+    for args in [
+        &["fit", log][..],
+        &["identify", log][..],
+        &["identify", "--eigenvalues", table][..],
+    ] {
+        let out = bikedyn(args);
+        let err = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("--bike") && err.contains("thesis-format"),
+            "{args:?}: {err}"
+        );
+    }
+    let set = example_set();
+    let out = bikedyn(&["fit", set.to_str().unwrap(), "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}

@@ -378,10 +378,10 @@ fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
     }
     // Issue 17, point 6: the weave eigenvalue error, weighted by each
     // fit's standard error, at least halves on fitted and held-out runs.
-    // The plain RMS cannot halve on this set: the fitted eigenvalues
+    // The plain RMS is held to a floor instead: the fitted eigenvalues
     // scatter about the truth's (the frozen-speed weave of the simulated
-    // model, in synth's truth files) by about 0.38 1/s, so the plain RMS
-    // is held to that floor instead.
+    // model, in synth's truth files) by about 0.35 1/s over the 11 kicks
+    // `fit` accepts (0.38 over all 12, when it could not halve).
     for part in [&j["error_before"], &j["error_after"]] {
         assert!(part["eigen_weighted_rms"].is_number() && part["held_out"]["eigen_weighted_rms"].is_number());
     }
@@ -398,6 +398,12 @@ fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
     let kicks = ok_json(&["fit", dir.to_str().unwrap(), "--json"]);
     let mut ss = Vec::new();
     for k in kicks.as_array().unwrap() {
+        // The kicks whose fit is a measured weave eigenvalue, as in the
+        // eigenvalue figures (run05's standard errors are a seventh of its
+        // eigenvalue: refused).
+        if k["weave"].is_null() {
+            continue;
+        }
         let run = std::path::Path::new(k["run"].as_str().unwrap())
             .file_name()
             .unwrap()
@@ -601,7 +607,14 @@ fn measured_eigenvalue_tables_are_identified() {
         path
     };
     let damped = table("damped", Some(0.3));
-    let v = ok_json(&["identify", "--eigenvalues", damped.to_str().unwrap(), "--json"]);
+    let v = ok_json(&[
+        "identify",
+        "--eigenvalues",
+        damped.to_str().unwrap(),
+        "--bike",
+        "thesis",
+        "--json",
+    ]);
     assert_eq!(v["selected"], serde_json::json!(["steer_damping"]), "{v}");
     let c = v["parameters"]["c_steer"][0].as_f64().unwrap();
     assert!((c - 0.3).abs() < 0.015, "c_steer {c}");
@@ -609,12 +622,19 @@ fn measured_eigenvalue_tables_are_identified() {
     assert!(v["eigen_rms_held_out"].as_f64().unwrap() < 0.5 * v["eigen_rms_before"].as_f64().unwrap());
 
     let plain = table("plain", None);
-    let v = ok_json(&["identify", "--eigenvalues", plain.to_str().unwrap(), "--json"]);
+    let v = ok_json(&[
+        "identify",
+        "--eigenvalues",
+        plain.to_str().unwrap(),
+        "--bike",
+        "thesis",
+        "--json",
+    ]);
     assert_eq!(v["selected"], serde_json::json!([]), "{v}");
 
     let bad = dir.join("bad.csv");
     std::fs::write(&bad, "v,re,im\n4,-1,5\n5,-1.2,6\n6,-1.3,7,0.1\n").unwrap();
-    let out = bikedyn(&["identify", "--eigenvalues", bad.to_str().unwrap()]);
+    let out = bikedyn(&["identify", "--eigenvalues", bad.to_str().unwrap(), "--bike", "thesis"]);
     assert!(!out.status.success());
     let err = text(&out.stderr);
     assert!(err.contains("bad.csv:4") && err.contains("4 fields"), "{err}");

@@ -10,7 +10,11 @@ fn pair(v: &serde_json::Value) -> [f64; 2] {
 /// and every reliable fit (r^2 > 0.95) is within 20 % of the model's
 /// frozen-speed weave eigenvalue over the window's speed interval. The dev runs
 /// contain physics the rigid model lacks, so they are not expected to match
-/// it exactly; 20 % is the bound asked of the fit.
+/// it exactly; 20 % is the bound asked of the fit. Below 3 m/s, where the
+/// weave merges with the slow modes, run05 and run09 converge only in the
+/// speed-varying form, with slopes of 11 and 15 (1/s)/(m/s) against the
+/// model's 1.9 and 2.2: not the weave changing with speed, so they are
+/// refused (they counted as reliable before).
 #[test]
 fn dev_set_fits_every_run_near_the_model() {
     let Some(dev) = shared("data/dev") else { return };
@@ -36,6 +40,12 @@ fn dev_set_fits_every_run_near_the_model() {
         assert!(e["clock_offset"]["value"].is_f64() && e["clock_offset"]["stderr"].is_f64());
         let w = pair(&e["window"]);
         assert!(w[0] >= e["kick_time"].as_f64().unwrap() && w[1] > w[0]);
+        let run = e["run"].as_str().unwrap();
+        if run.ends_with("run05") || run.ends_with("run09") {
+            let r = &e["refused"];
+            assert_eq!(r["test"], "only_speed_form", "{e}");
+            assert_eq!(r["why"]["test"], "implausible", "{e}");
+        }
         if e["weave"].is_null() {
             continue;
         }
@@ -61,7 +71,7 @@ fn dev_set_fits_every_run_near_the_model() {
             assert!(rel < 0.2, "{}: {rel}", e["run"]);
         }
     }
-    assert!(reliable >= 8, "only {reliable} reliable fits");
+    assert!(reliable >= 7, "only {reliable} reliable fits");
 }
 
 /// `--plot` writes one response plot per kick and the continuation diagram
@@ -86,24 +96,63 @@ fn plots_are_written() {
     }
 }
 
-/// A TU Delft log: many kicks, times on the row-index clock, no clock offset.
+/// A TU Delft log with its bicycle: many kicks, times on the row-index
+/// clock, no clock offset. Every kick has a verdict: a measured weave
+/// eigenvalue, or refused with the test it failed. The kick at 140.21 s
+/// (its window noise, fitted at 314.16 rad/s, the log's Nyquist limit, with
+/// r² 0.003) is refused as above a quarter of the Nyquist frequency, and
+/// the speed-varying form, chosen for most kicks before (slopes of hundreds
+/// of (1/s)/(m/s) over speed changes of hundredths of a m/s), is chosen for
+/// none of this log's kicks.
 #[test]
 fn tudelft_log_json() {
     let Some(log) = shared("realdata/tudelft_sbw_kicks/logs/eigen_normal_sil6.5n2_16.2kph.log") else {
         return;
     };
-    let out = bikedyn(&["fit", log.to_str().unwrap(), "--json"]);
-    assert!(out.status.success());
+    let bike = fixture_arg("tudelft_sbw_bicycle.toml");
+    let out = bikedyn(&["fit", log.to_str().unwrap(), "--bike", &bike, "--json"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
     let v = stdout_json(&out);
     let list = v.as_array().unwrap();
     assert!(list.len() > 20);
+    let mut accepted = 0;
     for e in list {
         assert!(e.get("clock_offset").is_none());
-        assert!(e.get("predicted_weave").is_none());
         let t = e["kick_time"].as_f64().unwrap();
         // Row index times 0.01 s: a multiple of 0.01.
         assert!(((t * 100.0) - (t * 100.0).round()).abs() < 1e-6);
+        // Measured, or refused with a reason; never both.
+        assert_ne!(e["weave"].is_null(), e["refused"].is_null(), "{e}");
+        if e["refused"].is_object() {
+            assert!(!e["refused"]["reason"].as_str().unwrap().is_empty());
+        } else {
+            accepted += 1;
+        }
+        assert!(
+            !e["form"].as_str().is_some_and(|f| f.starts_with("speed_varying")),
+            "{e}"
+        );
     }
+    assert!(accepted >= 20, "{accepted} accepted");
+    let k = list
+        .iter()
+        .find(|e| (e["kick_time"].as_f64().unwrap() - 140.21).abs() < 1e-6)
+        .expect("the kick at 140.21 s");
+    let r = &k["refused"];
+    assert_eq!(r["test"], "above_nyquist", "{k}");
+    assert!((r["omega"].as_f64().unwrap() - 314.159).abs() < 0.01, "{r}");
+    assert!((r["limit"].as_f64().unwrap() - 78.54).abs() < 0.01, "{r}");
+    assert!(r["reason"].as_str().unwrap().contains("Nyquist"), "{r}");
+    assert!(k["weave"].is_null() && r["fit"]["r2"].as_f64().unwrap() < 0.01, "{k}");
+    // The console lists it with the reason.
+    let out = bikedyn(&["fit", log.to_str().unwrap(), "--bike", &bike]);
+    let console = text(&out.stdout);
+    assert!(
+        console
+            .lines()
+            .any(|l| l.starts_with("refused: ") && l.contains("kick at 140.21 s") && l.contains("Nyquist")),
+        "{console}"
+    );
 }
 
 /// A missing calibration and a corrupt file are reported on stderr, the

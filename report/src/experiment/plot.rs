@@ -4,6 +4,7 @@
 //! its speed interval (Figures 14-15). Same style, formats and options as
 //! every figure ([`crate::plot`]).
 
+use super::accept::rejected_label;
 use crate::identify::plot::{measured_parts, MeasuredWeave};
 use crate::plot::style::{self, Area, Frame, Icon, Legend, Marker, Measured, Stroke};
 use crate::plot::{de, label_area_width, render, DrawErr, Figure, PlotError, PlotOptions};
@@ -66,8 +67,10 @@ impl Figure for Response<'_> {
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let title = match fit {
-            Some(f) => format!(
+        // A fit that is no measured weave eigenvalue is drawn, and the
+        // title says so.
+        let title = match (fit, &k.rejected) {
+            (Some(f), None) => format!(
                 "{run}, kick at {:.2} s: eigenvalue {:.3} {:+.3}i 1/s (r2 {:.4}, {})",
                 k.kick_time,
                 f.eigenvalue[0],
@@ -75,7 +78,16 @@ impl Figure for Response<'_> {
                 f.r2,
                 f.form.name()
             ),
-            None => format!("{run}, kick at {:.2} s: no fit", k.kick_time),
+            (Some(f), Some(r)) => format!(
+                "{run}, kick at {:.2} s: refused ({}): fit {:.3} {:+.3}i 1/s (r2 {:.4}, {})",
+                k.kick_time,
+                rejected_label(r),
+                f.eigenvalue[0],
+                f.eigenvalue[1],
+                f.r2,
+                f.form.name()
+            ),
+            (None, _) => format!("{run}, kick at {:.2} s: no fit", k.kick_time),
         };
         root.fill(&WHITE).map_err(de)?;
         let area = style::titled(root, o, &title)?;
@@ -143,8 +155,9 @@ impl Figure for Response<'_> {
 
 /// The model's weave eigenvalue (real part solid, imaginary part dashed)
 /// over speed, and each measured eigenvalue at its mean speed with error
-/// bars (one standard error) and its speed interval. The default size
-/// (when `opts` gives none) is 900x620.
+/// bars (one standard error) and its speed interval: the kicks whose fit is
+/// a measured weave eigenvalue ([`KickFit::measured_weave`]); the title
+/// counts the others. The default size (when `opts` gives none) is 900x620.
 pub fn plot_measured_continuation(
     path: &Path,
     c: &dyn LinearBicycle,
@@ -173,7 +186,7 @@ pub fn plot_measured_continuation(
     let measured: Vec<MeasuredWeave> = kicks
         .iter()
         .filter_map(|k| {
-            k.chosen_fit().map(|f| MeasuredWeave {
+            k.measured_weave().map(|f| MeasuredWeave {
                 speed_interval: k.speed_interval,
                 mean_speed: k.mean_speed,
                 eigenvalue: f.eigenvalue,
@@ -181,20 +194,39 @@ pub fn plot_measured_continuation(
             })
         })
         .collect();
+    let refused = kicks
+        .iter()
+        .filter(|k| k.chosen_fit().is_some() && k.rejected.is_some())
+        .count();
     let o = opts.sized_by_default((900, 620));
-    render(path, &o, &MeasuredContinuation { model, measured, vmax })
+    render(
+        path,
+        &o,
+        &MeasuredContinuation {
+            model,
+            measured,
+            refused,
+            vmax,
+        },
+    )
 }
 
 struct MeasuredContinuation {
     model: Vec<(f64, f64, f64)>,
     measured: Vec<MeasuredWeave>,
+    /// Fitted eigenvalues left out (not measured weave eigenvalues).
+    refused: usize,
     vmax: f64,
 }
 
 impl Figure for MeasuredContinuation {
     fn draw(&self, root: &Area<'_>, o: &PlotOptions) -> Result<(), DrawErr> {
         root.fill(&WHITE).map_err(de)?;
-        let area = style::titled(root, o, "weave eigenvalue: model and measured")?;
+        let title = match self.refused {
+            0 => "weave eigenvalue: model and measured".to_string(),
+            n => format!("weave eigenvalue: model and measured ({n} fits refused, not shown)"),
+        };
+        let area = style::titled(root, o, &title)?;
         let re: Vec<(f64, f64)> = self.model.iter().map(|p| (p.0, p.1)).collect();
         let im: Vec<(f64, f64)> = self.model.iter().map(|p| (p.0, p.2)).collect();
         let [mre, mim] = measured_parts(&self.measured);

@@ -15,6 +15,23 @@ pub fn predicted_weave(c: &dyn LinearBicycle, v: f64) -> Option<[f64; 2]> {
         .next()
 }
 
+/// The model's `d lambda / d v` of the weave `[real, imag]` ((1/s)/(m/s))
+/// at speed `v`, by central differences over 0.01 m/s (one-sided where
+/// the weave stops being oscillatory on one side); `None` where the model
+/// has no oscillatory weave at `v`.
+pub fn weave_slope(c: &dyn LinearBicycle, v: f64) -> Option<[f64; 2]> {
+    const H: f64 = 0.01;
+    let at = predicted_weave(c, v)?;
+    let (lo, hi) = (predicted_weave(c, v - H), predicted_weave(c, v + H));
+    let (a, b, dv) = match (lo, hi) {
+        (Some(l), Some(h)) => (l, h, 2.0 * H),
+        (None, Some(h)) => (at, h, H),
+        (Some(l), None) => (l, at, H),
+        (None, None) => return None,
+    };
+    Some([(b[0] - a[0]) / dv, (b[1] - a[1]) / dv])
+}
+
 /// Prediction over a speed interval.
 #[derive(Clone, Debug, Serialize)]
 pub struct Prediction {

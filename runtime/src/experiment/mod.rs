@@ -6,9 +6,12 @@
 //! ([`angles`]), speed from the reed switch ([`speed`]), clock offset of the
 //! two loggers ([`sync`]), kick and free-response window ([`kicks`]), fits
 //! ([`fit`]). A TU Delft log ([`process_tudelft`]) skips the first four:
-//! it records roll, roll rate and speed directly. [`compare`] sets the
-//! measured eigenvalues against the model; [`synth`] writes synthetic runs.
+//! it records roll, roll rate and speed directly. [`accept`] says which
+//! fitted eigenvalues are measured weave eigenvalues (and which form is
+//! reported); [`compare`] sets them against the model; [`synth`] writes
+//! synthetic runs.
 
+pub mod accept;
 pub mod angles;
 pub mod compare;
 pub mod fit;
@@ -72,9 +75,19 @@ pub struct KickFit {
     pub fits: Vec<FitResult>,
     /// Fits that failed, with the reason.
     pub failed: Vec<(FitForm, String)>,
-    /// Index in `fits` of the reported fit (constant or speed-varying form
-    /// on the primary signal, smaller BIC).
+    /// The constant form on the primary signal: roll angle for thesis-style
+    /// runs, roll rate for TU Delft logs.
+    pub primary: FitForm,
+    /// Index in `fits` of the reported fit: the constant form on the
+    /// primary signal, or its speed-varying form where that passes
+    /// [`accept::speed_form_test`] and has the smaller BIC
+    /// ([`accept::choose_form`]).
     pub chosen: Option<usize>,
+    /// Why a speed-varying fit that converged is not the reported one.
+    pub speed_form: Option<accept::SpeedFormRejected>,
+    /// Why the reported eigenvalue is not a measured weave eigenvalue
+    /// (`None`: it is one; [`accept`]).
+    pub rejected: Option<accept::Rejected>,
     /// Clock offset of the run (thesis-style runs).
     pub clock_offset: Option<ClockOffset>,
     /// Samples of the window (for plots): time, roll (rad), roll rate
@@ -97,9 +110,15 @@ pub struct Samples {
 }
 
 impl KickFit {
-    /// The reported fit.
+    /// The reported fit, accepted or not.
     pub fn chosen_fit(&self) -> Option<&FitResult> {
         self.chosen.map(|i| &self.fits[i])
+    }
+    /// The reported fit if its eigenvalue is a measured weave eigenvalue
+    /// (it passed every test of [`accept`]): what tables, plots and error
+    /// figures may show.
+    pub fn measured_weave(&self) -> Option<&FitResult> {
+        self.chosen_fit().filter(|_| self.rejected.is_none())
     }
 }
 
@@ -187,7 +206,30 @@ fn fit_window(
     offset: Option<ClockOffset>,
 ) -> KickFit {
     let (a, b) = (k.start, k.end);
-    let (ts, rs, qs, vs) = (&t[a..b], &roll[a..b], &rate[a..b], &speed[a..b]);
+    let samples = Samples {
+        t: t[a..b].to_vec(),
+        roll: roll[a..b].to_vec(),
+        roll_rate: rate[a..b].to_vec(),
+        speed: speed[a..b].to_vec(),
+    };
+    let mut fit = fit_kick(run, k.time, k.end_reason, samples, primary);
+    fit.window = [t[a], t[b.max(a + 1) - 1]];
+    fit.clock_offset = offset;
+    fit
+}
+
+/// Fit every form to a kick's free-response window (`samples`, the kick at
+/// `kick_time`) and report the constant form on the `primary` signal
+/// (roll angle or roll rate), judged without a model
+/// ([`accept::check_fit`]); [`accept::judge`] judges again with one.
+pub fn fit_kick(
+    run: &Path,
+    kick_time: f64,
+    window_end: kicks::WindowEnd,
+    samples: Samples,
+    primary: FitForm,
+) -> KickFit {
+    let (ts, rs, qs, vs) = (&samples.t, &samples.roll, &samples.roll_rate, &samples.speed);
     let finite_v: Vec<f64> = vs.iter().copied().filter(|v| v.is_finite()).collect();
     let (lo, hi) = finite_v
         .iter()
@@ -245,39 +287,28 @@ fn fit_window(
             Err(e) => failed.push((form, e.to_string())),
         }
     }
-    let varying = match primary {
-        FitForm::RollAngle => FitForm::SpeedVaryingRollAngle,
-        _ => FitForm::SpeedVaryingRollRate,
+    let window = match (ts.first(), ts.last()) {
+        (Some(&a), Some(&b)) => [a, b],
+        _ => [f64::NAN; 2],
     };
-    let pick = |f: FitForm| fits.iter().position(|x| x.form == f);
-    let better = |c: Option<usize>, v: Option<usize>| match (c, v) {
-        (Some(c), Some(v)) => Some(if fits[v].bic < fits[c].bic { v } else { c }),
-        (c, v) => c.or(v),
-    };
-    // If no fit on the primary signal converged, report the other signal's.
-    let (other, other_varying) = match primary {
-        FitForm::RollAngle => (FitForm::RollRate, FitForm::SpeedVaryingRollRate),
-        _ => (FitForm::RollAngle, FitForm::SpeedVaryingRollAngle),
-    };
-    let chosen = better(pick(primary), pick(varying)).or_else(|| better(pick(other), pick(other_varying)));
-    KickFit {
+    let mut k = KickFit {
         run: run.to_path_buf(),
-        kick_time: k.time,
-        window: [t[a], t[b.max(a + 1) - 1]],
-        window_end: k.end_reason,
+        kick_time,
+        window,
+        window_end,
         speed_interval: if lo.is_finite() { [lo, hi] } else { [f64::NAN, f64::NAN] },
         mean_speed: mean,
         fits,
         failed,
-        chosen,
-        clock_offset: offset,
-        samples: Samples {
-            t: ts.to_vec(),
-            roll: rs.to_vec(),
-            roll_rate: qs.to_vec(),
-            speed: vs.to_vec(),
-        },
-    }
+        primary,
+        chosen: None,
+        speed_form: None,
+        rejected: None,
+        clock_offset: None,
+        samples,
+    };
+    accept::judge([&mut k], None);
+    k
 }
 
 /// Linear trend `v = a + b (t - t0)` of the speed over a window, if its slope
