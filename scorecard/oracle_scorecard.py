@@ -280,12 +280,20 @@ def main():
             print(f"    error: {e}", file=sys.stderr, flush=True)
     print_table(results)
     s = summary(results)
-    print(f"\nright cause: {s['right_causes']} of {s['sets_with_cause']} sets with a cause; "
-          f"clean controls: {s['clean_controls']} of {s['controls']}; "
-          f"false causes beside them: {s['false_causes_on_sets_with_cause']}; "
-          f"parameters within 25 %: {s['parameters_within_25pct']} of {s['parameters_scored']}; "
-          f"held-out error halved: {s['errors_halved']} of {s['sets_with_cause']}; "
-          f"identify time {s['seconds']:.0f} s")
+    def mark(ok):
+        return "met" if ok else "missed"
+
+    n = max(s["sets_with_cause"], 1)
+    print(f"\nright cause: {s['right_causes']} of {s['sets_with_cause']} sets with a cause "
+          f"({100 * s['right_causes'] / n:.0f} %; target 90 %: {mark(s['right_causes'] >= TARGET_RIGHT * s['sets_with_cause'])})")
+    print(f"controls with nothing but speed decay: {s['clean_controls']} of {s['controls']} "
+          f"(target all: {mark(s['clean_controls'] == s['controls'])})")
+    print(f"false causes beside the right ones: {s['false_causes_on_sets_with_cause']}")
+    print(f"parameters within 25 %: {s['parameters_within_25pct']} of {s['parameters_scored']} "
+          f"(target all: {mark(s['parameters_within_25pct'] == s['parameters_scored'])})")
+    print(f"held-out weave eigenvalue or median-run roll error at least halved: {s['errors_halved']} of "
+          f"{s['sets_with_cause']} (target all: {mark(s['errors_halved'] == s['sets_with_cause'])})")
+    print(f"identify time: {s['seconds']:.0f} s in all")
     if args.json:
         with open(args.json, "w") as fh:
             json.dump({"summary": s, "sets": results, "seed_base": args.seed_base}, fh, indent=1)

@@ -313,6 +313,23 @@ pub fn run_plan<R: ModelRegistry>(
     )
     .expect("registered model")?;
     let values_after = effect_values(&id.after, &id.after.values, cands);
+    // A separating experiment is proposed only where the bicycle can do
+    // it: kicks at speeds where the identified model's weave is a stable
+    // oscillation (below the weave speed the bicycle falls before a weave
+    // can be fitted).
+    let mut id = id;
+    for step in &mut id.steps {
+        for c in &mut step.confounded {
+            let speeds: Vec<f64> = c.designs.iter().map(|d| d.speed).collect();
+            let weave = predict(driven, bike, &values_after, &speeds)?;
+            let mut k = 0;
+            c.designs.retain(|_| {
+                let stable = weave[k].is_some_and(|[re, im]| re < 0.0 && im > 0.0);
+                k += 1;
+                stable
+            });
+        }
+    }
     // Steer-rate amplitude of each segment, from the fitted simulation.
     let steer_rate: Vec<f64> = (0..segs.len())
         .map(|i| {

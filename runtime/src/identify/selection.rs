@@ -695,28 +695,12 @@ impl<'s> Search<'s> {
     /// prior: within [`PLAUSIBLE_PRIOR_SDS`] prior standard deviations of the
     /// measured value (a candidate without a prior, an effect, always is).
     fn plausible(&self, candidate: &Candidate, values: &[f64]) -> bool {
-        self.farthest_from_prior(&[candidate], values)
-            .is_none_or(|(_, _, sds)| sds <= PLAUSIBLE_PRIOR_SDS)
+        farthest_from_prior(self.stated, &[candidate], values).is_none_or(|(_, _, sds)| sds <= PLAUSIBLE_PRIOR_SDS)
     }
 
-    /// Of the fitted `values` of `members` (their parameters in order), the
-    /// one farthest from its stated prior: symbol, value and distance in
-    /// prior standard deviations (`None`: no parameter has a prior).
+    /// [`farthest_from_prior`] under the stated priors.
     fn farthest_from_prior(&self, members: &[&Candidate], values: &[f64]) -> Option<(String, f64, f64)> {
-        let mut out: Option<(String, f64, f64)> = None;
-        let params = members.iter().flat_map(|m| {
-            let stated = self.stated.iter().find(|c| c.name == m.name).unwrap_or(m);
-            stated.parameters.iter()
-        });
-        for (p, &v) in params.zip(values) {
-            if let Some((mean, sd)) = p.prior {
-                let d = ((v - mean) / sd).abs();
-                if out.as_ref().is_none_or(|o| d > o.2) {
-                    out = Some((p.symbol.clone(), v, d));
-                }
-            }
-        }
-        out
+        farthest_from_prior(self.stated, members, values)
     }
 }
 
@@ -779,6 +763,28 @@ fn first_passing<S, E>(
     Ok(None)
 }
 
+/// Of the fitted `values` of `members` (their parameters in order), the
+/// one farthest from its prior as `stated` declares it (the candidates'
+/// priors before they are put on the data's scale): symbol, value and
+/// distance in prior standard deviations (`None`: no parameter has a prior,
+/// e.g. an effect).
+fn farthest_from_prior(stated: &[Candidate], members: &[&Candidate], values: &[f64]) -> Option<(String, f64, f64)> {
+    let mut out: Option<(String, f64, f64)> = None;
+    let params = members.iter().flat_map(|m| {
+        let declared = stated.iter().find(|c| c.name == m.name).unwrap_or(m);
+        declared.parameters.iter()
+    });
+    for (p, &v) in params.zip(values) {
+        if let Some((mean, sd)) = p.prior {
+            let d = ((v - mean) / sd).abs();
+            if out.as_ref().is_none_or(|o| d > o.2) {
+                out = Some((p.symbol.clone(), v, d));
+            }
+        }
+    }
+    out
+}
+
 /// A correction further than this many prior standard deviations from its
 /// measured value is no plausible rival explanation (beyond three, a
 /// Gaussian prior gives it odds below 1 in 370).
@@ -815,6 +821,50 @@ pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> O
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn candidate(name: &str, symbol: &str, prior: Option<(f64, f64)>) -> Candidate {
+        Candidate {
+            name: name.into(),
+            effects: Vec::new(),
+            parameters: vec![super::super::EffectParameter {
+                symbol: symbol.into(),
+                tied: Vec::new(),
+                moves: Vec::new(),
+                scale: 0.1,
+                dissipative: false,
+                unit: String::new(),
+                initial: None,
+                lower: None,
+                prior,
+            }],
+            fixed: Vec::new(),
+            speed_decay: false,
+            reason: String::new(),
+            alternative_model: false,
+        }
+    }
+
+    #[test]
+    fn a_rival_correction_beyond_three_prior_deviations_is_implausible() {
+        let stated = vec![
+            candidate("correct I2x", "I2x", Some((0.0884, 0.00884))),
+            candidate("steer_damping", "c_steer", None),
+        ];
+        // The search fits with the priors on the data's scale (tighter);
+        // plausibility is judged under the stated ones.
+        let mut scaled = stated[0].clone();
+        scaled.parameters[0].prior = Some((0.0884, 0.001));
+        let (symbol, _, sds) = farthest_from_prior(&stated, &[&scaled], &[0.1633]).unwrap();
+        assert_eq!(symbol, "I2x");
+        assert!((sds - 8.47).abs() < 0.01 && sds > PLAUSIBLE_PRIOR_SDS, "{sds}");
+        let (_, _, near) = farthest_from_prior(&stated, &[&scaled], &[0.10]).unwrap();
+        assert!(near < PLAUSIBLE_PRIOR_SDS, "{near}");
+        // An effect has no prior: always plausible.
+        assert!(farthest_from_prior(&stated, &[&stated[1]], &[5.0]).is_none());
+        // A pair: the member farther from its prior counts.
+        let (symbol, _, _) = farthest_from_prior(&stated, &[&stated[1], &stated[0]], &[0.2, 0.2]).unwrap();
+        assert_eq!(symbol, "I2x");
+    }
 
     #[test]
     fn candidates_are_fitted_best_predicted_first_and_none_that_cannot_gain() {
