@@ -64,266 +64,20 @@ use serde::Serialize;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
+mod candidate;
 pub mod confounding;
+mod nuisance;
 mod screen;
+mod segment;
 pub mod selection;
+pub use candidate::{Candidate, EffectParameter};
 pub use confounding::{Confounding, Design, CONFOUNDED};
+use nuisance::nuisance_scale;
+pub use nuisance::{at_rest, EXTRA_STATES, INITIAL_MOTION, NUISANCE, STEER_BIAS};
+pub use segment::{RollChannel, Segment, Weights};
 pub use selection::{
     bic, folds_by_run, identify, paired_gain, Identification, Step, Trial, Verdict, PLAUSIBLE_PRIOR_SDS,
 };
-
-/// Room for the per-segment nuisance parameters, the state at the window
-/// start: the initial motion ([`INITIAL_MOTION`]: roll, steer (rad), roll
-/// rate, steer rate (rad/s), forward speed (m/s)), then, for a model with
-/// `e` extra first-order states (`M::STATES`, at most [`EXTRA_STATES`]: a
-/// tyre model's lagged lateral forces, N), their values (`e` entries) and
-/// their rates (`e` entries, N/s). A window starts just after a kick,
-/// while the forces still lag behind the slip the kick gave the wheels:
-/// neither is at rest, and the rates set the slip (the free lateral
-/// velocities are solved from them). A model without extra states leaves
-/// those entries at zero. The last entry ([`STEER_BIAS`]) is a sensor
-/// nuisance, not a state: the measured steer's offset over the window.
-pub const NUISANCE: usize = INITIAL_MOTION + 2 * EXTRA_STATES + 1;
-/// Where a kick's steer bias (rad) sits in its nuisances: the offset of the
-/// measured steer angle over the window, fitted per kick. A steer angle
-/// taken from two orientation sensors (frame and handlebar) inherits the
-/// difference of their heading references, which drift and carry errors of
-/// a degree or more that the calibration at rest cannot fix (each run's
-/// heading fusion settles anew), and an encoder's zero is set by hand; a
-/// mechanical candidate asked to explain such an offset would take up a
-/// sensor error (a few degrees of steer is what a lateral mass offset of
-/// centimetres gives). It is held at the same index in every model, so a
-/// fit's nuisances carry over between models with and without extra
-/// states.
-pub const STEER_BIAS: usize = NUISANCE - 1;
-/// Scale of the steer bias (rad).
-const STEER_BIAS_SCALE: f64 = 0.01;
-/// Number of initial-motion nuisances (roll, steer, their rates, speed).
-pub const INITIAL_MOTION: usize = 5;
-/// Most extra first-order states a model may have for identification.
-pub const EXTRA_STATES: usize = crate::simulate::MAX_STATE_RATES;
-/// Scales of the initial-motion nuisances (difference steps and LM scaling).
-const MOTION_SCALE: [f64; INITIAL_MOTION] = [0.01, 0.01, 0.1, 0.1, 0.1];
-/// Scales of an extra state (a tyre force, N) and of its rate (N/s).
-const STATE_SCALE: [f64; 2] = [10.0, 100.0];
-
-/// A window-start state from the initial motion, the extra states at rest.
-pub fn at_rest(motion: [f64; INITIAL_MOTION]) -> [f64; NUISANCE] {
-    let mut x = [0.0; NUISANCE];
-    x[..INITIAL_MOTION].copy_from_slice(&motion);
-    x
-}
-
-/// What the roll channel of a segment measures: the roll angle (the
-/// thesis's IMU orientation) or the roll rate (a gyro, as on the TU Delft
-/// steer-by-wire bicycle, whose roll angle is a filter's estimate).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum RollChannel {
-    /// Roll angle (rad).
-    Angle,
-    /// Roll rate (rad/s).
-    Rate,
-}
-
-impl RollChannel {
-    /// Name of the channel in reports.
-    pub fn describe(self) -> &'static str {
-        match self {
-            RollChannel::Angle => "roll",
-            RollChannel::Rate => "roll rate",
-        }
-    }
-    /// Unit of the channel in reports (degrees).
-    pub fn unit_deg(self) -> &'static str {
-        match self {
-            RollChannel::Angle => "deg",
-            RollChannel::Rate => "deg/s",
-        }
-    }
-}
-
-/// One measured free response.
-#[derive(Clone, Debug, Serialize)]
-pub struct Segment {
-    /// Run (path) the kick belongs to.
-    pub run: String,
-    /// Time of the window start on the IMU clock (s).
-    pub t0: f64,
-    /// Sample times from the window start (s).
-    pub t: Vec<f64>,
-    /// Measured roll channel, positive leaning right: the roll angle (rad)
-    /// or, for [`RollChannel::Rate`], the roll rate (rad/s).
-    pub roll: Vec<f64>,
-    /// What `roll` measures.
-    pub roll_channel: RollChannel,
-    /// Measured steer (rad, positive turning left).
-    pub steer: Vec<f64>,
-    /// Speed sample times from the window start (s).
-    pub speed_t: Vec<f64>,
-    /// Measured forward speed (m/s).
-    pub speed: Vec<f64>,
-    /// Initial state estimated from the data: roll, steer (rad), their rates
-    /// (rad/s), speed (m/s).
-    pub initial: [f64; NUISANCE],
-    /// Mean speed over the window (m/s) and its range.
-    pub mean_speed: f64,
-    pub speed_interval: [f64; 2],
-    /// Measured weave eigenvalue and its standard error (1/s), when fitted.
-    pub weave: Option<([f64; 2], [f64; 2])>,
-    /// Coefficient of determination of that eigenvalue fit.
-    pub weave_r2: Option<f64>,
-}
-
-impl Segment {
-    /// Build a segment from measured series on one clock; `t0` is the window
-    /// start. The initial roll, steer and rates come from a least-squares
-    /// line through the first `SLOPE_SPAN` seconds (a slope over a tenth of a
-    /// weave period averages the 120 Hz noise without bending the response).
-    #[allow(clippy::too_many_arguments)]
-    pub fn new(
-        run: String,
-        t0: f64,
-        t: Vec<f64>,
-        roll: Vec<f64>,
-        steer: Vec<f64>,
-        speed_t: Vec<f64>,
-        speed: Vec<f64>,
-        weave: Option<([f64; 2], [f64; 2])>,
-    ) -> Option<Segment> {
-        const SLOPE_SPAN: f64 = 0.06;
-        if t.len() < 12 || speed.is_empty() {
-            return None;
-        }
-        let line = |x: &[f64]| {
-            let k = t.iter().take_while(|&&s| s <= SLOPE_SPAN).count().max(4).min(t.len());
-            let (n, st, sx) = (k as f64, t[..k].iter().sum::<f64>(), x[..k].iter().sum::<f64>());
-            let stt: f64 = t[..k].iter().map(|a| a * a).sum();
-            let stx: f64 = t[..k].iter().zip(&x[..k]).map(|(a, b)| a * b).sum();
-            let slope = (n * stx - st * sx) / (n * stt - st * st);
-            ((sx - slope * st) / n, slope)
-        };
-        let (r0, dr0) = line(&roll);
-        let (s0, ds0) = line(&steer);
-        let v0 = speed[0];
-        let mean_speed = speed.iter().sum::<f64>() / speed.len() as f64;
-        let lo = speed.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = speed.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        let initial = at_rest([r0, s0, dr0, ds0, v0]);
-        if initial.iter().any(|x| !x.is_finite()) || !(v0 > 0.0) {
-            return None;
-        }
-        Some(Segment {
-            run,
-            t0,
-            t,
-            roll,
-            roll_channel: RollChannel::Angle,
-            steer,
-            speed_t,
-            speed,
-            initial,
-            mean_speed,
-            speed_interval: [lo, hi],
-            weave,
-            weave_r2: None,
-        })
-    }
-
-    /// A segment whose roll channel is a gyro's roll rate (rad/s): the
-    /// initial roll comes from `roll_angle` (a filter's estimate, used only
-    /// as the starting value of that nuisance), the initial roll rate from
-    /// the rate itself.
-    #[allow(clippy::too_many_arguments)]
-    pub fn with_roll_rate(
-        run: String,
-        t0: f64,
-        t: Vec<f64>,
-        roll_angle: Vec<f64>,
-        roll_rate: Vec<f64>,
-        steer: Vec<f64>,
-        speed_t: Vec<f64>,
-        speed: Vec<f64>,
-        weave: Option<([f64; 2], [f64; 2])>,
-    ) -> Option<Segment> {
-        let mut s = Segment::new(run, t0, t, roll_angle, steer, speed_t, speed, weave)?;
-        if roll_rate.len() != s.t.len() || roll_rate.iter().any(|x| !x.is_finite()) {
-            return None;
-        }
-        let k = s.t.iter().take_while(|&&x| x <= 0.06).count().clamp(1, s.t.len());
-        s.initial[2] = roll_rate[..k].iter().sum::<f64>() / k as f64;
-        s.roll = roll_rate;
-        s.roll_channel = RollChannel::Rate;
-        Some(s)
-    }
-
-    /// Window length (s).
-    pub fn duration(&self) -> f64 {
-        self.t
-            .last()
-            .copied()
-            .unwrap_or(0.0)
-            .max(self.speed_t.last().copied().unwrap_or(0.0))
-    }
-
-    fn len(&self) -> usize {
-        2 * self.t.len() + self.speed.len()
-    }
-}
-
-/// A fitted effect parameter.
-#[derive(Clone, Debug, Serialize)]
-pub struct EffectParameter {
-    /// Model parameter symbol.
-    pub symbol: String,
-    /// Other symbols set to the same value (e.g. front and rear rolling
-    /// resistance coefficients).
-    pub tied: Vec<String>,
-    /// Model parameters this one moves, when `symbol` is not one of the
-    /// model's own but a quantity of the bicycle file that the model holds
-    /// in several parameters (the front assembly's mass-centre height
-    /// `zH`: the steer-axis point, the front wheel centre from it and the
-    /// offset from the axis). Each `(model symbol, coefficient)` is
-    /// simulated at its base value plus the coefficient times this value's
-    /// change from `initial` (the tangent of the file's conversion to the
-    /// model's parameters). Empty: `symbol` and `tied` are model parameters
-    /// set to the value.
-    pub moves: Vec<(String, f64)>,
-    /// Typical magnitude (difference step and LM scaling).
-    pub scale: f64,
-    /// Physical only when positive (dissipation).
-    pub dissipative: bool,
-    /// Unit, for reports.
-    pub unit: String,
-    /// Starting value of the fit (default a tenth of the scale).
-    pub initial: Option<f64>,
-    /// Smallest value the model is simulated with (values below are held
-    /// there): for parameters the model is undefined or singular without,
-    /// such as a relaxation length.
-    pub lower: Option<f64>,
-    /// Gaussian prior `(mean, standard deviation)`: a measured parameter
-    /// corrected by identification moves only as far as the data demand
-    /// (the fit adds `((value - mean) / sd)^2` to its weighted sum).
-    pub prior: Option<(f64, f64)>,
-}
-
-/// A candidate effect (or a combination): the parameters fitted when it is
-/// added, and fixed parameters it needs (e.g. the air density).
-#[derive(Clone, Debug, Serialize)]
-pub struct Candidate {
-    pub name: String,
-    /// Effects of the library it switches on.
-    pub effects: Vec<String>,
-    pub parameters: Vec<EffectParameter>,
-    pub fixed: Vec<(String, f64)>,
-    /// A speed-decay effect (rolling resistance, drag).
-    pub speed_decay: bool,
-    /// Why this effect is suspected, from the residual pattern.
-    pub reason: String,
-    /// Simulated with the alternative model (e.g. the tyre model, which
-    /// replaces the no-slip constraints) instead of the base model.
-    pub alternative_model: bool,
-}
 
 /// Makes the fitting setup of one model (type-erased, so identification
 /// can switch models for a candidate without compiling every pair).
@@ -360,17 +114,6 @@ impl<M: MultibodyModel> ModelFactory for Factory<M> {
     ) -> Result<Setup<'a>, IdentifyError> {
         Setup::new::<M>(&self.base, segments, weights, active)
     }
-}
-
-/// Noise scales of the three channels.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct Weights {
-    /// Roll (rad).
-    pub roll: f64,
-    /// Steer (rad).
-    pub steer: f64,
-    /// Speed (m/s).
-    pub speed: f64,
 }
 
 /// Errors of identification.
@@ -509,19 +252,6 @@ fn initial_conditions(x0: &[f64; NUISANCE], extra: usize) -> InitialConditions {
         speed: x0[4],
         yaw: 0.0,
         state_rates,
-    }
-}
-
-/// The scale of nuisance `j` of a model with `extra` extra states.
-fn nuisance_scale(j: usize, extra: usize) -> f64 {
-    if j == STEER_BIAS {
-        STEER_BIAS_SCALE
-    } else if j < INITIAL_MOTION {
-        MOTION_SCALE[j]
-    } else if j < INITIAL_MOTION + extra {
-        STATE_SCALE[0]
-    } else {
-        STATE_SCALE[1]
     }
 }
 
@@ -1491,28 +1221,6 @@ mod tests {
         assert_eq!(interp(&ts, &xs, 0.5), 1.0);
         assert_eq!(interp(&ts, &xs, 5.0), 4.0);
         assert_eq!(interp(&ts, &xs, -1.0), 0.0);
-    }
-
-    #[test]
-    fn segment_initial_state_from_a_line_through_the_first_samples() {
-        let t: Vec<f64> = (0..120).map(|k| k as f64 / 120.0).collect();
-        let roll: Vec<f64> = t.iter().map(|&x| 0.02 + 0.3 * x).collect();
-        let steer: Vec<f64> = t.iter().map(|&x| -0.01 - 0.5 * x).collect();
-        let s = Segment::new(
-            "r".into(),
-            0.0,
-            t.clone(),
-            roll,
-            steer,
-            vec![0.0, 0.5],
-            vec![5.0, 4.9],
-            None,
-        )
-        .unwrap();
-        assert!((s.initial[0] - 0.02).abs() < 1e-12 && (s.initial[2] - 0.3).abs() < 1e-9);
-        assert!((s.initial[1] + 0.01).abs() < 1e-12 && (s.initial[3] + 0.5).abs() < 1e-9);
-        assert_eq!(s.initial[4], 5.0);
-        assert_eq!(s.speed_interval, [4.9, 5.0]);
     }
 
     #[test]
