@@ -19,7 +19,8 @@
 //! design whose correlation is well below the data's would tell the
 //! candidates apart.
 
-use super::{at_rest, Candidate, ModelFactory, Normal, Segment, SegmentJacobian, Setup, NUISANCE};
+use super::normal::{Normal, SegmentJacobian};
+use super::{at_rest, Candidate, ModelFactory, Segment, Setup, NUISANCE};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::Serialize;
