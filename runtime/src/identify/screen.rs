@@ -20,9 +20,10 @@
 //! candidates' parameters costs. Candidates simulated with another model
 //! (the tyre model) or not nested are not screened: they are fitted.
 
+use super::fit::{Free, Problem};
 use super::normal::{Normal, SegmentJacobian};
 use super::Candidate;
-use super::{bic, CandidateFit, Free, ModelFactory, Problem, Segment, SegmentError, Weights};
+use super::{bic, CandidateFit, ModelFactory, Segment, SegmentError, Weights};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeSet;
 use std::sync::atomic::Ordering;

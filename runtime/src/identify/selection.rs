@@ -24,6 +24,7 @@
 //! previous step's base plus the change it selected.
 
 use super::confounding::{self, Confounding};
+pub use super::cross_validation::{folds_by_run, paired_gain};
 use super::screen;
 use super::{
     cross_validate, fit_candidate, Candidate, CandidateFit, Factory, IdentifyError, IdentifyOptions, ModelFactory,
@@ -187,29 +188,6 @@ pub struct Identification {
     pub fold_of: Vec<usize>,
     /// Simulations run in all.
     pub simulations: usize,
-}
-
-/// The folds of the cross-validation: by run, so that a held-out error is
-/// that of runs (or logs, with many kicks each) the fit never saw; runs are
-/// dealt to `folds` folds in their order. With a single run the folds are
-/// by kick.
-pub fn folds_by_run(segments: &[Segment], folds: usize) -> (usize, Vec<usize>) {
-    let mut runs: Vec<&str> = Vec::new();
-    for s in segments {
-        if !runs.contains(&s.run.as_str()) {
-            runs.push(&s.run);
-        }
-    }
-    if runs.len() < 2 {
-        let folds = folds.clamp(2, segments.len().max(2));
-        return (folds, (0..segments.len()).map(|s| s % folds).collect());
-    }
-    let folds = folds.clamp(2, runs.len());
-    let fold_of = segments
-        .iter()
-        .map(|s| runs.iter().position(|r| *r == s.run).unwrap_or(0) % folds)
-        .collect();
-    (folds, fold_of)
 }
 
 /// The largest number of pairs fitted in a step whose single candidates all
@@ -789,34 +767,6 @@ fn farthest_from_prior(stated: &[Candidate], members: &[&Candidate], values: &[f
 /// measured value is no plausible rival explanation (beyond three, a
 /// Gaussian prior gives it odds below 1 in 370).
 pub const PLAUSIBLE_PRIOR_SDS: f64 = 3.0;
-
-/// Paired comparison of the held-out errors of two models, run by run:
-/// mean gain (weighted mean square, `base - candidate`) and its standard
-/// error. Selection asks the gain to exceed two standard errors, so an
-/// effect that improves the held-out error only on average over a few runs
-/// (an artefact of one run, noise) is not added.
-pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> Option<(f64, f64)> {
-    let mse = |e: &SegmentError, w: &Weights| {
-        let ss = e.channel_ss[0] / (w.roll * w.roll)
-            + e.channel_ss[1] / (w.steer * w.steer)
-            + e.channel_ss[2] / (w.speed * w.speed);
-        ss / (e.channel_n.iter().sum::<usize>().max(1) as f64)
-    };
-    let d: Vec<f64> = base
-        .held_out
-        .iter()
-        .zip(&cand.held_out)
-        .zip(w)
-        .map(|((a, b), w)| mse(a, w) - mse(b, w))
-        .collect();
-    let n = d.len() as f64;
-    if n < 2.0 {
-        return None;
-    }
-    let m = d.iter().sum::<f64>() / n;
-    let var = d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0);
-    Some((m, (var / n).sqrt()))
-}
 
 #[cfg(test)]
 mod tests {

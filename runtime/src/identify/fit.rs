@@ -1,0 +1,513 @@
+//! Fitting one candidate model: Levenberg-Marquardt over the effect
+//! parameters and every kick's nuisances together (a `Problem` says which
+//! are free), the residual statistics of each kick ([`SegmentError`]), the
+//! standard errors inflated for autocorrelated residuals, and the check that
+//! dissipative parameters stay positive. The held-out half of judging a fit
+//! is [`cross_validate`](super::cross_validate).
+
+use super::normal::{Normal, SegmentJacobian};
+use super::nuisance::nuisance_scale;
+use super::{bic, cross_validate, EffectParameter, IdentifyError, Segment, Setup, Weights, NUISANCE};
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::sync::atomic::Ordering;
+use std::sync::Mutex;
+
+/// Which parameters a fit frees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Free {
+    /// Effect parameters and every segment's initial state.
+    All,
+    /// Effect parameters only (initial states held).
+    Shared,
+    /// Initial states only (effect parameters held).
+    Nuisance,
+}
+
+/// One fit: the segments taking part, which parameters are free, and the
+/// current effect values and initial states.
+pub(super) struct Problem<'s, 'a> {
+    pub(super) setup: &'s Setup<'a>,
+    /// Segments taking part.
+    pub(super) segs: Vec<usize>,
+    pub(super) free: Free,
+    pub(super) g: Vec<f64>,
+    pub(super) x0: Vec<[f64; NUISANCE]>,
+    /// Last residuals per segment, for the Jacobian at the same point.
+    pub(super) cache: Mutex<Option<(Vec<f64>, Vec<Vec<f64>>)>>,
+}
+
+impl Problem<'_, '_> {
+    fn n_free(&self) -> usize {
+        match self.free {
+            Free::All => self.setup.k() + self.setup.nuisance() * self.segs.len(),
+            Free::Shared => self.setup.k(),
+            Free::Nuisance => self.setup.nuisance() * self.segs.len(),
+        }
+    }
+    fn pack(&self) -> Vec<f64> {
+        let mut x = Vec::with_capacity(self.n_free());
+        if self.free != Free::Nuisance {
+            x.extend(&self.g);
+        }
+        if self.free != Free::Shared {
+            for &s in &self.segs {
+                x.extend((0..self.setup.nuisance()).map(|j| self.x0[s][self.setup.nuisance_index(j)]));
+            }
+        }
+        x
+    }
+    fn unpack(&mut self, x: &[f64]) {
+        let mut i = 0;
+        if self.free != Free::Nuisance {
+            let k = self.setup.k();
+            self.g.copy_from_slice(&x[..k]);
+            i = k;
+        }
+        if self.free != Free::Shared {
+            for &s in &self.segs {
+                let nn = self.setup.nuisance();
+                for j in 0..nn {
+                    self.x0[s][self.setup.nuisance_index(j)] = x[i + j];
+                }
+                i += nn;
+            }
+        }
+    }
+    /// The parameters with a prior while they are free: `(column, sd)`.
+    fn prior_rows(&self) -> Vec<(usize, f64)> {
+        if self.free == Free::Nuisance {
+            return Vec::new();
+        }
+        self.setup
+            .parameters
+            .iter()
+            .enumerate()
+            .filter_map(|(j, p)| p.prior.map(|(_, sd)| (j, sd)))
+            .collect()
+    }
+    /// Residuals of the priors (after the data's).
+    fn prior_residuals(&self) -> Vec<f64> {
+        self.prior_rows()
+            .into_iter()
+            .map(|(j, sd)| {
+                let mean = self.setup.parameters[j].prior.map_or(0.0, |(m, _)| m);
+                (self.g[j] - mean) / sd
+            })
+            .collect()
+    }
+    pub(super) fn all_residuals(&self) -> Option<Vec<Vec<f64>>> {
+        let x = self.pack();
+        if let Some((cx, r)) = self.cache.lock().ok()?.as_ref() {
+            if *cx == x {
+                return Some(r.clone());
+            }
+        }
+        let r: Option<Vec<Vec<f64>>> = self
+            .segs
+            .par_iter()
+            .map(|&s| self.setup.residuals(&self.g, s, &self.x0[s]).ok())
+            .collect();
+        let r = r?;
+        *self.cache.lock().ok()? = Some((x, r.clone()));
+        Some(r)
+    }
+}
+
+impl Problem<'_, '_> {
+    /// Jacobian blocks at the current point, one per segment taking part:
+    /// by forward sensitivities (one simulation in dual numbers per
+    /// segment), else by forward differences (a column costs one
+    /// simulation of one segment).
+    pub(super) fn jacobian_blocks(&self) -> Option<Vec<SegmentJacobian>> {
+        let base = self.all_residuals()?;
+        let k = if self.free == Free::Nuisance { 0 } else { self.setup.k() };
+        let nn = if self.free == Free::Shared {
+            0
+        } else {
+            self.setup.nuisance()
+        };
+        let (shared, nuisance) = (k > 0, nn > 0);
+        let exact: Vec<Option<SegmentJacobian>> = self
+            .segs
+            .par_iter()
+            .zip(&base)
+            .map(|(&s, r)| {
+                self.setup
+                    .jacobian(&self.g, s, &self.x0[s], shared, nuisance)
+                    .filter(|j| j.a.nrows() == r.len() && j.b.nrows() == r.len())
+            })
+            .collect();
+        // Columns by differences where the sensitivities did not apply:
+        // (segment position, shared parameter or nuisance j).
+        let mut tasks = Vec::new();
+        for p in (0..self.segs.len()).filter(|&p| exact[p].is_none()) {
+            tasks.extend((0..k).map(|j| (p, false, j)));
+            tasks.extend((0..nn).map(|j| (p, true, j)));
+        }
+        let cols: Option<Vec<(usize, bool, usize, Vec<f64>)>> = tasks
+            .par_iter()
+            .map(|&(p, nuisance, j)| {
+                let s = self.segs[p];
+                let mut g = self.g.clone();
+                let mut x0 = self.x0[s];
+                let h = if nuisance {
+                    let at = self.setup.nuisance_index(j);
+                    let h = 1e-3 * nuisance_scale(at, self.setup.extra_states).max(x0[at].abs());
+                    x0[at] += h;
+                    h
+                } else {
+                    let h = 1e-3 * self.setup.parameters[j].scale.max(g[j].abs());
+                    g[j] += h;
+                    h
+                };
+                let r = self.setup.residuals(&g, s, &x0).ok()?;
+                Some((
+                    p,
+                    nuisance,
+                    j,
+                    r.iter().zip(&base[p]).map(|(a, b)| (a - b) / h).collect(),
+                ))
+            })
+            .collect();
+        let mut blocks: Vec<SegmentJacobian> = base
+            .iter()
+            .zip(exact)
+            .map(|(r, e)| {
+                e.unwrap_or_else(|| SegmentJacobian {
+                    a: DMatrix::zeros(r.len(), k),
+                    b: DMatrix::zeros(r.len(), nn),
+                })
+            })
+            .collect();
+        for (p, nuisance, j, d) in cols? {
+            let m = if nuisance { &mut blocks[p].b } else { &mut blocks[p].a };
+            m.column_mut(j).copy_from_slice(&d);
+        }
+        Some(blocks)
+    }
+
+    /// Scale of each free parameter in packed order (steps are measured
+    /// against it).
+    fn scales(&self) -> Vec<f64> {
+        let mut x = Vec::with_capacity(self.n_free());
+        if self.free != Free::Nuisance {
+            x.extend(self.setup.parameters.iter().map(|p| p.scale));
+        }
+        if self.free != Free::Shared {
+            for _ in &self.segs {
+                x.extend(
+                    (0..self.setup.nuisance())
+                        .map(|j| nuisance_scale(self.setup.nuisance_index(j), self.setup.extra_states)),
+                );
+            }
+        }
+        x
+    }
+}
+
+/// Residual statistics of one segment, unweighted.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct SegmentError {
+    /// RMS roll residual (rad).
+    pub roll_rms: f64,
+    /// RMS steer residual (rad).
+    pub steer_rms: f64,
+    /// RMS speed residual (m/s).
+    pub speed_rms: f64,
+    /// Lag-1 autocorrelation of the roll and steer residuals.
+    pub rho: f64,
+    #[serde(skip)]
+    pub channel_ss: [f64; 3],
+    #[serde(skip)]
+    pub channel_n: [usize; 3],
+}
+
+impl SegmentError {
+    pub(super) fn of(r: &[f64], seg: &Segment, w: Weights) -> SegmentError {
+        let n = seg.t.len();
+        let (roll, rest) = r.split_at(n);
+        let (steer, speed) = rest.split_at(n);
+        let ss = |x: &[f64], s: f64| x.iter().map(|a| (a * s) * (a * s)).sum::<f64>();
+        let channel_ss = [ss(roll, w.roll), ss(steer, w.steer), ss(speed, w.speed)];
+        let channel_n = [n, n, speed.len()];
+        let rms = |c: usize| (channel_ss[c] / channel_n[c].max(1) as f64).sqrt();
+        let lag1 = |x: &[f64]| {
+            let m = x.iter().sum::<f64>() / x.len().max(1) as f64;
+            let num: f64 = x.windows(2).map(|w| (w[0] - m) * (w[1] - m)).sum();
+            let den: f64 = x.iter().map(|a| (a - m) * (a - m)).sum();
+            if den > 0.0 {
+                (num / den).clamp(0.0, 0.999)
+            } else {
+                0.0
+            }
+        };
+        SegmentError {
+            roll_rms: rms(0),
+            steer_rms: rms(1),
+            speed_rms: rms(2),
+            rho: 0.5 * (lag1(roll) + lag1(steer)),
+            channel_ss,
+            channel_n,
+        }
+    }
+}
+
+/// Result of fitting one candidate model.
+#[derive(Clone, Debug, Serialize)]
+pub struct CandidateFit {
+    /// Effect names in the model (empty: the base model).
+    pub effects: Vec<String>,
+    pub parameters: Vec<EffectParameter>,
+    /// Fitted values and standard errors of the effect parameters.
+    pub values: Vec<f64>,
+    pub stderr: Vec<f64>,
+    /// Fitted initial state of each segment.
+    #[serde(skip)]
+    pub nuisance: Vec<[f64; NUISANCE]>,
+    /// Errors per segment at the fit.
+    pub errors: Vec<SegmentError>,
+    /// Errors per segment held out (cross-validation).
+    pub held_out: Vec<SegmentError>,
+    /// Effect values fitted without each fold (fold of each segment).
+    #[serde(skip)]
+    pub fold_values: Vec<Vec<f64>>,
+    /// Bayesian information criterion with effective sample sizes.
+    pub bic: f64,
+    /// Cross-validated weighted error (mean squared weighted residual).
+    pub cv: f64,
+    /// Weighted sum of squares at the fit.
+    pub chi2: f64,
+    /// Simulations run for this candidate.
+    pub simulations: usize,
+    /// Whether every dissipative parameter is positive.
+    pub physical: bool,
+}
+
+/// Options of identification.
+#[derive(Clone, Debug)]
+pub struct IdentifyOptions {
+    /// Folds of the cross-validation (by run, see [`folds_by_run`](super::folds_by_run)).
+    pub folds: usize,
+    /// Largest number of effects added.
+    pub max_effects: usize,
+    /// LM evaluation budget (patience) per fit.
+    pub patience: usize,
+}
+
+impl Default for IdentifyOptions {
+    fn default() -> Self {
+        IdentifyOptions {
+            folds: 4,
+            max_effects: 3,
+            patience: 4,
+        }
+    }
+}
+
+/// Levenberg-Marquardt on the block-arrow problem (see [`Normal`]):
+/// Marquardt's damping of the normal equations, the damping lowered after
+/// a step that lowers the cost and raised until one does. It stops when an
+/// accepted step changes the cost or the parameters (on their scales) by
+/// less than 1e-6 relative (the simulations are accurate to about 1e-8, and
+/// the parameters' uncertainty is far larger than what further iterations
+/// would change), or after `patience` times the parameters of one segment
+/// (plus one) residual evaluations.
+pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
+    const TOL: f64 = 1e-6;
+    let k = if p.free == Free::Nuisance { 0 } else { p.setup.k() };
+    if p.n_free() == 0 {
+        return p;
+    }
+    let cost = |p: &Problem<'_, '_>| -> Option<f64> {
+        let r = p.all_residuals()?;
+        let pr = p.prior_residuals();
+        Some(r.iter().flatten().chain(&pr).map(|x| x * x).sum::<f64>())
+    };
+    let Some(mut c) = cost(&p) else { return p };
+    let scales = p.scales();
+    let budget = patience.max(1) * (k + p.setup.nuisance() + 1) * 4;
+
+    let mut evals = 1;
+    let mut lambda = 1e-3;
+    'outer: while evals < budget {
+        let (Some(blocks), Some(res)) = (p.jacobian_blocks(), p.all_residuals()) else {
+            break;
+        };
+        let prior: Vec<(usize, f64, f64)> = p
+            .prior_rows()
+            .into_iter()
+            .zip(p.prior_residuals())
+            .map(|((j, sd), r)| (j, sd, r))
+            .collect();
+        let x = p.pack();
+        loop {
+            let step = Normal::new(&blocks, &res, &prior, k, lambda).and_then(|n| n.step());
+            let Some(dx) = step.filter(|d| d.iter().all(|v| v.is_finite())) else {
+                lambda *= 10.0;
+                if lambda > 1e12 {
+                    break 'outer;
+                }
+                continue;
+            };
+            let trial: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
+            p.unpack(&trial);
+            evals += 1;
+            match cost(&p) {
+                Some(ct) if ct < c => {
+                    let df = (c - ct) / c.max(f64::MIN_POSITIVE);
+                    let dn = dx.iter().zip(&scales).map(|(d, s)| (d / s).powi(2)).sum::<f64>().sqrt();
+                    let xn = x.iter().zip(&scales).map(|(v, s)| (v / s).powi(2)).sum::<f64>().sqrt();
+                    c = ct;
+                    lambda = (lambda / 3.0).max(1e-12);
+                    if df <= TOL || dn <= TOL * (xn + TOL) {
+                        break 'outer;
+                    }
+                    break;
+                }
+                _ => {
+                    p.unpack(&x);
+                    lambda *= 4.0;
+                    if lambda > 1e12 || evals >= budget {
+                        break 'outer;
+                    }
+                }
+            }
+        }
+    }
+    p
+}
+
+/// Fit a model with the setup's effect parameters free, starting from `g0`
+/// and the initial states `x0`, then cross-validate it. `fold_of[s]` is the
+/// fold of segment `s`.
+pub fn fit_candidate(
+    setup: &Setup<'_>,
+    effects: Vec<String>,
+    g0: &[f64],
+    x0: &[[f64; NUISANCE]],
+    fold_of: &[usize],
+    opts: &IdentifyOptions,
+    reference: Option<&CandidateFit>,
+) -> Result<CandidateFit, IdentifyError> {
+    let nseg = setup.segments.len();
+    if nseg == 0 {
+        return Err(IdentifyError::NoData);
+    }
+    let sims_before = setup.simulations.load(Ordering::Relaxed);
+    let all: Vec<usize> = (0..nseg).collect();
+    let problem = |segs: Vec<usize>, free: Free, g: Vec<f64>, x0: Vec<[f64; NUISANCE]>| Problem {
+        setup,
+        segs,
+        free,
+        g,
+        x0,
+        cache: Mutex::new(None),
+    };
+    // A fit where every segment's initial state moves: effect parameters
+    // and states together (the base model: states alone).
+    let free = if setup.k() == 0 { Free::Nuisance } else { Free::All };
+    let full = lm_fit(problem(all.clone(), free, g0.to_vec(), x0.to_vec()), opts.patience);
+    let simulations = || setup.simulations.load(Ordering::Relaxed) - sims_before;
+    let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
+        run: setup.segments[0].run.clone(),
+        message: "the fitted model does not simulate every segment".into(),
+    })?;
+    let errors: Vec<SegmentError> = res
+        .iter()
+        .zip(setup.segments)
+        .zip(&setup.weights)
+        .map(|((r, s), w)| SegmentError::of(r, s, *w))
+        .collect();
+    let chi2: f64 = res.iter().flatten().map(|x| x * x).sum();
+    // Values below a parameter's floor were simulated at the floor.
+    let g: Vec<f64> = full
+        .g
+        .iter()
+        .zip(&setup.parameters)
+        .map(|(&v, p)| p.lower.map_or(v, |lo| v.max(lo)))
+        .collect();
+    let nuisance = full.x0.clone();
+
+    // Standard errors of the effect parameters from the Jacobian at the
+    // fit: the shared block of (J^T J)^-1 is the inverse of the reduced
+    // matrix of the normal equations without damping.
+    let mut stderr = vec![f64::NAN; setup.k()];
+    if setup.k() > 0 {
+        if let (Some(blocks), Some(res)) = (full.jacobian_blocks(), full.all_residuals()) {
+            let n: usize = res.iter().map(Vec::len).sum::<usize>() + full.prior_rows().len();
+            let p = full.n_free() as f64;
+            let rho = errors.iter().map(|e| e.rho).sum::<f64>() / errors.len() as f64;
+            let s2 = chi2 / (n as f64 - p).max(1.0) * (1.0 + rho) / (1.0 - rho);
+            let prior: Vec<(usize, f64, f64)> = full.prior_rows().into_iter().map(|(j, sd)| (j, sd, 0.0)).collect();
+            if let Some(inv) = Normal::new(&blocks, &res, &prior, setup.k(), 0.0).and_then(|nm| nm.s.try_inverse()) {
+                for (i, s) in stderr.iter_mut().enumerate() {
+                    *s = (inv[(i, i)] * s2).sqrt();
+                }
+            }
+        }
+    }
+    let physical = setup
+        .parameters
+        .iter()
+        .zip(&full.g)
+        .all(|(p, v)| !p.dissipative || *v > p.lower.unwrap_or(0.0));
+    let mut fit = CandidateFit {
+        effects,
+        parameters: setup.parameters.clone(),
+        values: g.clone(),
+        stderr,
+        nuisance: nuisance.clone(),
+        errors,
+        held_out: vec![SegmentError::default(); nseg],
+        fold_values: Vec::new(),
+        bic: f64::NAN,
+        cv: f64::NAN,
+        chi2,
+        simulations: 0,
+        physical,
+    };
+    // Cross-validation is the costly half: a candidate is cross-validated
+    // apart ([`cross_validate`]), only when selection needs its held-out
+    // error (not when the information criterion or physics rejects it).
+    match reference {
+        Some(r) => fit.bic = bic(&fit, r),
+        None => cross_validate(setup, &mut fit, fold_of, opts),
+    }
+    fit.simulations = simulations();
+    Ok(fit)
+}
+
+/// Overall RMS of a channel over segments (rad or m/s).
+pub fn pooled_rms(errors: &[SegmentError], channel: usize) -> f64 {
+    let (ss, n) = errors.iter().fold((0.0, 0usize), |(a, b), e| {
+        (a + e.channel_ss[channel], b + e.channel_n[channel])
+    });
+    (ss / n.max(1) as f64).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn residual_statistics_unweight_and_count_channels() {
+        let t: Vec<f64> = (0..20).map(|k| k as f64 * 0.01).collect();
+        let z = vec![0.0; 20];
+        let s = Segment::new("r".into(), 0.0, t, z.clone(), z, vec![0.0], vec![5.0], None).unwrap();
+        let w = Weights {
+            roll: 0.1,
+            steer: 0.2,
+            speed: 0.5,
+        };
+        let mut r = vec![1.0; 20];
+        r.extend(vec![2.0; 20]);
+        r.push(4.0);
+        let e = SegmentError::of(&r, &s, w);
+        assert!((e.roll_rms - 0.1).abs() < 1e-12);
+        assert!((e.steer_rms - 0.4).abs() < 1e-12);
+        assert!((e.speed_rms - 2.0).abs() < 1e-12);
+        assert_eq!(e.channel_n, [20, 20, 1]);
+    }
+}
