@@ -4,33 +4,33 @@
 //!
 //! # Method
 //!
-//! * **Data.** Each kick of a measured set gives a [`Segment`]: roll and steer
-//!   (rad) on the IMU clock and the reed-switch speed (m/s) over the kick's
-//!   free-response window (found by `experiment`, never by hand).
-//! * **Time-series residuals.** A candidate model is the free-speed model `M`
-//!   (every effect of the library, each absent unless fitted) with some effect
-//!   parameters free. Each segment is simulated with the full nonlinear
-//!   equations from its own initial state (roll, steer, their rates and the
-//!   speed at the window start). The residual is measured minus simulated
-//!   roll, steer and speed at the measurement times, each channel divided by
-//!   its noise scale ([`Weights`]).
-//! * **Fitting.** Effect parameters are shared by all segments; the initial
-//!   states are per-segment nuisance parameters. Both are fitted together by
-//!   Levenberg-Marquardt on the block-arrow structure of the problem (a
-//!   segment depends only on the shared parameters and its own initial
-//!   state): the normal equations are reduced to the shared parameters by
-//!   eliminating each segment's 5x5 block, so an iteration costs linearly in
-//!   the number of kicks (a dense solver's QR grows with their cube, and a
-//!   hundred kicks of the TU Delft logs took minutes per iteration; the
-//!   `levenberg-marquardt` crate has no sparse path). The Jacobian comes
+//! * **Data** (`segment.rs`). Each kick of a measured set gives a [`Segment`]:
+//!   roll and steer (rad) on the IMU clock and the reed-switch speed (m/s) over
+//!   the kick's free-response window (found by `experiment`, never by hand).
+//! * **Time-series residuals** (`residuals.rs`). A candidate model is the
+//!   free-speed model `M` (every effect of the library, each absent unless
+//!   fitted) with some effect parameters free (`candidate.rs`). Each segment is
+//!   simulated with the full nonlinear equations from its own initial state
+//!   (roll, steer, their rates and the speed at the window start). The residual
+//!   is measured minus simulated roll, steer and speed at the measurement
+//!   times, each channel divided by its noise scale ([`Weights`]).
+//! * **Fitting** (`fit.rs`). Effect parameters are shared by all segments; the
+//!   initial states are per-segment nuisance parameters (`nuisance.rs`). Both
+//!   are fitted together by Levenberg-Marquardt on the block-arrow structure of
+//!   the problem (`normal.rs`: a segment depends only on the shared parameters
+//!   and its own initial state): the normal equations are reduced to the shared
+//!   parameters by eliminating each segment's 5x5 block, so an iteration costs
+//!   linearly in the number of kicks (a dense solver's QR grows with their
+//!   cube, and a hundred kicks of the TU Delft logs took minutes per iteration;
+//!   the `levenberg-marquardt` crate has no sparse path). The Jacobian comes
 //!   from forward sensitivities (`simulate::sensitivity`): each segment is
-//!   simulated once in dual numbers carrying the derivatives along its
-//!   initial state and the effect parameters (in passes of [`WIDTH`]
-//!   directions), exact to the integration tolerance (rtol 1e-8); forward
-//!   differences of whole simulations (a column per simulation) remain
-//!   only where the explicit integrator fails (a stiff candidate, simulated
-//!   with Radau5). Residuals alone take the lean path of the same module
-//!   (channel samples only). Segments run in parallel.
+//!   simulated once in dual numbers carrying the derivatives along its initial
+//!   state and the effect parameters (in passes of `WIDTH` directions of
+//!   `residuals.rs`), exact to the integration tolerance (rtol 1e-8); forward
+//!   differences of whole simulations (a column per simulation) remain only
+//!   where the explicit integrator fails (a stiff candidate, simulated with
+//!   Radau5). Residuals alone take the lean path of the same module (channel
+//!   samples only). Segments run in parallel.
 //! * **Roll channel and speed.** Thesis-style runs measure the roll angle
 //!   and leave the speed free after the release; a log of a gyro-equipped
 //!   bicycle whose motor holds the speed (the TU Delft logs) measures the
@@ -40,19 +40,20 @@
 //!   the residual variance, inflated by `(1 + rho) / (1 - rho)` for the lag-1
 //!   autocorrelation `rho` of the residuals: 120 Hz samples of a smooth
 //!   model error are not independent.
-//! * **Selection** ([`selection`]). Forward stepwise: a candidate is added
-//!   only if it lowers the Bayesian information criterion computed with the
+//! * **Selection** ([`selection`]). Forward stepwise: a candidate is added only
+//!   if it lowers the Bayesian information criterion computed with the
 //!   effective sample size (`n (1 - rho) / (1 + rho)` per channel, from the
 //!   base model's residuals) *and* lowers the cross-validated error over
-//!   held-out runs (k-fold by run or log, the effect fitted on the other
-//!   runs and only the held-out run's initial state fitted to it), *and*
-//!   its dissipative parameters are positive (a negative damper is not
-//!   physics). The score test ([`screen`]: one simulation per kick in dual
-//!   numbers linearises every candidate at once) orders the candidates and
-//!   skips those that cannot lower the criterion; when the best fails, the
-//!   next is tried, and pairs when no single candidate passes. Sensor
-//!   nuisances (mounting misalignment, clock offset) are estimated per set by
-//!   the measured-run pipeline before, and are never candidates.
+//!   held-out runs (k-fold by run or log, the effect fitted on the other runs
+//!   and only the held-out run's initial state fitted to it:
+//!   `cross_validation.rs`), *and* its dissipative parameters are positive (a
+//!   negative damper is not physics). The score test ([`screen`]: one
+//!   simulation per kick in dual numbers linearises every candidate at once)
+//!   orders the candidates and skips those that cannot lower the criterion;
+//!   when the best fails, the next is tried, and pairs when no single candidate
+//!   passes. Sensor nuisances (mounting misalignment, clock offset) are
+//!   estimated per set by the measured-run pipeline before, and are never
+//!   candidates.
 
 mod candidate;
 pub mod confounding;
