@@ -461,7 +461,7 @@ pub fn verdict_text(v: &Verdict) -> String {
             "not fitted: linearised at the current fit (score test), its best BIC change is {predicted_bic_change:+.1}, no gain"
         ),
         Verdict::BehindAdded { predicted_bic_change, added } => format!(
-            "not fitted: predicted BIC change {predicted_bic_change:+.1}, and {added}, predicted to gain more, passed first (tried again in the next step)"
+            "not fitted: predicted BIC change {predicted_bic_change:+.1}; the step added {added} before reaching it (tried again in the next step)"
         ),
         Verdict::CriterionAboveAdded { bic_change, added } => {
             format!("not added: BIC {bic_change:+.1}, above that of {added} (not cross-validated)")

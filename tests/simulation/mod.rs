@@ -585,28 +585,37 @@ fn stiff_tyres_approach_the_no_slip_kick_response() {
 /// speed `S = sqrt(|v_c|^2 + 0.05^2)`, and the tyre force rate has slope
 /// `-S / sigma` in the force.
 fn tyre_loads(param: &[f64], p: &[f64], dp: &[f64]) -> [f64; 2] {
+    use bikedyn::runtime::model::CoordinateRole;
     type T = bikedyn::generated::TyreFree;
     let nq = T::nq();
-    let np = T::PARAMETERS.len();
     let mut q = param.to_vec();
     let mut loads = [0.0; 2];
-    for (i, w) in ["rear", "front"].iter().enumerate() {
+    for (i, (w, role, radius)) in [
+        ("rear", CoordinateRole::RearWheelRotation, "Rt"),
+        ("front", CoordinateRole::FrontWheelRotation, "Rd"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        // The rolling-resistance moment `-Crr N R w / sqrt(w^2 + w0^2)`
+        // about the axle, `w` the wheel's spin: its generalized force on
+        // the wheel's rotation coordinate is the moment itself (the spin
+        // moves one for one with that rate), and its power is the moment
+        // times `w`. With Crr = 1 the two give `w`, then `N`.
         q[T::parameter_index(&format!("Crr_{w}")).unwrap()] = 1.0;
         let f = T::FORCES
             .iter()
             .position(|f| f.name == format!("rolling_resistance_{w}"))
             .unwrap();
+        let rotation = T::COORDINATE_ROLES.iter().find(|(r, _)| *r == role).unwrap().1;
         let mut terms = vec![0.0; T::FORCES.len() * nq];
         T::applied_force_terms(&q, 0.0, p, dp, &mut terms);
         let power: f64 = (0..nq).map(|j| terms[f * nq + j] * dp[j]).sum();
-        let mut rates = [[0.0; 2]; 2];
-        for (s, force) in [0.0, 1.0].iter().enumerate() {
-            q[np + i] = *force;
-            T::state_rates(&q, 0.0, p, dp, &mut rates[s]);
-        }
-        let sigma = param[T::parameter_index(&format!("sigma_{w}")).unwrap()];
-        let speed = -(rates[1][i] - rates[0][i]) * sigma;
-        loads[i] = -power * speed / (speed * speed - 0.05 * 0.05);
+        let moment = terms[f * nq + rotation];
+        let spin = power / moment;
+        let r = param[T::parameter_index(radius).unwrap()];
+        let w0 = 0.05 / r;
+        loads[i] = -moment * (spin * spin + w0 * w0).sqrt() / (r * spin);
     }
     loads
 }

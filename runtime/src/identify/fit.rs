@@ -290,7 +290,8 @@ pub struct CandidateFit {
 pub struct IdentifyOptions {
     /// Folds of the cross-validation (by run, see [`folds_by_run`](super::folds_by_run)).
     pub folds: usize,
-    /// Largest number of effects added.
+    /// Largest number of effects and corrections added beside the speed
+    /// loss (rolling resistance and drag, which do not count).
     pub max_effects: usize,
     /// LM evaluation budget (patience) per fit.
     pub patience: usize,

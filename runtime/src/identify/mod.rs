@@ -19,7 +19,7 @@
 //!   are fitted together by Levenberg-Marquardt on the block-arrow structure of
 //!   the problem (`normal.rs`: a segment depends only on the shared parameters
 //!   and its own initial state): the normal equations are reduced to the shared
-//!   parameters by eliminating each segment's 5x5 block, so an iteration costs
+//!   parameters by eliminating each segment's 6x6 block (10x10 with the tyre model), so an iteration costs
 //!   linearly in the number of kicks (a dense solver's QR grows with their
 //!   cube, and a hundred kicks of the TU Delft logs took minutes per iteration;
 //!   the `levenberg-marquardt` crate has no sparse path). The Jacobian comes

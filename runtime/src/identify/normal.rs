@@ -19,7 +19,7 @@ pub(super) struct SegmentJacobian {
 
 /// The normal equations of the block-arrow least-squares problem, reduced
 /// to the shared parameters. With `J = [A_i B_i]` per segment, `J^T J` has a
-/// shared block `sum A_i^T A_i` (plus the priors), a 5x5 block `B_i^T B_i`
+/// shared block `sum A_i^T A_i` (plus the priors), a 6x6 block `B_i^T B_i` (10x10 with the tyre model)
 /// per segment, and couplings `A_i^T B_i`; eliminating each segment's block
 /// (Schur complement) leaves a k x k system. Its cost grows linearly with
 /// the number of kicks, where a dense QR of `J` grows with their cube (a

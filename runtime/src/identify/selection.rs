@@ -16,7 +16,8 @@
 //! linearised fit beats each member's alone are fitted and validated the
 //! same way (a damper and an inertia error may each explain only part of
 //! a misfit). The search ends when a step adds nothing, or after
-//! [`IdentifyOptions::max_effects`] additions.
+//! [`IdentifyOptions::max_effects`] additions beside the speed loss, which
+//! is modelled first (rolling resistance and drag, in steps of their own).
 //!
 //! The criterion of every fit, at every step, is computed with the
 //! effective sample sizes of the base model's residuals (one reference for
@@ -97,7 +98,8 @@ pub enum Verdict {
     /// The score test's linearised fit does not lower the criterion: it
     /// cannot win this step (not fitted).
     NoPredictedGain { predicted_bic_change: f64 },
-    /// Not fitted: a candidate predicted to gain more passed first.
+    /// Not fitted: the step added another candidate before reaching it in
+    /// the order of the search (a contender, or one predicted to gain more).
     BehindAdded { predicted_bic_change: f64, added: String },
     /// Fitted, with a criterion above the added candidate's: not
     /// cross-validated.
@@ -271,24 +273,35 @@ pub fn identify<M: MultibodyModel>(
     let mut current = before.clone();
     let mut selected: Vec<&Candidate> = Vec::new();
     let mut steps: Vec<Step> = Vec::new();
-    while selected.len() < opts.max_effects {
-        let remaining: Vec<&Candidate> = scaled
-            .iter()
-            .filter(|c| !selected.iter().any(|s| s.name == c.name))
-            .filter(|c| !c.alternative_model || alternative.is_some())
-            .collect();
-        if remaining.is_empty() {
-            break;
+    // Two phases: the speed loss first (rolling resistance, drag: they
+    // move the speed channel and hardly the lateral motion), then every
+    // candidate. Modelling the speed loss first keeps a lateral candidate
+    // from being chosen for what it takes up of a missing speed loss, and
+    // the speed-decay effects do not count against `max_effects` (every
+    // measured run slows, so they would otherwise take the places of the
+    // effects the search is for).
+    let lateral = |selected: &[&Candidate]| selected.iter().filter(|c| !c.speed_decay).count();
+    for speed_phase in [true, false] {
+        while lateral(&selected) < opts.max_effects {
+            let remaining: Vec<&Candidate> = scaled
+                .iter()
+                .filter(|c| !selected.iter().any(|s| s.name == c.name))
+                .filter(|c| !c.alternative_model || alternative.is_some())
+                .filter(|c| !speed_phase || c.speed_decay)
+                .collect();
+            if remaining.is_empty() {
+                break;
+            }
+            let (step, fit, sims) = search.step(&current, &selected, &remaining)?;
+            simulations += sims;
+            let added = step.added.clone();
+            steps.push(step);
+            let Some(fit) = fit else { break };
+            for name in &added {
+                selected.push(scaled.iter().find(|c| &c.name == name).expect("added candidate"));
+            }
+            current = fit;
         }
-        let (step, fit, sims) = search.step(&current, &selected, &remaining)?;
-        simulations += sims;
-        let added = step.added.clone();
-        steps.push(step);
-        let Some(fit) = fit else { break };
-        for name in &added {
-            selected.push(scaled.iter().find(|c| &c.name == name).expect("added candidate"));
-        }
-        current = fit;
     }
     Ok(Identification {
         weights,
@@ -413,7 +426,10 @@ impl<'s> Search<'s> {
         if winner.is_none() {
             let mut pairs = screened.pairs.clone();
             pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
-            for ((a, b), p) in pairs.into_iter().filter(|(_, p)| *p < reference_bic).take(MAX_PAIRS) {
+            pairs.retain(|(_, p)| *p < reference_bic);
+            pairs.truncate(MAX_PAIRS);
+            let count = pairs.len();
+            for (n, ((a, b), p)) in pairs.into_iter().enumerate() {
                 let mut pair = Pending {
                     members: vec![remaining[a], remaining[b]],
                     predicted: change(Some(p)),
@@ -421,6 +437,7 @@ impl<'s> Search<'s> {
                     verdict: None,
                 };
                 self.fit(&mut pair, current, selected, base_bic)?;
+                (self.progress)(&format!("fitted pair {}", pair.name()), Some((n + 1, count)));
                 pending.push(pair);
                 winner = self.validate(&mut pending, current)?;
                 if winner.is_some() {
@@ -566,13 +583,16 @@ impl<'s> Search<'s> {
             let bic = |i: usize| pending[i].fit.as_ref().map_or(f64::INFINITY, |f| f.0.bic);
             bic(a).total_cmp(&bic(b))
         });
-        for i in order {
+        let total = order.len();
+        for (done, i) in order.into_iter().enumerate() {
             let name = pending[i].name();
             let Some((fit, setup)) = pending[i].fit.as_mut() else {
                 continue;
             };
             cross_validate(setup, fit, self.fold_of, self.opts);
-            (self.progress)(&format!("cross-validated {name}"), None);
+            // At most the fitted candidates waiting for it: the first that
+            // passes ends the stage.
+            (self.progress)(&format!("cross-validated {name}"), Some((done + 1, total)));
             let verdict = if !(fit.cv < current.cv) {
                 Verdict::HeldOutNotLower {
                     cv: fit.cv,
