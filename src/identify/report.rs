@@ -463,6 +463,9 @@ pub fn verdict_text(v: &Verdict) -> String {
         Verdict::BehindAdded { predicted_bic_change, added } => format!(
             "not fitted: predicted BIC change {predicted_bic_change:+.1}; the step added {added} before reaching it (tried again in the next step)"
         ),
+        Verdict::BeyondBudget { predicted_bic_change, budget } => format!(
+            "not fitted: predicted BIC change {predicted_bic_change:+.1}; the step had fitted its budget of {budget} candidates before reaching it (a compute limit, not a verdict)"
+        ),
         Verdict::CriterionAboveAdded { bic_change, added } => {
             format!("not added: BIC {bic_change:+.1}, above that of {added} (not cross-validated)")
         }

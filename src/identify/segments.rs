@@ -79,7 +79,8 @@ pub fn segments(out: &FitOutcome) -> Segments {
                 speed_idx.iter().map(|&i| sp.t[i] + offset - w0).collect(),
                 speed_idx.iter().map(|&i| sp.v[i]).collect(),
                 weave,
-            );
+            )
+            .map(Segment::with_steer_bias);
             keep(seg, 0.5, r, k, [w0, w1], &mut segs);
         }
         if r.kicks.is_empty() {

@@ -295,6 +295,12 @@ pub struct IdentifyOptions {
     pub max_effects: usize,
     /// LM evaluation budget (patience) per fit.
     pub patience: usize,
+    /// Most candidates a step fits beyond its contenders (those the score
+    /// test ranks close to the best, always fitted), in the order of their
+    /// predicted gain: a compute budget (a fit of a hundred TU Delft kicks
+    /// takes tens of seconds), never a verdict; the report lists the
+    /// candidates it left unfitted.
+    pub max_fits_per_step: usize,
 }
 
 impl Default for IdentifyOptions {
@@ -303,6 +309,7 @@ impl Default for IdentifyOptions {
             folds: 4,
             max_effects: 3,
             patience: 4,
+            max_fits_per_step: 8,
         }
     }
 }

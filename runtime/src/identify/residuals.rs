@@ -72,6 +72,8 @@ pub struct Setup<'a> {
     /// Number of the model's extra first-order states (each kick's window
     /// start fits their values and rates beside its motion).
     pub(super) extra_states: usize,
+    /// The segments' steer bias is a nuisance ([`Segment::steer_bias`]).
+    pub(super) steer_bias: bool,
     /// Number of the model's parameters (the extra states' initial values
     /// follow them in a simulation's parameter vector).
     model_parameters: usize,
@@ -333,6 +335,7 @@ impl<'a> Setup<'a> {
             simulate: simulate_segment::<M>,
             sensitivities: segment_sensitivities::<M>,
             extra_states: M::STATES.len(),
+            steer_bias: segments.iter().any(|s| s.steer_bias),
             model_parameters: M::PARAMETERS.len(),
             simulations: AtomicUsize::new(0),
         })
@@ -341,7 +344,7 @@ impl<'a> Setup<'a> {
     /// Nuisances per segment: the initial motion, the model's extra states
     /// and their rates, and the steer bias.
     pub(super) fn nuisance(&self) -> usize {
-        INITIAL_MOTION + 2 * self.extra_states + 1
+        INITIAL_MOTION + 2 * self.extra_states + self.steer_bias as usize
     }
 
     /// Where the segment's nuisances sit in a `[f64; NUISANCE]`, in the
@@ -441,7 +444,7 @@ impl<'a> Setup<'a> {
         let opts = self.sensitivity_options();
         // The steer bias is no simulation direction: its column is set
         // below.
-        let simulated = k + nn.saturating_sub(1);
+        let simulated = k + nn - (nuisance && self.steer_bias) as usize;
         let (_, columns) = (self.sensitivities)(&self.param(g), seg, x0, &opts, &dirs, simulated)?;
         let w = self.weights[i];
         let (nr, ns) = (seg.roll.len(), seg.steer.len());
@@ -461,10 +464,10 @@ impl<'a> Setup<'a> {
         for d in 0..k {
             a.set_column(d, &column(d));
         }
-        for d in 0..nn.saturating_sub(1) {
+        for d in 0..simulated - k {
             b.set_column(d, &column(k + d));
         }
-        if nuisance {
+        if nuisance && self.steer_bias {
             // d r / d bias = -1 / w_steer on the steer rows.
             let mut bias = DVector::zeros(rows);
             for r in nr..(nr + ns).min(rows) {

@@ -66,6 +66,11 @@ pub struct Segment {
     pub weave: Option<([f64; 2], [f64; 2])>,
     /// Coefficient of determination of that eigenvalue fit.
     pub weave_r2: Option<f64>,
+    /// The steer angle comes from two orientation sensors (frame and
+    /// handlebar), whose heading references differ run by run: its bias
+    /// over the window is a nuisance of the kick ([`super::STEER_BIAS`]).
+    /// An encoder's steer (the TU Delft logs) has none.
+    pub steer_bias: bool,
 }
 
 impl Segment {
@@ -120,6 +125,7 @@ impl Segment {
             speed_interval: [lo, hi],
             weave,
             weave_r2: None,
+            steer_bias: false,
         })
     }
 
@@ -148,6 +154,13 @@ impl Segment {
         s.roll = roll_rate;
         s.roll_channel = RollChannel::Rate;
         Some(s)
+    }
+
+    /// The same segment with its steer's bias fitted per kick (a steer
+    /// angle from two orientation sensors).
+    pub fn with_steer_bias(mut self) -> Segment {
+        self.steer_bias = true;
+        self
     }
 
     /// Window length (s).

@@ -101,6 +101,9 @@ pub enum Verdict {
     /// Not fitted: the step added another candidate before reaching it in
     /// the order of the search (a contender, or one predicted to gain more).
     BehindAdded { predicted_bic_change: f64, added: String },
+    /// Not fitted: the step had fitted its budget of candidates
+    /// ([`super::IdentifyOptions::max_fits_per_step`]) before reaching it.
+    BeyondBudget { predicted_bic_change: f64, budget: usize },
     /// Fitted, with a criterion above the added candidate's: not
     /// cross-validated.
     CriterionAboveAdded { bic_change: f64, added: String },
@@ -404,7 +407,17 @@ impl<'s> Search<'s> {
                 }
             })
             .collect();
-        let plan = SearchOrder::of(&predicted);
+        let mut plan = SearchOrder::of(&predicted);
+        // The compute budget: the contenders, then at most
+        // `max_fits_per_step` more, in the order of the search.
+        let budget = plan.contenders.max(self.opts.max_fits_per_step);
+        for &i in plan.order.iter().skip(budget) {
+            pending[i].verdict = Some(Verdict::BeyondBudget {
+                predicted_bic_change: pending[i].predicted.unwrap_or(f64::NAN),
+                budget,
+            });
+        }
+        plan.order.truncate(budget);
         let mut fitted = 0;
         let mut winner = first_passing(
             &mut pending,
