@@ -57,6 +57,7 @@
 
 mod candidate;
 pub mod confounding;
+mod criterion;
 mod cross_validation;
 mod fit;
 mod normal;

@@ -25,6 +25,8 @@
 //! previous step's base plus the change it selected.
 
 use super::confounding::{self, Confounding};
+pub use super::criterion::{bic, PLAUSIBLE_PRIOR_SDS};
+use super::criterion::{farthest_from_prior, with_priors_on_the_data_scale};
 pub use super::cross_validation::{folds_by_run, paired_gain};
 use super::screen;
 use super::{
@@ -34,57 +36,6 @@ use super::{
 use crate::model::MultibodyModel;
 use serde::Serialize;
 use std::sync::atomic::Ordering;
-
-/// The candidates with their priors put on the scale of the weighted data.
-/// The weighted sum of squares counts every sample as independent with
-/// variance one, but the residuals of a smooth response are strongly
-/// autocorrelated and their level is not the weight: the information the
-/// data carry is that sum divided by `s2 = chi2 / n (1 + rho) / (1 - rho)`
-/// (the inflation the standard errors use). A prior `sd` is therefore
-/// applied as `sd / sqrt(s2)`, measured on the base model's fit, never
-/// weaker than as stated; without this a correction would move several
-/// prior deviations for a small gain in a sum that overstates the data.
-fn with_priors_on_the_data_scale(candidates: &[Candidate], base: &CandidateFit) -> Vec<Candidate> {
-    let n: usize = base.errors.iter().flat_map(|e| e.channel_n).sum();
-    let rho = base.errors.iter().map(|e| e.rho).sum::<f64>() / base.errors.len().max(1) as f64;
-    let s2 = base.chi2 / n.max(1) as f64 * (1.0 + rho) / (1.0 - rho);
-    let scale = if s2.is_finite() { s2.max(1.0).sqrt() } else { 1.0 };
-    candidates
-        .iter()
-        .map(|c| {
-            let mut c = c.clone();
-            for p in &mut c.parameters {
-                p.prior = p.prior.map(|(mean, sd)| (mean, sd / scale));
-            }
-            c
-        })
-        .collect()
-}
-
-/// Bayesian information criterion of `fit` with the effective sample size
-/// of each channel taken from `reference` (the base model of the search):
-/// the profile likelihood of Gaussian residuals with one unknown variance
-/// per channel of each segment (a run that the model follows badly, e.g.
-/// one that diverges toward a fall, then counts by the log of its misfit
-/// and cannot outweigh the others): `sum n_eff ln(SS / n) + k ln(n_eff)`.
-pub fn bic(fit: &CandidateFit, reference: &CandidateFit) -> f64 {
-    let mut total = 0.0;
-    let mut n_eff_all = 0.0;
-    for (e, r) in fit.errors.iter().zip(&reference.errors) {
-        for c in 0..3 {
-            let n = e.channel_n[c];
-            if n == 0 || !(e.channel_ss[c] > 0.0) {
-                continue;
-            }
-            // Speed samples are sparse (one per magnet): about independent.
-            let rho = if c == 2 { 0.0 } else { r.rho };
-            let n_eff = n as f64 * (1.0 - rho) / (1.0 + rho);
-            total += n_eff * (e.channel_ss[c] / n as f64).ln();
-            n_eff_all += n_eff;
-        }
-    }
-    total + fit.values.len() as f64 * n_eff_all.max(1.0).ln()
-}
 
 /// Why a candidate of a step was or was not added, with the numbers behind
 /// it. Changes of the criterion are against the step's base model
@@ -774,157 +725,6 @@ fn first_passing<S, E>(
     Ok(None)
 }
 
-/// Of the fitted `values` of `members` (their parameters in order), the
-/// one farthest from its prior as `stated` declares it (the candidates'
-/// priors before they are put on the data's scale): symbol, value and
-/// distance in prior standard deviations (`None`: no parameter has a prior,
-/// e.g. an effect).
-fn farthest_from_prior(stated: &[Candidate], members: &[&Candidate], values: &[f64]) -> Option<(String, f64, f64)> {
-    let mut out: Option<(String, f64, f64)> = None;
-    let params = members.iter().flat_map(|m| {
-        let declared = stated.iter().find(|c| c.name == m.name).unwrap_or(m);
-        declared.parameters.iter()
-    });
-    for (p, &v) in params.zip(values) {
-        if let Some((mean, sd)) = p.prior {
-            let d = ((v - mean) / sd).abs();
-            if out.as_ref().is_none_or(|o| d > o.2) {
-                out = Some((p.symbol.clone(), v, d));
-            }
-        }
-    }
-    out
-}
-
-/// A correction further than this many prior standard deviations from its
-/// measured value is no plausible rival explanation (beyond three, a
-/// Gaussian prior gives it odds below 1 in 370).
-pub const PLAUSIBLE_PRIOR_SDS: f64 = 3.0;
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn candidate(name: &str, symbol: &str, prior: Option<(f64, f64)>) -> Candidate {
-        Candidate {
-            name: name.into(),
-            effects: Vec::new(),
-            parameters: vec![super::super::EffectParameter {
-                symbol: symbol.into(),
-                tied: Vec::new(),
-                moves: Vec::new(),
-                scale: 0.1,
-                dissipative: false,
-                unit: String::new(),
-                initial: None,
-                lower: None,
-                prior,
-            }],
-            fixed: Vec::new(),
-            speed_decay: false,
-            reason: String::new(),
-            alternative_model: false,
-        }
-    }
-
-    #[test]
-    fn a_rival_correction_beyond_three_prior_deviations_is_implausible() {
-        let stated = vec![
-            candidate("correct I2x", "I2x", Some((0.0884, 0.00884))),
-            candidate("steer_damping", "c_steer", None),
-        ];
-        // The search fits with the priors on the data's scale (tighter);
-        // plausibility is judged under the stated ones.
-        let mut scaled = stated[0].clone();
-        scaled.parameters[0].prior = Some((0.0884, 0.001));
-        let (symbol, _, sds) = farthest_from_prior(&stated, &[&scaled], &[0.1633]).unwrap();
-        assert_eq!(symbol, "I2x");
-        assert!((sds - 8.47).abs() < 0.01 && sds > PLAUSIBLE_PRIOR_SDS, "{sds}");
-        let (_, _, near) = farthest_from_prior(&stated, &[&scaled], &[0.10]).unwrap();
-        assert!(near < PLAUSIBLE_PRIOR_SDS, "{near}");
-        // An effect has no prior: always plausible.
-        assert!(farthest_from_prior(&stated, &[&stated[1]], &[5.0]).is_none());
-        // A pair: the member farther from its prior counts.
-        let (symbol, _, _) = farthest_from_prior(&stated, &[&stated[1], &stated[0]], &[0.2, 0.2]).unwrap();
-        assert_eq!(symbol, "I2x");
-    }
-
-    #[test]
-    fn candidates_are_fitted_best_predicted_first_and_none_that_cannot_gain() {
-        // Predicted changes: c0 -100, c1 not screened, c2 +5 (no gain),
-        // c3 -400, c4 -350 (within 81 % of c3), c5 -10.
-        let plan = SearchOrder::of(&[Some(-100.0), None, Some(5.0), Some(-400.0), Some(-350.0), Some(-10.0)]);
-        assert_eq!(plan.order, vec![1, 3, 4, 0, 5]);
-        assert_eq!(
-            plan.contenders, 3,
-            "the unscreened one and the two within 81 % of the best"
-        );
-    }
-
-    /// A mock step: which candidates pass cross-validation, and the log of
-    /// what was fitted and validated.
-    struct Mock {
-        passes: Vec<bool>,
-        fitted: Vec<usize>,
-        validated: Vec<usize>,
-    }
-
-    impl Mock {
-        fn validate(&mut self) -> Result<Option<usize>, ()> {
-            // Cross-validate every fitted one not yet validated, in the
-            // order fitted, until one passes.
-            for &i in &self.fitted.clone() {
-                if self.validated.contains(&i) {
-                    continue;
-                }
-                self.validated.push(i);
-                if self.passes[i] {
-                    return Ok(Some(i));
-                }
-            }
-            Ok(None)
-        }
-    }
-
-    fn run(predicted: &[Option<f64>], passes: Vec<bool>) -> (Option<usize>, Mock) {
-        let mut m = Mock {
-            passes,
-            fitted: Vec::new(),
-            validated: Vec::new(),
-        };
-        let plan = SearchOrder::of(predicted);
-        let w = first_passing(
-            &mut m,
-            &plan,
-            |m, i| {
-                m.fitted.push(i);
-                Ok(())
-            },
-            Mock::validate,
-        )
-        .unwrap();
-        (w, m)
-    }
-
-    #[test]
-    fn a_candidate_far_behind_the_best_is_tried_when_the_best_fails() {
-        // The best-predicted candidate (drag, -450) fails cross-validation;
-        // the right one is predicted to gain only 29 % of it (-130), below
-        // the contenders' mark. It is fitted and added all the same.
-        let (w, m) = run(&[Some(-450.0), Some(-130.0), Some(-20.0)], vec![false, true, true]);
-        assert_eq!(w, Some(1));
-        assert_eq!(m.fitted, vec![0, 1], "the third is not fitted once the second passed");
-    }
-
-    #[test]
-    fn the_search_ends_only_when_every_candidate_that_could_gain_failed() {
-        let (w, m) = run(&[Some(-450.0), Some(-130.0), Some(3.0), Some(-20.0)], vec![false; 4]);
-        assert_eq!(w, None);
-        assert_eq!(
-            m.fitted,
-            vec![0, 1, 3],
-            "every candidate with a predicted gain, best first"
-        );
-        assert_eq!(m.validated, vec![0, 1, 3]);
-    }
-}
+#[path = "selection_tests.rs"]
+mod tests;
