@@ -41,7 +41,7 @@ fn synth_and_identify(name: &str, hidden: (&str, f64), seed: u64) -> (Vec<String
     );
     let request = IdentifyRequest {
         inputs: vec![dir.clone()],
-        bike: "thesis".into(),
+        bike: Some("thesis".into()),
         ..IdentifyRequest::default()
     };
     let outcome = run_in::<Registry>(&request, &|_| {}).expect("identification");
