@@ -5,9 +5,8 @@
 //! selection step compares two models run by run ([`paired_gain`]).
 
 use super::fit::{lm_fit, Free, Problem};
-use super::{CandidateFit, IdentifyOptions, Segment, SegmentError, Setup, Weights, NUISANCE};
+use super::{CandidateFit, IdentifyOptions, Segment, SegmentError, Setup, Weights};
 use std::sync::atomic::Ordering;
-use std::sync::Mutex;
 
 /// Cross-validate a fit of `setup`: for each fold, the effect parameters
 /// from the other segments (their initial states held at the full fit),
@@ -27,14 +26,6 @@ pub fn cross_validate(setup: &Setup<'_>, fit: &mut CandidateFit, fold_of: &[usiz
         return;
     }
     let all: Vec<usize> = (0..nseg).collect();
-    let problem = |segs: Vec<usize>, free: Free, g: Vec<f64>, x0: Vec<[f64; NUISANCE]>| Problem {
-        setup,
-        segs,
-        free,
-        g,
-        x0,
-        cache: Mutex::new(None),
-    };
     let g = fit.values.clone();
     let nuisance = fit.nuisance.clone();
     let mut held_out = vec![SegmentError::default(); nseg];
@@ -47,13 +38,16 @@ pub fn cross_validate(setup: &Setup<'_>, fit: &mut CandidateFit, fold_of: &[usiz
             continue;
         }
         let gf = if setup.k() > 0 && !train.is_empty() {
-            let p = lm_fit(problem(train, Free::Shared, g.clone(), nuisance.clone()), opts.patience);
+            let p = lm_fit(
+                Problem::new(setup, train, Free::Shared, g.clone(), nuisance.clone()),
+                opts.patience,
+            );
             p.g.clone()
         } else {
             g.clone()
         };
         let p = lm_fit(
-            problem(test.clone(), Free::Nuisance, gf.clone(), nuisance.clone()),
+            Problem::new(setup, test.clone(), Free::Nuisance, gf.clone(), nuisance.clone()),
             opts.patience,
         );
         if let Some(r) = p.all_residuals() {

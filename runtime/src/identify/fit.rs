@@ -38,6 +38,27 @@ pub(super) struct Problem<'s, 'a> {
     pub(super) cache: Mutex<Option<(Vec<f64>, Vec<Vec<f64>>)>>,
 }
 
+impl<'s, 'a> Problem<'s, 'a> {
+    /// The problem of `setup` over the segments `segs`, with `free`
+    /// parameters starting from effect values `g` and window starts `x0`.
+    pub(super) fn new(
+        setup: &'s Setup<'a>,
+        segs: Vec<usize>,
+        free: Free,
+        g: Vec<f64>,
+        x0: Vec<[f64; NUISANCE]>,
+    ) -> Self {
+        Problem {
+            setup,
+            segs,
+            free,
+            g,
+            x0,
+            cache: Mutex::new(None),
+        }
+    }
+}
+
 impl Problem<'_, '_> {
     fn n_free(&self) -> usize {
         match self.free {
@@ -405,18 +426,13 @@ pub fn fit_candidate(
     }
     let sims_before = setup.simulations.load(Ordering::Relaxed);
     let all: Vec<usize> = (0..nseg).collect();
-    let problem = |segs: Vec<usize>, free: Free, g: Vec<f64>, x0: Vec<[f64; NUISANCE]>| Problem {
-        setup,
-        segs,
-        free,
-        g,
-        x0,
-        cache: Mutex::new(None),
-    };
     // A fit where every segment's initial state moves: effect parameters
     // and states together (the base model: states alone).
     let free = if setup.k() == 0 { Free::Nuisance } else { Free::All };
-    let full = lm_fit(problem(all.clone(), free, g0.to_vec(), x0.to_vec()), opts.patience);
+    let full = lm_fit(
+        Problem::new(setup, all.clone(), free, g0.to_vec(), x0.to_vec()),
+        opts.patience,
+    );
     let simulations = || setup.simulations.load(Ordering::Relaxed) - sims_before;
     let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
         run: setup.segments[0].run.clone(),

@@ -27,7 +27,6 @@ use super::{bic, CandidateFit, ModelFactory, Segment, SegmentError, Weights};
 use nalgebra::{DMatrix, DVector};
 use std::collections::BTreeSet;
 use std::sync::atomic::Ordering;
-use std::sync::Mutex;
 
 /// What one step's screen looks at.
 pub(super) struct Screen<'s> {
@@ -215,14 +214,13 @@ pub(super) fn screen(s: &Screen<'_>) -> Screened {
         }
         columns.push(cols);
     }
-    let problem = Problem {
-        setup: &setup,
-        segs: (0..s.segments.len()).collect(),
-        free: Free::All,
-        g: g.clone(),
-        x0: s.current.nuisance.clone(),
-        cache: Mutex::new(None),
-    };
+    let problem = Problem::new(
+        &setup,
+        (0..s.segments.len()).collect(),
+        Free::All,
+        g.clone(),
+        s.current.nuisance.clone(),
+    );
     if let (Some(blocks), Some(res)) = (problem.jacobian_blocks(), problem.all_residuals()) {
         let base: Vec<usize> = (0..ks).collect();
         out.reference = predict(s, &setup, &blocks, &res, &g, &base);
@@ -263,14 +261,13 @@ pub(super) fn screen(s: &Screen<'_>) -> Screened {
         if g.len() != setup.k() {
             continue;
         }
-        let problem = Problem {
-            setup: &setup,
-            segs: (0..s.segments.len()).collect(),
-            free: Free::All,
-            g: g.clone(),
-            x0: s.current.nuisance.clone(),
-            cache: Mutex::new(None),
-        };
+        let problem = Problem::new(
+            &setup,
+            (0..s.segments.len()).collect(),
+            Free::All,
+            g.clone(),
+            s.current.nuisance.clone(),
+        );
         if let (Some(blocks), Some(res)) = (problem.jacobian_blocks(), problem.all_residuals()) {
             let cols: Vec<usize> = (0..setup.k()).collect();
             out.predictions[i] = predict(s, &setup, &blocks, &res, &g, &cols);
