@@ -51,7 +51,7 @@ fn png_header(path: &PathBuf) -> (u32, u32, Option<u32>) {
 /// the resolution asked for; the SVG's title names bicycle and model, and
 /// `--xlim` sets the axis.
 #[test]
-fn issue_20_eig_plot_size_dpi_title_and_limits() {
+fn eig_plot_keeps_size_dpi_title_and_limits() {
     let png = tmp("eig.png");
     let svg = tmp("eig.svg");
     for (p, extra) in [
@@ -88,7 +88,7 @@ fn issue_20_eig_plot_size_dpi_title_and_limits() {
 /// `eig --plot-root-locus` and `--plot-mode-shapes --speed`: the two views
 /// of bicycleparameters, each titled with bicycle and model.
 #[test]
-fn issue_20_eig_root_locus_and_mode_shapes() {
+fn eig_draws_the_root_locus_and_mode_shapes() {
     let locus = tmp("locus.svg");
     let modes = tmp("modes.svg");
     let out = bikedyn(&[
@@ -133,7 +133,7 @@ fn issue_20_eig_root_locus_and_mode_shapes() {
 
 /// Bad plot options are errors naming the flag, before any output.
 #[test]
-fn issue_20_bad_plot_options_name_their_flag() {
+fn bad_plot_options_name_their_flag() {
     let p = tmp("never.svg");
     for (args, flag) in [
         (vec!["--plot-size", "0x3"], "--plot-size"),
@@ -192,7 +192,7 @@ fn issue_20_bad_plot_options_name_their_flag() {
 /// `sweep --plot` with one parameter draws the quantity against it; a map
 /// of the least stable real part says the speed it was made at.
 #[test]
-fn issue_20_sweep_plots() {
+fn sweep_plots_draw_maps_and_curves() {
     let one = tmp("sweep1.svg");
     let out = bikedyn(&[
         "sweep",
@@ -256,7 +256,7 @@ fn issue_20_sweep_plots() {
 /// `simulate --plot`: a title with bicycle and model, one time label, the
 /// kick marked (dashed), a speed axis around the (constant) speed.
 #[test]
-fn issue_20_simulation_plot() {
+fn simulation_plot_has_one_time_label_and_the_kick() {
     let svg = tmp("sim.svg");
     let out = bikedyn(&[
         "simulate",
@@ -309,7 +309,7 @@ fn issue_20_simulation_plot() {
 /// simulation's three stacked panels are 800x900 by default, and
 /// `--plot-size 8x6` makes them 800x600.
 #[test]
-fn issue_20_an_explicit_plot_size_is_kept() {
+fn an_explicit_plot_size_is_kept() {
     for (name, extra, size) in [
         ("sim-default.png", vec![], (800, 900)),
         ("sim-8x6.png", vec!["--plot-size", "8x6"], (800, 600)),
