@@ -28,7 +28,7 @@ fn candidate(name: &str, symbol: &str, prior: Option<(f64, f64)>) -> Candidate {
 #[test]
 fn a_rival_correction_beyond_three_prior_deviations_is_implausible() {
     let stated = vec![
-        candidate("correct I2x", "I2x", Some((0.0884, 0.00884))),
+        candidate("correct I_roll", "I_roll", Some((0.0884, 0.00884))),
         candidate("steer_damping", "c_steer", None),
     ];
     // The search fits with the priors on the data's scale (tighter);
@@ -36,7 +36,7 @@ fn a_rival_correction_beyond_three_prior_deviations_is_implausible() {
     let mut scaled = stated[0].clone();
     scaled.parameters[0].prior = Some((0.0884, 0.001));
     let (symbol, _, sds) = farthest_from_prior(&stated, &[&scaled], &[0.1633]).unwrap();
-    assert_eq!(symbol, "I2x");
+    assert_eq!(symbol, "I_roll");
     assert!((sds - 8.47).abs() < 0.01 && sds > PLAUSIBLE_PRIOR_SDS, "{sds}");
     let (_, _, near) = farthest_from_prior(&stated, &[&scaled], &[0.10]).unwrap();
     assert!(near < PLAUSIBLE_PRIOR_SDS, "{near}");
@@ -44,7 +44,7 @@ fn a_rival_correction_beyond_three_prior_deviations_is_implausible() {
     assert!(farthest_from_prior(&stated, &[&stated[1]], &[5.0]).is_none());
     // A pair: the member farther from its prior counts.
     let (symbol, _, _) = farthest_from_prior(&stated, &[&stated[1], &stated[0]], &[0.2, 0.2]).unwrap();
-    assert_eq!(symbol, "I2x");
+    assert_eq!(symbol, "I_roll");
 }
 
 #[test]
