@@ -16,7 +16,12 @@ outcome is scored against the truth the oracle wrote apart:
   to the true shift;
 * errors before and after on the fitted and on the held-out runs: the weave
   eigenvalue RMS (1/s) and the median run's roll RMS (deg);
-* time of the identification (s).
+* time of the identification (s);
+* signal: how far the cause moves the weave, from the oracle's own
+  linearisation of its nominal and true models at each run's speed (root
+  sum of squares over the runs), in units of one kick's scatter about the
+  model (the controls' eigenvalue RMS): a cause with a signal below about 2
+  cannot be told from the scatter of that many runs by any method.
 
 Targets (issue 33): the right cause on at least 90 % of the sets with a
 cause, nothing but speed decay on the controls, parameters within 25 %, and
@@ -112,6 +117,37 @@ def causes_of(row, truth):
     return out
 
 
+# Causes whose effect on the weave the oracle's own linearisation gives
+# (viscous damping and parameter errors); Coulomb friction and a lateral
+# offset act through the nonlinear response, and are not scored for signal.
+NONLINEAR_CAUSES = {"T_coul", "yB"}
+
+
+def weave_shift(row, work):
+    """The cause's shift of the weave eigenvalue at each run's mean speed,
+    from the oracle's truth (its nominal and its true linearised model; no
+    bikedyn number): the root of the sum over runs of |shift|^2 (1/s), or
+    None where a cause acts only through the nonlinear response."""
+    if not (row.get("effects") or row.get("thesis")):
+        return None
+    if NONLINEAR_CAUSES & set(pairs(row.get("effects", ""))):
+        return None
+    folder = os.path.join(work, "truth", row["name"])
+    total = 0.0
+    for run in sorted(os.listdir(folder)):
+        path = os.path.join(folder, run, "truth.json")
+        if not os.path.isfile(path):
+            continue
+        with open(path) as fh:
+            t = json.load(fh)
+        if t.get("kind") != "run":
+            continue
+        e = t["eigenvalues_at_mean_speed"]
+        a, b = e["nominal_whipple"]["weave"], e["true_model_with_effects"]["weave"]
+        total += (a[0] - b[0]) ** 2 + (abs(a[1]) - abs(b[1])) ** 2
+    return math.sqrt(total)
+
+
 def base_name(selected: str) -> str:
     return selected.split(" (")[0]
 
@@ -179,18 +215,18 @@ def fmt(x, digits=3):
 
 
 def print_table(rows, out=sys.stdout):
-    print("| set | causes | selected | right | false | parameter error | eigen RMS held-out (1/s) | median-run roll held-out (deg) | s |", file=out)
-    print("|---|---|---|---|---|---|---|---|---|", file=out)
+    print("| set | causes | signal | selected | right | false | parameter error | eigen RMS held-out (1/s) | median-run roll held-out (deg) | s |", file=out)
+    print("|---|---|---|---|---|---|---|---|---|---|", file=out)
     for r in rows:
         if "error" in r:
-            print(f"| {r['set']} | | error: {r['error']} | no | | | | | |", file=out)
+            print(f"| {r['set']} | | | error: {r['error']} | no | | | | | |", file=out)
             continue
         causes = ", ".join(r["causes"]) or "none (control)"
         sel = ", ".join(r["selected"]) or "nothing"
         right = "yes" if r["right"] else ("no" if r["right"] is False else ("clean" if r["control_clean"] else "no"))
         perr = ", ".join(f"{p['symbol']} {100 * p['relative_error']:.0f} %" for p in r["parameters"]) or "-"
         e, m = r["figures"]["eigen_rms_held_out"], r["figures"]["median_run_roll_held_out_deg"]
-        print(f"| {r['set']} | {causes} | {sel} | {right} | {', '.join(r['false']) or '-'} | {perr} | "
+        print(f"| {r['set']} | {causes} | {fmt(r.get('signal'), 1)} | {sel} | {right} | {', '.join(r['false']) or '-'} | {perr} | "
               f"{fmt(e[0])} -> {fmt(e[1])} | {fmt(m[0])} -> {fmt(m[1])} | {r['seconds']:.0f} |", file=out)
 
 
@@ -272,14 +308,25 @@ def main():
                 report = json.load(fh)
             results.append(score(row, truth, report, seconds))
             r = results[-1]
+            r["weave_shift"] = weave_shift(row, args.work)
             print(f"    selected {', '.join(r['selected']) or 'nothing'}; right {r['right']}; false {r['false']}; "
                   f"{seconds:.0f} s", file=sys.stderr, flush=True)
         except (subprocess.CalledProcessError, RuntimeError, OSError, KeyError) as e:
             failed = True
             results.append({"set": row["name"], "error": str(e), "has_cause": has_cause})
             print(f"    error: {e}", file=sys.stderr, flush=True)
+    # The signal of each cause: its weave shift over all runs against the
+    # scatter of one kick's measured weave about the model, taken from the
+    # controls (their eigenvalue RMS after the speed decay is modelled).
+    scatter = sorted(r["figures"]["eigen_rms"][1] for r in results
+                     if r.get("control_clean") is not None and "figures" in r)
+    kick_scatter = scatter[len(scatter) // 2] if scatter else None
+    for r in results:
+        shift = r.get("weave_shift")
+        r["signal"] = shift / kick_scatter if shift is not None and kick_scatter else None
     print_table(results)
     s = summary(results)
+    s["kick_scatter"] = kick_scatter
     def mark(ok):
         return "met" if ok else "missed"
 
@@ -293,6 +340,12 @@ def main():
           f"(target all: {mark(s['parameters_within_25pct'] == s['parameters_scored'])})")
     print(f"held-out weave eigenvalue or median-run roll error at least halved: {s['errors_halved']} of "
           f"{s['sets_with_cause']} (target all: {mark(s['errors_halved'] == s['sets_with_cause'])})")
+    if kick_scatter:
+        weak = [r for r in results if r.get("signal") is not None and r["signal"] < 2.0]
+        print(f"signal: the cause's weave shift over the set's runs, in units of one kick's scatter about the model "
+              f"({kick_scatter:.3f} 1/s, the controls' median); below 2 in "
+              f"{len(weak)} set(s){': ' + ', '.join(r['set'] + ' (' + fmt(r['signal'], 1) + ')' for r in weak) if weak else ''}"
+              f"{' (right on ' + str(sum(1 for r in weak if r.get('right'))) + ')' if weak else ''}")
     print(f"identify time: {s['seconds']:.0f} s in all")
     if args.json:
         with open(args.json, "w") as fh:

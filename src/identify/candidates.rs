@@ -141,6 +141,7 @@ pub fn candidates<R: ModelRegistry>(
                         .flatten(),
                     lower: f.floor,
                     prior: None,
+                    gross_beyond: bikedyn_runtime::identify::PLAUSIBLE_PRIOR_SDS,
                 })
                 .collect(),
             fixed: d

@@ -242,6 +242,7 @@ pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
             initial: Some(c.value),
             lower: None,
             prior: Some((c.value, c.sd)),
+            gross_beyond: bikedyn_runtime::identify::PLAUSIBLE_PRIOR_SDS,
         }],
         fixed: Vec::new(),
         speed_decay: false,

@@ -179,6 +179,31 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
             let _ = writeln!(s);
         }
     }
+    if !id.final_check.is_empty() {
+        let _ = writeln!(
+            s,
+            "Final check: each selected candidate that a later one followed, tested against the model without it by the same entry test (the criterion and the held-out error must fall, consistently over the runs); one that fails no longer earns its place and is removed, the model refitted without it.\n\n| candidate | in the model | without it: BIC change, held-out error | outcome |\n|---|---|---|---|"
+        );
+        for c in &id.final_check {
+            let without = match &c.without {
+                Some(_) if c.cv_without.is_finite() => format!("{:+.1}, {:.4}", -c.bic_change, c.cv_without),
+                Some(_) => format!("{:+.1}, -", -c.bic_change),
+                None => "fit failed".into(),
+            };
+            let outcome = if c.verdict.added() {
+                format!("keeps its place ({})", verdict_text(&c.verdict))
+            } else if c.removed {
+                format!("removed: {}", verdict_text(&c.verdict))
+            } else {
+                format!(
+                    "failed as well ({}); tested again after the removal",
+                    verdict_text(&c.verdict)
+                )
+            };
+            let _ = writeln!(s, "| `{}` | {} | {without} | {outcome} |", c.name, c.model.join(" + "));
+        }
+        let _ = writeln!(s);
+    }
     if id.selected.is_empty() {
         let _ = writeln!(s, "**No effect warranted.** No candidate lowered both the information criterion and the held-out error with physical parameter values: the residual of the base model is not explained better by any effect of the library than by noise. The model is left as it is.\n");
     } else {

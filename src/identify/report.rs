@@ -128,10 +128,27 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
             })
         })
         .collect();
+    let final_check: Vec<Value> = id
+        .final_check
+        .iter()
+        .map(|c| {
+            json!({
+                "name": c.name,
+                "model": c.model,
+                "removed": c.removed,
+                "bic_change": Some(c.bic_change).filter(|x| x.is_finite()),
+                "cv_with": Some(c.cv_with).filter(|x| x.is_finite()),
+                "cv_without": Some(c.cv_without).filter(|x| x.is_finite()),
+                "outcome": c.verdict,
+                "verdict": verdict_text(&c.verdict),
+            })
+        })
+        .collect();
     json!({
         "selected_effects": sel,
         "parameters": params,
         "candidates": cands,
+        "final_check": final_check,
         "confounded": confounded,
         "error_before": errors_json(o, false),
         "error_after": errors_json(o, true),
@@ -211,6 +228,14 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
         id.selected.join(" + ")
     };
     let _ = writeln!(s, "selected: {sel}");
+    for c in id.final_check.iter().filter(|c| c.removed) {
+        let _ = writeln!(
+            s,
+            "removed by the final check: {} (against the model without it, {})",
+            c.name,
+            verdict_text(&c.verdict)
+        );
+    }
     for line in confounding_lines(o) {
         let _ = writeln!(s, "{line}");
     }
@@ -483,6 +508,11 @@ pub fn verdict_text(v: &Verdict) -> String {
         Verdict::HeldOutGainNotConsistent { gain, stderr } => format!(
             "rejected: held-out gain per run {gain:.4} within two standard errors ({stderr:.4}) of zero (not a consistent improvement)"
         ),
+        Verdict::Encompassed { by, t, remains } => format!(
+            "replaced by {by}: fitted together with it, its parameters keep {:.0} % of their shift alone ({t:.1} standard errors from their absence) while {by} stays significant; it stood in for {by}",
+            100.0 * remains
+        ),
+        Verdict::NotAdded => "fitted for the encompassing test only (not a candidate of its own)".into(),
     }
 }
 

@@ -24,6 +24,8 @@ pub(super) fn with_priors_on_the_data_scale(candidates: &[Candidate], base: &Can
             let mut c = c.clone();
             for p in &mut c.parameters {
                 p.prior = p.prior.map(|(mean, sd)| (mean, sd / scale));
+                // The same place in the stated units.
+                p.gross_beyond *= scale;
             }
             c
         })

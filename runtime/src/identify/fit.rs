@@ -118,6 +118,30 @@ impl Problem<'_, '_> {
             })
             .collect()
     }
+    /// The priors' penalty: Huber's, `r^2` within `gross_beyond` (c) of
+    /// the mean and `2 c |r| - c^2` beyond ([`EffectParameter::gross_beyond`]).
+    fn prior_penalty(&self) -> f64 {
+        self.prior_rows()
+            .into_iter()
+            .zip(self.prior_residuals())
+            .map(|((j, _), r)| huber(r, self.setup.parameters[j].gross_beyond))
+            .sum()
+    }
+    /// The priors as rows of the normal equations `(column, sd, residual)`,
+    /// with Huber's weight `min(1, c / |r|)` folded into the standard
+    /// deviation and the residual (iteratively reweighted: the step is
+    /// Gauss-Newton on the penalty's quadratic model at the current value).
+    fn prior_normal_rows(&self) -> Vec<(usize, f64, f64)> {
+        self.prior_rows()
+            .into_iter()
+            .zip(self.prior_residuals())
+            .map(|((j, sd), r)| {
+                let c = self.setup.parameters[j].gross_beyond;
+                let w = if r.abs() > c { (c / r.abs()).sqrt() } else { 1.0 };
+                (j, sd / w, r * w)
+            })
+            .collect()
+    }
     pub(super) fn all_residuals(&self) -> Option<Vec<Vec<f64>>> {
         let x = self.pack();
         if let Some((cx, r)) = self.cache.lock().ok()?.as_ref() {
@@ -351,8 +375,7 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
     }
     let cost = |p: &Problem<'_, '_>| -> Option<f64> {
         let r = p.all_residuals()?;
-        let pr = p.prior_residuals();
-        Some(r.iter().flatten().chain(&pr).map(|x| x * x).sum::<f64>())
+        Some(r.iter().flatten().map(|x| x * x).sum::<f64>() + p.prior_penalty())
     };
     let Some(mut c) = cost(&p) else { return p };
     let scales = p.scales();
@@ -364,12 +387,7 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
         let (Some(blocks), Some(res)) = (p.jacobian_blocks(), p.all_residuals()) else {
             break;
         };
-        let prior: Vec<(usize, f64, f64)> = p
-            .prior_rows()
-            .into_iter()
-            .zip(p.prior_residuals())
-            .map(|((j, sd), r)| (j, sd, r))
-            .collect();
+        let prior = p.prior_normal_rows();
         let x = p.pack();
         loop {
             let step = Normal::new(&blocks, &res, &prior, k, lambda).and_then(|n| n.step());
@@ -464,7 +482,11 @@ pub fn fit_candidate(
             let p = full.n_free() as f64;
             let rho = errors.iter().map(|e| e.rho).sum::<f64>() / errors.len() as f64;
             let s2 = chi2 / (n as f64 - p).max(1.0) * (1.0 + rho) / (1.0 - rho);
-            let prior: Vec<(usize, f64, f64)> = full.prior_rows().into_iter().map(|(j, sd)| (j, sd, 0.0)).collect();
+            let prior: Vec<(usize, f64, f64)> = full
+                .prior_normal_rows()
+                .into_iter()
+                .map(|(j, sd, _)| (j, sd, 0.0))
+                .collect();
             if let Some(inv) = Normal::new(&blocks, &res, &prior, setup.k(), 0.0).and_then(|nm| nm.s.try_inverse()) {
                 for (i, s) in stderr.iter_mut().enumerate() {
                     *s = (inv[(i, i)] * s2).sqrt();
@@ -533,5 +555,15 @@ mod tests {
         assert!((e.steer_rms - 0.4).abs() < 1e-12);
         assert!((e.speed_rms - 2.0).abs() < 1e-12);
         assert_eq!(e.channel_n, [20, 20, 1]);
+    }
+}
+
+/// Huber's penalty of a standardised residual `r` with its turn at `c`:
+/// `r^2` within, `2 c |r| - c^2` beyond (continuous with its slope).
+fn huber(r: f64, c: f64) -> f64 {
+    if r.abs() <= c || !(c > 0.0) {
+        r * r
+    } else {
+        2.0 * c * r.abs() - c * c
     }
 }

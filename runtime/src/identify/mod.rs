@@ -51,7 +51,9 @@
 //!   simulation per kick in dual numbers linearises every candidate at once)
 //!   orders the candidates and skips those that cannot lower the criterion;
 //!   when the best fails, the next is tried, and pairs when no single candidate
-//!   passes. Sensor nuisances (mounting misalignment, clock offset) are
+//!   passes. After the forward search, every candidate followed by a later
+//!   addition is tested again against the final model without it
+//!   (`elimination.rs`). Sensor nuisances (mounting misalignment, clock offset) are
 //!   estimated per set by the measured-run pipeline before, and are never
 //!   candidates.
 
@@ -59,6 +61,7 @@ mod candidate;
 pub mod confounding;
 mod criterion;
 mod cross_validation;
+mod elimination;
 mod fit;
 mod normal;
 mod nuisance;
@@ -73,7 +76,7 @@ pub use fit::{fit_candidate, pooled_rms, CandidateFit, IdentifyOptions, SegmentE
 pub use nuisance::{at_rest, EXTRA_STATES, INITIAL_MOTION, NUISANCE, STEER_BIAS};
 pub use residuals::{Factory, ModelFactory, Setup, Sim};
 pub use segment::{RollChannel, Segment, Weights};
-pub use selection::{bic, identify, Identification, Step, Trial, Verdict, PLAUSIBLE_PRIOR_SDS};
+pub use selection::{bic, identify, Identification, MemberCheck, Step, Trial, Verdict, PLAUSIBLE_PRIOR_SDS};
 
 /// Errors of identification.
 #[derive(Debug, thiserror::Error)]

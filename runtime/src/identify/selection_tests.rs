@@ -17,6 +17,7 @@ fn candidate(name: &str, symbol: &str, prior: Option<(f64, f64)>) -> Candidate {
             initial: None,
             lower: None,
             prior,
+            gross_beyond: PLAUSIBLE_PRIOR_SDS,
         }],
         fixed: Vec::new(),
         speed_decay: false,
@@ -50,12 +51,12 @@ fn a_rival_correction_beyond_three_prior_deviations_is_implausible() {
 #[test]
 fn candidates_are_fitted_best_predicted_first_and_none_that_cannot_gain() {
     // Predicted changes: c0 -100, c1 not screened, c2 +5 (no gain),
-    // c3 -400, c4 -350 (within 81 % of c3), c5 -10.
+    // c3 -400, c4 -350 (within half of c3's gain), c5 -10.
     let plan = SearchOrder::of(&[Some(-100.0), None, Some(5.0), Some(-400.0), Some(-350.0), Some(-10.0)]);
     assert_eq!(plan.order, vec![1, 3, 4, 0, 5]);
     assert_eq!(
         plan.contenders, 3,
-        "the unscreened one and the two within 81 % of the best"
+        "the unscreened one and the two within half of the best gain"
     );
 }
 

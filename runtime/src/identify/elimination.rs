@@ -1,0 +1,205 @@
+//! The backward check of a forward search: every selected candidate must
+//! still earn its place once the ones added after it are in the model.
+//!
+//! A forward step judges a candidate against the model of that step. A
+//! later addition can explain the same misfit better (a steer friction
+//! taken up early for what a rear-frame roll inertia explains once the
+//! speed loss is right), and the early one then stays in the model with a
+//! value near zero. Each selected candidate that was followed by another
+//! is therefore tested again, against the final model without it, by the
+//! same entry test a forward step uses (the criterion falls, the held-out
+//! error falls, consistently over the runs). The one that fails with the
+//! largest criterion change is removed, the model refitted without it,
+//! and the others tested again. (The last one added was tested against
+//! exactly the model without it when it entered.)
+
+use super::criterion::bic;
+use super::cross_validation::paired_gain;
+use super::selection::{Search, Verdict};
+use super::{cross_validate, fit_candidate, Candidate, CandidateFit, IdentifyError};
+use serde::Serialize;
+
+/// A selected candidate tested against the final model without it.
+#[derive(Clone, Debug, Serialize)]
+pub struct MemberCheck {
+    /// The candidate tested.
+    pub name: String,
+    /// The candidates of the model it was tested in (it included).
+    pub model: Vec<String>,
+    /// The fit of that model without it (`None`: the fit failed; the
+    /// candidate keeps its place).
+    pub without: Option<CandidateFit>,
+    /// The criterion with it minus without it (negative: it still lowers
+    /// the criterion; `NaN` when the fit without it failed).
+    pub bic_change: f64,
+    /// Held-out error with it, and without it (`NaN`: not cross-validated,
+    /// the criterion decided).
+    pub cv_with: f64,
+    pub cv_without: f64,
+    /// The entry test of the candidate against the model without it:
+    /// [`Verdict::Added`] means it keeps its place (its numbers are those
+    /// of keeping it); any other verdict is why it was removed.
+    pub verdict: Verdict,
+    /// Whether it was removed.
+    pub removed: bool,
+}
+
+impl<'s> Search<'s> {
+    /// Test every selected candidate followed by a later addition (speed
+    /// decay apart: every run slows, and its law is chosen in a phase of its
+    /// own) against `current` without it; remove those that fail, one at a
+    /// time. Returns the checks in the order made.
+    pub(super) fn eliminate<'c>(
+        &self,
+        current: &mut CandidateFit,
+        selected: &mut Vec<&'c Candidate>,
+        simulations: &mut usize,
+    ) -> Result<Vec<MemberCheck>, IdentifyError> {
+        let mut checks = Vec::new();
+        // Each round tests every candidate followed by a later lateral
+        // addition; a removal changes the model, so the next round tests
+        // the rest again. At most one round per selected candidate.
+        loop {
+            let last_lateral = selected.iter().rposition(|c| !c.speed_decay);
+            let testable: Vec<usize> = (0..selected.len())
+                .filter(|&j| !selected[j].speed_decay && Some(j) != last_lateral)
+                .collect();
+            if testable.is_empty() {
+                break;
+            }
+            let mut failing: Vec<(usize, f64, usize)> = Vec::new();
+            let start = checks.len();
+            for &j in &testable {
+                let (check, fit) = self.without(current, selected, j, simulations)?;
+                if check.removed {
+                    let change = fit.as_ref().map_or(f64::INFINITY, |f| f.bic - current.bic);
+                    failing.push((j, change, checks.len()));
+                }
+                checks.push((check, fit));
+            }
+            // The one whose removal lowers the criterion most goes.
+            failing.sort_by(|a, b| a.1.total_cmp(&b.1));
+            let Some(&(j, _, at)) = failing.first() else {
+                break;
+            };
+            // Only one is removed per round; the others that failed keep
+            // their verdict and are tested again against the refitted model.
+            for (k, (c, _)) in checks.iter_mut().enumerate().skip(start) {
+                c.removed = k == at;
+            }
+            let refit = checks[at].1.clone().expect("a removal has its fit");
+            (self.progress)(
+                &format!("removed {} (no longer earns its place)", selected[j].name),
+                None,
+            );
+            selected.remove(j);
+            *current = refit;
+        }
+        Ok(checks.into_iter().map(|(c, _)| c).collect())
+    }
+
+    /// The entry test of `selected[j]` against the model `current` without
+    /// it: the check, and the fit without it (cross-validated when the
+    /// criterion alone does not decide).
+    fn without<'c>(
+        &self,
+        current: &CandidateFit,
+        selected: &[&'c Candidate],
+        j: usize,
+        simulations: &mut usize,
+    ) -> Result<(MemberCheck, Option<CandidateFit>), IdentifyError> {
+        let model: Vec<String> = selected.iter().map(|c| c.name.clone()).collect();
+        let active: Vec<&Candidate> = selected
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i != j)
+            .map(|(_, c)| *c)
+            .collect();
+        // The member's parameters in the current values: after those of
+        // the candidates before it.
+        let offset: usize = selected[..j].iter().map(|c| c.parameters.len()).sum();
+        let width = selected[j].parameters.len();
+        let mut g0 = current.values.clone();
+        g0.drain(offset..offset + width);
+        let setup = match self.alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
+            Some(f) => f.setup(self.segments, self.weights, &active)?,
+            None => self.main.setup(self.segments, self.weights, &active)?,
+        };
+        let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
+        let name = selected[j].name.clone();
+        (self.progress)(&format!("testing {name} against the model without it"), None);
+        let mut fit = match fit_candidate(
+            &setup,
+            effects,
+            &g0,
+            &current.nuisance,
+            self.fold_of,
+            self.opts,
+            Some(self.reference),
+        ) {
+            Ok(f) => f,
+            Err(_) => {
+                let keep = Verdict::Added {
+                    bic_change: f64::NAN,
+                    cv: current.cv,
+                    base_cv: f64::NAN,
+                };
+                return Ok((
+                    MemberCheck {
+                        name,
+                        model,
+                        without: None,
+                        bic_change: f64::NAN,
+                        cv_with: current.cv,
+                        cv_without: f64::NAN,
+                        verdict: keep,
+                        removed: false,
+                    },
+                    None,
+                ));
+            }
+        };
+        let with_bic = bic(current, self.reference);
+        // The same order of tests as a forward step: the criterion first,
+        // then the held-out error and its consistency over the runs.
+        let verdict = if !(with_bic < fit.bic) {
+            Verdict::NoCriterionGain {
+                bic_change: with_bic - fit.bic,
+            }
+        } else {
+            cross_validate(&setup, &mut fit, self.fold_of, self.opts);
+            if !(current.cv < fit.cv) {
+                Verdict::HeldOutNotLower {
+                    cv: current.cv,
+                    base_cv: fit.cv,
+                }
+            } else if let Some((gain, stderr)) =
+                paired_gain(&fit, current, self.weights).filter(|(d, se)| !(*d > 2.0 * se))
+            {
+                Verdict::HeldOutGainNotConsistent { gain, stderr }
+            } else {
+                Verdict::Added {
+                    bic_change: with_bic - fit.bic,
+                    cv: current.cv,
+                    base_cv: fit.cv,
+                }
+            }
+        };
+        fit.simulations = setup.simulations.load(std::sync::atomic::Ordering::Relaxed);
+        *simulations += fit.simulations;
+        let removed = !verdict.added();
+        Ok((
+            MemberCheck {
+                name,
+                model,
+                bic_change: with_bic - fit.bic,
+                cv_with: current.cv,
+                cv_without: fit.cv,
+                without: Some(fit.clone()),
+                verdict,
+                removed,
+            },
+            Some(fit),
+        ))
+    }
+}
