@@ -240,12 +240,18 @@ pub fn write_out(args: std::fmt::Arguments<'_>) -> Result<()> {
     std::io::stdout().lock().write_fmt(args).map_err(stdout_error)
 }
 
+/// Standard output was closed by its reader (`| head -1`): the reader has
+/// what it wanted, so the command stops quietly with exit status 0, as
+/// Unix tools do (issue 35, reproducer 28). Other write errors (a full
+/// disk) remain errors.
+#[derive(Debug, thiserror::Error)]
+#[error("standard output was closed before everything was written (broken pipe)")]
+pub struct StdoutClosed;
+
 /// The error of a failed write to standard output.
 pub fn stdout_error(e: std::io::Error) -> anyhow::Error {
     if e.kind() == std::io::ErrorKind::BrokenPipe {
-        anyhow::anyhow!(
-            "standard output was closed before everything was written (broken pipe); the output is incomplete"
-        )
+        anyhow::Error::new(StdoutClosed)
     } else {
         anyhow::anyhow!("writing to standard output: {e}; the output is incomplete")
     }
@@ -262,6 +268,10 @@ pub fn stdout_error_of(e: Box<dyn std::error::Error + Send + Sync>) -> anyhow::E
         // A CSV writer's I/O error is its kind, not its source.
         if let Some(csv::ErrorKind::Io(io)) = c.downcast_ref::<csv::Error>().map(|e| e.kind()) {
             return stdout_error(std::io::Error::new(io.kind(), io.to_string()));
+        }
+        // So is a JSON writer's (its `source` skips the I/O error).
+        if let Some(kind) = c.downcast_ref::<serde_json::Error>().and_then(|e| e.io_error_kind()) {
+            return stdout_error(std::io::Error::new(kind, c.to_string()));
         }
         cause = c.source();
     }

@@ -4,7 +4,7 @@
 
 use crate::common::*;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 fn tmp(name: &str) -> PathBuf {
     let d = scratch("reliability").join(name);
@@ -12,35 +12,15 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-/// Run `args` with standard output a pipe whose reading end is closed at
-/// once (as `| head -0` does), and return the exit code and standard error.
-fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
-    (out.status.code(), text(&out.stderr))
-}
-
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
-
 /// A closed pipe or a full device on standard output used to panic (exit
-/// 101) in most commands: now it is an error (exit 2) that says the output
-/// is incomplete. Outputs larger than a pipe's buffer (64 KiB), so the
-/// write surely fails: a streamed CSV and two aligned tables.
+/// 101) in most commands. A full device is an error (exit 2) that says the
+/// output is incomplete; a pipe closed by its reader (`| head -1`) stops
+/// the command quietly with exit 0, as Unix tools do (issue 35, reproducer
+/// 28: the JSON path printed "Broken pipe (os error 32)"). Outputs larger
+/// than a pipe's buffer (64 KiB), so the write surely fails: streamed CSV
+/// and JSON, and two aligned tables.
 #[test]
-fn a_failed_write_to_standard_output_is_an_error_not_a_panic() {
+fn a_closed_pipe_stops_quietly_and_a_full_device_is_an_error() {
     for args in [
         &[
             "eig",
@@ -50,6 +30,15 @@ fn a_failed_write_to_standard_output_is_an_error_not_a_panic() {
             "0:100:0.001",
             "--format",
             "csv",
+        ][..],
+        &[
+            "eig",
+            "--bike",
+            "benchmark",
+            "--speeds",
+            "0:100:0.001",
+            "--format",
+            "json",
         ][..],
         &["eig", "--bike", "benchmark", "--speeds", "0:20:0.001"][..],
         &[
@@ -63,10 +52,9 @@ fn a_failed_write_to_standard_output_is_an_error_not_a_panic() {
         ][..],
     ] {
         let (code, stderr) = with_closed_stdout(args);
-        assert_eq!(code, Some(2), "{args:?}: {stderr}");
-        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(code, Some(0), "{args:?}: {stderr}");
         assert!(
-            stderr.contains("broken pipe") && stderr.contains("incomplete"),
+            !stderr.contains("panicked") && !stderr.contains("error") && !stderr.to_lowercase().contains("broken pipe"),
             "{args:?}: {stderr}"
         );
     }
@@ -120,12 +108,12 @@ fn synth_refuses_a_folder_with_files_and_replaces_it_whole_when_forced() {
 
 /// `synth | head -1` used to leave a half-written set: the set is now
 /// complete before the first line is printed, so a closed pipe costs only
-/// the console lines.
+/// the console lines (and stops quietly).
 #[test]
 fn synth_into_a_closed_pipe_still_writes_the_whole_set() {
     let dir = tmp("synth-closed-pipe");
     let (code, stderr) = with_closed_stdout(&["synth", "--runs", "2", "--out", dir.to_str().unwrap()]);
-    assert_eq!(code, Some(2), "{stderr}");
+    assert_eq!(code, Some(0), "{stderr}");
     assert_eq!(entries(&dir), vec!["calibration", "run01", "run02", "truth"]);
     assert!(!entries(&dir.join("truth")).is_empty());
 }
