@@ -12,6 +12,7 @@ pub mod eig;
 pub mod fit;
 pub mod identify;
 pub mod models;
+mod outputs;
 pub mod params;
 mod progress;
 pub mod report;
@@ -22,6 +23,7 @@ pub mod synth;
 pub mod text;
 pub mod verify;
 
+pub use outputs::Paths;
 pub use progress::ProgressDisplay;
 
 use anyhow::{bail, Context, Result};

@@ -25,6 +25,11 @@ pub fn run(a: SweepArgs) -> Result<bool> {
         at_speed,
     } = a;
     let base_opts = plot_options(&plot_args, None)?;
+    super::Paths::new()
+        .bike("--bike", Some(&bike))
+        .file("--output", out.as_deref())
+        .file("--plot", plot.as_deref())
+        .check()?;
     check_outputs(out.as_deref(), plot.as_deref())?;
     let b = load(&bike)?;
     let quantity = match map {

@@ -4,3 +4,4 @@ mod commands;
 mod inputs_and_outputs;
 mod plots;
 mod reliability;
+mod user_files;
