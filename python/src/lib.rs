@@ -576,6 +576,13 @@ fn sweep<'py>(
                 "values: no parameter values given",
             ));
         }
+        if param2.as_deref().is_some_and(|p2| p2.trim() == param.trim()) {
+            // The second value would overwrite the first in every cell.
+            return Err(Failure::new(
+                "InvalidArgumentError",
+                format!("param and param2 both name `{param}`: a map needs two different parameters (for one, leave out param2 and values2)"),
+            ));
+        }
         let ys: Vec<Option<f64>> = match (&param2, ys) {
             (Some(_), Some(ys)) if !ys.is_empty() => ys.into_iter().map(Some).collect(),
             (Some(p2), _) => {

@@ -79,6 +79,16 @@ pub fn range_spec(s: &str, what: &str, limit: usize) -> Result<(f64, f64, usize)
     }
 }
 
+/// `--speed-max`: the searched speeds are 0 to it, so it must be a
+/// positive finite speed (0 searched nothing and reported "never
+/// self-stable").
+pub fn check_speed_max(v: f64) -> Result<f64> {
+    if !(v.is_finite() && v > 0.0) {
+        bail!("--speed-max {v}: the upper end of the searched speeds must be a positive finite speed (m/s), e.g. --speed-max 10");
+    }
+    Ok(v)
+}
+
 pub fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
     let (a, h, n) = range_spec(s, what, MAX_POINTS)?;
     Ok((0..n).map(|k| a + k as f64 * h).collect())

@@ -1,5 +1,6 @@
 //! The command line: every command's output formats and its errors.
 
+mod arguments;
 mod commands;
 mod inputs_and_outputs;
 mod plots;
