@@ -332,6 +332,7 @@ fn a_killed_synth_leaves_the_old_set_or_the_new_one() {
 /// output that is an input (by any path: `./`, a link, a hard link) or
 /// another output is refused before any work, naming both flags, and the
 /// file is left as it was.
+#[cfg(unix)]
 #[test]
 fn an_output_is_never_an_input_or_another_output() {
     let dir = tmp("output-is-input");
