@@ -8,6 +8,7 @@ use crate::bicycle::{Bicycle, BicycleError, Linear};
 use crate::progress::{OnProgress, Progress};
 use crate::registry::BuiltIn;
 use bikedyn_report::plot::PlotError;
+use bikedyn_report::staged::{FolderKind, StagedDir};
 use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::experiment::{
     self, accept,
@@ -90,13 +91,10 @@ pub enum FitError {
         #[source]
         source: ParameterError,
     },
-    /// A folder of plots could not be created.
-    #[error("creating {}", path.display())]
-    CreateDir {
-        path: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
+    /// The folder of plots could not be written (see
+    /// `bikedyn_report::staged`).
+    #[error(transparent)]
+    Output(#[from] bikedyn_report::output::OutputError),
     /// A plot could not be drawn or written.
     #[error(transparent)]
     Plot(#[from] PlotError),
@@ -588,16 +586,22 @@ pub fn speed_form_text(out: &FitOutcome) -> String {
 }
 
 /// Response plots (one per kick) and the continuation diagram with the
-/// measured eigenvalues, in `dir` (created), each as SVG and PNG. The axis
-/// limits of `opts` apply to the continuation diagram only; its subject
-/// gets the model's name there.
+/// measured eigenvalues, in the folder `dir`, each as SVG and PNG. The
+/// folder is written whole beside its place and moved in (a kill leaves the
+/// earlier plots or the new ones); it must be new, empty or earlier plots of
+/// `fit` (`bikedyn_report::staged`). The axis limits of `opts` apply to the
+/// continuation diagram only; its subject gets the model's name there.
 pub fn plots(out: &FitOutcome, dir: &Path, opts: &bikedyn_report::plot::PlotOptions) -> Result<(), FitError> {
+    let staged = StagedDir::new(dir, FolderKind::FitPlots)?;
+    plots_into(out, staged.path(), opts)?;
+    Ok(staged.commit()?)
+}
+
+/// [`plots`] into an existing folder `dir`, for a caller that stages the
+/// folder itself (with more files in it).
+pub fn plots_into(out: &FitOutcome, dir: &Path, opts: &bikedyn_report::plot::PlotOptions) -> Result<(), FitError> {
     use bikedyn_report::experiment::plot as xplot;
     use bikedyn_report::plot::PlotOptions;
-    std::fs::create_dir_all(dir).map_err(|source| FitError::CreateDir {
-        path: dir.to_path_buf(),
-        source,
-    })?;
     for r in &out.reports {
         let stem = r
             .run

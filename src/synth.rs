@@ -18,6 +18,7 @@ use crate::bicycle::{canonical_of, Bicycle, BicycleError};
 use crate::registry::BuiltIn;
 use bikedyn_report::experiment::synth::{write_run, WriteRunError};
 use bikedyn_report::output::{save_json, write_atomic, OutputError};
+use bikedyn_report::staged::{FolderKind, StagedDir};
 use bikedyn_runtime::eigen::{eigenvalues_of, EigenError};
 use bikedyn_runtime::experiment::synth::{rest_trajectory, RunKind, SensorModel};
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
@@ -53,8 +54,10 @@ pub struct SynthOptions {
     pub seed: u64,
     /// Output folder: it must not exist or be empty, unless `force`.
     pub out: PathBuf,
-    /// Replace a non-empty output folder (its old content is removed once
-    /// the new set is complete).
+    /// Replace a set that `synth` wrote in `out` (recognised by its marker,
+    /// `bikedyn_report::staged::MARKER`; a folder without it, or with
+    /// files the set does not list, is refused). The old set is removed
+    /// once the new one is complete.
     pub force: bool,
 }
 
@@ -91,19 +94,8 @@ pub struct SynthRun {
 pub enum SynthError {
     /// The output folder holds files already (a set must never be mixed
     /// with another's runs or overwrite measured data).
-    #[error("{} is not empty: choose a new folder, or pass --force to replace its content", path.display())]
+    #[error("{} is not empty: choose a new folder, or pass --force to replace a set that bikedyn synth wrote there", path.display())]
     OutputNotEmpty { path: PathBuf },
-    /// The output path names no folder (`.`, `..`, a root).
-    #[error("{}: name a folder to create (not `.`, `..` or a root)", path.display())]
-    OutputName { path: PathBuf },
-    /// The finished set could not be moved into place.
-    #[error("moving the finished set from {} to {}", from.display(), to.display())]
-    Rename {
-        from: PathBuf,
-        to: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
     /// The number of runs is outside 1 to 1000.
     #[error("--runs must be between 1 and 1000")]
     RunCount { runs: usize },
@@ -143,70 +135,20 @@ pub enum SynthError {
     Json(#[from] serde_json::Error),
 }
 
-/// A set being written: a hidden folder beside the output folder, removed
-/// if the set is not completed (an error, a full disk), and renamed onto
-/// the output folder once every file is written, so the output folder
-/// holds a whole set or stays as it was.
-struct PartialSet {
-    dir: PathBuf,
-    done: bool,
-}
-
-impl PartialSet {
-    fn new(out: &Path, force: bool) -> Result<PartialSet, SynthError> {
-        let name = out
-            .file_name()
-            .filter(|n| *n != "." && *n != "..")
-            .ok_or_else(|| SynthError::OutputName {
-                path: out.to_path_buf(),
-            })?;
-        if !force {
-            let non_empty = match std::fs::read_dir(out) {
-                Ok(mut entries) => entries.next().is_some(),
-                // Not a folder (a file): creating the set will fail and say so.
-                Err(e) => e.kind() != std::io::ErrorKind::NotFound,
-            };
-            if non_empty {
-                return Err(SynthError::OutputNotEmpty {
-                    path: out.to_path_buf(),
-                });
-            }
-        }
-        let parent = out
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        let dir = parent.join(format!(".{}.partial-{}", name.to_string_lossy(), std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        create_dir(&dir)?;
-        Ok(PartialSet { dir, done: false })
+/// Refuse a non-empty output folder without `force` (with it, the staged
+/// set checks that the folder is a set bikedyn wrote).
+fn check_empty(out: &Path, force: bool) -> Result<(), SynthError> {
+    let non_empty = match std::fs::read_dir(out) {
+        Ok(mut entries) => entries.next().is_some(),
+        // Not a folder (a file): staging the set says so.
+        Err(_) => false,
+    };
+    if non_empty && !force {
+        return Err(SynthError::OutputNotEmpty {
+            path: out.to_path_buf(),
+        });
     }
-
-    /// Put the finished set in place of `out` (removing what `out` held).
-    fn finish(mut self, out: &Path) -> Result<(), SynthError> {
-        if out.is_dir() {
-            std::fs::remove_dir_all(out).map_err(|source| SynthError::Rename {
-                from: self.dir.clone(),
-                to: out.to_path_buf(),
-                source,
-            })?;
-        }
-        std::fs::rename(&self.dir, out).map_err(|source| SynthError::Rename {
-            from: self.dir.clone(),
-            to: out.to_path_buf(),
-            source,
-        })?;
-        self.done = true;
-        Ok(())
-    }
-}
-
-impl Drop for PartialSet {
-    fn drop(&mut self) {
-        if !self.done {
-            let _ = std::fs::remove_dir_all(&self.dir);
-        }
-    }
+    Ok(())
 }
 
 fn create_dir(dir: &Path) -> Result<(), SynthError> {
@@ -333,8 +275,9 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
     // model simulated, damping, controllers and tyre states included (not
     // the bare Whipple bicycle's).
     let linear = bike.linear_with(Some(info.name))?;
-    let set = PartialSet::new(&a.out, a.force)?;
-    let out = set.dir.clone();
+    check_empty(&a.out, a.force)?;
+    let set = StagedDir::new(&a.out, FolderKind::SyntheticSet)?;
+    let out = set.path().to_path_buf();
     let lookup = bike.lookup()?;
     // Sensors like the thesis's instrumentation (FORMAT.md), on this
     // bicycle's rear wheel.
@@ -413,5 +356,5 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
             plan,
         });
     }
-    set.finish(&a.out)
+    Ok(set.commit()?)
 }

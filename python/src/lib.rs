@@ -13,11 +13,12 @@
 //! computations run without the GIL, so other Python threads go on.
 
 use bikedyn::bicycle::{Bicycle, BicycleError, Linear};
-use bikedyn::fit::{kick_json, plots, run_fit, FitOptions, FitOutcome};
+use bikedyn::fit::{kick_json, plots_into, run_fit, FitOptions, FitOutcome};
 use bikedyn::identify::eigen_table::{identify_table, write_table_report, TableOutcome, TableRequest};
 use bikedyn::identify::{report as identify_report, run as identify_run, IdentifyRequest, Outcome};
 use bikedyn::report::output::{stability_json, write_atomic};
 use bikedyn::report::plot::PlotOptions;
+use bikedyn::report::staged::{FolderKind, StagedDir};
 use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, eigenvalues_of, LinearBicycle};
 use bikedyn::runtime::experiment::angles::AngleMethod;
 use bikedyn::runtime::parameters::ParameterSet;
@@ -575,6 +576,13 @@ fn sweep<'py>(
                 "values: no parameter values given",
             ));
         }
+        if param2.as_deref().is_some_and(|p2| p2.trim() == param.trim()) {
+            // The second value would overwrite the first in every cell.
+            return Err(Failure::new(
+                "InvalidArgumentError",
+                format!("param and param2 both name `{param}`: a map needs two different parameters (for one, leave out param2 and values2)"),
+            ));
+        }
         let ys: Vec<Option<f64>> = match (&param2, ys) {
             (Some(_), Some(ys)) if !ys.is_empty() => ys.into_iter().map(Some).collect(),
             (Some(p2), _) => {
@@ -917,15 +925,17 @@ impl PyFitResult {
         let out = &self.outcome;
         let json = &self.json;
         detached(py, move || {
-            std::fs::create_dir_all(&dir)
-                .map_err(|e| Failure::new("OutputError", format!("{}: {e}", dir.display())))?;
-            write_atomic(dir.join("kicks.json"), |w| w.write_all(json.as_bytes()))
+            // Written whole beside `dir` and moved in, as `bikedyn fit
+            // --plot` does; only a folder of earlier plots is replaced.
+            let staged = StagedDir::new(&dir, FolderKind::FitPlots).map_err(|e| Failure::new("OutputError", e))?;
+            write_atomic(staged.path().join("kicks.json"), |w| w.write_all(json.as_bytes()))
                 .map_err(|e| Failure::new("OutputError", e))?;
             let opts = PlotOptions {
                 subject: self.subject.clone(),
                 ..PlotOptions::default()
             };
-            plots(out, &dir, &opts).map_err(|e| Failure::new("OutputError", e))
+            plots_into(out, staged.path(), &opts).map_err(|e| Failure::new("OutputError", e))?;
+            staged.commit().map_err(|e| Failure::new("OutputError", e))
         })
     }
 }

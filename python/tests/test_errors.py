@@ -72,6 +72,12 @@ def test_sweep_errors_name_the_design():
         bikedyn.sweep("benchmark", "mB", [85.0, -1.0], [5.0])
 
 
+def test_sweep_refuses_the_same_parameter_twice():
+    # Issue 35, reproducer 15: every cell took the second value.
+    with pytest.raises(bikedyn.InvalidArgumentError, match="param and param2 both name `c`"):
+        bikedyn.sweep("benchmark", "c", [0.08, 0.1], [5.0], param2="c", values2=[0.08, 0.1])
+
+
 def test_a_rust_panic_is_an_exception_with_its_message():
     from bikedyn import _bikedyn
 

@@ -8,7 +8,9 @@
 //! and sweep formats, tables), [`plot`] (continuation diagram, stability
 //! map, fonts), [`simulate`] (time-history CSV and plot), [`identify`]
 //! (identification plots), [`experiment`] (measured-run plots, the residual
-//! table, the synthetic sensor files).
+//! table, the synthetic sensor files), [`staged`] (output folders written
+//! as a whole and recognised as bikedyn's, cleanup of killed runs'
+//! temporaries).
 // The same allowances as the runtime, whose code this was: index loops over
 // grid cells read more plainly than zipped iterators.
 #![allow(clippy::needless_range_loop)]
@@ -20,3 +22,4 @@ pub mod identify;
 pub mod output;
 pub mod plot;
 pub mod simulate;
+pub mod staged;

@@ -115,14 +115,39 @@ pub enum OutputError {
         /// Underlying error.
         source: io::Error,
     },
-    /// An output folder holds files that are not an earlier output of
-    /// the same kind (so replacing it would destroy someone's files).
-    #[error("cannot write {}: the folder holds files but no {marker} of an earlier run; choose a new or empty folder", .path.display())]
+    /// An output folder holds files but no marker of bikedyn's (so
+    /// replacing it could destroy someone's files; see `crate::staged`).
+    #[error("cannot write {}: the folder holds files and no {marker} file says bikedyn wrote it (measured data, someone's files, or an output of a bikedyn older than this one); choose a new or empty folder, or remove this one yourself if nothing in it is needed", .path.display())]
     ForeignFolder {
         /// The folder.
         path: PathBuf,
-        /// The file an earlier output would hold (`report.json`).
+        /// The marker file an output of bikedyn holds.
         marker: &'static str,
+    },
+    /// An output folder of bikedyn's holds a file bikedyn did not write.
+    #[error("cannot replace {}: {} was not written by bikedyn (the folder's list of its files does not name it); move it out of the folder, or choose a new folder", .path.display(), .file.display())]
+    ForeignFile {
+        /// The folder.
+        path: PathBuf,
+        /// The first file bikedyn did not write.
+        file: PathBuf,
+    },
+    /// An output folder holds another kind of bikedyn output.
+    #[error("cannot write {}: it holds a {found}, not a {expected}; choose another folder", .path.display())]
+    OtherKind {
+        /// The folder.
+        path: PathBuf,
+        /// What the folder's marker says it holds.
+        found: String,
+        /// What this run writes.
+        expected: &'static str,
+    },
+    /// The output folder appeared or changed while this run was writing
+    /// (another run writing the same place): nothing was replaced.
+    #[error("cannot write {}: it appeared or changed while this run was writing it (another run writing the same folder?); it was left as it is: run again, or choose another folder", .path.display())]
+    Changed {
+        /// The folder.
+        path: PathBuf,
     },
     /// Producing the content failed (encoding or rendering).
     #[error("cannot write {}: {source}", .path.display())]
@@ -144,6 +169,9 @@ impl OutputError {
             | OutputError::InvalidPath { path }
             | OutputError::Io { path, .. }
             | OutputError::ForeignFolder { path, .. }
+            | OutputError::ForeignFile { path, .. }
+            | OutputError::OtherKind { path, .. }
+            | OutputError::Changed { path }
             | OutputError::Content { path, .. } => path,
         }
     }
@@ -151,7 +179,6 @@ impl OutputError {
 
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// Reserve a fresh temporary file next to `path`; returns (file, temp path).
 /// The directory a file `path` goes in (`.` for a bare name), which must
 /// exist.
 fn existing_dir_of(path: &Path) -> Result<PathBuf, OutputError> {
@@ -168,6 +195,7 @@ fn existing_dir_of(path: &Path) -> Result<PathBuf, OutputError> {
     Ok(dir)
 }
 
+/// Reserve a fresh temporary file next to `path`; returns (file, temp path).
 fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
     let name = match path.file_name() {
         Some(n) => n.to_string_lossy().into_owned(),
@@ -178,6 +206,8 @@ fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
         }
     };
     let dir = existing_dir_of(path)?;
+    // Temporaries of killed runs in the same folder go now (issue 35).
+    crate::staged::clean_stale(&dir);
     // Keep the extension last: some encoders choose the format from it.
     let stem = path
         .file_stem()
@@ -415,125 +445,6 @@ where
 /// Atomically write `contents` to `path`.
 pub fn write_string_atomic(path: impl AsRef<Path>, contents: &str) -> Result<(), OutputError> {
     write_atomic(path, |w| w.write_all(contents.as_bytes()))
-}
-
-/// An output folder written as a whole (a report): its files go into a
-/// hidden folder beside it, which takes the target's place on
-/// [`StagedDir::commit`]; dropped without a commit (an error on the way), it
-/// is removed and the target is left as it was. A target that exists must
-/// be empty or an earlier output (holding `marker`), which is replaced
-/// whole, so no file of the old output stays beside the new ones.
-pub struct StagedDir {
-    staging: PathBuf,
-    target: PathBuf,
-    committed: bool,
-}
-
-impl StagedDir {
-    /// Check that `target` can be written (before any work): its parent
-    /// folder exists and takes a new folder, and `target` is new, empty or
-    /// an earlier output holding `marker`.
-    pub fn check(target: &Path, marker: &'static str) -> Result<(), OutputError> {
-        drop(StagedDir::new(target, marker)?);
-        Ok(())
-    }
-
-    /// Start writing `target` (see [`StagedDir::check`]).
-    pub fn new(target: &Path, marker: &'static str) -> Result<StagedDir, OutputError> {
-        let name = target
-            .file_name()
-            .filter(|n| *n != "." && *n != "..")
-            .ok_or_else(|| OutputError::InvalidPath {
-                path: target.to_path_buf(),
-            })?;
-        match fs::read_dir(target) {
-            Ok(mut entries) => {
-                if entries.next().is_some() && !target.join(marker).is_file() {
-                    return Err(OutputError::ForeignFolder {
-                        path: target.to_path_buf(),
-                        marker,
-                    });
-                }
-            }
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
-            Err(e) => {
-                let (op, source) = if target.is_dir() {
-                    ("read the folder", e)
-                } else {
-                    (
-                        "create the folder",
-                        io::Error::new(io::ErrorKind::AlreadyExists, "a file of that name exists"),
-                    )
-                };
-                return Err(OutputError::Io {
-                    path: target.to_path_buf(),
-                    op,
-                    source,
-                });
-            }
-        }
-        let parent = target
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty())
-            .unwrap_or(Path::new("."));
-        if !parent.is_dir() {
-            return Err(OutputError::NoSuchDirectory {
-                path: target.to_path_buf(),
-                dir: parent.to_path_buf(),
-            });
-        }
-        let staging = parent.join(format!(".{}.partial-{}", name.to_string_lossy(), std::process::id()));
-        let _ = fs::remove_dir_all(&staging);
-        fs::create_dir(&staging).map_err(|source| OutputError::Io {
-            path: target.to_path_buf(),
-            op: "create a folder beside it",
-            source,
-        })?;
-        Ok(StagedDir {
-            staging,
-            target: target.to_path_buf(),
-            committed: false,
-        })
-    }
-
-    /// The folder to write the files into.
-    pub fn path(&self) -> &Path {
-        &self.staging
-    }
-
-    /// Put the written folder in the target's place (an earlier output is
-    /// moved aside first and removed once the new one is in place).
-    pub fn commit(mut self) -> Result<(), OutputError> {
-        let io = |op: &'static str| {
-            let path = self.target.clone();
-            move |source| OutputError::Io { path, op, source }
-        };
-        let old = self.staging.with_extension("old");
-        let had_old = self.target.exists();
-        if had_old {
-            let _ = fs::remove_dir_all(&old);
-            fs::rename(&self.target, &old).map_err(io("move the earlier output aside"))?;
-        }
-        if let Err(e) = fs::rename(&self.staging, &self.target) {
-            if had_old {
-                let _ = fs::rename(&old, &self.target);
-            }
-            return Err(io("move the new output into place")(e));
-        }
-        self.committed = true;
-        if had_old {
-            let _ = fs::remove_dir_all(&old);
-        }
-        Ok(())
-    }
-}
-
-impl Drop for StagedDir {
-    fn drop(&mut self) {
-        if !self.committed {
-            let _ = fs::remove_dir_all(&self.staging);
-        }
-    }
 }
 
 // ---------------------------------------------------------------------------

@@ -408,7 +408,9 @@ pub struct SynthArgs {
     /// complete).
     #[arg(long)]
     pub out: PathBuf,
-    /// Replace the content of a non-empty output folder.
+    /// Replace a set that `bikedyn synth` wrote in the output folder (a
+    /// folder without its marker, or with files it did not write, is
+    /// refused).
     #[arg(long)]
     pub force: bool,
 }

@@ -17,10 +17,23 @@ pub fn run(quick: bool, identify: bool) -> Result<bool> {
     Ok(true)
 }
 
+/// A scratch folder `name-<pid>` in the system's temporary folder, which
+/// must exist: a bench never creates a missing `TMPDIR` (nor leaves one).
+fn scratch(name: &str) -> Result<std::path::PathBuf> {
+    let root = std::env::temp_dir();
+    if !root.is_dir() {
+        anyhow::bail!(
+            "the temporary folder {} (TMPDIR) does not exist or is no folder: create it, or set TMPDIR to an existing folder",
+            root.display()
+        );
+    }
+    Ok(root.join(format!("{name}-{}", std::process::id())))
+}
+
 /// A full `identify` on a 12-run synthetic set (steer damping hidden), made
 /// in a temporary folder.
 fn identify_bench() -> Result<()> {
-    let dir = std::env::temp_dir().join(format!("bikedyn-bench-identify-{}", std::process::id()));
+    let dir = scratch("bikedyn-bench-identify")?;
     let _ = std::fs::remove_dir_all(&dir);
     super::synth::thesis_set(&dir, 12, 22, &["c_steer=0.25"])?;
     let request = IdentifyRequest {
@@ -60,7 +73,7 @@ pub fn experiment(quick: bool) -> Result<()> {
             Some(root.join("realdata/tudelft_sbw_kicks/logs/eigen_normal_sil6.5n2_16.2kph.log")),
         )
     } else {
-        let d = std::env::temp_dir().join(format!("bikedyn-bench-{}", std::process::id()));
+        let d = scratch("bikedyn-bench")?;
         let spec = ResponseSpec::default();
         let s = SensorModel::default();
         write_run(

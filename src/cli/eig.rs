@@ -30,6 +30,13 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
     let OutputArgs { format, output: out } = out;
     // Every output and plot option is checked before any work.
     let mut opts = plot_options(&plots.args, None)?;
+    super::Paths::new()
+        .bike("--bike", Some(&bike))
+        .file("--output", out.as_deref())
+        .file("--plot", plots.continuation.as_deref())
+        .file("--plot-root-locus", plots.root_locus.as_deref())
+        .file("--plot-mode-shapes", plots.mode_shapes.as_deref())
+        .check()?;
     check_outputs(out.as_deref(), plots.continuation.as_deref())?;
     check_outputs(None, plots.root_locus.as_deref())?;
     check_outputs(None, plots.mode_shapes.as_deref())?;

@@ -33,6 +33,18 @@ pub fn options(args: &FitArgs) -> Result<FitOptions> {
 pub fn run(args: &FitArgs) -> Result<bool> {
     let mut plot_opts = super::plot_options(&args.plot_args, None)?;
     let opts = options(args)?;
+    let mut paths = super::Paths::new()
+        .input("--calibration", args.calibration.as_deref())
+        .bike("--bike", args.bike.as_deref())
+        .folder("--plot", args.plot.as_deref());
+    for i in &args.inputs {
+        paths = paths.input("INPUT", Some(i));
+    }
+    paths.check()?;
+    if let Some(dir) = &args.plot {
+        // Before the computation, as `identify --report`.
+        bikedyn::report::staged::StagedDir::check(dir, bikedyn::report::staged::FolderKind::FitPlots)?;
+    }
     let out = {
         // The bar is cleared before anything is printed.
         let display = ProgressDisplay::new();

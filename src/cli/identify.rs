@@ -35,8 +35,17 @@ pub fn run(a: &IdentifyArgs) -> Result<bool> {
     // A report folder that cannot be written fails now, not after the
     // computation.
     let plot_opts = super::plot_options(&a.plot_args, None)?;
+    let mut paths = super::Paths::new()
+        .input("--eigenvalues", a.eigenvalues.as_deref())
+        .input("--calibration", a.calibration.as_deref())
+        .bike("--bike", a.bike.as_deref())
+        .folder("--report", a.report.as_deref());
+    for i in &a.inputs {
+        paths = paths.input("INPUT", Some(i));
+    }
+    paths.check()?;
     if let Some(dir) = &a.report {
-        bikedyn::report::output::StagedDir::check(dir, "report.json")?;
+        bikedyn::report::staged::StagedDir::check(dir, bikedyn::report::staged::FolderKind::IdentifyReport)?;
     }
     if let Some(table) = &a.eigenvalues {
         // A table of someone's measured eigenvalues is no thesis-format run:

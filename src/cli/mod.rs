@@ -12,6 +12,7 @@ pub mod eig;
 pub mod fit;
 pub mod identify;
 pub mod models;
+mod outputs;
 pub mod params;
 mod progress;
 pub mod report;
@@ -22,6 +23,7 @@ pub mod synth;
 pub mod text;
 pub mod verify;
 
+pub use outputs::Paths;
 pub use progress::ProgressDisplay;
 
 use anyhow::{bail, Context, Result};
@@ -75,6 +77,16 @@ pub fn range_spec(s: &str, what: &str, limit: usize) -> Result<(f64, f64, usize)
         }
         _ => bail!("{what}: `{s}` must be START:STOP:STEP with STEP > 0 and STOP >= START"),
     }
+}
+
+/// `--speed-max`: the searched speeds are 0 to it, so it must be a
+/// positive finite speed (0 searched nothing and reported "never
+/// self-stable").
+pub fn check_speed_max(v: f64) -> Result<f64> {
+    if !(v.is_finite() && v > 0.0) {
+        bail!("--speed-max {v}: the upper end of the searched speeds must be a positive finite speed (m/s), e.g. --speed-max 10");
+    }
+    Ok(v)
 }
 
 pub fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
@@ -240,12 +252,18 @@ pub fn write_out(args: std::fmt::Arguments<'_>) -> Result<()> {
     std::io::stdout().lock().write_fmt(args).map_err(stdout_error)
 }
 
+/// Standard output was closed by its reader (`| head -1`): the reader has
+/// what it wanted, so the command stops quietly with exit status 0, as
+/// Unix tools do (issue 35, reproducer 28). Other write errors (a full
+/// disk) remain errors.
+#[derive(Debug, thiserror::Error)]
+#[error("standard output was closed before everything was written (broken pipe)")]
+pub struct StdoutClosed;
+
 /// The error of a failed write to standard output.
 pub fn stdout_error(e: std::io::Error) -> anyhow::Error {
     if e.kind() == std::io::ErrorKind::BrokenPipe {
-        anyhow::anyhow!(
-            "standard output was closed before everything was written (broken pipe); the output is incomplete"
-        )
+        anyhow::Error::new(StdoutClosed)
     } else {
         anyhow::anyhow!("writing to standard output: {e}; the output is incomplete")
     }
@@ -262,6 +280,10 @@ pub fn stdout_error_of(e: Box<dyn std::error::Error + Send + Sync>) -> anyhow::E
         // A CSV writer's I/O error is its kind, not its source.
         if let Some(csv::ErrorKind::Io(io)) = c.downcast_ref::<csv::Error>().map(|e| e.kind()) {
             return stdout_error(std::io::Error::new(io.kind(), io.to_string()));
+        }
+        // So is a JSON writer's (its `source` skips the I/O error).
+        if let Some(kind) = c.downcast_ref::<serde_json::Error>().and_then(|e| e.io_error_kind()) {
+            return stdout_error(std::io::Error::new(kind, c.to_string()));
         }
         cause = c.source();
     }

@@ -10,6 +10,10 @@ use bikedyn::report::output;
 pub fn run(command: ParamsCommand) -> Result<bool> {
     match command {
         ParamsCommand::Convert { to, file, output: out } => {
+            super::Paths::new()
+                .bike("FILE", Some(&file))
+                .file("--output", out.as_deref())
+                .check()?;
             let b = load(&file)?;
             let mut text = match to {
                 FormName::Benchmark => b.parameters.to_benchmark()?.to_toml_string(),

@@ -4,18 +4,22 @@
 
 use super::text::{canonical_text, stability_json, stability_text};
 use super::{load, parse_range};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use bikedyn::bicycle::BUILT_IN;
 use bikedyn::identify::{report, IdentifyRequest};
 use bikedyn::report::output;
 use bikedyn::report::plot::{plot_continuation, subject, PlotOptions};
+use bikedyn::report::staged::{FolderKind, StagedDir};
 use bikedyn::runtime::eigen::{critical_speeds, eigen_sweep};
 use bikedyn::runtime::verify::VerifyOptions;
 use std::path::PathBuf;
 
-/// Run `bikedyn report --out OUT`.
-pub fn run(out: PathBuf) -> Result<bool> {
-    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+/// Run `bikedyn report --out OUT`: the folder is written whole beside its
+/// place and moved in at the end, so a kill leaves the earlier report or
+/// the new one; it must be new, empty or an earlier `report` folder.
+pub fn run(target: PathBuf) -> Result<bool> {
+    let staged = StagedDir::new(&target, FolderKind::Report)?;
+    let out = staged.path().to_path_buf();
     let mut ok = true;
     for m in bikedyn::models::model_names() {
         let r = bikedyn::models::verify_model(m, &VerifyOptions::default()).expect("known model");
@@ -47,7 +51,6 @@ pub fn run(out: PathBuf) -> Result<bool> {
         }
         output::save_json(out.join(format!("{name}_stability.json")), &stability_json(name, &crit))?;
     }
-    outln!("wrote tables and plots to {}", out.display());
     // Close the loop on the committed example set (made by `bikedyn
     // synth` with steer damping hidden): measured eigenvalues on the
     // continuation diagram, the identified effect, before and after.
@@ -63,7 +66,12 @@ pub fn run(out: PathBuf) -> Result<bool> {
     let o = super::identify::run_with_progress(&request)?;
     let dir = out.join("identify");
     report::write_report(&o, &request, &dir, &PlotOptions::default())?;
+    staged.commit()?;
+    outln!(
+        "wrote tables, plots and the identification report to {}",
+        target.display()
+    );
     outln!("{}", report::summary(&o));
-    outln!("report: {}", dir.join("report.md").display());
+    outln!("report: {}", target.join("identify/report.md").display());
     Ok(ok)
 }

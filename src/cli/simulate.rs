@@ -80,9 +80,12 @@ pub fn parse_pulse(spec: &str) -> Result<TorquePulse> {
 /// Run `bikedyn simulate`.
 pub fn run(a: SimulateArgs) -> Result<bool> {
     let mut plot_opts = super::plot_options(&a.plot_args, None)?;
-    if let Some(p) = &a.plot {
-        super::check_outputs(None, Some(p))?;
-    }
+    super::Paths::new()
+        .bike("--bike", Some(&a.bike))
+        .file("--out", a.out.as_deref())
+        .file("--plot", a.plot.as_deref())
+        .check()?;
+    super::check_outputs(a.out.as_deref(), a.plot.as_deref())?;
     let bike = Bicycle::resolve(&a.bike)?;
     super::show_warnings(&bike);
     let info = simulate::choose_model(&bike, a.model.as_deref(), a.free_speed)?;

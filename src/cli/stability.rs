@@ -9,6 +9,7 @@ use bikedyn::runtime::eigen::critical_speeds_of;
 /// Run `bikedyn stability`.
 pub fn run(bike: BikeArg, speed_max: f64, json: bool) -> Result<bool> {
     let BikeArg { spec: bike, model } = bike;
+    let speed_max = super::check_speed_max(speed_max)?;
     let b = load(&bike)?;
     let lin = b.linear_with(model.as_deref())?;
     let crit = critical_speeds_of(&lin, 0.0, speed_max)?;

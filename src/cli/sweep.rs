@@ -25,6 +25,15 @@ pub fn run(a: SweepArgs) -> Result<bool> {
         at_speed,
     } = a;
     let base_opts = plot_options(&plot_args, None)?;
+    let speed_max = super::check_speed_max(speed_max)?;
+    if param2.as_deref().is_some_and(|p2| p2.trim() == param.trim()) {
+        bail!("--param and --param2 both name `{param}`: a map needs two different parameters (for one, drop --param2 and --values2)");
+    }
+    super::Paths::new()
+        .bike("--bike", Some(&bike))
+        .file("--output", out.as_deref())
+        .file("--plot", plot.as_deref())
+        .check()?;
     check_outputs(out.as_deref(), plot.as_deref())?;
     let b = load(&bike)?;
     let quantity = match map {

@@ -91,6 +91,10 @@ pub fn run(a: SynthArgs) -> Result<bool> {
         anyhow::bail!("--runs must be between 1 and 1000");
     }
     let effects = effects(&a.effects)?;
+    super::Paths::new()
+        .bike("--bike", Some(&a.bike))
+        .folder("--out", Some(&a.out))
+        .check()?;
     make(&SynthOptions {
         speeds: speeds(&a.speeds)?,
         bike: a.bike,

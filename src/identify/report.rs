@@ -11,7 +11,8 @@ use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
 use bikedyn_report::experiment::accept::rejected_text;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
-use bikedyn_report::output::{save_json, write_string_atomic, StagedDir};
+use bikedyn_report::output::{save_json, write_string_atomic};
+use bikedyn_report::staged::{FolderKind, StagedDir};
 use bikedyn_runtime::identify::confounding::CONFOUNDED;
 use bikedyn_runtime::identify::{pooled_rms, Candidate, Verdict, PLAUSIBLE_PRIOR_SDS};
 use bikedyn_runtime::registry::ModelRegistry;
@@ -340,7 +341,7 @@ pub fn write_report<R: ModelRegistry>(
     // Written beside `dir` and moved into its place at the end: a failure
     // leaves an earlier report as it was, and no old file stays beside the
     // new ones.
-    let staged = StagedDir::new(dir, "report.json")?;
+    let staged = StagedDir::new(dir, FolderKind::IdentifyReport)?;
     let out = staged.path();
     let bike = Bicycle::<R>::resolve_in(&o.bike)?;
     save_json(out.join("report.json"), &outcome_json(o))?;

@@ -1,6 +1,8 @@
 //! The command line: every command's output formats and its errors.
 
+mod arguments;
 mod commands;
 mod inputs_and_outputs;
 mod plots;
 mod reliability;
+mod user_files;

@@ -4,7 +4,7 @@
 
 use crate::common::*;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 
 fn tmp(name: &str) -> PathBuf {
     let d = scratch("reliability").join(name);
@@ -12,35 +12,15 @@ fn tmp(name: &str) -> PathBuf {
     d
 }
 
-/// Run `args` with standard output a pipe whose reading end is closed at
-/// once (as `| head -0` does), and return the exit code and standard error.
-fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    drop(child.stdout.take());
-    let out = child.wait_with_output().unwrap();
-    (out.status.code(), text(&out.stderr))
-}
-
-fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
-
 /// A closed pipe or a full device on standard output used to panic (exit
-/// 101) in most commands: now it is an error (exit 2) that says the output
-/// is incomplete. Outputs larger than a pipe's buffer (64 KiB), so the
-/// write surely fails: a streamed CSV and two aligned tables.
+/// 101) in most commands. A full device is an error (exit 2) that says the
+/// output is incomplete; a pipe closed by its reader (`| head -1`) stops
+/// the command quietly with exit 0, as Unix tools do (issue 35, reproducer
+/// 28: the JSON path printed "Broken pipe (os error 32)"). Outputs larger
+/// than a pipe's buffer (64 KiB), so the write surely fails: streamed CSV
+/// and JSON, and two aligned tables.
 #[test]
-fn a_failed_write_to_standard_output_is_an_error_not_a_panic() {
+fn a_closed_pipe_stops_quietly_and_a_full_device_is_an_error() {
     for args in [
         &[
             "eig",
@@ -50,6 +30,15 @@ fn a_failed_write_to_standard_output_is_an_error_not_a_panic() {
             "0:100:0.001",
             "--format",
             "csv",
+        ][..],
+        &[
+            "eig",
+            "--bike",
+            "benchmark",
+            "--speeds",
+            "0:100:0.001",
+            "--format",
+            "json",
         ][..],
         &["eig", "--bike", "benchmark", "--speeds", "0:20:0.001"][..],
         &[
@@ -63,10 +52,9 @@ fn a_failed_write_to_standard_output_is_an_error_not_a_panic() {
         ][..],
     ] {
         let (code, stderr) = with_closed_stdout(args);
-        assert_eq!(code, Some(2), "{args:?}: {stderr}");
-        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert_eq!(code, Some(0), "{args:?}: {stderr}");
         assert!(
-            stderr.contains("broken pipe") && stderr.contains("incomplete"),
+            !stderr.contains("panicked") && !stderr.contains("error") && !stderr.to_lowercase().contains("broken pipe"),
             "{args:?}: {stderr}"
         );
     }
@@ -88,12 +76,12 @@ fn a_failed_write_to_standard_output_is_an_error_not_a_panic() {
 
 /// `synth --out` into a folder with files in it used to overwrite its
 /// calibration and first runs and keep the rest: now it is refused and the
-/// folder left as it was; `--force` replaces the whole content (no run of
-/// the old set survives beside the new ones). A set is written beside the
-/// folder and renamed into place, so a refused or failed run leaves no
-/// partial folder.
+/// folder left as it was; `--force` replaces a set synth wrote whole (no
+/// run of the old set survives beside the new ones), and only such a set
+/// (see `user_files`). A set is written beside the folder and renamed into
+/// place, so a refused or failed run leaves no partial folder.
 #[test]
-fn synth_refuses_a_folder_with_files_and_replaces_it_whole_when_forced() {
+fn synth_refuses_a_folder_with_files_and_replaces_its_own_set_whole_when_forced() {
     let dir = tmp("synth-existing");
     std::fs::create_dir_all(dir.join("run09")).unwrap();
     std::fs::write(dir.join("run09/run.toml"), "measured data\n").unwrap();
@@ -111,22 +99,29 @@ fn synth_refuses_a_folder_with_files_and_replaces_it_whole_when_forced() {
         "measured data\n"
     );
 
+    // A set of synth's own with more runs is replaced whole.
+    std::fs::remove_dir_all(&dir).unwrap();
+    let out = bikedyn(&["synth", "--runs", "2", "--out", out_arg]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
     let out = bikedyn(&["synth", "--runs", "1", "--out", out_arg, "--force"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert_eq!(entries(&dir), vec!["calibration", "run01", "truth"]);
+    assert_eq!(entries(&dir), vec![".bikedyn-output", "calibration", "run01", "truth"]);
     let parent = entries(dir.parent().unwrap());
     assert!(!parent.iter().any(|n| n.contains(".partial-")), "{parent:?}");
 }
 
 /// `synth | head -1` used to leave a half-written set: the set is now
 /// complete before the first line is printed, so a closed pipe costs only
-/// the console lines.
+/// the console lines (and stops quietly).
 #[test]
 fn synth_into_a_closed_pipe_still_writes_the_whole_set() {
     let dir = tmp("synth-closed-pipe");
     let (code, stderr) = with_closed_stdout(&["synth", "--runs", "2", "--out", dir.to_str().unwrap()]);
-    assert_eq!(code, Some(2), "{stderr}");
-    assert_eq!(entries(&dir), vec!["calibration", "run01", "run02", "truth"]);
+    assert_eq!(code, Some(0), "{stderr}");
+    assert_eq!(
+        entries(&dir),
+        vec![".bikedyn-output", "calibration", "run01", "run02", "truth"]
+    );
     assert!(!entries(&dir.join("truth")).is_empty());
 }
 
@@ -404,7 +399,8 @@ fn negative_values_and_kick_formats() {
 /// `identify --report` into a folder that cannot take a report fails before
 /// any computation; an earlier report is replaced whole (a failed run
 /// would leave it as it was: the new one is written beside it and moved
-/// into place), so no old file stays beside the new ones.
+/// into place), so no old file stays beside the new ones. (A file that no
+/// report wrote is never deleted: see `user_files`.)
 #[test]
 fn an_identify_report_is_checked_first_and_replaced_whole() {
     let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping");
@@ -415,7 +411,7 @@ fn an_identify_report_is_checked_first_and_replaced_whole() {
     let stderr = text(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
-        stderr.contains("no report.json of an earlier run") && !stderr.contains("progress:"),
+        stderr.contains("no .bikedyn-output file") && !stderr.contains("progress:"),
         "{stderr}"
     );
     assert_eq!(entries(&foreign), vec!["thesis.tex"]);
@@ -430,9 +426,14 @@ fn an_identify_report_is_checked_first_and_replaced_whole() {
     assert!(!text(&out.stderr).contains("progress:"), "{}", text(&out.stderr));
 
     let earlier = tmp("report-earlier");
-    std::fs::create_dir_all(&earlier).unwrap();
-    std::fs::write(earlier.join("report.json"), "{}\n").unwrap();
+    let out = bikedyn(&["identify", set.to_str().unwrap(), "--report", earlier.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // An earlier report with a plot this one does not draw (listed among
+    // the files bikedyn wrote, as a report of another version would be).
     std::fs::write(earlier.join("stale_plot.svg"), "<svg/>\n").unwrap();
+    let marker = earlier.join(".bikedyn-output");
+    let listed = std::fs::read_to_string(&marker).unwrap() + "stale_plot.svg\n";
+    std::fs::write(&marker, listed).unwrap();
     let out = bikedyn(&["identify", set.to_str().unwrap(), "--report", earlier.to_str().unwrap()]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let files = entries(&earlier);

@@ -11,6 +11,31 @@ pub fn bikedyn(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()
 }
 
+/// Runs `bikedyn args` with standard output a pipe whose reading end is
+/// closed at once (as `| head -0` does); returns the exit code and
+/// standard error.
+pub fn with_closed_stdout(args: &[&str]) -> (Option<i32>, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bikedyn"))
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    (out.status.code(), text(&out.stderr))
+}
+
+/// The names in a folder, sorted.
+pub fn entries(dir: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    names
+}
+
 /// Bytes of a command's output as text (lossy).
 pub fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()

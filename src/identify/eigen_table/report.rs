@@ -43,10 +43,11 @@ pub fn table_summary(o: &TableOutcome) -> String {
 /// at every step, per-speed table) into `dir`.
 pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyError> {
     use bikedyn_report::output::{save_json, write_string_atomic};
+    use bikedyn_report::staged::{FolderKind, StagedDir};
     use std::fmt::Write as _;
     // Written beside `dir` and moved into place at the end (see
-    // `bikedyn_report::output::StagedDir`).
-    let staged = bikedyn_report::output::StagedDir::new(dir, "report.json")?;
+    // `bikedyn_report::staged`).
+    let staged = StagedDir::new(dir, FolderKind::IdentifyReport)?;
     let out = staged.path();
     save_json(
         out.join("report.json"),
