@@ -296,6 +296,9 @@ def main():
             with open(os.path.join(args.work, "truth", row["name"], "set_truth.json")) as fh:
                 truth = json.load(fh)
             report_dir = os.path.join(args.work, "reports", row["name"])
+            # The scorecard's own folder: an earlier scorecard's report goes
+            # (bikedyn replaces only reports it marked as its own).
+            shutil.rmtree(report_dir, ignore_errors=True)
             os.makedirs(os.path.dirname(report_dir), exist_ok=True)
             t0 = time.time()
             cmd = [args.bikedyn, "identify", os.path.join(args.work, "data", row["name"]),
