@@ -567,3 +567,26 @@ fn huber(r: f64, c: f64) -> f64 {
         2.0 * c * r.abs() - c * c
     }
 }
+
+#[cfg(test)]
+mod prior_tests {
+    use super::huber;
+
+    #[test]
+    fn the_prior_penalty_is_gaussian_within_its_turn_and_linear_beyond() {
+        let c = 3.0;
+        for r in [-2.9, -1.0, 0.0, 0.5, 3.0] {
+            assert_eq!(huber(r, c), r * r);
+        }
+        // Continuous, with the Gaussian's slope at the turn (2 c), and
+        // growing by 2 c per standard deviation beyond it.
+        let e = 1e-7;
+        assert!((huber(c + e, c) - huber(c - e, c)).abs() < 1e-5);
+        assert!(((huber(c + 2.0 * e, c) - huber(c + e, c)) / e - 2.0 * c).abs() < 1e-4);
+        assert!((huber(-8.0, c) - (2.0 * c * 8.0 - c * c)).abs() < 1e-12);
+        // Five standard deviations out: 21 instead of 25; at ten, 51
+        // instead of 100 (a gross error costs far less than a Gaussian says).
+        assert_eq!(huber(5.0, c), 21.0);
+        assert_eq!(huber(10.0, c), 51.0);
+    }
+}

@@ -17,7 +17,17 @@
 //! same way (a damper and an inertia error may each explain only part of
 //! a misfit). The search ends when a step adds nothing, or after
 //! [`IdentifyOptions::max_effects`] additions beside the speed loss, which
-//! is modelled first (rolling resistance and drag, in steps of their own).
+//! is modelled first (rolling resistance and drag, in steps of their own,
+//! and together as one trial).
+//!
+//! Two checks keep a plausible stand-in from taking the place of the cause:
+//! a winner that fitted worse than a correction beyond its prior is fitted
+//! together with that correction, and gives way to it when the correction
+//! explains most of what it did (the encompassing test, [`Verdict::Encompassed`]);
+//! and after the forward search every candidate that a later one followed
+//! is tested again against the final model without it (the backward check,
+//! [`super::elimination`]); one that fails is removed and the forward
+//! search resumes once.
 //!
 //! The criterion of every fit, at every step, is computed with the
 //! effective sample sizes of the base model's residuals (one reference for
@@ -30,6 +40,7 @@ use super::criterion::{farthest_from_prior, with_priors_on_the_data_scale};
 pub use super::cross_validation::{folds_by_run, paired_gain};
 pub use super::elimination::MemberCheck;
 use super::screen;
+use super::search_order::{first_passing, SearchOrder};
 use super::{
     cross_validate, fit_candidate, Candidate, CandidateFit, Factory, IdentifyError, IdentifyOptions, ModelFactory,
     RollChannel, Segment, SegmentError, Setup, Weights, NUISANCE,
@@ -319,15 +330,15 @@ pub(super) struct Search<'s> {
 
 /// A trial being considered: its members (indices into the step's
 /// remaining candidates) and what the step knows of it so far.
-struct Pending<'c> {
-    members: Vec<&'c Candidate>,
-    predicted: Option<f64>,
-    fit: Option<(CandidateFit, Setup<'c>)>,
-    verdict: Option<Verdict>,
+pub(super) struct Pending<'c> {
+    pub(super) members: Vec<&'c Candidate>,
+    pub(super) predicted: Option<f64>,
+    pub(super) fit: Option<(CandidateFit, Setup<'c>)>,
+    pub(super) verdict: Option<Verdict>,
 }
 
 impl<'c> Pending<'c> {
-    fn name(&self) -> String {
+    pub(super) fn name(&self) -> String {
         self.members
             .iter()
             .map(|c| c.name.as_str())
@@ -539,7 +550,7 @@ impl<'s> Search<'s> {
     /// Fit a pending trial on top of `current`; a failed fit gets its
     /// verdict, and so does a fit that is not physical or does not lower
     /// the criterion.
-    fn fit(
+    pub(super) fn fit(
         &self,
         p: &mut Pending<'s>,
         current: &CandidateFit,
@@ -650,7 +661,7 @@ impl<'s> Search<'s> {
 
     /// Cross-validate one fitted trial against `current`: its verdict
     /// (`None`: not fitted).
-    fn validate_one(&self, p: &mut Pending<'s>, current: &CandidateFit) -> Option<Verdict> {
+    pub(super) fn validate_one(&self, p: &mut Pending<'s>, current: &CandidateFit) -> Option<Verdict> {
         let (fit, setup) = p.fit.as_mut()?;
         cross_validate(setup, fit, self.fold_of, self.opts);
         Some(if !(fit.cv < current.cv) {
@@ -668,118 +679,6 @@ impl<'s> Search<'s> {
                 base_cv: current.cv,
             }
         })
-    }
-
-    /// The encompassing test of a plausible winner `w` against the
-    /// corrections of the step that fitted better but lie beyond their
-    /// prior: fitted together with the best of them, does the winner still
-    /// explain anything? When its parameters fall within two standard
-    /// errors of their absence, or keep less than half of their shift,
-    /// while the correction's shift stays significant, the winner was a
-    /// proxy for the correction, and the correction is added in its place
-    /// if it passes the held-out test itself (a measurement can be wrong by
-    /// more than its stated uncertainty: a lamp or a bag on the handlebar).
-    /// Returns the new winner, if any; the pair's fit is kept as a trial.
-    fn encompassed(
-        &self,
-        pending: &mut Vec<Pending<'s>>,
-        w: usize,
-        single: usize,
-        current: &CandidateFit,
-        selected: &[&'s Candidate],
-        base_bic: f64,
-    ) -> Result<Option<usize>, IdentifyError> {
-        let bic_of = |p: &Pending<'s>| p.fit.as_ref().map_or(f64::INFINITY, |f| f.0.bic);
-        let wbic = bic_of(&pending[w]);
-        let Some(x) = (0..single)
-            .filter(|&i| matches!(pending[i].verdict, Some(Verdict::ImplausibleUnderPrior { .. })))
-            .filter(|&i| bic_of(&pending[i]) < wbic)
-            .min_by(|&a, &b| bic_of(&pending[a]).total_cmp(&bic_of(&pending[b])))
-        else {
-            return Ok(None);
-        };
-        if pending[w].members.len() != 1 {
-            return Ok(None);
-        }
-        let mut pair = Pending {
-            members: vec![pending[w].members[0], pending[x].members[0]],
-            predicted: None,
-            fit: None,
-            verdict: None,
-        };
-        self.fit(&mut pair, current, selected, base_bic)?;
-        (self.progress)(&format!("fitted pair {} (encompassing test)", pair.name()), None);
-        let ks = current.values.len();
-        let kw = pending[w].members[0].parameters.len();
-        // How far each member's parameters lie from their absence (zero for
-        // an effect, the measured value for a correction), in standard
-        // errors of the joint fit: the largest of each member.
-        let distance = |f: &CandidateFit, from: usize, member: &Candidate| {
-            member
-                .parameters
-                .iter()
-                .enumerate()
-                .map(|(j, q)| {
-                    let absent = q.prior.map_or(0.0, |p| p.0);
-                    ((f.values[from + j] - absent) / f.stderr[from + j]).abs()
-                })
-                .filter(|d| d.is_finite())
-                .fold(0.0f64, f64::max)
-        };
-        // The winner's shift from its absence, alone and beside the
-        // correction (largest over its parameters, relative).
-        let shift = |values: &[f64], from: usize, member: &Candidate| {
-            member
-                .parameters
-                .iter()
-                .enumerate()
-                .map(|(j, q)| values[from + j] - q.prior.map_or(0.0, |p| p.0))
-                .collect::<Vec<f64>>()
-        };
-        let alone = pending[w]
-            .fit
-            .as_ref()
-            .map(|(f, _)| shift(&f.values, ks, pair.members[0]));
-        let swap = match (&pair.fit, alone) {
-            (Some((f, _)), Some(alone))
-                if f.physical && f.values.len() == f.stderr.len() && f.values.len() > ks + kw =>
-            {
-                let t_winner = distance(f, ks, pair.members[0]);
-                let t_correction = distance(f, ks + kw, pair.members[1]);
-                let beside = shift(&f.values, ks, pair.members[0]);
-                // The share of the winner's own shift that remains beside the
-                // correction: below one half, the correction explains most
-                // of what the winner did (its parameters may still be
-                // significant: with many samples a remnant always is).
-                let remains = beside
-                    .iter()
-                    .zip(&alone)
-                    .map(|(b, a)| if *a != 0.0 { (b / a).max(0.0) } else { 1.0 })
-                    .fold(0.0f64, f64::max);
-                ((t_winner < 2.0 || remains < 0.5) && t_correction > 2.0).then_some((t_winner, remains))
-            }
-            _ => None,
-        };
-        if pair.verdict.is_none() || matches!(pair.verdict, Some(Verdict::ImplausibleUnderPrior { .. })) {
-            pair.verdict = Some(Verdict::NotAdded);
-        }
-        pending.push(pair);
-        let Some((t_winner, remains)) = swap else {
-            return Ok(None);
-        };
-        let Some(verdict) = self.validate_one(&mut pending[x], current) else {
-            return Ok(None);
-        };
-        if !verdict.added() {
-            return Ok(None);
-        }
-        pending[x].verdict = Some(verdict);
-        pending[w].verdict = Some(Verdict::Encompassed {
-            by: pending[x].name(),
-            t: t_winner,
-            remains,
-        });
-        Ok(Some(x))
     }
 
     /// The candidate a step adds against each fitted rival that also
@@ -864,75 +763,6 @@ impl<'s> Search<'s> {
     fn farthest_from_prior(&self, members: &[&Candidate], values: &[f64]) -> Option<(String, f64, f64)> {
         farthest_from_prior(self.stated, members, values)
     }
-}
-
-/// The order in which a step fits its candidates, from the score test's
-/// predicted change of the criterion of each (`None`: not screened; a
-/// change at or above zero: it cannot lower the criterion, never fitted).
-#[derive(Clone, Debug, PartialEq)]
-struct SearchOrder {
-    /// The candidates to fit: those not screened first (they were always
-    /// fitted), then by predicted gain, best first.
-    order: Vec<usize>,
-    /// How many of `order` are fitted before any is cross-validated: the
-    /// candidates predicted to gain at least [`CONTENDER_SHARE`] of the
-    /// best one's gain. Among those that pass, the criterion chooses, so
-    /// the score test's ranking decides only between candidates it
-    /// separates by more than its own error.
-    contenders: usize,
-}
-
-/// The share of the best predicted gain within which a candidate is a
-/// contender. The score test linearises every candidate at the current
-/// fit, and a candidate's fitted change of the criterion differs from its
-/// prediction: on the scorecard's independent sets (267 fitted candidates)
-/// the ratio fitted / predicted had a median of 1.0 and a 95th percentile
-/// of 1.9. A candidate predicted at half the best one's gain can therefore
-/// still beat it once fitted, and is fitted before either is accepted.
-const CONTENDER_SHARE: f64 = 0.5;
-
-impl SearchOrder {
-    fn of(predicted: &[Option<f64>]) -> SearchOrder {
-        let mut order: Vec<usize> = (0..predicted.len())
-            .filter(|&i| predicted[i].is_none_or(|d| d < 0.0))
-            .collect();
-        let key = |i: usize| predicted[i].unwrap_or(f64::NEG_INFINITY);
-        order.sort_by(|&a, &b| key(a).total_cmp(&key(b)));
-        let best_gain = order
-            .iter()
-            .filter_map(|&i| predicted[i])
-            .fold(0.0, |m: f64, d| m.max(-d));
-        let near = CONTENDER_SHARE * best_gain;
-        let contenders = order
-            .iter()
-            .take_while(|&&i| predicted[i].is_none_or(|d| -d >= near))
-            .count();
-        SearchOrder { order, contenders }
-    }
-}
-
-/// The search of one step: fit the contenders, cross-validate, and while
-/// nothing has passed, fit the next candidate in the order and
-/// cross-validate again, until one passes (its index) or none is left. A
-/// candidate is never skipped because another one failed.
-fn first_passing<S, E>(
-    state: &mut S,
-    plan: &SearchOrder,
-    mut fit: impl FnMut(&mut S, usize) -> Result<(), E>,
-    mut validate: impl FnMut(&mut S) -> Result<Option<usize>, E>,
-) -> Result<Option<usize>, E> {
-    let mut next = 0;
-    while next < plan.order.len() {
-        let batch = if next == 0 { plan.contenders.max(1) } else { 1 };
-        for &i in &plan.order[next..(next + batch).min(plan.order.len())] {
-            fit(state, i)?;
-        }
-        next += batch;
-        if let Some(w) = validate(state)? {
-            return Ok(Some(w));
-        }
-    }
-    Ok(None)
 }
 
 #[cfg(test)]
