@@ -24,7 +24,7 @@ use super::corrections;
 use super::predict::predict;
 use super::IdentifyError;
 use crate::bicycle::Bicycle;
-use bikedyn_runtime::identify::Candidate;
+use bikedyn_runtime::identify::{Candidate, Verdict};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
 use bikedyn_runtime::registry::ModelInfo;
 use nalgebra::{DMatrix, DVector};
@@ -62,7 +62,11 @@ pub struct TableTrial {
     /// Leave-one-speed-out error (mean squared weighted residual).
     pub cv: f64,
     pub base_cv: f64,
-    pub verdict: String,
+    /// Why it was or was not selected, with its numbers (the held-out
+    /// error is the leave-one-speed-out error); in JSON `outcome`, as the
+    /// run-set reports name it.
+    #[serde(rename = "outcome")]
+    pub verdict: Verdict,
 }
 
 /// What identification from a table found.
@@ -187,14 +191,23 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
             } else {
                 (f64::NAN, vec![])
             };
+            // A candidate that passes is `Added` until the step's best is
+            // known (below).
             let verdict = if !physical {
-                "rejected: a dissipative parameter fitted at or below zero (not physics)".to_string()
+                Verdict::NotPhysical
             } else if db >= 0.0 {
-                format!("rejected: BIC {db:+.1} (no gain beyond its added parameters)")
+                Verdict::NoCriterionGain { bic_change: db }
             } else if !(cv < current_cv) {
-                format!("rejected: leave-one-speed-out error {cv:.4} not below {current_cv:.4}")
+                Verdict::HeldOutNotLower {
+                    cv,
+                    base_cv: current_cv,
+                }
             } else {
-                format!("passes: BIC {db:+.1}, leave-one-speed-out error {cv:.4} (was {current_cv:.4})")
+                Verdict::Added {
+                    bic_change: db,
+                    cv,
+                    base_cv: current_cv,
+                }
             };
             let names = set.iter().flat_map(|c| c.parameters.iter().map(|p| p.symbol.clone()));
             trials.push(TableTrial {
@@ -214,19 +227,22 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
             }
         }
         let Some((ci, f, db, cv, d2)) = best else { break };
+        // The step's other passing candidates came after the best in the
+        // order of the criterion.
+        for t in trials.iter_mut().filter(|t| t.step == step && t.name != cands[ci].name) {
+            if let Verdict::Added { bic_change, .. } = t.verdict {
+                t.verdict = Verdict::CriterionAboveAdded {
+                    bic_change,
+                    added: cands[ci].name.clone(),
+                };
+            }
+        }
         selected.push(&cands[ci]);
         current_bic += db;
         current_cv = cv;
         current_chi2 = f.chi2;
         held_d2 = d2;
         current_fit = f;
-        if let Some(t) = trials
-            .iter_mut()
-            .rev()
-            .find(|t| t.step == step && t.name == cands[ci].name)
-        {
-            t.verdict = t.verdict.replacen("passes", "selected", 1);
-        }
     }
     let _ = current_chi2;
     let vals = values_map(&selected, &current_fit.values);

@@ -78,7 +78,7 @@ pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyEr
             vals.join(", "),
             t.bic_change,
             t.cv,
-            t.verdict
+            crate::identify::report::verdict_text(&t.verdict)
         );
     }
     let _ = writeln!(s, "\n## Per speed\n\n| line | speed (m/s) | measured | predicted before | predicted after |\n|---|---|---|---|---|");
