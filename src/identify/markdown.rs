@@ -182,7 +182,7 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     if !id.final_check.is_empty() {
         let _ = writeln!(
             s,
-            "Final check: each selected candidate that a later one followed, tested against the model without it by the same entry test (the criterion and the held-out error must fall, consistently over the runs); one that fails no longer earns its place and is removed, the model refitted without it.\n\n| candidate | in the model | without it: BIC change, held-out error | outcome |\n|---|---|---|---|"
+            "Final check: each selected candidate that a later one followed, tested against the model without it: it stays while the criterion and the held-out error are lower with it (the entry test without its bar of a consistent gain over the runs, which is the evidence for entering); one that fails no longer earns its place and is removed, the model refitted without it.\n\n| candidate | in the model | without it: BIC change, held-out error | outcome |\n|---|---|---|---|"
         );
         for c in &id.final_check {
             let without = match &c.without {
