@@ -385,9 +385,16 @@ fn no_speed_reason(r: &RunReport, k: &KickFit) -> String {
     use bikedyn_runtime::experiment::kicks::{KickOptions, WindowEnd};
     if k.samples.t.len() < 2 {
         let fall = KickOptions::default().fall_angle;
+        // A log's lean column is read as given: in degrees it is beyond
+        // the fall angle at once; a run's roll comes from the orientations.
+        let hint = if r.log.is_some() {
+            " (a lean column in degrees rather than radians?)"
+        } else {
+            " (the bicycle fell)"
+        };
         return match k.window_end {
             WindowEnd::Fall => format!(
-                "the free-response window is empty: the roll angle is beyond the fall angle ({fall} rad) from the kick on (a lean column in degrees rather than radians?)"
+                "the free-response window is empty: the roll angle passes the fall angle ({fall} rad) at once after the kick{hint}"
             ),
             end => format!("the free-response window is empty (it ends at once: {end:?})"),
         };

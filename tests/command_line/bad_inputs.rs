@@ -372,7 +372,8 @@ fn a_parameter_file_is_read_in_the_format_of_its_content() {
 
 /// A folder of a set that looks like a run but has no run.toml (missing,
 /// or a folder of that name) used to be skipped without a word: it is
-/// named in a warning; a folder that is no run (notes) is not.
+/// named in a warning; a folder that is no run (notes, a synthetic set's
+/// truth) is not.
 #[test]
 fn a_run_folder_without_run_toml_is_named_in_a_warning() {
     let s = small_set("no-run-toml");
@@ -383,6 +384,9 @@ fn a_run_folder_without_run_toml_is_named_in_a_warning() {
     std::fs::create_dir(s.join("run08/run.toml")).unwrap();
     std::fs::create_dir(s.join("docs")).unwrap();
     std::fs::write(s.join("docs/notes.txt"), "x\n").unwrap();
+    // A synthetic set's truth files are CSV too, but no run's records.
+    std::fs::create_dir(s.join("truth")).unwrap();
+    std::fs::write(s.join("truth/run01_trajectory.csv"), "t,roll\n0,0\n").unwrap();
     let out = bikedyn(&["fit", arg(&s), "--json"]);
     let err = text(&out.stderr);
     assert!(out.status.success(), "{err}");
@@ -391,7 +395,7 @@ fn a_run_folder_without_run_toml_is_named_in_a_warning() {
         "{err}"
     );
     assert!(err.contains("run08: left out") && err.contains("not a file"), "{err}");
-    assert!(!err.contains("docs"), "{err}");
+    assert!(!err.contains("docs") && !err.contains("truth"), "{err}");
     assert_eq!(stdout_json(&out).as_array().unwrap().len(), 1);
 }
 

@@ -529,7 +529,8 @@ pub fn classify(path: &Path) -> Result<Vec<Input>, RunError> {
 }
 
 /// [`classify`], with the folders of a set left out because they look like
-/// runs (they hold CSV files, or a `run.toml` that is no file) but have no
+/// runs (they hold IMU or speed-switch CSV files, or a `run.toml` that is
+/// no file) but have no
 /// `run.toml` to read ([`RunError::NoRunToml`]): a run is never dropped
 /// without a word. Other folders (notes, plots) are not runs and pass
 /// unremarked.
@@ -604,7 +605,7 @@ pub fn classify_reporting(path: &Path) -> Result<(Vec<Input>, Vec<RunError>), Ru
 
 /// Why a folder of a set without a readable `run.toml` looks like a run
 /// that was meant: its `run.toml` is something other than a file, or it
-/// holds CSV records. Hidden folders (bikedyn's own temporaries) are not.
+/// holds IMU or speed-switch records. Hidden folders (bikedyn's own temporaries) are not.
 fn looks_like_a_run(p: &Path) -> Option<&'static str> {
     let hidden = p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.'));
     if hidden || !p.is_dir() {
@@ -614,11 +615,13 @@ fn looks_like_a_run(p: &Path) -> Option<&'static str> {
     if toml.exists() {
         return Some("its run.toml is not a file");
     }
-    let has_csv = std::fs::read_dir(p)
-        .ok()?
-        .filter_map(|e| e.ok())
-        .any(|e| e.path().extension().is_some_and(|x| x.eq_ignore_ascii_case("csv")));
-    has_csv.then_some("it holds CSV records but no run.toml")
+    // A run's records by their usual names (FORMAT.md); other CSV files
+    // (a synthetic set's `truth/` trajectories) are no run.
+    let has_records = std::fs::read_dir(p).ok()?.filter_map(|e| e.ok()).any(|e| {
+        let name = e.file_name().to_string_lossy().to_ascii_lowercase();
+        name.ends_with(".csv") && (name.starts_with("imu") || name.starts_with("speed_switch"))
+    });
+    has_records.then_some("it holds a run's records (IMU or speed-switch CSV) but no run.toml")
 }
 
 /// Process a set of thesis-style runs: calibration (completed with the
