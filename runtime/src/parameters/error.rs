@@ -296,14 +296,6 @@ pub enum ParameterError {
         field: String,
         /// Its value (m).
         value: f64,
-        /// The geometry, for the message (m).
-        x4: f64,
-        /// See `x4`.
-        z4: f64,
-        /// See `x4`.
-        x5: f64,
-        /// See `x4`.
-        z5: f64,
         /// What it gives (a steer-axis tilt out of range, no ground contact).
         problem: String,
         /// File and line, when read from a file.
@@ -408,20 +400,12 @@ impl ParameterError {
             ParameterError::ImpossibleGeometry {
                 field,
                 value,
-                x4,
-                z4,
-                x5,
-                z5,
                 problem,
                 origin,
             } if origin.path.is_none() => ParameterError::ImpossibleGeometry {
                 origin: Origin::new(path, line_of(&field)),
                 field,
                 value,
-                x4,
-                z4,
-                x5,
-                z5,
                 problem,
             },
             ParameterError::NonPhysicalInertia {

@@ -279,10 +279,6 @@ impl ThesisParameters {
         Err(ParameterError::ImpossibleGeometry {
             field: field.to_string(),
             value,
-            x4: s.steer_point_x,
-            z4: s.steer_point_z,
-            x5: s.front_wheel_x,
-            z5: s.front_wheel_z,
             problem,
             origin: Default::default(),
         })
