@@ -503,3 +503,49 @@ fn peak_memory_kib(args: &[&str]) -> Option<u64> {
     assert!(out.status.success(), "{args:?}: {}", text(&out.stderr));
     peak
 }
+
+/// On a real TU Delft log (`../shared`; skipped without it): a lean column
+/// in degrees used to be reported as "no usable speed record"; each kick
+/// now says its window is empty because the roll passes the fall angle at
+/// once, and asks about degrees. The same log with every row written twice
+/// (it halved the measured frequencies) is refused at its first repetition.
+#[test]
+fn a_real_log_in_degrees_or_doubled_states_the_cause() {
+    let Some(dir) = shared("realdata/tudelft_sbw_kicks") else {
+        return;
+    };
+    let Some(log) = std::fs::read_dir(dir.join("logs"))
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .find(|p| p.extension().is_some_and(|x| x == "log"))
+    else {
+        return;
+    };
+    let bike = dir.join("bicycle.toml");
+    let text = std::fs::read_to_string(&log).unwrap();
+    let mut lines = text.lines();
+    let header = lines.next().unwrap();
+    let rows: Vec<&str> = lines.filter(|l| !l.trim().is_empty()).collect();
+    let d = tmp("real-logs");
+    // lean_angle and lean_rate (columns 3 and 4) in degrees.
+    let degrees: Vec<String> = rows
+        .iter()
+        .map(|r| {
+            let mut f: Vec<String> = r.split(',').map(String::from).collect();
+            for c in [2, 3] {
+                f[c] = (f[c].parse::<f64>().unwrap().to_degrees()).to_string();
+            }
+            f.join(",")
+        })
+        .collect();
+    let p = d.join("degrees.log");
+    std::fs::write(&p, format!("{header}\n{}\n", degrees.join("\n"))).unwrap();
+    let err = fails(&["fit", arg(&p), "--bike", arg(&bike)]);
+    assert!(err.contains("fall angle") && err.contains("degrees"), "{err}");
+    assert!(!err.contains("wheel sensor gave no speed"), "{err}");
+    let doubled: Vec<&str> = rows.iter().flat_map(|r| [*r, *r]).collect();
+    let p = d.join("doubled.log");
+    std::fs::write(&p, format!("{header}\n{}\n", doubled.join("\n"))).unwrap();
+    let err = fails(&["fit", arg(&p), "--bike", arg(&bike)]);
+    assert!(err.contains("doubled.log:3") && err.contains("repeats line 2"), "{err}");
+}
