@@ -128,12 +128,34 @@ fn identity(path: &Path) -> Option<(PathBuf, u64)> {
         files.sort();
         for f in files {
             f.file_name().hash(&mut h);
-            std::fs::read(&f).ok()?.hash(&mut h);
+            hash_file(&f, &mut h)?;
         }
     } else {
-        std::fs::read(&canonical).ok()?.hash(&mut h);
+        hash_file(&canonical, &mut h)?;
     }
     Some((canonical, h.finish()))
+}
+
+/// Hash a file's bytes a block at a time, so memory stays bounded; a file
+/// above the readers' cap is hashed by its size alone (the reader refuses
+/// it, from its size, before reading).
+fn hash_file(path: &Path, h: &mut impl std::hash::Hasher) -> Option<()> {
+    use std::io::Read;
+    let mut file = std::fs::File::open(path).ok()?;
+    let len = file.metadata().ok()?.len();
+    h.write_u64(len);
+    if len > read::MAX_DATA_FILE_BYTES {
+        return Some(());
+    }
+    let mut buf = vec![0u8; 1 << 16];
+    loop {
+        match file.read(&mut buf) {
+            Ok(0) => return Some(()),
+            Ok(n) => h.write(&buf[..n]),
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(_) => return None,
+        }
+    }
 }
 
 /// Refuse a run folder or log that the inputs name twice, by path or by
@@ -192,6 +214,10 @@ pub struct FitOutcome {
     pub reports: Vec<RunReport>,
     /// Skipped runs with the reason.
     pub errors: Vec<String>,
+    /// Folders of a set that look like runs but have no `run.toml` (left
+    /// out, said so; the exit status is unchanged, since a set may hold
+    /// other folders).
+    pub warnings: Vec<String>,
     /// The bicycle (as given, or `thesis`, the default for thesis-format runs).
     pub bike: String,
     /// The bicycle's linear equations through its model (any effects): the
@@ -213,9 +239,13 @@ pub fn run_fit(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome
 pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>) -> Result<FitOutcome, FitError> {
     let mut inputs = Vec::new();
     let mut errors = Vec::new();
+    let mut warnings = Vec::new();
     for p in &opts.inputs {
-        match experiment::classify(p) {
-            Ok(i) => inputs.extend(i),
+        match experiment::classify_reporting(p) {
+            Ok((i, left_out)) => {
+                inputs.extend(i);
+                warnings.extend(left_out.iter().map(|e| e.to_string()));
+            }
             Err(e) => errors.push(e.to_string()),
         }
     }
@@ -276,7 +306,7 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
                 if runs.is_empty() {
                     if let Some(c) = calibration.filter(|c| !calibrating.contains(c)) {
                         errors.push(format!(
-                            "{}: skipped: a calibration run (the bicycle at rest, kind = \"calibration\" in its run.toml), with no kick to fit",
+                            "{}: a calibration run (the bicycle at rest, kind = \"calibration\" in its run.toml), with no kick to fit",
                             c.display()
                         ));
                     }
@@ -311,6 +341,16 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
             }
         }
     }
+    // A run or log in which no kick was found gave nothing: it is skipped
+    // with the reason, so the exit status says something was left out (a
+    // list of no kicks with exit 0 read as success).
+    for r in &mut reports {
+        if r.kicks.is_empty() {
+            let note = r.notes.iter().position(|n| n.starts_with(experiment::NO_KICK));
+            let why = note.map_or_else(|| experiment::NO_KICK.to_string(), |i| r.notes.remove(i));
+            errors.push(format!("{}: {why}", r.run.display()));
+        }
+    }
     // Which fitted eigenvalues are measured weave eigenvalues, and which
     // form is reported, judged against the bicycle's model (the outlier
     // test over every kick of the inputs).
@@ -319,16 +359,59 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
     // model: say so (and the exit status says something was left out).
     for r in &reports {
         for k in r.kicks.iter().filter(|k| !k.mean_speed.is_finite()) {
-            errors.push(format!("{} kick at {:.2} s: {NO_SPEED}", k.run.display(), k.kick_time));
+            errors.push(format!(
+                "{} kick at {:.2} s: {}",
+                k.run.display(),
+                k.kick_time,
+                no_speed_reason(r, k)
+            ));
         }
     }
     Ok(FitOutcome {
         reports,
         errors,
+        warnings,
         bike: spec.to_string(),
         linear,
         calibrations,
     })
+}
+
+/// The real cause of a kick without a speed: an empty window (the roll
+/// beyond the fall angle from the start, as a lean column in degrees
+/// gives), a speed record that the clock offset moves away from the IMU
+/// record (a wrong `nominal_offset_s`), or the wheel sensor's silence.
+fn no_speed_reason(r: &RunReport, k: &KickFit) -> String {
+    use bikedyn_runtime::experiment::kicks::{KickOptions, WindowEnd};
+    if k.samples.t.len() < 2 {
+        let fall = KickOptions::default().fall_angle;
+        // A log's lean column is read as given: in degrees it is beyond
+        // the fall angle at once; a run's roll comes from the orientations.
+        let hint = if r.log.is_some() {
+            " (a lean column in degrees rather than radians?)"
+        } else {
+            " (the bicycle fell)"
+        };
+        return match k.window_end {
+            WindowEnd::Fall => format!(
+                "the free-response window is empty: the roll angle passes the fall angle ({fall} rad) at once after the kick{hint}"
+            ),
+            end => format!("the free-response window is empty (it ends at once: {end:?})"),
+        };
+    }
+    if let (Some(sp), Some(off)) = (&r.speed, &r.clock_offset) {
+        let (a, b) = (sp.t.first(), sp.t.last());
+        if let (Some(&a), Some(&b)) = (a, b) {
+            let (a, b) = (a + off.value, b + off.value);
+            if b < k.window[0] || a > k.window[1] {
+                return format!(
+                    "the speed record, moved onto the IMU clock by the clock offset of {:.3} s, covers {a:.2} to {b:.2} s and misses the window {:.2} to {:.2} s: check [clocks] nominal_offset_s in run.toml",
+                    off.value, k.window[0], k.window[1]
+                );
+            }
+        }
+    }
+    NO_SPEED.to_string()
 }
 
 /// Why a kick has no predicted weave although it was fitted.

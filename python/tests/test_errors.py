@@ -29,6 +29,19 @@ def test_bad_parameter_file_names_file_line_and_field(tmp_path):
     assert "bad.toml" in msg and "mB" in msg
 
 
+def test_impossible_thesis_geometry_is_refused_naming_file_and_field(tmp_path):
+    # Issue 35, reproducer 7: x4 = -1 (a steer-axis tilt of 2.83 rad) was
+    # accepted by everything but `params show`.
+    lines = bikedyn.Bicycle("thesis").to_toml().splitlines()
+    lines = ["x4 = -1" if l.startswith("x4 ") else l for l in lines]
+    p = tmp_path / "tilted.toml"
+    p.write_text("\n".join(lines) + "\n")
+    with pytest.raises(bikedyn.ParameterError) as e:
+        bikedyn.Bicycle(str(p))
+    msg = str(e.value)
+    assert "tilted.toml" in msg and "`x4`" in msg and "tilt" in msg
+
+
 def test_dict_errors_name_the_key():
     par = dict(meijaard2007()["parameters"])
     del par["IHxz"]

@@ -200,6 +200,15 @@ pub struct PlotOptions {
 /// (8 x 6 inches at 100 dpi).
 pub const DEFAULT_SIZE: (u32, u32) = (800, 600);
 
+/// The most pixels a figure may have: 40 million (a 8000 x 5000 poster,
+/// 27 x 17 inches at 300 dpi). A PNG is drawn on an oversampled canvas of
+/// up to 80 million pixels and averaged down, so the peak memory stays
+/// near 300 MB; the earlier cap of 20000 x 20000 pixels took 2.3 GB.
+pub const MAX_PIXELS: u64 = 40_000_000;
+
+/// The longest side of a figure (pixels).
+pub const MAX_SIDE: u32 = 20_000;
+
 impl Default for PlotOptions {
     fn default() -> Self {
         Self {
@@ -251,8 +260,11 @@ impl PlotOptions {
             return bad(format!("font_size must be positive, got {}", self.font_size));
         }
         let (w, h) = self.pixel_size();
-        if w < 200 || h < 150 || w > 20_000 || h > 20_000 {
-            return bad(format!("image size {w}x{h} px out of range (200x150 to 20000x20000)"));
+        if w < 200 || h < 150 || w > MAX_SIDE || h > MAX_SIDE || w as u64 * h as u64 > MAX_PIXELS {
+            return bad(format!(
+                "image size {w}x{h} px out of range (at least 200x150, at most {MAX_SIDE} on a side and {} million pixels)",
+                MAX_PIXELS / 1_000_000
+            ));
         }
         for (name, r) in [("x_range", self.x_range), ("y_range", self.y_range)] {
             if let Some((lo, hi)) = r {

@@ -52,6 +52,9 @@ pub fn run(args: &FitArgs) -> Result<bool> {
     };
     // The figures name the bicycle (given, or the thesis default).
     plot_opts.subject = Some(bikedyn::report::plot::subject(&out.bike, None));
+    for w in &out.warnings {
+        eprintln!("warning: {w}");
+    }
     for e in &out.errors {
         eprintln!("skipped: {e}");
     }

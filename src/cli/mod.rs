@@ -222,11 +222,13 @@ pub fn plot_options(a: &args::PlotArgs, subject: Option<String>) -> Result<biked
         }
     }
     let (pw, ph) = o.pixel_size();
-    if pw > 20_000 || ph > 20_000 {
+    use bikedyn::report::plot::{MAX_PIXELS, MAX_SIDE};
+    if pw > MAX_SIDE || ph > MAX_SIDE || pw as u64 * ph as u64 > MAX_PIXELS {
         bail!(
-            "--plot-size {} at --dpi {} gives {pw}x{ph} pixels, more than 20000 on a side",
+            "--plot-size {} at --dpi {} gives {pw}x{ph} pixels, more than {MAX_SIDE} on a side or {} million in all (the memory a figure may take): give a smaller size or --dpi",
             a.plot_size.as_deref().unwrap_or("8x6"),
-            o.dpi()
+            o.dpi(),
+            MAX_PIXELS / 1_000_000
         );
     }
     let limits = |flag: &str, spec: &Option<String>| -> Result<Option<(f64, f64)>> {

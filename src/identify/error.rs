@@ -23,6 +23,16 @@ pub enum IdentifyError {
     /// An effect asked for is not a candidate of the identification models.
     #[error("--effects: `{effect}` is not a candidate effect of the identification models ({})", known.join(", "))]
     NotACandidate { effect: String, known: Vec<&'static str> },
+    /// An effect asked for cannot be tried from an eigenvalue table.
+    #[error(
+        "--effects: `{effect}` cannot be tried from an eigenvalue table ({reason}); effects that can: {}",
+        if triable.is_empty() { "none".to_string() } else { triable.join(", ") }
+    )]
+    NotTriableFromTable {
+        effect: String,
+        reason: String,
+        triable: Vec<String>,
+    },
     /// Nothing to test: a conclusion ("no effect warranted") would mean nothing.
     #[error(
         "no candidate effect for `{bicycle}` through model `{model}` (effects: {}): identification would conclude without testing anything",

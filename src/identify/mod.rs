@@ -259,7 +259,10 @@ pub fn run_plan<R: ModelRegistry>(
         rejected,
         mut skipped,
     } = segments(&out);
+    // Runs and logs `fit` skipped (no kick found among them) and folders
+    // of a set left out for want of a run.toml.
     skipped.extend(out.errors.iter().cloned());
+    skipped.extend(out.warnings.iter().cloned());
     let failed_inputs = out.errors.clone();
     if segs.len() < 2 {
         return Err(IdentifyError::TooFewKicks {

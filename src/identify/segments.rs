@@ -83,9 +83,6 @@ pub fn segments(out: &FitOutcome) -> Segments {
             .map(Segment::with_steer_bias);
             keep(seg, 0.5, r, k, [w0, w1], &mut segs);
         }
-        if r.kicks.is_empty() {
-            segs.skipped.push(format!("{}: no kick found", r.run.display()));
-        }
     }
     segs
 }
@@ -128,9 +125,6 @@ fn log_segments(
             weave,
         );
         keep(seg, MIN_LOG_WINDOW, r, k, [w0, w1], segs);
-    }
-    if r.kicks.is_empty() {
-        segs.skipped.push(format!("{}: no kick found", r.run.display()));
     }
 }
 

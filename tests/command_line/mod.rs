@@ -1,6 +1,7 @@
 //! The command line: every command's output formats and its errors.
 
 mod arguments;
+mod bad_inputs;
 mod commands;
 mod inputs_and_outputs;
 mod plots;

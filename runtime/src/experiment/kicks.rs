@@ -246,6 +246,45 @@ pub fn find_kicks(
     out
 }
 
+/// Why [`find_kicks`] found no kick in a record, in words a user can act
+/// on: too short a record for the detector's stencil, a roll rate that
+/// never changes (a frozen sensor), or no jump standing out of the noise
+/// (a record of noise alone, or a rate or time unit that makes the kick's
+/// time scale wrong).
+pub fn no_kick_reason(t: &[f64], roll_rate: &[f64], opt: &KickOptions) -> String {
+    let n = t.len();
+    let span = match (t.first(), t.last()) {
+        (Some(a), Some(b)) => b - a,
+        _ => 0.0,
+    };
+    if n >= 2 {
+        let diffs: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+        let dt = median(&diffs);
+        let w = ((opt.rise_time / dt).round() as usize).max(2);
+        if n < 10 || n <= 2 * w + 2 {
+            return format!(
+                "the record holds {n} samples over {span:.3} s, too few to tell a kick (a rise of {} s) from the response after it",
+                opt.rise_time
+            );
+        }
+    } else {
+        return format!("the record holds {n} sample(s): nothing to find a kick in");
+    }
+    // Below a micro-radian per second the rate is rounding, not motion.
+    let (lo, hi) = roll_rate
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        });
+    if !(hi - lo > 1e-6) {
+        return "the roll rate never changes (a frozen sensor, or a run at rest)".to_string();
+    }
+    format!(
+        "no jump of the roll rate stands {} noise levels out of the record ({span:.1} s, {n} samples): a record of noise alone, no kick given, or times in other units than seconds",
+        opt.threshold_sigmas
+    )
+}
+
 /// Noise of the roll rate: robust spread of raw minus smoothed.
 fn sigma_rate(smooth: &[f64], raw: &[f64]) -> f64 {
     let d: Vec<f64> = raw.iter().zip(smooth).map(|(a, b)| a - b).collect();

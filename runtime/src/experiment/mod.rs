@@ -122,6 +122,10 @@ impl KickFit {
     }
 }
 
+/// The note of a run or log in which no kick was found (followed by the
+/// reason).
+pub const NO_KICK: &str = "no kick found";
+
 /// Result of one run or log.
 #[derive(Clone, Debug, Serialize)]
 pub struct RunReport {
@@ -191,6 +195,23 @@ pub enum RunError {
     NotARun {
         /// The path.
         path: PathBuf,
+    },
+    /// The named folder could not be listed (missing, or no permission).
+    #[error("{}: cannot be read: {source}", path.display())]
+    Unreadable {
+        /// The path.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// A folder of a set that holds a run's files but no readable
+    /// `run.toml`: it is left out, and said so.
+    #[error("{}: left out of the set: {why} (a run folder needs its run.toml beside the data files)", path.display())]
+    NoRunToml {
+        /// The folder.
+        path: PathBuf,
+        /// `run.toml` missing, or not a file.
+        why: &'static str,
     },
 }
 
@@ -383,7 +404,8 @@ pub fn process_thesis_run(run: &ThesisRun, cal: &Calibration, opt: &PipelineOpti
     );
     let mut notes = Vec::new();
     if found.is_empty() {
-        notes.push("no kick found".to_string());
+        let why = kicks::no_kick_reason(&t[k0..], &rate[k0..], &ko);
+        notes.push(format!("{NO_KICK}: {why}"));
     }
     let kicks = found
         .into_iter()
@@ -442,7 +464,8 @@ pub fn process_tudelft(log: &TudelftLog, opt: &PipelineOptions) -> RunReport {
     let found = kicks::find_kicks(&log.t, &log.roll, &log.roll_rate, Some(&log.steer), &[], &ko);
     let mut notes = Vec::new();
     if found.is_empty() {
-        notes.push("no kick found".to_string());
+        let why = kicks::no_kick_reason(&log.t, &log.roll_rate, &ko);
+        notes.push(format!("{NO_KICK}: {why}"));
     }
     let kicks = found
         .iter()
@@ -502,32 +525,55 @@ fn kind_of(p: &Path) -> Option<RunKind> {
 /// `calibration/` or the folder whose run.toml says so), a run folder (the
 /// calibration beside it), a log file, or a folder of log files.
 pub fn classify(path: &Path) -> Result<Vec<Input>, RunError> {
+    classify_reporting(path).map(|(inputs, _)| inputs)
+}
+
+/// [`classify`], with the folders of a set left out because they look like
+/// runs (they hold IMU or speed-switch CSV files, or a `run.toml` that is
+/// no file) but have no
+/// `run.toml` to read ([`RunError::NoRunToml`]): a run is never dropped
+/// without a word. Other folders (notes, plots) are not runs and pass
+/// unremarked.
+pub fn classify_reporting(path: &Path) -> Result<(Vec<Input>, Vec<RunError>), RunError> {
     if path.is_file() {
-        return Ok(vec![Input::Log(path.to_path_buf())]);
+        return Ok((vec![Input::Log(path.to_path_buf())], vec![]));
     }
     if is_run_dir(path) {
         let cal = path.parent().map(|p| p.join("calibration")).filter(|c| is_run_dir(c));
         if kind_of(path) == Some(RunKind::Calibration) {
-            return Ok(vec![Input::Set {
-                runs: vec![],
-                calibration: Some(path.to_path_buf()),
-            }]);
+            return Ok((
+                vec![Input::Set {
+                    runs: vec![],
+                    calibration: Some(path.to_path_buf()),
+                }],
+                vec![],
+            ));
         }
-        return Ok(vec![Input::Set {
-            runs: vec![path.to_path_buf()],
-            calibration: cal,
-        }]);
+        return Ok((
+            vec![Input::Set {
+                runs: vec![path.to_path_buf()],
+                calibration: cal,
+            }],
+            vec![],
+        ));
     }
-    let Ok(rd) = std::fs::read_dir(path) else {
-        return Err(RunError::NotARun {
+    let rd = std::fs::read_dir(path).map_err(|source| match source.kind() {
+        // A file that is not a regular one (a device) or a folder whose
+        // run.toml is no file: no run, not an I/O fault.
+        std::io::ErrorKind::NotADirectory => RunError::NotARun {
             path: path.to_path_buf(),
-        });
-    };
+        },
+        _ => RunError::Unreadable {
+            path: path.to_path_buf(),
+            source,
+        },
+    })?;
     let mut entries: Vec<PathBuf> = rd.filter_map(|e| e.ok().map(|e| e.path())).collect();
     entries.sort();
     let mut runs = Vec::new();
     let mut calibration = None;
     let mut logs = Vec::new();
+    let mut left_out = Vec::new();
     for e in entries {
         if is_run_dir(&e) {
             let named = e.file_name().is_some_and(|n| n == "calibration");
@@ -538,19 +584,44 @@ pub fn classify(path: &Path) -> Result<Vec<Input>, RunError> {
             }
         } else if e.is_file() && e.extension().is_some_and(|x| x == "log") {
             logs.push(Input::Log(e));
+        } else if let Some(why) = looks_like_a_run(&e) {
+            left_out.push(RunError::NoRunToml { path: e, why });
         }
     }
-    if runs.is_empty() && logs.is_empty() {
-        return Err(RunError::NotARun {
+    if runs.is_empty() && logs.is_empty() && calibration.is_none() {
+        return Err(left_out.into_iter().next().unwrap_or(RunError::NotARun {
             path: path.to_path_buf(),
-        });
+        }));
     }
     let mut out = Vec::new();
-    if !runs.is_empty() {
+    if !runs.is_empty() || calibration.is_some() {
+        // A calibration alone is listed (and skipped with its reason by
+        // `fit`), not "not a run folder".
         out.push(Input::Set { runs, calibration });
     }
     out.extend(logs);
-    Ok(out)
+    Ok((out, left_out))
+}
+
+/// Why a folder of a set without a readable `run.toml` looks like a run
+/// that was meant: its `run.toml` is something other than a file, or it
+/// holds IMU or speed-switch records. Hidden folders (bikedyn's own temporaries) are not.
+fn looks_like_a_run(p: &Path) -> Option<&'static str> {
+    let hidden = p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.'));
+    if hidden || !p.is_dir() {
+        return None;
+    }
+    let toml = p.join("run.toml");
+    if toml.exists() {
+        return Some("its run.toml is not a file");
+    }
+    // A run's records by their usual names (FORMAT.md); other CSV files
+    // (a synthetic set's `truth/` trajectories) are no run.
+    let has_records = std::fs::read_dir(p).ok()?.filter_map(|e| e.ok()).any(|e| {
+        let name = e.file_name().to_string_lossy().to_ascii_lowercase();
+        name.ends_with(".csv") && (name.starts_with("imu") || name.starts_with("speed_switch"))
+    });
+    has_records.then_some("it holds a run's records (IMU or speed-switch CSV) but no run.toml")
 }
 
 /// Process a set of thesis-style runs: calibration (completed with the

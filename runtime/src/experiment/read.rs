@@ -10,6 +10,9 @@
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::path::{Path, PathBuf};
 
+mod capped;
+pub use capped::{read_capped, read_text_capped, MAX_DATA_FILE_BYTES, MAX_LOG_FILE_BYTES, MAX_TEXT_FILE_BYTES};
+
 /// Quaternion norms within this distance of 1 are taken as they are (the
 /// files print 7 decimals, so rounding alone gives ~1e-7).
 pub const QUAT_ROUNDING_TOL: f64 = 1e-4;
@@ -164,6 +167,35 @@ pub enum ReadError {
         /// Its rows.
         other_rows: usize,
     },
+    /// A row that repeats the one before it in every field: a sample
+    /// logged twice. In a log without a time column the times come from the
+    /// row count, so repeated rows would stretch them (every row twice
+    /// halves the measured frequencies).
+    #[error(
+        "{}:{line}: row repeats line {previous_line} field for field (a sample logged twice; the log has no time column, so its times come from counting rows and a repeated row stretches them): remove the repeated rows",
+        path.display()
+    )]
+    RepeatedRow {
+        /// File.
+        path: PathBuf,
+        /// Line of the repetition.
+        line: usize,
+        /// Line it repeats.
+        previous_line: usize,
+    },
+    /// A forward speed no bicycle rides at (or a column in other units).
+    #[error(
+        "{}:{line}: column `speed` is {speed} m/s, not a bicycle's speed (from {MIN_LOG_SPEED_M_S} to {MAX_SPEED_M_S} m/s): check the column's units and the row",
+        path.display()
+    )]
+    ImplausibleSpeed {
+        /// File.
+        path: PathBuf,
+        /// Line.
+        line: usize,
+        /// The speed (m/s).
+        speed: f64,
+    },
     /// A bad `run.toml`.
     #[error("{}: {message}", path.display())]
     Metadata {
@@ -195,39 +227,13 @@ fn normalise_name(s: &str) -> String {
     s.trim().trim_matches('"').to_ascii_lowercase().replace([' ', '-'], "_")
 }
 
-/// The largest data file read (a sensor log of hours at kilohertz rates
-/// is far smaller): anything larger is not a log, and reading it whole
-/// would exhaust memory (a device such as `/dev/zero` never ends).
-pub const MAX_DATA_FILE_BYTES: u64 = 512 << 20;
-
-/// The largest metadata or parameter file read.
-pub const MAX_TEXT_FILE_BYTES: u64 = 16 << 20;
-
-/// Read at most `limit` bytes of `path`; a longer file (or an endless
-/// device) is an error that says so, before memory grows.
-pub fn read_capped(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
-    use std::io::Read;
-    let mut out = Vec::new();
-    std::fs::File::open(path)?.take(limit + 1).read_to_end(&mut out)?;
-    if out.len() as u64 > limit {
-        return Err(std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            format!("larger than {} MiB: not a file this reads", limit >> 20),
-        ));
-    }
-    Ok(out)
-}
-
-/// [`read_capped`] as text (invalid UTF-8 is an error).
-pub fn read_text_capped(path: &Path, limit: u64) -> std::io::Result<String> {
-    String::from_utf8(read_capped(path, limit)?)
-        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "stream did not contain valid UTF-8"))
-}
-
 /// Read a comma-separated numeric table. `wanted` lists, per column, the
 /// accepted header names (first = canonical name used in messages).
-fn read_table(path: &Path, wanted: &[&[&'static str]]) -> Result<Table, ReadError> {
-    let bytes = read_capped(path, MAX_DATA_FILE_BYTES).map_err(|source| ReadError::Io {
+/// With `no_repeats`, a data row equal to the one before it in every field
+/// is an error ([`ReadError::RepeatedRow`]): for files without a time
+/// column, where nothing else would notice.
+fn read_table(path: &Path, wanted: &[&[&'static str]], limit: u64, no_repeats: bool) -> Result<Table, ReadError> {
+    let bytes = read_capped(path, limit).map_err(|source| ReadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
@@ -242,6 +248,7 @@ fn read_table(path: &Path, wanted: &[&[&'static str]]) -> Result<Table, ReadErro
     let mut lines = Vec::new();
     // One buffer of fields for every line (a log has 10^4 lines).
     let mut fields: Vec<&str> = Vec::new();
+    let mut previous_row: Option<(&str, usize)> = None;
     for (i, raw) in all.iter().enumerate() {
         let line_no = i + 1;
         let l = raw.trim_end_matches('\r').trim();
@@ -312,6 +319,16 @@ fn read_table(path: &Path, wanted: &[&[&'static str]]) -> Result<Table, ReadErro
             }
             cols[c].push(v);
         }
+        if let Some((previous, previous_line)) = previous_row.filter(|_| no_repeats) {
+            if previous == l {
+                return Err(ReadError::RepeatedRow {
+                    path: path.to_path_buf(),
+                    line: line_no,
+                    previous_line,
+                });
+            }
+        }
+        previous_row = Some((l, line_no));
         lines.push(line_no);
     }
     if header.is_none() {
@@ -391,6 +408,8 @@ pub fn read_imu(path: &Path, rate_hz: f64) -> Result<ImuRecord, ReadError> {
             &["q2", "qy", "y", "quat_y"],
             &["q3", "qz", "z", "quat_z"],
         ],
+        MAX_DATA_FILE_BYTES,
+        false,
     )?;
     let t = tab.cols[0].clone();
     let gaps = check_time(path, &t, &tab.lines, 1.0 / rate_hz)?;
@@ -443,6 +462,8 @@ pub fn read_switch(path: &Path, rate_hz: f64) -> Result<SwitchRecord, ReadError>
             &["time_s", "time", "t", "timestamp", "time_sec"],
             &["volts", "voltage", "v", "volt", "voltage_v", "volts_v"],
         ],
+        MAX_DATA_FILE_BYTES,
+        false,
     )?;
     let t = tab.cols[0].clone();
     let gaps = check_time(path, &t, &tab.lines, 1.0 / rate_hz)?;
@@ -495,6 +516,31 @@ pub const MAX_MAGNETS: usize = 1000;
 /// Highest sample rate accepted (Hz).
 pub const MAX_RATE_HZ: f64 = 1e6;
 
+/// The most characters of one line of a file echoed in a message: the
+/// TOML parser quotes the offending line, which may be a 200 KB line of
+/// nested brackets.
+pub const MAX_ECHOED_CHARS: usize = 160;
+
+/// `text` with each line cut to `max` characters (marked with how many
+/// more there were).
+pub fn clip_lines(text: &str, max: usize) -> String {
+    text.lines()
+        .map(|l| {
+            let n = l.chars().count();
+            if n > max {
+                format!(
+                    "{}... ({} more characters)",
+                    l.chars().take(max).collect::<String>(),
+                    n - max
+                )
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
 /// Read `run.toml`.
 pub fn read_meta(path: &Path) -> Result<RunMeta, ReadError> {
     let text = read_text_capped(path, MAX_TEXT_FILE_BYTES).map_err(|source| ReadError::Io {
@@ -505,7 +551,9 @@ pub fn read_meta(path: &Path) -> Result<RunMeta, ReadError> {
         path: path.to_path_buf(),
         message,
     };
-    let v: toml::Table = text.parse().map_err(|e: toml::de::Error| meta(e.to_string()))?;
+    let v: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| meta(clip_lines(&e.to_string(), MAX_ECHOED_CHARS)))?;
     let num = |sec: &str, key: &str| -> Result<f64, ReadError> {
         let x = v
             .get(sec)
@@ -662,6 +710,15 @@ pub fn read_run(dir: &Path) -> Result<ThesisRun, ReadError> {
     })
 }
 
+/// Highest forward speed read from a log or an eigenvalue table (m/s, 108
+/// km/h): faster than a bicycle is ridden for a measurement; a larger
+/// value is a fault or other units.
+pub const MAX_SPEED_M_S: f64 = 30.0;
+
+/// Lowest speed of a log row (m/s): a wheel sensor at rest reads a little
+/// below zero with its noise; riding backwards is no bicycle measurement.
+pub const MIN_LOG_SPEED_M_S: f64 = -0.1;
+
 /// Sample period of the TU Delft logs (s): they have no time column.
 pub const TUDELFT_PERIOD_S: f64 = 0.01;
 
@@ -697,7 +754,19 @@ pub fn read_tudelft(path: &Path) -> Result<TudelftLog, ReadError> {
             &["hand_angle", "handlebar_angle", "steer_angle"],
             &["fork_angle"],
         ],
+        MAX_LOG_FILE_BYTES,
+        true,
     )?;
+    if let Some(k) = tab.cols[0]
+        .iter()
+        .position(|&v| !(MIN_LOG_SPEED_M_S..=MAX_SPEED_M_S).contains(&v))
+    {
+        return Err(ReadError::ImplausibleSpeed {
+            path: path.to_path_buf(),
+            line: tab.lines[k],
+            speed: tab.cols[0][k],
+        });
+    }
     let n = tab.lines.len();
     Ok(TudelftLog {
         path: path.to_path_buf(),

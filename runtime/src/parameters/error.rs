@@ -281,6 +281,27 @@ pub enum ParameterError {
         tilt: f64,
     },
 
+    /// A thesis set whose geometry is no upright bicycle: its steer-axis
+    /// point and front wheel (`x4`, `z4`, `x5`, `z5`, with the radii) give
+    /// no frame pitch with the front wheel on the ground ahead of the rear
+    /// one and the steer axis leaning less than 90 degrees from vertical.
+    /// `field` is the likeliest culprit (a value of the wrong sign against
+    /// every real bicycle: `x4 > 0`, `z5 < 0`), else `x4`.
+    #[error(
+        "parameter `{field}` = {value:?}{origin}: the geometry (x4, z4, x5, z5) {problem}; a bicycle's steer axis \
+         leans back less than 90 degrees (with x4 > 0 and z5 < 0) and its front wheel is on the ground ahead of the rear one"
+    )]
+    ImpossibleGeometry {
+        /// The symbol named (`x4`, `z5`).
+        field: String,
+        /// Its value (m).
+        value: f64,
+        /// What it gives (a steer-axis tilt out of range, no ground contact).
+        problem: String,
+        /// File and line, when read from a file.
+        origin: Origin,
+    },
+
     /// The steer-axis tilt `lam` of a benchmark set is not within the stated
     /// range `(-pi/2, pi/2)` rad (exclusive: `lam = pi/2` is a horizontal steer
     /// axis, a degenerate bicycle). A value such as 18 was probably meant in
@@ -376,6 +397,17 @@ impl ParameterError {
                     value,
                 }
             }
+            ParameterError::ImpossibleGeometry {
+                field,
+                value,
+                problem,
+                origin,
+            } if origin.path.is_none() => ParameterError::ImpossibleGeometry {
+                origin: Origin::new(path, line_of(&field)),
+                field,
+                value,
+                problem,
+            },
             ParameterError::NonPhysicalInertia {
                 body,
                 ixx,
@@ -406,6 +438,7 @@ impl ParameterError {
             | ParameterError::NotFinite { field, .. }
             | ParameterError::NonPositive { field, .. }
             | ParameterError::TiltOutOfRange { field, .. }
+            | ParameterError::ImpossibleGeometry { field, .. }
             | ParameterError::TooLarge { field, .. }
             | ParameterError::InvalidUncertainty { field, .. } => Some(field),
             _ => None,
@@ -426,6 +459,7 @@ impl ParameterError {
             ParameterError::NotFinite { origin, .. }
             | ParameterError::NonPositive { origin, .. }
             | ParameterError::TiltOutOfRange { origin, .. }
+            | ParameterError::ImpossibleGeometry { origin, .. }
             | ParameterError::TooLarge { origin, .. } => origin.line,
             _ => None,
         }

@@ -89,8 +89,10 @@ pub struct LoadedSet {
 }
 
 impl ParameterSet {
-    /// Read and validate a parameter file. Files ending in `.toml` are read as
-    /// TOML ([`from_toml_str`](Self::from_toml_str)), all others as benchmark
+    /// Read and validate a parameter file. Files ending in `.toml`, and
+    /// others whose content is TOML (quoted values, `[tables]`, `form = `:
+    /// a pipe, `/dev/stdin`, a `.txt` name), are read as TOML
+    /// ([`from_toml_str`](Self::from_toml_str)), all others as benchmark
     /// text files ([`from_text_str`](Self::from_text_str)).
     ///
     /// Returns the set and its warnings (triangle inequality, extra names of
@@ -99,8 +101,7 @@ impl ParameterSet {
     pub fn load(path: impl AsRef<Path>) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         let text = read(path)?;
-        let is_toml = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml"));
-        if is_toml {
+        if is_toml(path, &text) {
             Self::from_toml_str(&text, path)
         } else {
             Self::from_text_str(&text, path)
@@ -170,7 +171,7 @@ impl ParameterSet {
     pub fn load_with_extra(path: impl AsRef<Path>, extra: &[&str]) -> Result<LoadedSet, ParameterError> {
         let path = path.as_ref();
         let text = read(path)?;
-        if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) {
+        if is_toml(path, &text) {
             Self::from_toml_str_with_extra(&text, path, extra).map(|(set, effects, warnings)| LoadedSet {
                 set,
                 effects,
@@ -296,7 +297,7 @@ impl BenchmarkParameters {
     }
 
     /// Read and validate a benchmark-form file: TOML when the name ends in
-    /// `.toml`, else the text format (uncertainties dropped; see
+    /// `.toml` or the content is TOML (see [`is_toml`]), else the text format (uncertainties dropped; see
     /// [`MeasuredBenchmark::load`] to keep them).
     pub fn load(path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
@@ -327,6 +328,23 @@ pub(crate) fn read(path: &Path) -> Result<String, ParameterError> {
             path: path.to_path_buf(),
             source,
         }
+    })
+}
+
+/// Whether a parameter file is TOML: by its extension `.toml`, else by its
+/// content, so a file read through `/dev/stdin`, `<(...)`, a `.txt` name
+/// or no extension is read in the format it is in. The text format
+/// (`name = value[+/-std]` per line) has no quotes and no `[tables]`;
+/// every TOML parameter file has `form = "..."` or quoted values or
+/// tables, and a TOML file of bare numbers reads the same either way.
+pub(crate) fn is_toml(path: &Path, text: &str) -> bool {
+    if let Some(e) = path.extension() {
+        if e.eq_ignore_ascii_case("toml") {
+            return true;
+        }
+    }
+    text.lines().map(str::trim).any(|l| {
+        !l.starts_with('#') && (l.starts_with('[') || l.contains('"') || l.contains('\'') || l.starts_with("form"))
     })
 }
 

@@ -211,11 +211,17 @@ impl ThesisParameters {
     /// front wheel). The first problem found is the error; errors carry no
     /// file name here (loaders add it).
     ///
+    /// The geometry must be an upright bicycle's
+    /// ([`ParameterError::ImpossibleGeometry`]: no frame pitch puts the
+    /// front wheel on the ground ahead with the steer axis within 90 degrees
+    /// of vertical).
+    ///
     /// Plausibility warnings: a length over 10 m
     /// ([`ParameterWarning::LooksLikeMillimetres`]) and a frame or handlebar
     /// mass centre below the ground ([`ParameterWarning::MassCentreBelowGround`]).
     pub fn validate(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
         let mut warnings = self.validate_bodies()?;
+        self.check_geometry()?;
         let s = self;
         let lengths = [
             ("Rt", s.rear_wheel_radius),
@@ -230,6 +236,52 @@ impl ThesisParameters {
         ];
         plausibility(&lengths, self.to_benchmark().ok().as_ref(), &mut warnings);
         Ok(warnings)
+    }
+
+    /// The geometry is an upright bicycle's: a frame pitch puts the front
+    /// wheel on the ground ahead of the rear one with the steer axis less
+    /// than 90 degrees from vertical (the benchmark form's tilt range).
+    /// Every command and the Python package validate through here, so a
+    /// set such as `x4 = -1` (a tilt of 2.83 rad) is refused by all of
+    /// them, naming the field.
+    fn check_geometry(&self) -> Result<(), ParameterError> {
+        let s = self;
+        let (problem, radius) = match self.frame_pitch() {
+            Ok(_) => return Ok(()),
+            Err(ParameterError::SteerAxisNotUpright { tilt }) => (
+                format!(
+                    "gives a steer-axis tilt of {} rad ({} deg), outside (-pi/2, pi/2) rad",
+                    crate::number_text::format_significant(tilt, 3),
+                    crate::number_text::format_significant(tilt.to_degrees(), 3)
+                ),
+                None,
+            ),
+            // The larger wheel cannot reach the ground: name its radius.
+            Err(e @ ParameterError::NoGroundContact { .. }) => (
+                format!("gives {e}"),
+                Some(if s.front_wheel_radius > s.rear_wheel_radius {
+                    ("Rd", s.front_wheel_radius)
+                } else {
+                    ("Rt", s.rear_wheel_radius)
+                }),
+            ),
+            Err(e) => return Err(e),
+        };
+        let (field, value) = if let Some(r) = radius {
+            r
+        } else if s.steer_point_x <= 0.0 {
+            ("x4", s.steer_point_x)
+        } else if s.front_wheel_z >= 0.0 {
+            ("z5", s.front_wheel_z)
+        } else {
+            ("x4", s.steer_point_x)
+        };
+        Err(ParameterError::ImpossibleGeometry {
+            field: field.to_string(),
+            value,
+            problem,
+            origin: Default::default(),
+        })
     }
 
     fn validate_bodies(&self) -> Result<Vec<ParameterWarning>, ParameterError> {

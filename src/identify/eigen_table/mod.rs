@@ -102,7 +102,7 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
     let points = read_eigen_table(&req.path)?;
     let bike = Bicycle::resolve(&req.bike)?;
     let (_, driven, _) = identification_models(&bike, false)?;
-    let mut not_tried = Vec::new();
+    let mut not_tried: Vec<(String, String)> = Vec::new();
     let mut cands: Vec<Candidate> = Vec::new();
     for c in candidates(driven, None, &bike, &req.effects, true)? {
         if needs_amplitude(driven, &c.name) {
@@ -113,6 +113,19 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
         } else {
             cands.push(c);
         }
+    }
+    // An effect named on the command line that a table cannot try is an
+    // error, not a silent "not tried" beside a conclusion about the others.
+    if let Some((effect, reason)) = not_tried.iter().find(|(n, _)| req.effects.contains(n)) {
+        return Err(IdentifyError::NotTriableFromTable {
+            effect: effect.clone(),
+            reason: reason.clone(),
+            triable: candidates(driven, None, &bike, &[], true)?
+                .into_iter()
+                .filter(|c| !needs_amplitude(driven, &c.name))
+                .map(|c| c.name)
+                .collect(),
+        });
     }
     let speeds: Vec<f64> = points.iter().map(|p| p.speed).collect();
     let before = predict(driven, &bike, &BTreeMap::new(), &speeds)?;

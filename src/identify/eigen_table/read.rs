@@ -1,6 +1,7 @@
 //! Reading a measured eigenvalue table (format in the parent module's doc).
 
 use super::super::IdentifyError;
+use bikedyn_runtime::experiment::read::{read_text_capped, MAX_SPEED_M_S, MAX_TEXT_FILE_BYTES};
 use serde::Serialize;
 use std::path::Path;
 
@@ -18,14 +19,24 @@ pub struct EigenPoint {
 }
 
 /// Read a measured eigenvalue table (see the module doc).
+///
+/// Refused, naming the line: a speed outside `(0, 30]` m/s
+/// ([`MAX_SPEED_M_S`]: no bicycle is measured faster; a larger value is a
+/// typing slip or other units, and one such row pulls the corrections to
+/// non-physical values); rows of 3 and 5 fields mixed (a column shifted, or
+/// standard errors for some speeds only); a row repeating another's speed
+/// and eigenvalue (it would count twice). The file is read whole only
+/// below [`MAX_TEXT_FILE_BYTES`] (checked from its size first).
 pub fn read_eigen_table(path: &Path) -> Result<Vec<EigenPoint>, IdentifyError> {
     let bad = |line: usize, message: String| IdentifyError::EigenTable {
         path: path.to_path_buf(),
         line,
         message,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(0, e.to_string()))?;
-    let mut points = Vec::new();
+    let text = read_text_capped(path, MAX_TEXT_FILE_BYTES).map_err(|e| bad(0, e.to_string()))?;
+    let mut points: Vec<EigenPoint> = Vec::new();
+    // The first row's field count, with its line: every row has the same.
+    let mut width: Option<(usize, usize)> = None;
     let mut seen_row = false;
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
@@ -59,11 +70,39 @@ pub fn read_eigen_table(path: &Path) -> Result<Vec<EigenPoint>, IdentifyError> {
                 ),
             ));
         }
+        match width {
+            Some((w, first)) if w != v.len() => {
+                return Err(bad(
+                    line,
+                    format!(
+                        "{} fields, but line {first} has {w}: every row gives the same columns (standard errors for every speed or for none)",
+                        v.len()
+                    ),
+                ))
+            }
+            Some(_) => {}
+            None => width = Some((v.len(), line)),
+        }
         if v.iter().any(|x| !x.is_finite()) {
             return Err(bad(line, format!("`{l}`: not a finite number")));
         }
-        if !(v[0] > 0.0) {
-            return Err(bad(line, format!("speed {} m/s: must be positive", v[0])));
+        if !(v[0] > 0.0 && v[0] <= MAX_SPEED_M_S) {
+            return Err(bad(
+                line,
+                format!(
+                    "speed (first field) {} m/s is not a bicycle's speed (above 0, at most {MAX_SPEED_M_S} m/s): check the row and that speeds are in m/s",
+                    v[0]
+                ),
+            ));
+        }
+        if let Some(p) = points.iter().find(|p| p.speed == v[0] && p.eigenvalue == [v[1], v[2]]) {
+            return Err(bad(
+                line,
+                format!(
+                    "repeats line {} (speed {} m/s, the same eigenvalue): a repeated row would count twice; give each measurement once",
+                    p.line, v[0]
+                ),
+            ));
         }
         if !(v[2] > 0.0) {
             return Err(bad(
