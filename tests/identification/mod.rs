@@ -445,7 +445,11 @@ fn a_steer_inertia_beyond_its_prior_is_not_left_to_a_proxy() {
     // Exit 1 says that some runs were set aside (a kick whose window the
     // bicycle's fall cut short); the identification is on the others.
     let out = bikedyn(&["identify", dir.to_str().unwrap(), "--json"]);
-    assert!(matches!(out.status.code(), Some(0 | 1)), "identify: {}", text(&out.stderr));
+    assert!(
+        matches!(out.status.code(), Some(0 | 1)),
+        "identify: {}",
+        text(&out.stderr)
+    );
     let j = stdout_json(&out);
     let sel = selected_effects(&j);
     assert!(sel.iter().any(|s| s.starts_with("correct I4z")), "{sel:?}");

@@ -60,10 +60,14 @@ impl<'s> Search<'s> {
         // Each round tests every candidate followed by a later lateral
         // addition; a removal changes the model, so the next round tests
         // the rest again. At most one round per selected candidate.
+        // The last one added was tested against exactly the model without
+        // it when it entered; after a removal the model has changed, and
+        // every member is tested.
+        let mut changed = false;
         loop {
             let last_lateral = selected.iter().rposition(|c| !c.speed_decay);
             let testable: Vec<usize> = (0..selected.len())
-                .filter(|&j| !selected[j].speed_decay && Some(j) != last_lateral)
+                .filter(|&j| !selected[j].speed_decay && (changed || Some(j) != last_lateral))
                 .collect();
             if testable.is_empty() {
                 break;
@@ -95,6 +99,7 @@ impl<'s> Search<'s> {
             );
             selected.remove(j);
             *current = refit;
+            changed = true;
         }
         Ok(checks.into_iter().map(|(c, _)| c).collect())
     }
