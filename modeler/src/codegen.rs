@@ -176,7 +176,18 @@ pub fn symbolica_guard() -> SymbolicaGuard {
         .write(true)
         .open(&path)
         .ok()
-        .filter(|f| f.lock().is_ok());
+        .filter(|f| match f.try_lock() {
+            Ok(()) => true,
+            Err(std::fs::TryLockError::WouldBlock) => {
+                // Say why nothing happens: a wait can last minutes.
+                eprintln!(
+                    "bikedyn: waiting for Symbolica: another derivation on this machine holds it ({}; Symbolica's licence allows one thread per user)",
+                    path.display()
+                );
+                f.lock().is_ok()
+            }
+            Err(std::fs::TryLockError::Error(_)) => false,
+        });
     HOLDS_SYMBOLICA.with(|h| h.set(true));
     SymbolicaGuard {
         _file: file,
