@@ -50,10 +50,10 @@ impl<'s> Search<'s> {
     /// decay apart: every run slows, and its law is chosen in a phase of its
     /// own) against `current` without it; remove those that fail, one at a
     /// time. Returns the checks in the order made.
-    pub(super) fn eliminate<'c>(
+    pub(super) fn eliminate(
         &self,
         current: &mut CandidateFit,
-        selected: &mut Vec<&'c Candidate>,
+        selected: &mut Vec<&Candidate>,
         simulations: &mut usize,
     ) -> Result<Vec<MemberCheck>, IdentifyError> {
         let mut checks = Vec::new();
@@ -107,10 +107,10 @@ impl<'s> Search<'s> {
     /// The entry test of `selected[j]` against the model `current` without
     /// it: the check, and the fit without it (cross-validated when the
     /// criterion alone does not decide).
-    fn without<'c>(
+    fn without(
         &self,
         current: &CandidateFit,
-        selected: &[&'c Candidate],
+        selected: &[&Candidate],
         j: usize,
         simulations: &mut usize,
     ) -> Result<(MemberCheck, Option<CandidateFit>), IdentifyError> {
