@@ -354,7 +354,12 @@ class Bicycle:
         return list(self._b.geometry())
 
     def with_parameter(self, symbol: str, value: float) -> "Bicycle":
-        """A copy with one parameter (benchmark, thesis or effect symbol) changed."""
+        """A copy with one parameter (benchmark, thesis or effect symbol)
+        changed, checked as a parameter file's value is (a length over 10 m
+        is refused as millimetres)."""
+        # `True` is an int to Python; as a mass it would be 1 kg.
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+            raise InvalidArgumentError(f"{self.name}: `{symbol}` = {value!r} is not a number")
         return Bicycle._wrap(self._b.with_parameter(symbol, float(value)), self._model)
 
     def with_parameters(self, **values: float) -> "Bicycle":

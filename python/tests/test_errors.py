@@ -91,6 +91,17 @@ def test_sweep_refuses_the_same_parameter_twice():
         bikedyn.sweep("benchmark", "c", [0.08, 0.1], [5.0], param2="c", values2=[0.08, 0.1])
 
 
+def test_with_parameters_checks_values_as_a_file_would():
+    # Issue 35, reproducer 22: a wheelbase in millimetres and a boolean
+    # mass were taken as they came.
+    b = bikedyn.Bicycle("benchmark")
+    with pytest.raises(bikedyn.ParameterError, match="millimetres"):
+        b.with_parameters(w=1020)
+    with pytest.raises(bikedyn.InvalidArgumentError, match="mB"):
+        b.with_parameters(mB=True)
+    assert b.with_parameters(w=1.05).value("w") == pytest.approx(1.05)
+
+
 def test_a_rust_panic_is_an_exception_with_its_message():
     from bikedyn import _bikedyn
 

@@ -92,6 +92,25 @@ pub fn allow_implausible_units(allow: bool) {
     ALLOW_IMPLAUSIBLE_UNITS.store(allow, std::sync::atomic::Ordering::Relaxed);
 }
 
+/// Refuse parameters whose lengths look like millimetres (a length over
+/// 10 m), unless [`allow_implausible_units`] was set: `source` names the
+/// file, or the bicycle and the value set.
+fn refuse_millimetres(warnings: &[ParameterWarning], source: &str) -> Result<(), BicycleError> {
+    if ALLOW_IMPLAUSIBLE_UNITS.load(std::sync::atomic::Ordering::Relaxed) {
+        return Ok(());
+    }
+    match warnings
+        .iter()
+        .find(|w| matches!(w, ParameterWarning::LooksLikeMillimetres { .. }))
+    {
+        Some(w) => Err(BicycleError::LooksLikeMillimetres {
+            file: source.to_string(),
+            warning: w.to_string(),
+        }),
+        None => Ok(()),
+    }
+}
+
 impl Bicycle {
     /// Resolve `thesis`, `benchmark` or a parameter file (TOML in either form,
     /// or the `name = value[+/-std]` text form of bicycleparameters/HumanControl)
@@ -128,18 +147,7 @@ impl<R: ModelRegistry> Bicycle<R> {
                 for (name, &value) in &loaded.effects {
                     check_effect_value_in::<R>(name, value, path)?;
                 }
-                if !ALLOW_IMPLAUSIBLE_UNITS.load(std::sync::atomic::Ordering::Relaxed) {
-                    if let Some(w) = loaded
-                        .warnings
-                        .iter()
-                        .find(|w| matches!(w, ParameterWarning::LooksLikeMillimetres { .. }))
-                    {
-                        return Err(BicycleError::LooksLikeMillimetres {
-                            file: path.to_string(),
-                            warning: w.to_string(),
-                        });
-                    }
-                }
+                refuse_millimetres(&loaded.warnings, path)?;
                 return Ok(Bicycle {
                     name: spec.to_string(),
                     parameters: loaded.set,
@@ -216,17 +224,7 @@ impl<R: ModelRegistry> Bicycle<R> {
             text.push_str(&format!("{k} = {v:?}\n"));
         }
         let (parameters, _, warnings) = ParameterSet::from_toml_str_with_extra(&text, name, &[])?;
-        if !ALLOW_IMPLAUSIBLE_UNITS.load(std::sync::atomic::Ordering::Relaxed) {
-            if let Some(w) = warnings
-                .iter()
-                .find(|w| matches!(w, ParameterWarning::LooksLikeMillimetres { .. }))
-            {
-                return Err(BicycleError::LooksLikeMillimetres {
-                    file: name.to_string(),
-                    warning: w.to_string(),
-                });
-            }
-        }
+        refuse_millimetres(&warnings, name)?;
         Ok(Bicycle {
             name: name.to_string(),
             parameters,
@@ -365,6 +363,9 @@ impl<R: ModelRegistry> Bicycle<R> {
             return Err(unknown_parameter::<R>(symbol));
         };
         let warnings = parameters.validate()?;
+        // A value set here is checked as a file's would be (a wheelbase of
+        // 1020 is millimetres, not metres).
+        refuse_millimetres(&warnings, &format!("{} ({symbol} = {value})", self.name))?;
         Ok(Bicycle {
             name: format!("{} ({symbol} = {value})", self.name),
             parameters,

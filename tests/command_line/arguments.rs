@@ -80,3 +80,25 @@ fn bench_refuses_a_temporary_folder_that_does_not_exist() {
     );
     assert!(!missing.parent().unwrap().exists());
 }
+
+/// A value set by `sweep --param` is checked as a parameter file's would be:
+/// a wheelbase of 1000-1020 is millimetres, refused with the value named
+/// (Python's `with_parameters` goes through the same check).
+#[test]
+fn a_swept_length_in_millimetres_is_refused() {
+    let out = bikedyn(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "w",
+        "--values",
+        "1000:1020:10",
+    ]);
+    let stderr = text(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("w = 1000") && stderr.contains("millimetres"),
+        "{stderr}"
+    );
+}
