@@ -100,6 +100,9 @@ def test_with_parameters_checks_values_as_a_file_would():
     with pytest.raises(bikedyn.InvalidArgumentError, match="mB"):
         b.with_parameters(mB=True)
     assert b.with_parameters(w=1.05).value("w") == pytest.approx(1.05)
+    # A NaN was reported as an unknown parameter ("did you mean `c`?").
+    with pytest.raises(bikedyn.ParameterError, match="`c` = NaN is not a finite number"):
+        bikedyn.sweep("benchmark", "c", [float("nan")], [5.0])
 
 
 def test_a_rust_panic_is_an_exception_with_its_message():

@@ -45,6 +45,8 @@ pub enum BicycleError {
     LooksLikeMillimetres { file: String, warning: String },
     #[error("`{spec}` is neither a built-in bicycle (thesis, benchmark) nor an existing file")]
     NotFound { spec: String },
+    #[error("{bike}: `{symbol}` = {value} is not a finite number")]
+    NotFinite { bike: String, symbol: String, value: f64 },
     #[error("unknown model `{name}` (models: {known})")]
     UnknownModel { name: String, known: String },
     #[error("model `{model}` cannot represent `{bike}`: it has no parameter {missing} (see `bikedyn models`)")]
@@ -348,6 +350,15 @@ impl<R: ModelRegistry> Bicycle<R> {
     /// The same bicycle with one parameter changed. `symbol` is a thesis
     /// symbol (`Rt`, `x4`, `d4`, ...) or a benchmark symbol (`c`, `lam`, ...).
     pub fn with_parameter(&self, symbol: &str, value: f64) -> Result<Bicycle<R>, BicycleError> {
+        // (A NaN would otherwise fail the parameter table's conversion and
+        // be reported as an unknown parameter.)
+        if !value.is_finite() {
+            return Err(BicycleError::NotFinite {
+                bike: self.name.clone(),
+                symbol: symbol.to_string(),
+                value,
+            });
+        }
         if effect_parameters_in::<R>().iter().any(|p| p.name == symbol) {
             check_effect_value_in::<R>(symbol, value, &self.name)?;
             let mut b = self.clone();
