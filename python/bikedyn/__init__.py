@@ -601,6 +601,14 @@ def fit(
     return FitResult(_bikedyn.fit(_paths(paths, "fit"), cal, spec, angles, nominal_clock, progress))
 
 
+def _count(name: str, value: Any, low: int, high: int) -> int:
+    """An integer argument within ``[low, high]``, or an
+    :class:`InvalidArgumentError` naming it."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) or not low <= value <= high:
+        raise InvalidArgumentError(f"{name} = {value!r}: must be an integer from {low} to {high}")
+    return int(value)
+
+
 def identify(
     paths_or_eigen_table: Union[PathLike, Iterable[PathLike]],
     bike: Optional[BikeLike] = None,
@@ -623,6 +631,10 @@ def identify(
     ``progress(step, done, total)`` after each step of the selection (see
     :data:`ProgressCallback`; the eigenvalue table form takes seconds and
     does not report). Returns an :class:`IdentifyResult`."""
+    # As the command line's --folds and --corrections: named, with their range
+    # (an int beyond the machine's would be an OverflowError naming nothing).
+    folds = _count("folds", folds, 2, 1000)
+    corrections = None if corrections is None else _count("corrections", corrections, 0, 1_000_000)
     stack: List[Any] = []
     spec = None if bike is None else _bicycle(bike)._as_spec(stack)
     single = isinstance(paths_or_eigen_table, (str, os.PathLike))
@@ -632,7 +644,7 @@ def identify(
     cal = None if calibration is None else _paths(calibration, "calibration")[0]
     return IdentifyResult(
         _bikedyn.identify(
-            _paths(paths_or_eigen_table, "identify"), cal, spec, list(effects), int(folds), corrections, progress
+            _paths(paths_or_eigen_table, "identify"), cal, spec, list(effects), folds, corrections, progress
         )
     )
 

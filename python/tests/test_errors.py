@@ -105,6 +105,14 @@ def test_with_parameters_checks_values_as_a_file_would():
         bikedyn.sweep("benchmark", "c", [float("nan")], [5.0])
 
 
+def test_identify_counts_are_checked_and_named():
+    # Issue 35, reproducer 26: folds=2**70 and corrections=-1 were an
+    # OverflowError that named no argument.
+    for kwargs, name in [({"folds": 2**70}, "folds"), ({"folds": 1}, "folds"), ({"corrections": -1}, "corrections")]:
+        with pytest.raises(bikedyn.InvalidArgumentError, match=name):
+            bikedyn.identify("no-such-folder", **kwargs)
+
+
 def test_a_rust_panic_is_an_exception_with_its_message():
     from bikedyn import _bikedyn
 
