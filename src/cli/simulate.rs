@@ -105,6 +105,13 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
         kicks: a.kick.iter().map(|k| parse_kick(k)).collect::<Result<_>>()?,
         pulses: a.pulse.iter().map(|k| parse_pulse(k)).collect::<Result<_>>()?,
     };
+    // 0 disables a stop; a negative or non-finite angle is no angle (NaN
+    // would silently disable it too).
+    for (flag, deg) in [("--roll-limit", a.roll_limit), ("--steer-limit", a.steer_limit)] {
+        if !(deg.is_finite() && deg >= 0.0) {
+            bail!("{flag} {deg}: an angle in degrees, at least 0 (0 disables the stop)");
+        }
+    }
     let limit = |deg: f64| (deg > 0.0).then(|| deg.to_radians());
     let opts = SimOptions {
         rtol: a.rtol,

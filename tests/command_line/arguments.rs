@@ -102,3 +102,22 @@ fn a_swept_length_in_millimetres_is_refused() {
         "{stderr}"
     );
 }
+
+/// `simulate --roll-limit nan` (or -5) silently disabled the stop: a stop
+/// angle that is no angle is refused, naming the flag.
+#[test]
+fn a_stop_angle_that_is_not_an_angle_is_refused() {
+    for (flag, v) in [
+        ("--roll-limit", "nan"),
+        ("--roll-limit", "-5"),
+        ("--steer-limit", "inf"),
+    ] {
+        let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", flag, v]);
+        let stderr = text(&out.stderr);
+        assert!(!out.status.success(), "{flag} {v}: {stderr}");
+        assert!(stderr.contains(flag), "{stderr}");
+    }
+    // 0 still disables the stop.
+    let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", "--roll-limit", "0"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
