@@ -259,18 +259,8 @@ fn commit(tmp: &Path, path: &Path) -> Result<(), OutputError> {
         let _ = fs::set_permissions(tmp, meta.permissions());
     }
     fs::rename(tmp, path).map_err(|e| io_err("rename temporary file", e))?;
-    #[cfg(unix)]
-    if let Some(dir) = path.parent() {
-        let dir = if dir.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            dir
-        };
-        // Best effort: some file systems do not support fsync on directories.
-        if let Ok(d) = File::open(dir) {
-            let _ = d.sync_all();
-        }
-    }
+    // Best effort: some file systems do not support fsync on directories.
+    crate::staged::sync_dir(path);
     Ok(())
 }
 

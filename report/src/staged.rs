@@ -305,7 +305,7 @@ fn parent_of(target: &Path) -> Result<(PathBuf, String), OutputError> {
 }
 
 /// Best-effort fsync of the folder holding `path` (the rename itself).
-fn sync_dir(path: &Path) {
+pub(crate) fn sync_dir(path: &Path) {
     #[cfg(unix)]
     if let Some(dir) = path.parent() {
         let dir = if dir.as_os_str().is_empty() {
