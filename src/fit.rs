@@ -428,7 +428,7 @@ fn verdict_json<T: serde::Serialize>(verdict: &T, reason: String) -> Value {
     v
 }
 
-/// JSON entry of one kick (schema in README, "Measured runs"): `weave`,
+/// JSON entry of one kick (schema in docs/measured-runs.md, "Output"): `weave`,
 /// its standard errors, r² and form only for a measured weave eigenvalue;
 /// a refused fit under `refused`, with the test it failed.
 pub fn kick_json(k: &KickFit, linear: &dyn LinearBicycle) -> Value {

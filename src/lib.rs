@@ -1,6 +1,6 @@
 //! bikedyn: symbolic multibody bicycle models turned into fast generated
 //! Rust, and the numerics that use them (linearization, stability sweeps,
-//! verification). See README.md and ARCHITECTURE.md.
+//! verification). See README.md, ARCHITECTURE.md and docs/.
 
 pub use bikedyn_report as report;
 pub use bikedyn_runtime as runtime;

@@ -1,6 +1,6 @@
 //! The identification's outputs: the five-line summary, the JSON summary
-//! (schema in README, "Closing the loop"), and the report folder
-//! (`report.md`, `report.json`, plots, the fitted parameter file).
+//! (schema in docs/identification.md, "What it does", step 5), and the report
+//! folder (`report.md`, `report.json`, plots, the fitted parameter file).
 
 use super::candidates::identification_models;
 use super::confounded::confounding_lines;
@@ -67,7 +67,7 @@ pub(super) fn errors_json<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Valu
     })
 }
 
-/// The JSON summary (schema in README, "Closing the loop").
+/// The JSON summary (schema in docs/identification.md, "What it does", step 5).
 pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
     let id = &o.identification;
     let sel: Vec<String> = id

@@ -41,7 +41,7 @@ fn triple(v: &serde_json::Value) -> [f64; 3] {
 ///   model's frozen-speed eigenvalue over the window's speed interval, for
 ///   fits with r^2 > 0.95. The synthetic response is nonlinear, its speed
 ///   falls, the kick's forcing and the capsize drift overlap the window and
-///   the roll carries ~0.2 deg noise: the README's study of these effects
+///   the roll carries ~0.2 deg noise: the study of these effects in docs/validation.md
 ///   puts the fitted real part within 0.1-0.3 1/s (3-5 %) of the frozen-speed
 ///   value; 10 % leaves room for the window choice.
 #[test]

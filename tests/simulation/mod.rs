@@ -398,7 +398,7 @@ fn kick_to_peak(speed: f64, peak: f64) -> bikedyn_runtime::simulate::Simulation 
 
 /// Issue 7, point 5: the weave eigenvalue fitted to a simulated kick at small
 /// amplitude is the linear one; the table of its change with amplitude (5 to
-/// 25 degrees peak roll) goes in the README.
+/// 25 degrees peak roll) is in docs/validation.md.
 #[test]
 fn weave_fit_versus_amplitude() {
     for speed in [4.5, 5.5] {
@@ -899,7 +899,7 @@ fn kick_to_peak_of<N: MultibodyModel>(param: &[f64], speed: f64, peak: f64) -> b
 /// resistance and aerodynamic drag, against the fit of the driven model at
 /// the mean speed of the fit window (same kick amplitude: the fitting
 /// window's own bias cancels) and the frozen-speed linear eigenvalue there.
-/// Prints the README's speed-decay table.
+/// Prints the speed-decay table of docs/validation.md.
 #[test]
 fn weave_fit_with_speed_decay() {
     type E = bikedyn::generated::ExtendedFree;
