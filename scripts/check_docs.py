@@ -8,8 +8,9 @@ Usage (from anywhere in the clone):
     python3 scripts/check_docs.py --links-only  # links only (no binary needed)
     python3 scripts/check_docs.py --list        # which blocks would run
     python3 scripts/check_docs.py README.md     # only the files named
+    python3 scripts/check_docs.py --python .venv/bin/python   # the Python examples
 
-Files: README.md and docs/*.md (links also in python/README.md and
+Files: README.md, python/README.md and docs/*.md (links also in
 examples/data/README.md).
 
 Links: every Markdown link `[text](target)` that is not a URL must name an
@@ -27,6 +28,11 @@ replaced by the binary, and `bikedyn` is the binary on the PATH. The scratch
 folder holds a copy of the clone's files (`examples/`, `tests/`, ...), so
 paths in the clone work as written and no example changes the clone. A
 block fails on a nonzero exit.
+
+With `--python PY`, the ```python blocks run instead (each in the scratch
+folder, as a file, with `PY` and MPLBACKEND=Agg), unless marked no-check;
+a block that imports an optional module PY lacks (matplotlib, pandas, ...)
+is skipped with a note.
 
 The binary is `$BIKEDYN` when set, otherwise
 `$CARGO_TARGET_DIR/release/bikedyn` when CARGO_TARGET_DIR is set, otherwise
@@ -46,6 +52,9 @@ import time
 import unicodedata
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# Modules a Python example may use that the package does not need: a block
+# importing one the interpreter lacks is skipped with a note.
+OPTIONAL = {"matplotlib", "pandas", "bicycleparameters", "tqdm", "ray", "dask"}
 RUNNABLE = re.compile(r"^(bikedyn|cargo run --release --)(\s|$)")
 LINK = re.compile(r"(?<!!)\[(?:[^\[\]]|\[[^\]]*\])*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
 IMAGE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
@@ -55,7 +64,7 @@ def pages(args):
     if args:
         return [os.path.abspath(a) for a in args]
     docs = os.path.join(ROOT, "docs")
-    out = [os.path.join(ROOT, "README.md")]
+    out = [os.path.join(ROOT, "README.md"), os.path.join(ROOT, "python", "README.md")]
     if os.path.isdir(docs):
         out += sorted(
             os.path.join(docs, f) for f in os.listdir(docs) if f.endswith(".md")
@@ -138,7 +147,8 @@ def check_links(files):
 
 
 def blocks(page):
-    """(line, text, runnable, skip reason) of every ```sh block of a page."""
+    """(line, language, text, runnable, skip reason) of every ```sh and
+    ```python block of a page."""
     lines = open(page, encoding="utf-8").read().split("\n")
     out, i = [], 0
     while i < len(lines):
@@ -147,7 +157,8 @@ def blocks(page):
             j = i + 1
             while j < len(lines) and not lines[j].strip().startswith("```"):
                 j += 1
-            if fence in ("```sh", "```bash", "```shell"):
+            lang = {"```sh": "sh", "```bash": "sh", "```shell": "sh", "```python": "python"}.get(fence)
+            if lang:
                 body = lines[i + 1 : j]
                 first = next(
                     (l.strip() for l in body if l.strip() and not l.strip().startswith("#")),
@@ -159,7 +170,8 @@ def blocks(page):
                 skip = None
                 if k >= 0 and lines[k].strip().startswith("<!-- no-check"):
                     skip = lines[k].strip()[len("<!-- no-check") :].strip(" :->") or "marked"
-                out.append((i + 1, "\n".join(body), bool(RUNNABLE.match(first)), skip))
+                runnable = lang == "python" or bool(RUNNABLE.match(first))
+                out.append((i + 1, lang, "\n".join(body), runnable, skip))
             i = j + 1
         else:
             i += 1
@@ -197,19 +209,38 @@ def scratch(bin_path):
             shutil.copy2(src, dst)
     bindir = os.path.join(work, ".bin")
     os.mkdir(bindir)
-    os.symlink(bin_path, os.path.join(bindir, "bikedyn"))
+    if bin_path:
+        os.symlink(bin_path, os.path.join(bindir, "bikedyn"))
     return work, bindir
 
 
-def run_examples(files, listing):
-    bin_path = None if listing else binary()
+def missing_modules(python, body):
+    """The optional modules a Python block imports that `python` lacks."""
+    wanted = set(re.findall(r"^\s*(?:import|from)\s+(\w+)", body, re.M)) & OPTIONAL
+    out = []
+    for m in sorted(wanted):
+        probe = f"import importlib.util, sys; sys.exit(importlib.util.find_spec({m!r}) is None)"
+        if subprocess.run([python, "-c", probe]).returncode != 0:
+            out.append(m)
+    return out
+
+
+def run_examples(files, listing, python=None):
+    lang_run = "python" if python else "sh"
+    bin_path = None if listing or python else binary()
     timeout = float(os.environ.get("CHECK_DOCS_TIMEOUT", "600"))
     failures, ran, skipped = [], 0, 0
     for page in files:
         todo = blocks(page)
         work = None
-        for line, body, runnable, skip in todo:
+        for line, lang, body, runnable, skip in todo:
             where = f"{rel(page)}:{line}"
+            if lang != lang_run:
+                continue
+            if python and runnable and not skip and not listing:
+                lacking = missing_modules(python, body)
+                if lacking:
+                    skip = "no module " + ", ".join(lacking)
             if not runnable or skip:
                 if runnable and skip:
                     skipped += 1
@@ -220,12 +251,19 @@ def run_examples(files, listing):
                 continue
             if work is None:
                 work, bindir = scratch(bin_path)
-            script = re.sub(r"\bcargo run --release --(?=\s|$)", "bikedyn", body)
             env = dict(os.environ, PATH=bindir + os.pathsep + os.environ["PATH"])
+            if python:
+                with open(os.path.join(work, ".block.py"), "w", encoding="utf-8") as f:
+                    f.write(body + "\n")
+                command = [python, ".block.py"]
+                env["MPLBACKEND"] = "Agg"
+            else:
+                script = re.sub(r"\bcargo run --release --(?=\s|$)", "bikedyn", body)
+                command = ["bash", "-euo", "pipefail", "-c", script]
             start = time.time()
             try:
                 p = subprocess.run(
-                    ["bash", "-euo", "pipefail", "-c", script],
+                    command,
                     cwd=work,
                     env=env,
                     stdout=subprocess.PIPE,
@@ -252,20 +290,25 @@ def run_examples(files, listing):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("files", nargs="*", help="Markdown files (default: README.md, docs/*.md)")
+    ap.add_argument("files", nargs="*", help="Markdown files (default: README.md, python/README.md, docs/*.md)")
     ap.add_argument("--links-only", action="store_true", help="check links only")
     ap.add_argument("--list", action="store_true", help="list the blocks that would run")
+    ap.add_argument(
+        "--python",
+        metavar="PY",
+        help="run the ```python blocks with this interpreter (bikedyn installed) instead of the shell blocks",
+    )
     args = ap.parse_args()
     files = pages(args.files)
     extra = [] if args.files else [
-        os.path.join(ROOT, p) for p in ("python/README.md", "examples/data/README.md")
+        os.path.join(ROOT, p) for p in ("examples/data/README.md",)
         if os.path.exists(os.path.join(ROOT, p))
     ]
     errors = check_links(files + extra)
     for e in errors:
         print(e)
     print(f"links: {len(errors)} broken in {len(files + extra)} files")
-    failures = [] if args.links_only else run_examples(files, args.list)
+    failures = [] if args.links_only else run_examples(files, args.list, args.python)
     sys.exit(1 if errors or failures else 0)
 
 
