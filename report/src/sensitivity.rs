@@ -10,26 +10,43 @@ use bikedyn_runtime::sensitivity::{CriticalSensitivity, ModeSensitivity};
 /// Rows of the eigenvalue tables (the largest; CSV and JSON hold every one).
 pub const EIGEN_TABLE_ROWS: usize = 8;
 
+/// One parameter of the ranked table: `(derivative, elasticity)` of each
+/// speed, where that speed exists.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RankedRow {
+    pub parameter: &'static str,
+    pub value: f64,
+    pub weave: Option<(f64, f64)>,
+    pub capsize: Option<(f64, f64)>,
+}
+
+impl RankedRow {
+    /// The larger of the two elasticities' sizes.
+    pub fn size(&self) -> f64 {
+        self.weave
+            .map_or(0.0, |x| x.1.abs())
+            .max(self.capsize.map_or(0.0, |x| x.1.abs()))
+    }
+}
+
 /// The parameters in the order of the ranked table: by the larger of the two
-/// elasticities' sizes (weave speed, capsize speed), largest first, with
-/// their value and the two derivatives, where each speed exists.
-pub fn ranked(
-    weave: Option<&CriticalSensitivity>,
-    capsize: Option<&CriticalSensitivity>,
-) -> Vec<(&'static str, f64, Option<(f64, f64)>, Option<(f64, f64)>)> {
+/// elasticities' sizes (weave speed, capsize speed), largest first.
+pub fn ranked(weave: Option<&CriticalSensitivity>, capsize: Option<&CriticalSensitivity>) -> Vec<RankedRow> {
     let first = weave.or(capsize).map(|c| c.derivatives.as_slice()).unwrap_or(&[]);
     let find = |c: Option<&CriticalSensitivity>, p: &str| {
         c.and_then(|c| c.derivatives.iter().find(|d| d.parameter == p))
             .map(|d| (d.derivative, d.elasticity))
     };
-    let mut rows: Vec<_> = first
+    let mut rows: Vec<RankedRow> = first
         .iter()
-        .map(|d| (d.parameter, d.value, find(weave, d.parameter), find(capsize, d.parameter)))
+        .map(|d| RankedRow {
+            parameter: d.parameter,
+            value: d.value,
+            weave: find(weave, d.parameter),
+            capsize: find(capsize, d.parameter),
+        })
         .collect();
-    let size = |r: &(&str, f64, Option<(f64, f64)>, Option<(f64, f64)>)| {
-        r.2.map_or(0.0, |x| x.1.abs()).max(r.3.map_or(0.0, |x| x.1.abs()))
-    };
-    rows.sort_by(|a, b| size(b).total_cmp(&size(a)));
+    rows.sort_by(|a, b| b.size().total_cmp(&a.size()));
     rows
 }
 
@@ -42,7 +59,8 @@ pub fn sensitivity_table(
 ) -> String {
     let mut out = String::new();
     let f = |x: f64| format_significant(x, 5);
-    let speed = |c: Option<&CriticalSensitivity>| c.map_or("none in the range".to_string(), |c| format!("{} m/s", f(c.speed)));
+    let speed =
+        |c: Option<&CriticalSensitivity>| c.map_or("none in the range".to_string(), |c| format!("{} m/s", f(c.speed)));
     let _ = writeln!(
         out,
         "weave speed v_w = {}, capsize speed v_c = {}",
@@ -51,30 +69,37 @@ pub fn sensitivity_table(
     );
     let _ = writeln!(
         out,
-        "elasticity e = (p / v) dv/dp: per cent change of the speed per per cent change of the parameter; parameters in benchmark form (Meijaard et al. 2007, SI units)"
+        "elasticity e = (p / v) dv/dp: per cent change of the speed per per cent change of the parameter; parameters in benchmark form (Meijaard et al. 2007, SI units); exact derivatives (rounding below 1e-12 of the largest elasticity shown as 0)"
     );
     let header: Vec<String> = ["rank", "param", "value", "dv_w/dp", "e_w", "dv_c/dp", "e_c"]
         .iter()
         .map(|s| s.to_string())
         .collect();
-    let cell = |x: Option<(f64, f64)>, k: usize| {
+    let all = ranked(weave, capsize);
+    // Elasticities below 1e-12 of the largest are rounding (a parameter
+    // that does not enter, such as IBxx for the capsize speed, which
+    // depends on the stiffness only): shown as 0.
+    let largest = all.iter().map(RankedRow::size).fold(0.0, f64::max);
+    let cell = |x: Option<(f64, f64)>, k: usize, value: f64| {
         x.map_or("-".to_string(), |x| {
-            let v = if k == 0 { x.0 } else { x.1 };
-            f(v)
+            if value != 0.0 && x.1.abs() < 1e-12 * largest {
+                return "0".to_string();
+            }
+            f(if k == 0 { x.0 } else { x.1 })
         })
     };
-    let rows: Vec<Vec<String>> = ranked(weave, capsize)
+    let rows: Vec<Vec<String>> = all
         .iter()
         .enumerate()
-        .map(|(k, (p, value, w, c))| {
+        .map(|(k, r)| {
             vec![
                 (k + 1).to_string(),
-                p.to_string(),
-                f(*value),
-                cell(*w, 0),
-                cell(*w, 1),
-                cell(*c, 0),
-                cell(*c, 1),
+                r.parameter.to_string(),
+                f(r.value),
+                cell(r.weave, 0, r.value),
+                cell(r.weave, 1, r.value),
+                cell(r.capsize, 0, r.value),
+                cell(r.capsize, 1, r.value),
             ]
         })
         .collect();
@@ -121,7 +146,15 @@ pub fn sensitivity_table(
 }
 
 /// Columns of [`write_sensitivity_csv`].
-pub const CSV_COLUMNS: [&str; 7] = ["quantity", "rank", "parameter", "value", "derivative", "elasticity", "scaled"];
+pub const CSV_COLUMNS: [&str; 7] = [
+    "quantity",
+    "rank",
+    "parameter",
+    "value",
+    "derivative",
+    "elasticity",
+    "scaled",
+];
 
 /// Write the sensitivities as CSV, one row per quantity and parameter:
 /// `quantity` is `weave_speed`, `capsize_speed` (then `derivative` is

@@ -86,7 +86,13 @@ pub fn meijaard_canonical_in<T: Scalar>(p: &[T; 26]) -> CanonicalIn<T> {
     // A skate wheel (zero radius) has zero spin inertia (the two-mass-skate
     // bicycle, Kooijman et al. 2011): its gyrostatic coefficient is 0 (and
     // so are its derivatives: the spin inertia must stay zero there).
-    let gyrostatic = |i: T, r: T| if i.re() == 0.0 && r.re() == 0.0 { T::zero() } else { i / r };
+    let gyrostatic = |i: T, r: T| {
+        if i.re() == 0.0 && r.re() == 0.0 {
+            T::zero()
+        } else {
+            i / r
+        }
+    };
     let sr = gyrostatic(iryy, rr);
     let sf = gyrostatic(ifyy, rf);
     let st = sr + sf;
@@ -95,7 +101,10 @@ pub fn meijaard_canonical_in<T: Scalar>(p: &[T; 26]) -> CanonicalIn<T> {
     let m_pd = ialx + mu * itxz;
     let m0 = [[itxx, m_pd], [m_pd, iall + k(2.0) * mu * ialz + mu * mu * itzz]];
     let k0 = [[mt * zt, -sa], [-sa, -sa * sl]];
-    let k2 = [[T::zero(), (st - mt * zt) * cl / w], [T::zero(), (sa + sf * sl) * cl / w]];
+    let k2 = [
+        [T::zero(), (st - mt * zt) * cl / w],
+        [T::zero(), (sa + sf * sl) * cl / w],
+    ];
     let c1 = [
         [T::zero(), mu * st + sf * cl + itxz * cl / w - mu * mt * zt],
         [-(mu * st + sf * cl), ialz * cl / w + mu * (sa + itzz * cl / w)],

@@ -141,7 +141,9 @@ pub fn log_grid(lo: f64, hi: f64, n: usize) -> Result<Vec<f64>, FrequencyError> 
     let (a, b) = (lo.ln(), hi.ln());
     Ok((0..n)
         .map(|k| {
-            if k + 1 == n {
+            if k == 0 {
+                lo
+            } else if k + 1 == n {
                 hi
             } else {
                 (a + (b - a) * k as f64 / (n - 1) as f64).exp()
@@ -222,7 +224,7 @@ mod tests {
     fn the_grid_is_logarithmic_and_ends_exactly() {
         let g = log_grid(0.1, 100.0, 4).unwrap();
         assert_eq!(g.len(), 4);
-        assert_eq!(g[3], 100.0);
+        assert_eq!((g[0], g[3]), (0.1, 100.0));
         assert!((g[1] - 1.0).abs() < 1e-12 && (g[2] - 10.0).abs() < 1e-12, "{g:?}");
         assert!(log_grid(0.0, 1.0, 10).is_err());
         assert!(log_grid(1.0, 1.0, 10).is_err());

@@ -222,7 +222,10 @@ fn real_matrix(m: &Matrix2<f64>, f: C64) -> [[C64; 2]; 2] {
 }
 
 fn add(a: [[C64; 2]; 2], b: [[C64; 2]; 2]) -> [[C64; 2]; 2] {
-    [[a[0][0] + b[0][0], a[0][1] + b[0][1]], [a[1][0] + b[1][0], a[1][1] + b[1][1]]]
+    [
+        [a[0][0] + b[0][0], a[0][1] + b[0][1]],
+        [a[1][0] + b[1][0], a[1][1] + b[1][1]],
+    ]
 }
 
 /// The derivatives of the simple eigenvalue `s` at speed `v`: `(ds/dv,
