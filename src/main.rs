@@ -64,12 +64,13 @@ fn run(cli: Cli) -> Result<bool> {
         Command::Sweep(args) => cli::sweep::run(args),
         Command::Sensitivity {
             bike,
+            form,
             speed,
             speed_max,
             out,
             plot,
             plot_args,
-        } => cli::sensitivity::run(bike, speed, speed_max, out, plot, plot_args),
+        } => cli::sensitivity::run(bike, form, speed, speed_max, out, plot, plot_args),
         Command::Bode {
             bike,
             speed,

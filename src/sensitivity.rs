@@ -12,9 +12,11 @@
 //! reports them; the closed form must agree with them to 1e-8 before its
 //! derivatives are used.
 //!
-//! The parameters are the 26 of the benchmark form (Meijaard et al. 2007,
-//! Table 1), whatever form the bicycle was given in: the canonical matrices
-//! are closed-form functions of those. The result is for the Whipple
+//! The parameters are the 26 of the form the bicycle was given in (or the
+//! one asked for): the benchmark form (Meijaard et al. 2007, Table 1), of
+//! which the canonical matrices are closed-form functions, or the thesis
+//! form, through the conversion between the two, also in dual numbers. The
+//! result is for the Whipple
 //! bicycle, which is what the canonical form describes: a bicycle with an
 //! effect (damping, friction, a controller) is refused, since the generated
 //! code gives first derivatives only and the mixed derivatives a
@@ -23,6 +25,7 @@
 use crate::bicycle::{Bicycle, BicycleError};
 use crate::registry::ModelRegistry;
 use bikedyn_runtime::eigen::critical_speeds;
+use bikedyn_runtime::parameters::{Form, ParameterSet};
 use bikedyn_runtime::sensitivity::{
     critical_speed_sensitivities, eigenvalue_sensitivities, CanonicalJacobian, CriticalSensitivity, ModeSensitivity,
     SensitivityError as RuntimeError,
@@ -41,6 +44,9 @@ pub const CLOSED_FORM_TOLERANCE: f64 = 1e-8;
 pub struct SensitivityOptions {
     /// Generated model (`None`: the bicycle's default model).
     pub model: Option<String>,
+    /// The parameters differentiated with respect to: those of this form
+    /// (`None`: the form the bicycle was given in).
+    pub form: Option<Form>,
     /// Speed (m/s) of the eigenvalue derivatives; `None`: none.
     pub speed: Option<f64>,
     /// The critical speeds are searched on 0 to this speed (m/s).
@@ -51,6 +57,7 @@ impl Default for SensitivityOptions {
     fn default() -> Self {
         SensitivityOptions {
             model: None,
+            form: None,
             speed: None,
             speed_max: 10.0,
         }
@@ -74,8 +81,8 @@ pub struct Sensitivity {
     pub bike: String,
     /// The generated model of the matrices.
     pub model: &'static str,
-    /// The parameters' form: always `benchmark` (Meijaard et al. 2007,
-    /// Table 1 symbols, SI units).
+    /// The parameters' form: `benchmark` (Meijaard et al. 2007, Table 1
+    /// symbols) or `thesis` (Martin Recuero 2009); SI units.
     pub parameter_form: &'static str,
     /// The searched speeds' upper end (m/s).
     pub speed_max: f64,
@@ -142,7 +149,14 @@ pub fn sensitivity<R: ModelRegistry>(
             why,
         });
     };
-    let jac = CanonicalJacobian::of(&bike.parameters.to_benchmark().map_err(BicycleError::from)?);
+    let form = options.form.unwrap_or(match bike.parameters {
+        ParameterSet::Thesis(_) => Form::Thesis,
+        ParameterSet::Benchmark(_) => Form::Benchmark,
+    });
+    let jac = match form {
+        Form::Benchmark => CanonicalJacobian::of(&bike.parameters.to_benchmark().map_err(BicycleError::from)?),
+        Form::Thesis => CanonicalJacobian::of_thesis(&bike.thesis()?).map_err(BicycleError::from)?,
+    };
     let departure = jac.departure(&c);
     if !(departure <= CLOSED_FORM_TOLERANCE) {
         return Err(SensitivityError::ClosedFormDisagrees {
@@ -172,7 +186,7 @@ pub fn sensitivity<R: ModelRegistry>(
     Ok(Sensitivity {
         bike: bike.name.clone(),
         model: lin.model,
-        parameter_form: "benchmark",
+        parameter_form: form.name(),
         speed_max: options.speed_max,
         weave_speed: weave,
         capsize_speed: capsize,

@@ -53,6 +53,7 @@ pub fn ranked(weave: Option<&CriticalSensitivity>, capsize: Option<&CriticalSens
 /// The ranked table of the critical speeds' sensitivities, then, when
 /// given, the eigenvalues' at a speed (their largest entries).
 pub fn sensitivity_table(
+    form: &str,
     weave: Option<&CriticalSensitivity>,
     capsize: Option<&CriticalSensitivity>,
     eigen: Option<(f64, &[ModeSensitivity])>,
@@ -67,9 +68,14 @@ pub fn sensitivity_table(
         speed(weave),
         speed(capsize)
     );
+    let source = if form == "thesis" {
+        "thesis form (Martin Recuero 2009)"
+    } else {
+        "benchmark form (Meijaard et al. 2007)"
+    };
     let _ = writeln!(
         out,
-        "elasticity e = (p / v) dv/dp: per cent change of the speed per per cent change of the parameter; parameters in benchmark form (Meijaard et al. 2007, SI units); exact derivatives (rounding below 1e-12 of the largest elasticity shown as 0)"
+        "elasticity e = (p / v) dv/dp: per cent change of the speed per per cent change of the parameter; parameters in {source}, SI units; exact derivatives (rounding below 1e-12 of the largest elasticity shown as 0)"
     );
     let header: Vec<String> = ["rank", "param", "value", "dv_w/dp", "e_w", "dv_c/dp", "e_c"]
         .iter()

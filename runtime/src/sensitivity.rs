@@ -38,7 +38,7 @@
 use crate::benchmark_oracle::meijaard_canonical_in;
 use crate::canonical::CanonicalMatrices;
 use crate::eigen::{critical_speeds, eigenvalues, CriticalSpeeds, EigenError, Mode};
-use crate::parameters::BenchmarkParameters;
+use crate::parameters::{thesis_to_benchmark_in, BenchmarkParameters, ParameterError, ThesisParameters};
 use crate::scalar::{Dual, Scalar};
 use nalgebra::{Complex, Matrix2};
 use serde::Serialize;
@@ -60,12 +60,16 @@ pub struct CanonicalDerivative {
 }
 
 /// The canonical matrices of the closed form and their derivatives with
-/// respect to each benchmark parameter (order of
-/// [`BenchmarkParameters::SYMBOLS`]).
+/// respect to each parameter of one form: the benchmark parameters (order
+/// of [`BenchmarkParameters::SYMBOLS`]) or the thesis parameters (order of
+/// [`ThesisParameters::SYMBOLS`], through the conversion to the benchmark
+/// form, itself in dual numbers).
 #[derive(Clone, Debug, PartialEq)]
 pub struct CanonicalJacobian {
     /// The closed form's own values.
     pub value: CanonicalMatrices,
+    /// The parameters' symbols.
+    pub symbols: &'static [&'static str; NP],
     /// The parameter values.
     pub parameters: [f64; NP],
     /// `d/dp_k` of every matrix.
@@ -73,15 +77,33 @@ pub struct CanonicalJacobian {
 }
 
 impl CanonicalJacobian {
-    /// Exact derivatives of the canonical matrices of `p` (dual numbers
-    /// through the closed form).
+    /// Exact derivatives of the canonical matrices of `p` with respect to
+    /// the benchmark parameters (dual numbers through the closed form).
     pub fn of(p: &BenchmarkParameters) -> Self {
         let values: [f64; NP] = BenchmarkParameters::SYMBOLS.map(|k| p.get(k).expect("a benchmark symbol"));
         let mut x = [Dual::<NP>::cst(0.0); NP];
         for k in 0..NP {
             x[k] = Dual::variable(values[k], k);
         }
-        let m = meijaard_canonical_in(&x);
+        Self::from_duals(&x, &BenchmarkParameters::SYMBOLS, values)
+    }
+
+    /// Exact derivatives of the canonical matrices of `t` with respect to
+    /// the thesis parameters (dual numbers through the conversion to the
+    /// benchmark form and the closed form).
+    pub fn of_thesis(t: &ThesisParameters) -> Result<Self, ParameterError> {
+        let beta = t.frame_pitch()?;
+        let values = t.values();
+        let mut x = [Dual::<NP>::cst(0.0); NP];
+        for k in 0..NP {
+            x[k] = Dual::variable(values[k], k);
+        }
+        let b = thesis_to_benchmark_in(&x, beta);
+        Ok(Self::from_duals(&b, &ThesisParameters::SYMBOLS, values))
+    }
+
+    fn from_duals(b: &[Dual<NP>; NP], symbols: &'static [&'static str; NP], values: [f64; NP]) -> Self {
+        let m = meijaard_canonical_in(b);
         let re = |a: &[[Dual<NP>; 2]; 2]| Matrix2::from_fn(|i, j| a[i][j].re);
         let de = |a: &[[Dual<NP>; 2]; 2], k: usize| Matrix2::from_fn(|i, j| a[i][j].eps[k]);
         CanonicalJacobian {
@@ -92,6 +114,7 @@ impl CanonicalJacobian {
                 k2: re(&m.k2),
                 g: m.g.re,
             },
+            symbols,
             parameters: values,
             d: (0..NP)
                 .map(|k| CanonicalDerivative {
@@ -143,7 +166,7 @@ pub enum SensitivityError {
 /// One parameter's derivative of a critical speed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SpeedDerivative {
-    /// Benchmark symbol.
+    /// Parameter symbol (benchmark or thesis form).
     pub parameter: &'static str,
     /// Its value (SI).
     pub value: f64,
@@ -169,7 +192,7 @@ pub struct CriticalSensitivity {
 /// One parameter's derivative of an eigenvalue.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EigenvalueDerivative {
-    /// Benchmark symbol.
+    /// Parameter symbol (benchmark or thesis form).
     pub parameter: &'static str,
     /// Its value (SI).
     pub value: f64,
@@ -319,7 +342,7 @@ fn critical(
             let derivative = -d.re / slope;
             let value = jac.parameters[k];
             SpeedDerivative {
-                parameter: BenchmarkParameters::SYMBOLS[k],
+                parameter: jac.symbols[k],
                 value,
                 derivative,
                 elasticity: value / speed * derivative,
@@ -382,7 +405,7 @@ pub fn eigenvalue_sensitivities(
             .map(|(i, d)| {
                 let value = jac.parameters[i];
                 EigenvalueDerivative {
-                    parameter: BenchmarkParameters::SYMBOLS[i],
+                    parameter: jac.symbols[i],
                     value,
                     derivative: [d.re, d.im],
                     scaled: [value * d.re, value * d.im],
@@ -432,6 +455,35 @@ mod tests {
                 let mut v = serde_json::to_value(p).unwrap();
                 v[*sym] = x.into();
                 meijaard_canonical(&serde_json::from_value(v).unwrap())
+            };
+            let (a, b) = (at(x + h), at(x - h));
+            for (fd, d) in [
+                ((a.m0 - b.m0) / (2.0 * h), jac.d[k].m0),
+                ((a.c1 - b.c1) / (2.0 * h), jac.d[k].c1),
+                ((a.k0 - b.k0) / (2.0 * h), jac.d[k].k0),
+                ((a.k2 - b.k2) / (2.0 * h), jac.d[k].k2),
+            ] {
+                assert!((fd - d).amax() <= 1e-6 * (1.0 + d.amax()), "{sym}: {fd} vs {d}");
+            }
+        }
+    }
+
+    /// The thesis-form derivatives are the benchmark ones through the
+    /// conversion: against central differences of the f64 conversion and
+    /// closed form.
+    #[test]
+    fn thesis_form_derivatives_match_central_differences() {
+        let t = ThesisParameters::thesis_bicycle();
+        let jac = CanonicalJacobian::of_thesis(&t).unwrap();
+        assert!(jac.departure(&meijaard_canonical(&t.to_benchmark().unwrap())) < 1e-13);
+        for (k, sym) in ThesisParameters::SYMBOLS.iter().enumerate() {
+            let x = t.get(sym).unwrap();
+            let h = 1e-6 * x.abs().max(1e-2);
+            let at = |x: f64| {
+                let mut v = serde_json::to_value(t).unwrap();
+                v[*sym] = x.into();
+                let t: ThesisParameters = serde_json::from_value(v).unwrap();
+                meijaard_canonical(&t.to_benchmark().unwrap())
             };
             let (a, b) = (at(x + h), at(x - h));
             for (fd, d) in [

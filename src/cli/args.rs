@@ -182,6 +182,10 @@ pub enum Command {
     Sensitivity {
         #[command(flatten)]
         bike: BikeArg,
+        /// The parameters to differentiate with respect to: benchmark or
+        /// thesis symbols (default: the form the bicycle is given in).
+        #[arg(long, value_enum)]
+        form: Option<FormName>,
         /// Speed (m/s) at which the eigenvalues are differentiated too.
         #[arg(long, allow_hyphen_values = true)]
         speed: Option<f64>,

@@ -2,18 +2,21 @@
 //! (and of the eigenvalues at a speed) with respect to every parameter, as
 //! a ranked table of elasticities, CSV or JSON, and a bar chart.
 
-use super::args::{BikeArg, Format, OutputArgs, PlotArgs};
+use super::args::{BikeArg, FormName, Format, OutputArgs, PlotArgs};
 use super::{check_outputs, emit, load, plot_options};
 use anyhow::{bail, Context, Result};
 use bikedyn::report::plot::sensitivity::plot_sensitivity;
 use bikedyn::report::plot::subject;
 use bikedyn::report::sensitivity::{sensitivity_table, write_sensitivity_csv};
+use bikedyn::runtime::parameters::Form;
 use bikedyn::sensitivity::{sensitivity, SensitivityError, SensitivityOptions};
 use std::path::PathBuf;
 
 /// Run `bikedyn sensitivity`.
+#[allow(clippy::too_many_arguments)]
 pub fn run(
     bike: BikeArg,
+    form: Option<FormName>,
     speed: Option<f64>,
     speed_max: f64,
     out: OutputArgs,
@@ -40,6 +43,10 @@ pub fn run(
         &b,
         &SensitivityOptions {
             model: model.clone(),
+            form: form.map(|f| match f {
+                FormName::Benchmark => Form::Benchmark,
+                FormName::Thesis => Form::Thesis,
+            }),
             speed,
             speed_max,
         },
@@ -72,6 +79,7 @@ pub fn run(
         Format::Table => {
             format!("model: {}\n", s.model)
                 + &sensitivity_table(
+                    s.parameter_form,
                     s.weave_speed.as_ref(),
                     s.capsize_speed.as_ref(),
                     s.eigenvalues.as_ref().map(|e| (e.speed, e.modes.as_slice())),

@@ -39,6 +39,24 @@ fn sensitivity_json_ranks_every_parameter_of_both_speeds() {
         .map(|m| m["mode"].as_str().unwrap())
         .collect();
     assert_eq!(modes, ["weave", "capsize", "castering"]);
+    // The thesis bicycle in its own symbols, or in the benchmark's.
+    let v = ok_json(&["sensitivity", "--bike", "thesis", "--format", "json"]);
+    assert_eq!(v["parameter_form"], "thesis");
+    assert!(v["capsize_speed"]["derivatives"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|d| d["parameter"] == "x4"));
+    let v = ok_json(&[
+        "sensitivity",
+        "--bike",
+        "thesis",
+        "--form",
+        "benchmark",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(v["parameter_form"], "benchmark");
 }
 
 #[test]

@@ -5,15 +5,17 @@
 
 use bikedyn::bicycle::Bicycle;
 use bikedyn::runtime::eigen::{critical_speeds, eigenvalues};
+use bikedyn::runtime::parameters::Form;
 use bikedyn::sensitivity::{sensitivity, Sensitivity, SensitivityError, SensitivityOptions};
 use nalgebra::Complex;
 
-fn of(bike: &str, speed: Option<f64>) -> (Bicycle, Sensitivity) {
+fn of(bike: &str, form: Option<Form>, speed: Option<f64>) -> (Bicycle, Sensitivity) {
     let b = Bicycle::resolve(bike).unwrap();
     let s = sensitivity(
         &b,
         &SensitivityOptions {
             speed,
+            form,
             ..SensitivityOptions::default()
         },
     )
@@ -41,8 +43,8 @@ where
     (f(x - 2.0 * h) - f(x + 2.0 * h) + (f(x + h) - f(x - h)) * 8.0) * (1.0 / (12.0 * h))
 }
 
-fn critical_speeds_match_central_differences(bike: &str) {
-    let (b, s) = of(bike, None);
+fn critical_speeds_match_central_differences(bike: &str, form: Option<Form>) {
+    let (b, s) = of(bike, form, None);
     for (which, sens) in [("weave", s.weave_speed.as_ref()), ("capsize", s.capsize_speed.as_ref())] {
         let sens = sens.unwrap();
         assert_eq!(sens.derivatives.len(), 26);
@@ -73,12 +75,17 @@ fn critical_speeds_match_central_differences(bike: &str) {
 
 #[test]
 fn critical_speed_derivatives_of_the_benchmark_match_central_differences() {
-    critical_speeds_match_central_differences("benchmark");
+    critical_speeds_match_central_differences("benchmark", None);
 }
 
+/// In its own (thesis) symbols, through the conversion to the benchmark
+/// form, and in the benchmark symbols.
 #[test]
 fn critical_speed_derivatives_of_the_thesis_bicycle_match_central_differences() {
-    critical_speeds_match_central_differences("thesis");
+    let (_, s) = of("thesis", None, None);
+    assert_eq!(s.parameter_form, "thesis");
+    critical_speeds_match_central_differences("thesis", None);
+    critical_speeds_match_central_differences("thesis", Some(Form::Benchmark));
 }
 
 /// Euler's theorem on homogeneous functions: a speed scales as
@@ -87,19 +94,33 @@ fn critical_speed_derivatives_of_the_thesis_bicycle_match_central_differences() 
 /// the lengths' plus twice the inertias' sum to 1/2.
 #[test]
 fn elasticities_obey_dimensional_analysis() {
-    let lengths = ["w", "c", "rR", "rF", "xB", "zB", "xH", "zH"];
-    let masses = ["mR", "mB", "mH", "mF"];
-    let inertias = [
-        "IRxx", "IRyy", "IBxx", "IByy", "IBzz", "IBxz", "IHxx", "IHyy", "IHzz", "IHxz", "IFxx", "IFyy",
+    let benchmark: [&[&str]; 3] = [
+        &["w", "c", "rR", "rF", "xB", "zB", "xH", "zH"],
+        &["mR", "mB", "mH", "mF"],
+        &[
+            "IRxx", "IRyy", "IBxx", "IByy", "IBzz", "IBxz", "IHxx", "IHyy", "IHzz", "IHxz", "IFxx", "IFyy",
+        ],
     ];
-    for bike in ["benchmark", "thesis"] {
-        let (_, s) = of(bike, None);
+    let thesis: [&[&str]; 3] = [
+        &["Rt", "Rd", "x3", "z3", "x4", "z4", "x5", "z5", "d4"],
+        &["m2", "m3", "m4", "m5"],
+        &[
+            "I2x", "I2y", "I3x", "I3y", "I3z", "I3zx", "I4x", "I4y", "I4z", "I4xz", "I5x", "I5y",
+        ],
+    ];
+    for (bike, form, [lengths, masses, inertias]) in [
+        ("benchmark", Form::Benchmark, benchmark),
+        ("thesis", Form::Benchmark, benchmark),
+        ("thesis", Form::Thesis, thesis),
+        ("benchmark", Form::Thesis, thesis),
+    ] {
+        let (_, s) = of(bike, Some(form), None);
         for sens in [s.weave_speed.unwrap(), s.capsize_speed.unwrap()] {
             let e = |p: &str| sens.derivatives.iter().find(|d| d.parameter == p).unwrap().elasticity;
             let sum = |ps: &[&str]| ps.iter().map(|p| e(p)).sum::<f64>();
             assert!((e("g") - 0.5).abs() < 1e-12, "{bike}: e_g = {}", e("g"));
-            assert!((sum(&masses) + sum(&inertias)).abs() < 1e-12, "{bike}: mass scaling");
-            let l = sum(&lengths) + 2.0 * sum(&inertias);
+            assert!((sum(masses) + sum(inertias)).abs() < 1e-12, "{bike}: mass scaling");
+            let l = sum(lengths) + 2.0 * sum(inertias);
             assert!((l - 0.5).abs() < 1e-12, "{bike}: length scaling gives {l}");
         }
     }
@@ -108,7 +129,7 @@ fn elasticities_obey_dimensional_analysis() {
 #[test]
 fn eigenvalue_derivatives_match_central_differences() {
     let v = 5.0;
-    let (b, s) = of("benchmark", Some(v));
+    let (b, s) = of("benchmark", None, Some(v));
     let e = s.eigenvalues.unwrap();
     assert_eq!(e.speed, v);
     let names: Vec<&str> = e.modes.iter().map(|m| m.mode).collect();
