@@ -158,7 +158,7 @@ pub fn sensitivity<R: ModelRegistry>(
         Form::Thesis => CanonicalJacobian::of_thesis(&bike.thesis()?).map_err(BicycleError::from)?,
     };
     let departure = jac.departure(&c);
-    if !(departure <= CLOSED_FORM_TOLERANCE) {
+    if departure.is_nan() || departure > CLOSED_FORM_TOLERANCE {
         return Err(SensitivityError::ClosedFormDisagrees {
             bike: bike.name.clone(),
             departure,
