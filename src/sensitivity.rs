@@ -194,3 +194,90 @@ pub fn sensitivity<R: ModelRegistry>(
         closed_form_departure: departure,
     })
 }
+
+/// One parameter's part in a critical speed's variance.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct VarianceShare {
+    /// Parameter symbol (the file's own form).
+    pub parameter: &'static str,
+    /// Its standard deviation, as the file gives it.
+    pub standard_deviation: f64,
+    /// `(dv/dp sd_p)^2` over the speed's variance.
+    pub share: f64,
+}
+
+/// A critical speed's standard deviation from the file's.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SpeedUncertainty {
+    /// The critical speed (m/s).
+    pub speed: f64,
+    /// Its standard deviation (m/s): `sqrt(sum (dv/dp sd_p)^2)`.
+    pub standard_deviation: f64,
+    /// The parameters' shares of the variance, largest first (those with a
+    /// standard deviation only).
+    pub shares: Vec<VarianceShare>,
+}
+
+/// The standard deviations of the weave and capsize speeds.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StabilityUncertainty {
+    pub weave_speed: Option<SpeedUncertainty>,
+    pub capsize_speed: Option<SpeedUncertainty>,
+}
+
+/// The standard deviations of `bike`'s weave and capsize speeds that the
+/// standard deviations its file gives (`value+/-sd`) imply, to first
+/// order: `sd_v^2 = sum_p (dv/dp sd_p)^2`, with the exact derivatives of
+/// [`sensitivity`] in the file's own form and the file's standard
+/// deviations taken as independent (what the files' `+/-` values are:
+/// measurement errors of each parameter apart). `None` when the file gives
+/// none. Linear propagation holds while the speeds are near linear over a
+/// standard deviation of each parameter; the shares say which parameters'
+/// measurement limits the speed's.
+pub fn speed_uncertainties<R: ModelRegistry>(
+    bike: &Bicycle<R>,
+    options: &SensitivityOptions,
+) -> Result<Option<StabilityUncertainty>, SensitivityError> {
+    if bike.uncertainties.is_empty() {
+        return Ok(None);
+    }
+    let s = sensitivity(
+        bike,
+        &SensitivityOptions {
+            form: None,
+            speed: None,
+            ..options.clone()
+        },
+    )?;
+    let of = |c: &Option<CriticalSensitivity>| {
+        c.as_ref().map(|c| {
+            let terms: Vec<(&'static str, f64, f64)> = c
+                .derivatives
+                .iter()
+                .filter_map(|d| {
+                    let sd = *bike.uncertainties.get(d.parameter)?;
+                    Some((d.parameter, sd, (d.derivative * sd).powi(2)))
+                })
+                .collect();
+            let variance: f64 = terms.iter().map(|t| t.2).sum();
+            let mut shares: Vec<VarianceShare> = terms
+                .iter()
+                .map(|&(parameter, standard_deviation, v)| VarianceShare {
+                    parameter,
+                    standard_deviation,
+                    share: if variance > 0.0 { v / variance } else { 0.0 },
+                })
+                .collect();
+            shares.sort_by(|a, b| b.share.total_cmp(&a.share));
+            SpeedUncertainty {
+                speed: c.speed,
+                standard_deviation: variance.sqrt(),
+                shares,
+            }
+        })
+    };
+    Ok(Some(StabilityUncertainty {
+        weave_speed: of(&s.weave_speed),
+        capsize_speed: of(&s.capsize_speed),
+    }))
+}

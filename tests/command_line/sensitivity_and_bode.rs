@@ -178,3 +178,22 @@ fn bad_input_to_sensitivity_and_bode_names_the_flag_or_file() {
     ]);
     assert!(e.contains("x.pdf"), "{e}");
 }
+
+#[test]
+fn stability_gives_the_speeds_standard_deviations_from_the_files_uncertainties() {
+    let file = fixture_arg("Balanceassistv1Benchmark.txt");
+    let v = ok_json(&["stability", "--bike", &file, "--json"]);
+    let sd_w = v["weave_speed_sd"].as_f64().unwrap();
+    let sd_c = v["capsize_speed_sd"].as_f64().unwrap();
+    assert!(sd_w > 0.0 && sd_c > 0.0, "{v}");
+    assert_eq!(v["uncertainty"]["weave_speed"]["shares"][0]["parameter"], "lam");
+    let out = bikedyn(&["stability", "--bike", &file]);
+    let t = text(&out.stdout);
+    assert!(
+        t.contains("v_w = 3.44213 +/- ") && t.contains("from the file's +/- values"),
+        "{t}"
+    );
+    // The built-in bicycles carry no standard deviations: no such fields.
+    let v = ok_json(&["stability", "--bike", "benchmark", "--json"]);
+    assert!(v.get("weave_speed_sd").is_none(), "{v}");
+}

@@ -195,3 +195,46 @@ fn no_crossing_in_the_searched_speeds_is_an_error_saying_so() {
     .unwrap();
     assert!(s.weave_speed.is_none() && s.capsize_speed.is_none() && s.eigenvalues.is_some());
 }
+
+/// The speeds' standard deviations from a file's `+/-` values: the first-
+/// order sum `sum (dv/dp sd_p)^2` with the exact derivatives, against the
+/// same sum with five-point central differences; the shares add to one.
+#[test]
+fn speed_standard_deviations_propagate_the_files_uncertainties() {
+    use bikedyn::sensitivity::speed_uncertainties;
+    let file = crate::common::fixture_arg("Balanceassistv1Benchmark.txt");
+    let b = Bicycle::resolve(&file).unwrap();
+    let u = speed_uncertainties(&b, &SensitivityOptions::default())
+        .unwrap()
+        .expect("the file gives standard deviations");
+    for (which, x) in [("weave", u.weave_speed.unwrap()), ("capsize", u.capsize_speed.unwrap())] {
+        let mut variance = 0.0;
+        for (symbol, &sd) in &b.uncertainties {
+            let p = b.value(symbol).unwrap();
+            let h = STEP * p.abs().max(1e-2);
+            let speed_at = |x: f64| {
+                let c = b.with_parameter(symbol, x).unwrap().canonical().unwrap();
+                let crit = critical_speeds(&c, 0.0, 10.0).unwrap();
+                if which == "weave" {
+                    crit.weave_speed.unwrap()
+                } else {
+                    crit.capsize_speed.unwrap()
+                }
+            };
+            variance += (central(speed_at, p, h) * sd).powi(2);
+        }
+        let sd_fd = variance.sqrt();
+        assert!(
+            (x.standard_deviation - sd_fd).abs() <= 1e-6 * sd_fd,
+            "{which}: {} vs {sd_fd}",
+            x.standard_deviation
+        );
+        assert_eq!(x.shares.len(), b.uncertainties.len());
+        assert!((x.shares.iter().map(|s| s.share).sum::<f64>() - 1.0).abs() < 1e-12);
+    }
+    // A bicycle without standard deviations has none.
+    let plain = Bicycle::resolve("benchmark").unwrap();
+    assert!(speed_uncertainties(&plain, &SensitivityOptions::default())
+        .unwrap()
+        .is_none());
+}
