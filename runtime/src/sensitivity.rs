@@ -27,7 +27,9 @@
 //! `dM0/dp, dC1/dp, dK0/dp, dK2/dp` are exact: the closed-form canonical
 //! matrices of Meijaard et al. (2007), appendix A
 //! ([`crate::benchmark_oracle::meijaard_canonical_in`]), evaluated in dual
-//! numbers seeded on the 26 benchmark parameters. The generated code carries
+//! numbers seeded on the 26 benchmark parameters, or on the 26 thesis
+//! parameters through the conversion to the benchmark form
+//! ([`crate::parameters::thesis_to_benchmark_in`]). The generated code carries
 //! first derivatives only (its duals are seeded on the coordinates to
 //! linearize), so it cannot give these mixed second derivatives; the closed
 //! form holds for the Whipple bicycle, which is what the canonical form
@@ -37,7 +39,7 @@
 
 use crate::benchmark_oracle::meijaard_canonical_in;
 use crate::canonical::CanonicalMatrices;
-use crate::eigen::{critical_speeds, eigenvalues, CriticalSpeeds, EigenError, Mode};
+use crate::eigen::{eigenvalues, CriticalSpeeds, EigenError, Mode};
 use crate::parameters::{thesis_to_benchmark_in, BenchmarkParameters, ParameterError, ThesisParameters};
 use crate::scalar::{Dual, Scalar};
 use nalgebra::{Complex, Matrix2};
@@ -424,11 +426,6 @@ pub fn eigenvalue_sensitivities(
         });
     }
     Ok(out)
-}
-
-/// The critical speeds of `c` in `[0, speed_max]` (what `stability` finds).
-pub fn critical_speeds_in(c: &CanonicalMatrices, speed_max: f64) -> Result<CriticalSpeeds, EigenError> {
-    critical_speeds(c, 0.0, speed_max)
 }
 
 #[cfg(test)]
