@@ -430,7 +430,10 @@ class Bicycle:
         ``weave_speed``, ``capsize_speed``, ``weave_real_pair_merge_speed``,
         ``stable_intervals``, every ``crossings`` with speed, mode,
         direction and frequency in rad/s, ``model``); a speed is ``None``
-        when it is not in the range."""
+        when it is not in the range. A file with standard deviations
+        (``value+/-sd``) also gives ``weave_speed_sd``, ``capsize_speed_sd``
+        and ``uncertainty`` (first order, from ``speed_min = 0``; see
+        ``docs/design-questions.md``)."""
         return json.loads(self._b.stability(float(speed_min), float(speed_max), self._model))
 
     def sensitivity(

@@ -540,6 +540,21 @@ impl PyBicycle {
                 critical_speeds_of(&lin, speed_min, speed_max).map_err(|e| Failure::new("ComputationError", e))?;
             let mut v = stability_json(&self.inner.name, &crit);
             v["model"] = serde_json::json!(lin.model);
+            // The speeds' standard deviations from the file's +/- values,
+            // as `bikedyn stability --json` gives them (none where the file
+            // gives none or no exact derivative exists).
+            let options = bikedyn::sensitivity::SensitivityOptions {
+                model: model.clone(),
+                speed_max,
+                ..Default::default()
+            };
+            if speed_min == 0.0 {
+                if let Ok(Some(u)) = bikedyn::sensitivity::speed_uncertainties(&self.inner, &options) {
+                    v["weave_speed_sd"] = serde_json::json!(u.weave_speed.as_ref().map(|x| x.standard_deviation));
+                    v["capsize_speed_sd"] = serde_json::json!(u.capsize_speed.as_ref().map(|x| x.standard_deviation));
+                    v["uncertainty"] = serde_json::to_value(&u).map_err(|e| Failure::new("InternalError", e))?;
+                }
+            }
             Ok(v.to_string())
         })
     }

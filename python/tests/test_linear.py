@@ -171,3 +171,13 @@ def test_bode_equals_the_state_space_transfer_function():
         assert g["static_gain"] == pytest.approx((-C @ np.linalg.solve(A, B))[i, j], rel=1e-10)
     with pytest.raises(bikedyn.InvalidArgumentError):
         b.bode(float("nan"))
+
+
+def test_stability_gives_standard_deviations_from_a_files_uncertainties(tmp_path):
+    import pathlib
+    src = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "Balanceassistv1Benchmark.txt"
+    s = bikedyn.Bicycle(str(src)).stability()
+    assert s["weave_speed_sd"] > 0 and s["capsize_speed_sd"] > 0
+    shares = s["uncertainty"]["weave_speed"]["shares"]
+    assert abs(sum(x["share"] for x in shares) - 1) < 1e-12
+    assert "weave_speed_sd" not in bikedyn.Bicycle("benchmark").stability()
