@@ -27,8 +27,10 @@ pub mod registry {
 
 pub mod bicycle;
 pub mod fit;
+pub mod frequency;
 pub mod identify;
 pub mod models;
 pub mod progress;
+pub mod sensitivity;
 pub mod simulate;
 pub mod synth;

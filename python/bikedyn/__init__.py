@@ -430,8 +430,49 @@ class Bicycle:
         ``weave_speed``, ``capsize_speed``, ``weave_real_pair_merge_speed``,
         ``stable_intervals``, every ``crossings`` with speed, mode,
         direction and frequency in rad/s, ``model``); a speed is ``None``
-        when it is not in the range."""
+        when it is not in the range. A file with standard deviations
+        (``value+/-sd``) also gives ``weave_speed_sd``, ``capsize_speed_sd``
+        and ``uncertainty`` (first order, from ``speed_min = 0``; see
+        ``docs/design-questions.md``)."""
         return json.loads(self._b.stability(float(speed_min), float(speed_max), self._model))
+
+    def sensitivity(
+        self, speed: Optional[float] = None, speed_max: float = 10.0, form: Optional[str] = None
+    ) -> Dict[str, Any]:
+        """Exact derivatives of the weave and capsize speeds (searched on 0
+        to ``speed_max`` m/s) with respect to every parameter, and, with
+        ``speed``, of the eigenvalues there: the dict of ``bikedyn
+        sensitivity --format json`` (``weave_speed`` and ``capsize_speed``
+        each ``{speed, eigenvalue, real_part_slope, derivatives: [{parameter,
+        value, derivative, elasticity}]}`` ranked by elasticity, or ``None``;
+        ``eigenvalues``; ``parameter_form``). ``form``: ``"benchmark"``,
+        ``"thesis"`` or ``None`` (the bicycle's own). A bicycle with an
+        effect raises :class:`ModelError` (exact for the canonical form
+        only); see ``docs/design-questions.md``."""
+        return json.loads(
+            self._b.sensitivity(
+                None if speed is None else float(speed), float(speed_max), form, self._model
+            )
+        )
+
+    def bode(
+        self, speed: float, omega_min: float = 0.1, omega_max: float = 100.0, points: int = 200
+    ) -> Dict[str, Any]:
+        """Frequency response at ``speed`` (m/s): ``G(i omega)`` from the roll
+        and steer torques to the roll and steer angles on ``points``
+        log-spaced angular frequencies (rad/s). The dict of ``bikedyn bode
+        --format json`` with NumPy arrays: ``omega``, and per entry of
+        ``responses`` (``input``, ``output``) the complex ``G``,
+        ``magnitude_db``, ``phase_deg`` and ``static_gain``."""
+        r = json.loads(
+            self._b.bode(float(speed), float(omega_min), float(omega_max), int(points), self._model)
+        )
+        r["omega"] = np.asarray(r["omega"], dtype=float)
+        for g in r["responses"]:
+            g["G"] = np.asarray(g.pop("re"), dtype=float) + 1j * np.asarray(g.pop("im"), dtype=float)
+            g["magnitude_db"] = np.asarray(g["magnitude_db"], dtype=float)
+            g["phase_deg"] = np.asarray(g["phase_deg"], dtype=float)
+        return r
 
     def _as_spec(self, stack: List[Any]) -> str:
         """A spec the pipelines resolve: the original name or file, or a

@@ -540,7 +540,114 @@ impl PyBicycle {
                 critical_speeds_of(&lin, speed_min, speed_max).map_err(|e| Failure::new("ComputationError", e))?;
             let mut v = stability_json(&self.inner.name, &crit);
             v["model"] = serde_json::json!(lin.model);
+            // The speeds' standard deviations from the file's +/- values,
+            // as `bikedyn stability --json` gives them (none where the file
+            // gives none or no exact derivative exists).
+            let options = bikedyn::sensitivity::SensitivityOptions {
+                model: model.clone(),
+                speed_max,
+                ..Default::default()
+            };
+            if speed_min == 0.0 {
+                if let Ok(Some(u)) = bikedyn::sensitivity::speed_uncertainties(&self.inner, &options) {
+                    v["weave_speed_sd"] = serde_json::json!(u.weave_speed.as_ref().map(|x| x.standard_deviation));
+                    v["capsize_speed_sd"] = serde_json::json!(u.capsize_speed.as_ref().map(|x| x.standard_deviation));
+                    v["uncertainty"] = serde_json::to_value(&u).map_err(|e| Failure::new("InternalError", e))?;
+                }
+            }
             Ok(v.to_string())
+        })
+    }
+
+    /// The exact sensitivities of the weave and capsize speeds (and, at
+    /// `speed`, of the eigenvalues) to every parameter, as the JSON of
+    /// `bikedyn sensitivity --format json`. `form`: `benchmark`, `thesis`
+    /// or `None` (the bicycle's own).
+    #[pyo3(signature = (speed, speed_max, form, model))]
+    fn sensitivity(
+        &self,
+        py: Python<'_>,
+        speed: Option<f64>,
+        speed_max: f64,
+        form: Option<String>,
+        model: Option<String>,
+    ) -> PyResult<String> {
+        use bikedyn::runtime::parameters::Form;
+        use bikedyn::sensitivity::{sensitivity, SensitivityError as E, SensitivityOptions};
+        detached(py, move || {
+            let form = match form.as_deref() {
+                None => None,
+                Some("benchmark") => Some(Form::Benchmark),
+                Some("thesis") => Some(Form::Thesis),
+                Some(f) => {
+                    return Err(Failure::new(
+                        "InvalidArgumentError",
+                        format!("form {f:?}: expected \"benchmark\", \"thesis\" or None"),
+                    ))
+                }
+            };
+            let s = sensitivity(
+                &self.inner,
+                &SensitivityOptions {
+                    model,
+                    form,
+                    speed,
+                    speed_max,
+                },
+            )
+            .map_err(|e| match e {
+                E::Bicycle(b) => bicycle_failure(b),
+                E::NotCanonical { .. } => Failure::new("ModelError", e),
+                E::NonFiniteSpeed { .. } | E::BadSpeedMax { .. } | E::NoCrossing { .. } => {
+                    Failure::new("InvalidArgumentError", e)
+                }
+                e => Failure::new("ComputationError", e),
+            })?;
+            serde_json::to_string(&s).map_err(|e| Failure::new("InternalError", e))
+        })
+    }
+
+    /// The frequency response at `speed` (roll and steer torques to roll
+    /// and steer angles) on `points` log-spaced angular frequencies, as
+    /// the JSON of `bikedyn bode --format json`.
+    #[pyo3(signature = (speed, omega_min, omega_max, points, model))]
+    fn bode(
+        &self,
+        py: Python<'_>,
+        speed: f64,
+        omega_min: f64,
+        omega_max: f64,
+        points: usize,
+        model: Option<String>,
+    ) -> PyResult<String> {
+        use bikedyn::frequency::{frequency_response, FrequencyOptions, FrequencyResponseError as E};
+        use bikedyn::runtime::frequency::FrequencyError as F;
+        detached(py, move || {
+            let r = frequency_response(
+                &self.inner,
+                &FrequencyOptions {
+                    model,
+                    speed,
+                    omega_min,
+                    omega_max,
+                    points,
+                },
+            )
+            .map_err(|e| match e {
+                E::Bicycle(b) => bicycle_failure(b),
+                E::NonFiniteSpeed { .. }
+                | E::Points { .. }
+                | E::Frequency {
+                    source: F::BadFrequencies { .. },
+                    ..
+                } => Failure::new("InvalidArgumentError", e),
+                E::Frequency {
+                    source: F::FirstOrder { .. },
+                    ..
+                } => Failure::new("ModelError", e),
+                e => Failure::new("ComputationError", e),
+            })?;
+            serde_json::to_string(&r).map_err(|e| Failure::new("InternalError", e))
         })
     }
 }

@@ -128,3 +128,56 @@ def test_the_fast_eigenvalues_are_eigs_sorted():
         for i in range(len(v)):
             assert np.allclose(np.sort_complex(fast[i]), np.sort_complex(full[i]), atol=1e-9)
             assert np.all(np.diff(fast[i].real) <= 0)
+
+
+def test_sensitivity_is_exact_and_ranked():
+    s = bikedyn.Bicycle("benchmark").sensitivity(speed=5.0)
+    assert s["parameter_form"] == "benchmark"
+    w = s["weave_speed"]
+    assert abs(w["speed"] - meijaard2007()["critical_speeds"]["weave_speed"]) < 1e-10
+    e = [d["elasticity"] for d in w["derivatives"]]
+    assert len(e) == 26 and all(abs(a) >= abs(b) for a, b in zip(e, e[1:]))
+    # A speed scales as sqrt(g L): its elasticity to g is 1/2 exactly.
+    g = next(d for d in s["capsize_speed"]["derivatives"] if d["parameter"] == "g")
+    assert g["elasticity"] == pytest.approx(0.5, abs=1e-12)
+    assert [m["mode"] for m in s["eigenvalues"]["modes"]] == ["weave", "capsize", "castering"]
+    assert bikedyn.Bicycle("thesis").sensitivity()["parameter_form"] == "thesis"
+    assert bikedyn.Bicycle("thesis").sensitivity(form="benchmark")["parameter_form"] == "benchmark"
+
+
+def test_sensitivity_refuses_what_it_cannot_differentiate():
+    with pytest.raises(bikedyn.ModelError, match="canonical form"):
+        bikedyn.Bicycle("benchmark").with_parameters(c_steer=0.3).sensitivity()
+    with pytest.raises(bikedyn.InvalidArgumentError, match="no weave or capsize crossing"):
+        bikedyn.Bicycle("benchmark").sensitivity(speed_max=1.0)
+    with pytest.raises(bikedyn.InvalidArgumentError):
+        bikedyn.Bicycle("benchmark").sensitivity(form="metric")
+
+
+def test_bode_equals_the_state_space_transfer_function():
+    b = bikedyn.Bicycle("benchmark")
+    r = b.bode(5.0, omega_min=0.5, omega_max=20.0, points=7)
+    A, B = b.state_space([5.0])
+    A, B = A[0], B[0]
+    C = np.hstack([np.eye(2), np.zeros((2, 2))])
+    inputs, outputs = ["roll_torque", "steer_torque"], ["roll", "steer"]
+    for k, w in enumerate(r["omega"]):
+        G = C @ np.linalg.solve(1j * w * np.eye(4) - A, B)
+        for g in r["responses"]:
+            i, j = outputs.index(g["output"]), inputs.index(g["input"])
+            assert abs(g["G"][k] - G[i, j]) < 1e-10 * abs(G).max()
+    for g in r["responses"]:
+        i, j = outputs.index(g["output"]), inputs.index(g["input"])
+        assert g["static_gain"] == pytest.approx((-C @ np.linalg.solve(A, B))[i, j], rel=1e-10)
+    with pytest.raises(bikedyn.InvalidArgumentError):
+        b.bode(float("nan"))
+
+
+def test_stability_gives_standard_deviations_from_a_files_uncertainties(tmp_path):
+    import pathlib
+    src = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "Balanceassistv1Benchmark.txt"
+    s = bikedyn.Bicycle(str(src)).stability()
+    assert s["weave_speed_sd"] > 0 and s["capsize_speed_sd"] > 0
+    shares = s["uncertainty"]["weave_speed"]["shares"]
+    assert abs(sum(x["share"] for x in shares) - 1) < 1e-12
+    assert "weave_speed_sd" not in bikedyn.Bicycle("benchmark").stability()

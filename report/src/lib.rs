@@ -18,8 +18,10 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod experiment;
+pub mod frequency;
 pub mod identify;
 pub mod output;
 pub mod plot;
+pub mod sensitivity;
 pub mod simulate;
 pub mod staged;

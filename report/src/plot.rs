@@ -44,8 +44,10 @@ use style::{Area, Frame, Icon, Legend, Stroke};
 /// Font family name under which the font is registered and used.
 const FAMILY: &str = "sans-serif";
 
+pub mod bode;
 mod canvas;
 pub mod locus;
+pub mod sensitivity;
 pub(crate) mod style;
 pub mod sweep;
 

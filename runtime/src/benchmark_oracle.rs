@@ -5,10 +5,14 @@
 //!
 //! The product computes canonical matrices from the generated multibody equations;
 //! this independent hand-written route exists to check them (and the eigen
-//! analysis) against the paper.
+//! analysis) against the paper. Written over any [`Scalar`], it is also where
+//! `sensitivity` takes the exact derivatives of the canonical matrices with
+//! respect to the parameters (dual numbers seeded on them), after checking
+//! that its values agree with the generated model's.
 
 use crate::canonical::CanonicalMatrices;
 use crate::parameters::BenchmarkParameters;
+use crate::scalar::Scalar;
 use nalgebra::Matrix2;
 
 /// `M0`, `C1`, `K0`, `K2` of Meijaard et al. (2007), appendix A (eqs. A 1 - A 27),
@@ -23,25 +27,36 @@ use nalgebra::Matrix2;
 /// `SR = IRyy/rR`, `SF = IFyy/rF`, `ST = SR + SF`, and the static moment
 /// `SA = mA uA + mu mT xT`.
 pub fn meijaard_canonical(p: &BenchmarkParameters) -> CanonicalMatrices {
-    let w = p.wheelbase;
-    let c = p.trail;
-    let lam = p.steer_axis_tilt;
-    let (rr, mr, irxx, iryy) = (
-        p.rear_wheel_radius,
-        p.rear_wheel_mass,
-        p.rear_wheel_ixx,
-        p.rear_wheel_iyy,
-    );
-    let (xb, zb, mb) = (p.rear_frame_com_x, p.rear_frame_com_z, p.rear_frame_mass);
-    let (ibxx, ibzz, ibxz) = (p.rear_frame_ixx, p.rear_frame_izz, p.rear_frame_ixz);
-    let (xh, zh, mh) = (p.front_frame_com_x, p.front_frame_com_z, p.front_frame_mass);
-    let (ihxx, ihzz, ihxz) = (p.front_frame_ixx, p.front_frame_izz, p.front_frame_ixz);
-    let (rf, mf, ifxx, ifyy) = (
-        p.front_wheel_radius,
-        p.front_wheel_mass,
-        p.front_wheel_ixx,
-        p.front_wheel_iyy,
-    );
+    let values: [f64; 26] = BenchmarkParameters::SYMBOLS.map(|k| p.get(k).expect("a benchmark symbol"));
+    let m = meijaard_canonical_in(&values);
+    CanonicalMatrices {
+        m0: Matrix2::from_fn(|i, j| m.m0[i][j]),
+        c1: Matrix2::from_fn(|i, j| m.c1[i][j]),
+        k0: Matrix2::from_fn(|i, j| m.k0[i][j]),
+        k2: Matrix2::from_fn(|i, j| m.k2[i][j]),
+        g: m.g,
+    }
+}
+
+/// The canonical matrices over any [`Scalar`], rows first.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CanonicalIn<T> {
+    pub m0: [[T; 2]; 2],
+    pub c1: [[T; 2]; 2],
+    pub k0: [[T; 2]; 2],
+    pub k2: [[T; 2]; 2],
+    pub g: T,
+}
+
+/// [`meijaard_canonical`] over any [`Scalar`], from the parameters in the
+/// order of [`BenchmarkParameters::SYMBOLS`]. With [`crate::Dual`] numbers
+/// seeded on the parameters it gives the exact derivatives of `M0`, `C1`,
+/// `K0`, `K2` with respect to each (`sensitivity` uses it so; the values
+/// themselves come from the generated model there, checked against these).
+pub fn meijaard_canonical_in<T: Scalar>(p: &[T; 26]) -> CanonicalIn<T> {
+    let k = |x: f64| T::cst(x);
+    let [w, c, lam, g, rr, mr, irxx, iryy, xb, zb, mb, ibxx, _ibyy, ibzz, ibxz, xh, zh, mh, ihxx, _ihyy, ihzz, ihxz, rf, mf, ifxx, ifyy] =
+        *p;
 
     // (A 1-3) total mass and mass centre
     let mt = mr + mb + mh + mf;
@@ -63,28 +78,36 @@ pub fn meijaard_canonical(p: &BenchmarkParameters) -> CanonicalMatrices {
     // (A 14-17) steer-axis quantities
     let (sl, cl) = lam.sin_cos();
     let ua = (xa - w - c) * cl - za * sl;
-    let iall = ma * ua * ua + iaxx * sl * sl + 2.0 * iaxz * sl * cl + iazz * cl * cl;
+    let iall = ma * ua * ua + iaxx * sl * sl + k(2.0) * iaxz * sl * cl + iazz * cl * cl;
     let ialx = -ma * ua * za + iaxx * sl + iaxz * cl;
     let ialz = ma * ua * xa + iaxz * sl + iazz * cl;
     // (A 18-21)
     let mu = c / w * cl;
     // A skate wheel (zero radius) has zero spin inertia (the two-mass-skate
-    // bicycle, Kooijman et al. 2011): its gyrostatic coefficient is 0.
-    let gyrostatic = |i: f64, r: f64| if i == 0.0 { 0.0 } else { i / r };
+    // bicycle, Kooijman et al. 2011): its gyrostatic coefficient is 0 (and
+    // so are its derivatives: the spin inertia must stay zero there).
+    let gyrostatic = |i: T, r: T| {
+        if i.re() == 0.0 && r.re() == 0.0 {
+            T::zero()
+        } else {
+            i / r
+        }
+    };
     let sr = gyrostatic(iryy, rr);
     let sf = gyrostatic(ifyy, rf);
     let st = sr + sf;
     let sa = ma * ua + mu * mt * xt;
     // (A 22-27) canonical matrices
     let m_pd = ialx + mu * itxz;
-    let m0 = Matrix2::new(itxx, m_pd, m_pd, iall + 2.0 * mu * ialz + mu * mu * itzz);
-    let k0 = Matrix2::new(mt * zt, -sa, -sa, -sa * sl);
-    let k2 = Matrix2::new(0.0, (st - mt * zt) * cl / w, 0.0, (sa + sf * sl) * cl / w);
-    let c1 = Matrix2::new(
-        0.0,
-        mu * st + sf * cl + itxz * cl / w - mu * mt * zt,
-        -(mu * st + sf * cl),
-        ialz * cl / w + mu * (sa + itzz * cl / w),
-    );
-    CanonicalMatrices { m0, c1, k0, k2, g: p.g }
+    let m0 = [[itxx, m_pd], [m_pd, iall + k(2.0) * mu * ialz + mu * mu * itzz]];
+    let k0 = [[mt * zt, -sa], [-sa, -sa * sl]];
+    let k2 = [
+        [T::zero(), (st - mt * zt) * cl / w],
+        [T::zero(), (sa + sf * sl) * cl / w],
+    ];
+    let c1 = [
+        [T::zero(), mu * st + sf * cl + itxz * cl / w - mu * mt * zt],
+        [-(mu * st + sf * cl), ialz * cl / w + mu * (sa + itzz * cl / w)],
+    ];
+    CanonicalIn { m0, c1, k0, k2, g }
 }

@@ -176,6 +176,54 @@ pub enum Command {
     },
     /// Stability over one parameter, or over a grid of two (a stability map).
     Sweep(SweepArgs),
+    /// Exact derivatives of the weave and capsize speeds (and of the
+    /// eigenvalues at --speed) with respect to every parameter: a ranked
+    /// table of elasticities (% per %), CSV or JSON, and a bar chart.
+    Sensitivity {
+        #[command(flatten)]
+        bike: BikeArg,
+        /// The parameters to differentiate with respect to: benchmark or
+        /// thesis symbols (default: the form the bicycle is given in).
+        #[arg(long, value_enum)]
+        form: Option<FormName>,
+        /// Speed (m/s) at which the eigenvalues are differentiated too.
+        #[arg(long, allow_hyphen_values = true)]
+        speed: Option<f64>,
+        /// Upper end of the speeds searched for v_w and v_c (m/s).
+        #[arg(long, default_value_t = 10.0)]
+        speed_max: f64,
+        #[command(flatten)]
+        out: OutputArgs,
+        /// Bar chart of the elasticities (.svg or .png).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        #[command(flatten)]
+        plot_args: PlotArgs,
+    },
+    /// Frequency response at a speed: roll and steer torque to roll and
+    /// steer angle, G(i omega) = C (i omega I - A)^-1 B on a log-spaced
+    /// grid, as a table, CSV or JSON, and a Bode plot.
+    Bode {
+        #[command(flatten)]
+        bike: BikeArg,
+        /// Forward speed (m/s).
+        #[arg(long, allow_hyphen_values = true)]
+        speed: f64,
+        /// Angular frequencies MIN:MAX (rad/s), log-spaced.
+        #[arg(long, default_value = "0.1:100", allow_hyphen_values = true)]
+        omega: String,
+        /// Number of frequencies.
+        #[arg(long, default_value_t = 200)]
+        points: usize,
+        #[command(flatten)]
+        out: OutputArgs,
+        /// Bode plot (.svg or .png): magnitude (dB) and phase (deg) against
+        /// omega; --xlim in rad/s, --ylim the magnitude's range in dB.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        #[command(flatten)]
+        plot_args: PlotArgs,
+    },
     /// Parameter sets: show or convert between thesis and benchmark forms.
     Params {
         #[command(subcommand)]

@@ -4,7 +4,9 @@ use super::args::BikeArg;
 use super::load;
 use super::text::{stability_json, stability_text};
 use anyhow::Result;
+use bikedyn::report::output::format_significant;
 use bikedyn::runtime::eigen::critical_speeds_of;
+use bikedyn::sensitivity::{speed_uncertainties, SensitivityError, SensitivityOptions, StabilityUncertainty};
 
 /// Run `bikedyn stability`.
 pub fn run(bike: BikeArg, speed_max: f64, json: bool) -> Result<bool> {
@@ -13,13 +15,62 @@ pub fn run(bike: BikeArg, speed_max: f64, json: bool) -> Result<bool> {
     let b = load(&bike)?;
     let lin = b.linear_with(model.as_deref())?;
     let crit = critical_speeds_of(&lin, 0.0, speed_max)?;
+    // The standard deviations of v_w and v_c the file's `+/-` values imply
+    // (none for a file without them; a bicycle without canonical form, or
+    // where a derivative does not exist, says why on standard error).
+    let uncertainty = match speed_uncertainties(
+        &b,
+        &SensitivityOptions {
+            model: model.clone(),
+            speed_max,
+            ..SensitivityOptions::default()
+        },
+    ) {
+        Ok(u) => u,
+        Err(SensitivityError::NoCrossing { .. }) => None,
+        Err(e) => {
+            eprintln!("note: no standard deviations of the speeds from the file's +/- values: {e}");
+            None
+        }
+    };
     if json {
         let mut v = stability_json(&bike, &crit);
         v["model"] = serde_json::json!(lin.model);
+        if let Some(u) = &uncertainty {
+            v["weave_speed_sd"] = serde_json::json!(u.weave_speed.as_ref().map(|x| x.standard_deviation));
+            v["capsize_speed_sd"] = serde_json::json!(u.capsize_speed.as_ref().map(|x| x.standard_deviation));
+            v["uncertainty"] = serde_json::to_value(u)?;
+        }
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         outln!("model: {}", lin.model);
         out!("{}", stability_text(&bike, &crit));
+        if let Some(u) = &uncertainty {
+            out!("{}", uncertainty_text(u));
+        }
     }
     Ok(true)
+}
+
+/// The speeds' standard deviations with the three largest shares.
+fn uncertainty_text(u: &StabilityUncertainty) -> String {
+    let mut s = String::from(
+        "  standard deviations from the file's +/- values (first order, exact derivatives, parameters independent):\n",
+    );
+    for (name, x) in [("v_w", &u.weave_speed), ("v_c", &u.capsize_speed)] {
+        let Some(x) = x else { continue };
+        let top: Vec<String> = x
+            .shares
+            .iter()
+            .take(3)
+            .map(|p| format!("{} {:.0} %", p.parameter, 100.0 * p.share))
+            .collect();
+        s += &format!(
+            "    {name} = {} +/- {} m/s (variance from {})\n",
+            format_significant(x.speed, 6),
+            format_significant(x.standard_deviation, 2),
+            top.join(", ")
+        );
+    }
+    s
 }

@@ -6,4 +6,5 @@ mod commands;
 mod inputs_and_outputs;
 mod plots;
 mod reliability;
+mod sensitivity_and_bode;
 mod user_files;

@@ -6,4 +6,6 @@ mod benchmark;
 mod constraints;
 mod fast_path;
 mod free_speed;
+mod frequency_response;
 mod real_designs;
+mod sensitivity;

@@ -21,6 +21,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::{BenchmarkParameters, ParameterError, ThesisParameters};
+use crate::scalar::Scalar;
 
 /// `A(beta)`: rotation about Y by the frame pitch.
 fn pitch(beta: f64) -> Matrix3<f64> {
@@ -263,5 +264,109 @@ impl BenchmarkParameters {
             front_wheel_i_axial: self.front_wheel_iyy,
             g: self.g,
         })
+    }
+}
+
+/// [`ThesisParameters::to_benchmark`] over any [`Scalar`]: thesis values in
+/// the order of [`ThesisParameters::SYMBOLS`] to benchmark values in the
+/// order of [`BenchmarkParameters::SYMBOLS`]. With dual numbers seeded on
+/// the thesis values it gives the exact Jacobian of the conversion (the
+/// sensitivities in thesis symbols are the benchmark ones through it).
+/// `beta` is the frame pitch [`ThesisParameters::frame_pitch`] found for the
+/// real parts (it picks the root's branch; the derivatives follow from the
+/// ground-contact condition `Rt - sin(b) (x4 + x5) + cos(b) (z4 + z5) = Rd`
+/// at that root).
+pub fn thesis_to_benchmark_in<T: Scalar>(t: &[T; 26], beta: f64) -> [T; 26] {
+    let [rt, rd, x3, z3, x4, z4, x5, z5, d4, m2, m3, m4, m5, i2x, i2y, i3x, i3y, i3z, i3zx, i4x, i4y, i4z, i4xz, i5x, i5y, g] =
+        *t;
+    // beta = acos(d / R) - atan2(p, q); atan2 differs from atan(p / q) or
+    // pi/2 - atan(q / p) by a constant, so either carries its derivatives
+    // (the one whose argument is at most 1 in size, away from a pole).
+    let p = x4 + x5;
+    let q = z4 + z5;
+    let d = rd - rt;
+    let reach = (p * p + q * q).sqrt();
+    let angle = if q.re().abs() >= p.re().abs() {
+        (p / q).atan()
+    } else {
+        T::cst(std::f64::consts::FRAC_PI_2) - (q / p).atan()
+    };
+    let b = (d / reach).acos() - angle;
+    let b = b + T::cst(beta - b.re());
+    let (sb, cb) = b.sin_cos();
+    // Points (x, Z up) of the thesis axes.
+    let sx = cb * x4 + sb * z4;
+    let sz = rt - sb * x4 + cb * z4;
+    let wheelbase = sx + cb * x5 + sb * z5;
+    let ground_x = sx - sz * sb / cb;
+    let frame_x = cb * x3 + sb * z3;
+    let frame_z = rt - sb * x3 + cb * z3;
+    let fork_x = sx + cb * d4;
+    let fork_z = sz - sb * d4;
+    // P A I A^T P for I = [[xx, 0, xz], [0, yy, 0], [xz, 0, zz]]: the xz
+    // block rotated by beta, its xz entry's sign flipped by P.
+    let two = T::cst(2.0);
+    let tensor = |xx: T, zz: T, xz: T| {
+        (
+            cb * cb * xx + two * cb * sb * xz + sb * sb * zz,
+            sb * sb * xx - two * sb * cb * xz + cb * cb * zz,
+            -(-cb * sb * xx + (cb * cb - sb * sb) * xz + sb * cb * zz),
+        )
+    };
+    let (ibxx, ibzz, ibxz) = tensor(i3x, i3z, i3zx);
+    let (ihxx, ihzz, ihxz) = tensor(i4x, i4z, i4xz);
+    [
+        wheelbase,
+        ground_x - wheelbase,
+        -b,
+        g,
+        rt,
+        m2,
+        i2x,
+        i2y,
+        frame_x,
+        -frame_z,
+        m3,
+        ibxx,
+        i3y,
+        ibzz,
+        ibxz,
+        fork_x,
+        -fork_z,
+        m4,
+        ihxx,
+        i4y,
+        ihzz,
+        ihxz,
+        rd,
+        m5,
+        i5x,
+        i5y,
+    ]
+}
+
+#[cfg(test)]
+mod generic_tests {
+    use super::*;
+
+    /// The generic conversion gives `to_benchmark`'s values, for the
+    /// thesis bicycle and for the benchmark's thesis form (offset fork).
+    #[test]
+    fn generic_conversion_matches_to_benchmark() {
+        for t in [
+            ThesisParameters::thesis_bicycle(),
+            BenchmarkParameters::benchmark_bicycle().to_thesis().unwrap(),
+        ] {
+            let b = t.to_benchmark().unwrap();
+            let x = thesis_to_benchmark_in(&t.values(), t.frame_pitch().unwrap());
+            for (k, sym) in BenchmarkParameters::SYMBOLS.iter().enumerate() {
+                let want = b.get(sym).unwrap();
+                assert!(
+                    (x[k] - want).abs() <= 1e-13 * want.abs().max(1.0),
+                    "{sym}: {} vs {want}",
+                    x[k]
+                );
+            }
+        }
     }
 }

@@ -29,6 +29,7 @@
 
 mod benchmark;
 mod convert;
+pub use convert::thesis_to_benchmark_in;
 mod error;
 mod load;
 mod text;

@@ -1,0 +1,199 @@
+//! `bikedyn sensitivity` and `bikedyn bode`: their outputs (table, CSV,
+//! JSON, plots) and their errors for bad input, which name the flag or the
+//! file and never panic.
+
+use crate::common::*;
+use std::path::PathBuf;
+
+fn tmp(name: &str) -> PathBuf {
+    scratch("sensitivity_and_bode").join(name)
+}
+
+/// Runs a command that must fail cleanly: exit status 2, one error line
+/// naming the problem, no panic. Returns standard error.
+fn fails(args: &[&str]) -> String {
+    let out = bikedyn(args);
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    err
+}
+
+#[test]
+fn sensitivity_json_ranks_every_parameter_of_both_speeds() {
+    let v = ok_json(&["sensitivity", "--bike", "benchmark", "--speed", "5", "--format", "json"]);
+    assert_eq!(v["parameter_form"], "benchmark");
+    for which in ["weave_speed", "capsize_speed"] {
+        let d = v[which]["derivatives"].as_array().unwrap();
+        assert_eq!(d.len(), 26, "{which}");
+        let e: Vec<f64> = d.iter().map(|x| x["elasticity"].as_f64().unwrap().abs()).collect();
+        assert!(e.windows(2).all(|w| w[0] >= w[1]), "{which} not ranked: {e:?}");
+        let g = d.iter().find(|x| x["parameter"] == "g").unwrap();
+        assert!((g["elasticity"].as_f64().unwrap() - 0.5).abs() < 1e-12);
+    }
+    assert!((v["weave_speed"]["speed"].as_f64().unwrap() - 4.2923825363).abs() < 1e-9);
+    let modes: Vec<&str> = v["eigenvalues"]["modes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m["mode"].as_str().unwrap())
+        .collect();
+    assert_eq!(modes, ["weave", "capsize", "castering"]);
+    // The thesis bicycle in its own symbols, or in the benchmark's.
+    let v = ok_json(&["sensitivity", "--bike", "thesis", "--format", "json"]);
+    assert_eq!(v["parameter_form"], "thesis");
+    assert!(v["capsize_speed"]["derivatives"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|d| d["parameter"] == "x4"));
+    let v = ok_json(&[
+        "sensitivity",
+        "--bike",
+        "thesis",
+        "--form",
+        "benchmark",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(v["parameter_form"], "benchmark");
+}
+
+#[test]
+fn sensitivity_table_csv_and_bar_chart() {
+    let out = bikedyn(&["sensitivity", "--bike", "thesis"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let t = text(&out.stdout);
+    assert!(
+        t.contains("elasticity") && t.contains("dv_w/dp") && t.contains("e_c"),
+        "{t}"
+    );
+    let csv = tmp("s.csv");
+    let svg = tmp("s.svg");
+    let out = bikedyn(&[
+        "sensitivity",
+        "--bike",
+        "benchmark",
+        "--speed",
+        "4",
+        "--format",
+        "csv",
+        "--output",
+        csv.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let c = std::fs::read_to_string(&csv).unwrap();
+    assert_eq!(
+        c.lines().next().unwrap(),
+        "quantity,rank,parameter,value,derivative,elasticity,scaled"
+    );
+    // Two speeds and three eigenvalues' real and imaginary parts, 26 each.
+    assert_eq!(c.lines().count(), 1 + 26 * (2 + 2 * 3));
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+}
+
+#[test]
+fn bode_csv_json_and_plot() {
+    let csv = tmp("b.csv");
+    let png = tmp("b.png");
+    let out = bikedyn(&[
+        "bode",
+        "--bike",
+        "benchmark",
+        "--speed",
+        "5",
+        "--omega",
+        "0.1:100",
+        "--points",
+        "50",
+        "--format",
+        "csv",
+        "--output",
+        csv.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let c = std::fs::read_to_string(&csv).unwrap();
+    assert!(c.starts_with("omega,frequency_hz,input,output,re,im,magnitude,magnitude_db,phase_deg\n"));
+    assert_eq!(c.lines().count(), 1 + 4 * 50);
+    assert!(std::fs::read(&png).unwrap().starts_with(b"\x89PNG"));
+    let v = ok_json(&[
+        "bode", "--bike", "thesis", "--speed", "4", "--points", "20", "--format", "json",
+    ]);
+    assert_eq!(v["omega"].as_array().unwrap().len(), 20);
+    assert_eq!(v["responses"].as_array().unwrap().len(), 4);
+    assert_eq!(v["stable"], true);
+    let t = text(&bikedyn(&["bode", "--bike", "benchmark", "--speed", "5"]).stdout);
+    assert!(t.contains("steer_torque") && t.contains("G(0)"), "{t}");
+}
+
+#[test]
+fn bad_input_to_sensitivity_and_bode_names_the_flag_or_file() {
+    let missing = tmp("no-such-bike.toml");
+    let m = missing.to_str().unwrap();
+    for cmd in [
+        vec!["sensitivity", "--bike", m],
+        vec!["bode", "--bike", m, "--speed", "5"],
+    ] {
+        let e = fails(&cmd);
+        assert!(e.contains("no-such-bike.toml"), "{e}");
+    }
+    for speed in ["nan", "inf", "-inf"] {
+        let e = fails(&["sensitivity", "--bike", "benchmark", "--speed", speed]);
+        assert!(e.contains("--speed"), "{e}");
+        let e = fails(&["bode", "--bike", "benchmark", "--speed", speed]);
+        assert!(e.contains("--speed"), "{e}");
+    }
+    // No crossing below 1 m/s.
+    let e = fails(&["sensitivity", "--bike", "benchmark", "--speed-max", "1"]);
+    assert!(
+        e.contains("--speed-max") && e.contains("no weave or capsize crossing"),
+        "{e}"
+    );
+    let e = fails(&["sensitivity", "--bike", "benchmark", "--speed-max", "nan"]);
+    assert!(e.contains("--speed-max"), "{e}");
+    // A bicycle with an effect has no exact parameter derivatives.
+    let damped = tmp("damped.toml");
+    let bench = text(&bikedyn(&["params", "show", "benchmark"]).stdout);
+    std::fs::write(&damped, format!("{bench}\nc_steer = 0.3\n")).unwrap();
+    let e = fails(&["sensitivity", "--bike", damped.to_str().unwrap()]);
+    assert!(e.contains("canonical form") && e.contains("c_steer"), "{e}");
+    for omega in ["0:10", "10:1", "1", "a:b", "-1:10"] {
+        let e = fails(&["bode", "--bike", "benchmark", "--speed", "5", "--omega", omega]);
+        assert!(e.contains("--omega"), "{omega}: {e}");
+    }
+    let e = fails(&["bode", "--bike", "benchmark", "--speed", "5", "--points", "1"]);
+    assert!(e.contains("--points"), "{e}");
+    let e = fails(&[
+        "bode",
+        "--bike",
+        "benchmark",
+        "--speed",
+        "5",
+        "--plot",
+        &tmp("x.pdf").to_string_lossy(),
+    ]);
+    assert!(e.contains("x.pdf"), "{e}");
+}
+
+#[test]
+fn stability_gives_the_speeds_standard_deviations_from_the_files_uncertainties() {
+    let file = fixture_arg("Balanceassistv1Benchmark.txt");
+    let v = ok_json(&["stability", "--bike", &file, "--json"]);
+    let sd_w = v["weave_speed_sd"].as_f64().unwrap();
+    let sd_c = v["capsize_speed_sd"].as_f64().unwrap();
+    assert!(sd_w > 0.0 && sd_c > 0.0, "{v}");
+    assert_eq!(v["uncertainty"]["weave_speed"]["shares"][0]["parameter"], "lam");
+    let out = bikedyn(&["stability", "--bike", &file]);
+    let t = text(&out.stdout);
+    assert!(
+        t.contains("v_w = 3.44213 +/- ") && t.contains("from the file's +/- values"),
+        "{t}"
+    );
+    // The built-in bicycles carry no standard deviations: no such fields.
+    let v = ok_json(&["stability", "--bike", "benchmark", "--json"]);
+    assert!(v.get("weave_speed_sd").is_none(), "{v}");
+}
