@@ -5,7 +5,7 @@
 use super::error::IdentifyError;
 use crate::bicycle::Bicycle;
 use bikedyn_runtime::identify::{Candidate, EffectParameter};
-use bikedyn_runtime::model::{unit_of, CandidateDeclaration, EffectIdentification};
+use bikedyn_runtime::model::{unit_of, CandidateDeclaration, EffectIdentification, LinearEquivalent};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 
 /// The identification model, its driven twin, and the alternative model
@@ -152,6 +152,10 @@ pub fn candidates<R: ModelRegistry>(
             speed_decay: d.speed_decay,
             reason: d.reason.to_string(),
             alternative_model: d.own_model,
+            nonsmooth: matches!(
+                d.linear_equivalent,
+                Some(LinearEquivalent::DescribingFunctionDamping { .. })
+            ),
         });
     }
     Ok(out)

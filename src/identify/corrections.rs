@@ -270,5 +270,6 @@ pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
             c.reduction
         ),
         alternative_model: false,
+        nonsmooth: false,
     }
 }

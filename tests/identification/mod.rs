@@ -769,3 +769,19 @@ fn tyre_forces_at_the_window_start_are_fitted_per_kick() {
     );
     assert!(fit.chi2 < 1e-6, "chi2 {}", fit.chi2);
 }
+
+/// Coulomb friction's law is not smooth at zero torque: the score test
+/// cannot judge it from its slope there, so it is fitted in every step;
+/// viscous damping and the speed-loss effects are smooth and are screened.
+#[test]
+fn a_candidate_with_a_describing_function_is_fitted_not_screened() {
+    use bikedyn::bicycle::Bicycle;
+    use bikedyn::identify::candidates::{candidates, identification_models};
+    let bike = Bicycle::resolve("thesis").expect("built-in bicycle");
+    let (model, _, alt) = identification_models(&bike, false).expect("models");
+    let all = candidates(model, alt, &bike, &[], false).expect("candidates");
+    let flag = |name: &str| all.iter().find(|c| c.name == name).map(|c| c.nonsmooth);
+    assert_eq!(flag("steer_friction"), Some(true));
+    assert_eq!(flag("steer_damping"), Some(false));
+    assert_eq!(flag("rolling_resistance"), Some(false));
+}

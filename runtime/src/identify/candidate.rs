@@ -66,4 +66,10 @@ pub struct Candidate {
     /// Simulated with the alternative model (e.g. the tyre model, which
     /// replaces the no-slip constraints) instead of the base model.
     pub alternative_model: bool,
+    /// Its law is not smooth at its base value (Coulomb friction: a
+    /// describing-function equivalent). The score test linearises at that
+    /// value and sees only the law's slope there, not the stick and slip a
+    /// finite torque causes, so its prediction can miss the fitted gain by
+    /// far: such a candidate is not screened, it is always fitted.
+    pub nonsmooth: bool,
 }

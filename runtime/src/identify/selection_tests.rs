@@ -23,6 +23,7 @@ fn candidate(name: &str, symbol: &str, prior: Option<(f64, f64)>) -> Candidate {
         speed_decay: false,
         reason: String::new(),
         alternative_model: false,
+        nonsmooth: false,
     }
 }
 
