@@ -290,3 +290,17 @@ fn logs_and_tables_without_a_bicycle_are_errors_naming_bike() {
     let out = bikedyn(&["fit", set.to_str().unwrap(), "--json"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
 }
+
+/// The benchmark's structural zeros (Meijaard et al. 2007: `C1[0][0]`,
+/// `K2[0][0]`, `K2[1][0]`) are written as 0 in JSON, not as the round-off
+/// of the generated expressions (-4.4e-15 beside 33.9).
+#[test]
+fn canonical_json_writes_structural_zeros_as_zero() {
+    let v = ok_json(&["canonical", "--bike", "benchmark", "--json"]);
+    let at = |m: &str, i: usize, j: usize| v[m][i][j].as_f64().unwrap();
+    assert_eq!(at("C1", 0, 0), 0.0);
+    assert_eq!(at("K2", 0, 0), 0.0);
+    assert_eq!(at("K2", 1, 0), 0.0);
+    // Meijaard et al. (2007), the benchmark's C1[0][1] to 14 digits.
+    assert!((at("C1", 0, 1) - 33.866_413_914_924_94).abs() < 1e-12);
+}
