@@ -453,15 +453,26 @@ mod tests {
                 v[*sym] = x.into();
                 meijaard_canonical(&serde_json::from_value(v).unwrap())
             };
-            let (a, b) = (at(x + h), at(x - h));
-            for (fd, d) in [
-                ((a.m0 - b.m0) / (2.0 * h), jac.d[k].m0),
-                ((a.c1 - b.c1) / (2.0 * h), jac.d[k].c1),
-                ((a.k0 - b.k0) / (2.0 * h), jac.d[k].k0),
-                ((a.k2 - b.k2) / (2.0 * h), jac.d[k].k2),
-            ] {
-                assert!((fd - d).amax() <= 1e-6 * (1.0 + d.amax()), "{sym}: {fd} vs {d}");
-            }
+            assert_central_difference(sym, &jac.d[k], &at(x + h), &at(x - h), h);
+        }
+    }
+
+    /// Each matrix's derivative `d` against the central difference of the
+    /// closed form at `p + h` (`a`) and `p - h` (`b`).
+    fn assert_central_difference(
+        sym: &str,
+        d: &CanonicalDerivative,
+        a: &CanonicalMatrices,
+        b: &CanonicalMatrices,
+        h: f64,
+    ) {
+        for (fd, d) in [
+            ((a.m0 - b.m0) / (2.0 * h), d.m0),
+            ((a.c1 - b.c1) / (2.0 * h), d.c1),
+            ((a.k0 - b.k0) / (2.0 * h), d.k0),
+            ((a.k2 - b.k2) / (2.0 * h), d.k2),
+        ] {
+            assert!((fd - d).amax() <= 1e-6 * (1.0 + d.amax()), "{sym}: {fd} vs {d}");
         }
     }
 
@@ -482,15 +493,7 @@ mod tests {
                 let t: ThesisParameters = serde_json::from_value(v).unwrap();
                 meijaard_canonical(&t.to_benchmark().unwrap())
             };
-            let (a, b) = (at(x + h), at(x - h));
-            for (fd, d) in [
-                ((a.m0 - b.m0) / (2.0 * h), jac.d[k].m0),
-                ((a.c1 - b.c1) / (2.0 * h), jac.d[k].c1),
-                ((a.k0 - b.k0) / (2.0 * h), jac.d[k].k0),
-                ((a.k2 - b.k2) / (2.0 * h), jac.d[k].k2),
-            ] {
-                assert!((fd - d).amax() <= 1e-6 * (1.0 + d.amax()), "{sym}: {fd} vs {d}");
-            }
+            assert_central_difference(sym, &jac.d[k], &at(x + h), &at(x - h), h);
         }
     }
 
