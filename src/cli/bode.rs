@@ -3,7 +3,7 @@
 //! Bode plot.
 
 use super::args::{BikeArg, Format, OutputArgs, PlotArgs};
-use super::{check_outputs, emit, load, plot_options};
+use super::{emit, plot_options};
 use anyhow::{bail, Context, Result};
 use bikedyn::frequency::{frequency_response, FrequencyOptions, MAX_POINTS};
 use bikedyn::report::frequency::write_frequency_response_csv;
@@ -49,13 +49,7 @@ pub fn run(
             bail!("--xlim: the frequency axis is logarithmic, its limits must be positive angular frequencies (rad/s)");
         }
     }
-    super::Paths::new()
-        .bike("--bike", Some(&bike))
-        .file("--output", out.as_deref())
-        .file("--plot", plot.as_deref())
-        .check()?;
-    check_outputs(out.as_deref(), plot.as_deref())?;
-    let b = load(&bike)?;
+    let b = super::load_with_outputs(&bike, out.as_deref(), plot.as_deref())?;
     let r = frequency_response(
         &b,
         &FrequencyOptions {

@@ -96,6 +96,19 @@ pub fn parse_range(s: &str, what: &str) -> Result<Vec<f64>> {
     Ok((0..n).map(|k| a + k as f64 * h).collect())
 }
 
+/// The bicycle of a command that writes a table (`--output`) and a figure
+/// (`--plot`): every path is checked (the bicycle file readable, the
+/// outputs writable and not an input) before the bicycle is read.
+pub fn load_with_outputs(bike: &str, out: Option<&std::path::Path>, plot: Option<&std::path::Path>) -> Result<Bicycle> {
+    Paths::new()
+        .bike("--bike", Some(bike))
+        .file("--output", out)
+        .file("--plot", plot)
+        .check()?;
+    check_outputs(out, plot)?;
+    load(bike)
+}
+
 pub fn load(bike: &str) -> Result<Bicycle> {
     let b = Bicycle::resolve(bike)?;
     show_warnings(&b);

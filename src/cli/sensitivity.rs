@@ -3,7 +3,7 @@
 //! a ranked table of elasticities, CSV or JSON, and a bar chart.
 
 use super::args::{BikeArg, FormName, Format, OutputArgs, PlotArgs};
-use super::{check_outputs, emit, load, plot_options};
+use super::{emit, plot_options};
 use anyhow::{bail, Context, Result};
 use bikedyn::report::plot::sensitivity::plot_sensitivity;
 use bikedyn::report::plot::subject;
@@ -32,13 +32,7 @@ pub fn run(
             bail!("--speed {v}: the speed of the eigenvalue derivatives must be a finite speed (m/s), e.g. --speed 5");
         }
     }
-    super::Paths::new()
-        .bike("--bike", Some(&bike))
-        .file("--output", out.as_deref())
-        .file("--plot", plot.as_deref())
-        .check()?;
-    check_outputs(out.as_deref(), plot.as_deref())?;
-    let b = load(&bike)?;
+    let b = super::load_with_outputs(&bike, out.as_deref(), plot.as_deref())?;
     let s = sensitivity(
         &b,
         &SensitivityOptions {

@@ -1,7 +1,7 @@
 //! `bikedyn sweep`: stability over one parameter, or a stability map over two.
 
 use super::args::{BikeArg, Format, MapArg, OutputArgs, SweepArgs};
-use super::{check_outputs, emit, load, parse_range, plot_options, CellProgressBar, MAX_MAP_CELLS};
+use super::{emit, parse_range, plot_options, CellProgressBar, MAX_MAP_CELLS};
 use anyhow::{bail, Result};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::report::output;
@@ -29,13 +29,7 @@ pub fn run(a: SweepArgs) -> Result<bool> {
     if param2.as_deref().is_some_and(|p2| p2.trim() == param.trim()) {
         bail!("--param and --param2 both name `{param}`: a map needs two different parameters (for one, drop --param2 and --values2)");
     }
-    super::Paths::new()
-        .bike("--bike", Some(&bike))
-        .file("--output", out.as_deref())
-        .file("--plot", plot.as_deref())
-        .check()?;
-    check_outputs(out.as_deref(), plot.as_deref())?;
-    let b = load(&bike)?;
+    let b = super::load_with_outputs(&bike, out.as_deref(), plot.as_deref())?;
     let quantity = match map {
         MapArg::Width => MapQuantity::StableWidth,
         MapArg::Weave => MapQuantity::WeaveSpeed,
