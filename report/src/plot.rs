@@ -231,18 +231,21 @@ impl Default for PlotOptions {
 }
 
 /// The subject of a figure (see [`PlotOptions::subject`]): the bicycle (a
-/// built-in name, or a parameter file by its name without directory and
-/// extension) and the model, e.g. "bicycle benchmark, model whipple_offset".
+/// built-in name, or a parameter file by its file name without directory)
+/// and the model, e.g. "bicycle benchmark, model whipple_offset" or
+/// "bicycle.toml, model whipple_offset".
 pub fn subject(bike: &str, model: Option<&str>) -> String {
     let p = Path::new(bike);
+    // A parameter file is named by its file name (`bicycle.toml` would
+    // otherwise read "bicycle bicycle"); a built-in bicycle by its name.
     let name = if bike.contains(std::path::MAIN_SEPARATOR) || p.extension().is_some() {
-        p.file_stem().map_or(bike.into(), |s| s.to_string_lossy().into_owned())
+        p.file_name().map_or(bike.into(), |s| s.to_string_lossy().into_owned())
     } else {
-        bike.to_string()
+        format!("bicycle {bike}")
     };
     match model {
-        Some(m) => format!("bicycle {name}, model {m}"),
-        None => format!("bicycle {name}"),
+        Some(m) => format!("{name}, model {m}"),
+        None => name,
     }
 }
 
@@ -1523,6 +1526,17 @@ impl Figure for MapFigure<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_figure_names_a_parameter_file_by_its_file_name_and_a_builtin_as_a_bicycle() {
+        let file = std::path::Path::new("some").join("dir").join("bicycle.toml");
+        assert_eq!(
+            subject(&file.to_string_lossy(), Some("whipple_offset")),
+            "bicycle.toml, model whipple_offset"
+        );
+        assert_eq!(subject("benchmark", Some("whipple")), "bicycle benchmark, model whipple");
+        assert_eq!(subject("BluenosePar.txt", None), "BluenosePar.txt");
+    }
 
     #[test]
     fn plot_clip_polyline_splits_at_box() {

@@ -235,7 +235,7 @@ fn angle_methods_compared_on_a_synthetic_run() {
 /// eq. 94; observed below 3 %).
 #[test]
 fn linear_model_runs_give_the_models_weave_eigenvalue() {
-    use bikedyn_runtime::benchmark_oracle::meijaard_canonical;
+    use bikedyn_runtime::closed_form::meijaard_canonical;
     use bikedyn_runtime::experiment::{compare::predicted_weave, synth::linear_model_trajectory};
     use bikedyn_runtime::parameters::BenchmarkParameters;
     let c = meijaard_canonical(&BenchmarkParameters::benchmark_bicycle());

@@ -4,7 +4,7 @@
 // `!(x <= tol)` is deliberate throughout: it treats NaN as a failure.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod benchmark_oracle;
+pub mod closed_form;
 pub mod canonical;
 pub mod constraints;
 pub mod eigen;

@@ -26,7 +26,7 @@
 //! # The parameter derivatives
 //! `dM0/dp, dC1/dp, dK0/dp, dK2/dp` are exact: the closed-form canonical
 //! matrices of Meijaard et al. (2007), appendix A
-//! ([`crate::benchmark_oracle::meijaard_canonical_in`]), evaluated in dual
+//! ([`crate::closed_form::meijaard_canonical_in`]), evaluated in dual
 //! numbers seeded on the 26 benchmark parameters, or on the 26 thesis
 //! parameters through the conversion to the benchmark form
 //! ([`crate::parameters::thesis_to_benchmark_in`]). The generated code carries
@@ -37,7 +37,7 @@
 //! the generated model's ([`CanonicalJacobian::departure`]) before using its
 //! derivatives.
 
-use crate::benchmark_oracle::meijaard_canonical_in;
+use crate::closed_form::meijaard_canonical_in;
 use crate::canonical::CanonicalMatrices;
 use crate::eigen::{eigenvalues, CriticalSpeeds, EigenError, Mode};
 use crate::parameters::{thesis_to_benchmark_in, BenchmarkParameters, ParameterError, ThesisParameters};
@@ -431,7 +431,7 @@ pub fn eigenvalue_sensitivities(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::benchmark_oracle::meijaard_canonical;
+    use crate::closed_form::meijaard_canonical;
 
     fn benchmark() -> (CanonicalMatrices, CanonicalJacobian) {
         let p = BenchmarkParameters::benchmark_bicycle();

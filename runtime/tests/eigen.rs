@@ -2,7 +2,7 @@
 //! Proc. R. Soc. A 463:1955-1982, doi 10.1098/rspa.2007.1857 (figures in
 //! `tests/data/meijaard2007.toml`).
 
-use bikedyn_runtime::benchmark_oracle::meijaard_canonical;
+use bikedyn_runtime::closed_form::meijaard_canonical;
 use bikedyn_runtime::eigen::*;
 use bikedyn_runtime::parameters::BenchmarkParameters;
 use bikedyn_runtime::CanonicalMatrices;

@@ -64,11 +64,33 @@ pub struct BikeArg {
 /// Table/CSV/JSON output of a command.
 #[derive(Args)]
 pub struct OutputArgs {
-    #[arg(long, value_enum, default_value_t = Format::Table)]
-    pub format: Format,
+    /// Output format [default: table].
+    #[arg(long, value_enum)]
+    pub format: Option<Format>,
+    /// JSON output: the same as `--format json` (every command with
+    /// structured output takes `--json`).
+    #[arg(long, conflicts_with = "format")]
+    pub json: bool,
     /// Write the table/CSV/JSON to this file instead of standard output.
     #[arg(long)]
     pub output: Option<PathBuf>,
+}
+
+impl OutputArgs {
+    /// The format asked for (a table unless `--format` or `--json` says
+    /// otherwise).
+    pub fn format(&self) -> Format {
+        if self.json {
+            Format::Json
+        } else {
+            self.format.unwrap_or(Format::Table)
+        }
+    }
+    /// Whether the output was asked for by a flag (`--format`, `--json` or
+    /// `--output`) rather than by default.
+    pub fn asked_for(&self) -> bool {
+        self.json || self.format.is_some() || self.output.is_some()
+    }
 }
 
 /// Size, resolution and axis limits of the figures a command draws.

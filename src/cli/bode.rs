@@ -35,7 +35,8 @@ pub fn run(
     plot_args: PlotArgs,
 ) -> Result<bool> {
     let BikeArg { spec: bike, model } = bike;
-    let OutputArgs { format, output: out } = out;
+    let format = out.format();
+    let out = out.output;
     let mut opts = plot_options(&plot_args, None)?;
     if !speed.is_finite() {
         bail!("--speed {speed}: must be a finite forward speed (m/s), e.g. --speed 5");

@@ -27,7 +27,13 @@ pub struct Plots {
 /// Run `bikedyn eig`.
 pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Result<bool> {
     let BikeArg { spec: bike, model } = bike;
-    let OutputArgs { format, output: out } = out;
+    // With a figure asked for, the table is written only when asked for
+    // too (`--format`, `--json` or `--output`): a plot's speeds are often
+    // thousands of rows nobody wants on the terminal.
+    let plotting = plots.continuation.is_some() || plots.root_locus.is_some() || plots.mode_shapes.is_some();
+    let write_table = !plotting || out.asked_for();
+    let format = out.format();
+    let out = out.output;
     // Every output and plot option is checked before any work.
     let mut opts = plot_options(&plots.args, None)?;
     super::Paths::new()
@@ -78,6 +84,9 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
         Ok(())
     };
     match format {
+        _ if !write_table => {
+            eprintln!("table not printed (a figure was asked for): add --format table|csv|json or --output FILE for it")
+        }
         Format::Table => {
             let speeds: Vec<f64> = (0..n).map(speed).collect();
             emit(&output::format_eigen_table(&eigen_sweep_of(c, &speeds)?), &out)?;

@@ -24,7 +24,8 @@ pub fn run(
     plot_args: PlotArgs,
 ) -> Result<bool> {
     let BikeArg { spec: bike, model } = bike;
-    let OutputArgs { format, output: out } = out;
+    let format = out.format();
+    let out = out.output;
     let mut opts = plot_options(&plot_args, None)?;
     let speed_max = super::check_speed_max(speed_max)?;
     if let Some(v) = speed {

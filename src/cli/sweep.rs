@@ -1,6 +1,6 @@
 //! `bikedyn sweep`: stability over one parameter, or a stability map over two.
 
-use super::args::{BikeArg, Format, MapArg, OutputArgs, SweepArgs};
+use super::args::{BikeArg, Format, MapArg, SweepArgs};
 use super::{emit, parse_range, plot_options, CellProgressBar, MAX_MAP_CELLS};
 use anyhow::{bail, Result};
 use bikedyn::bicycle::Bicycle;
@@ -18,12 +18,14 @@ pub fn run(a: SweepArgs) -> Result<bool> {
         param2,
         values2,
         speed_max,
-        out: OutputArgs { format, output: out },
+        out: output_args,
         plot,
         plot_args,
         map,
         at_speed,
     } = a;
+    let format = output_args.format();
+    let out = output_args.output;
     let base_opts = plot_options(&plot_args, None)?;
     let speed_max = super::check_speed_max(speed_max)?;
     if param2.as_deref().is_some_and(|p2| p2.trim() == param.trim()) {

@@ -58,6 +58,30 @@ fn eig_csv_and_plot_files() {
 }
 
 #[test]
+fn eig_with_a_plot_prints_no_table_unless_one_is_asked_for() {
+    let svg = tmp("eig_plot_only.svg");
+    let args = ["eig", "--bike", "thesis", "--speeds", "0:10:0.01", "--plot", svg.to_str().unwrap()];
+    let out = bikedyn(&args);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.stdout.is_empty(), "{} bytes of table", out.stdout.len());
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("<svg"));
+    // Asked for, the table comes as well.
+    let out = bikedyn(&[&args[..], &["--format", "table"]].concat());
+    assert!(out.status.success());
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 2 + 1001);
+}
+
+#[test]
+fn eig_json_is_also_asked_for_with_json_as_stability_takes_it() {
+    let a = ok_json(&["eig", "--bike", "benchmark", "--speeds", "0:10:1", "--json"]);
+    let b = ok_json(&["eig", "--bike", "benchmark", "--speeds", "0:10:1", "--format", "json"]);
+    assert_eq!(a, b);
+    let both = bikedyn(&["eig", "--json", "--format", "csv"]);
+    assert!(!both.status.success());
+    assert!(String::from_utf8_lossy(&both.stderr).contains("--format"));
+}
+
+#[test]
 fn thesis_bicycle_is_self_stable_where_the_thesis_says() {
     // Thesis section 4.4: self-stable from 3.4 to 6.1 m/s (read off a 0.5 m/s grid).
     let v = ok_json(&["stability", "--bike", "thesis", "--json"]);

@@ -7,7 +7,7 @@
 
 use crate::common::*;
 use bikedyn::bicycle::{canonical_of, Bicycle};
-use bikedyn::runtime::benchmark_oracle::meijaard_canonical;
+use bikedyn::runtime::closed_form::meijaard_canonical;
 use bikedyn::runtime::eigen::critical_speeds;
 use bikedyn::runtime::parameters::{BenchmarkParameters, ParameterSet, ThesisParameters};
 use bikedyn::runtime::random::SplitMix64;

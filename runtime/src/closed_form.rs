@@ -1,11 +1,12 @@
-//! TEST ORACLE ONLY: the canonical matrices of the benchmark bicycle from the
-//! closed-form expressions of appendix A of Meijaard, Papadopoulos, Ruina & Schwab
-//! (2007), "Linearized dynamics equations for the balance and steer of a bicycle: a
-//! benchmark and review", Proc. R. Soc. A 463:1955-1982, doi 10.1098/rspa.2007.1857.
+//! The canonical matrices of a benchmark-form bicycle from the closed-form
+//! expressions of appendix A of Meijaard, Papadopoulos, Ruina & Schwab
+//! (2007), "Linearized dynamics equations for the balance and steer of a
+//! bicycle: a benchmark and review", Proc. R. Soc. A 463:1955-1982, doi
+//! 10.1098/rspa.2007.1857.
 //!
-//! The product computes canonical matrices from the generated multibody equations;
-//! this independent hand-written route exists to check them (and the eigen
-//! analysis) against the paper. Written over any [`Scalar`], it is also where
+//! bikedyn computes canonical matrices from the generated multibody
+//! equations; this independent route checks them (and the eigen analysis)
+//! against the paper. Written over any [`Scalar`], it is also where
 //! `sensitivity` takes the exact derivatives of the canonical matrices with
 //! respect to the parameters (dual numbers seeded on them), after checking
 //! that its values agree with the generated model's.
