@@ -1534,7 +1534,10 @@ mod tests {
             subject(&file.to_string_lossy(), Some("whipple_offset")),
             "bicycle.toml, model whipple_offset"
         );
-        assert_eq!(subject("benchmark", Some("whipple")), "bicycle benchmark, model whipple");
+        assert_eq!(
+            subject("benchmark", Some("whipple")),
+            "bicycle benchmark, model whipple"
+        );
         assert_eq!(subject("BluenosePar.txt", None), "BluenosePar.txt");
     }
 

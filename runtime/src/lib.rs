@@ -4,8 +4,8 @@
 // `!(x <= tol)` is deliberate throughout: it treats NaN as a failure.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-pub mod closed_form;
 pub mod canonical;
+pub mod closed_form;
 pub mod constraints;
 pub mod eigen;
 pub mod experiment;

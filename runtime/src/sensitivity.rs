@@ -37,8 +37,8 @@
 //! the generated model's ([`CanonicalJacobian::departure`]) before using its
 //! derivatives.
 
-use crate::closed_form::meijaard_canonical_in;
 use crate::canonical::CanonicalMatrices;
+use crate::closed_form::meijaard_canonical_in;
 use crate::eigen::{eigenvalues, CriticalSpeeds, EigenError, Mode};
 use crate::parameters::{thesis_to_benchmark_in, BenchmarkParameters, ParameterError, ThesisParameters};
 use crate::scalar::{Dual, Scalar};

@@ -60,7 +60,15 @@ fn eig_csv_and_plot_files() {
 #[test]
 fn eig_with_a_plot_prints_no_table_unless_one_is_asked_for() {
     let svg = tmp("eig_plot_only.svg");
-    let args = ["eig", "--bike", "thesis", "--speeds", "0:10:0.01", "--plot", svg.to_str().unwrap()];
+    let args = [
+        "eig",
+        "--bike",
+        "thesis",
+        "--speeds",
+        "0:10:0.01",
+        "--plot",
+        svg.to_str().unwrap(),
+    ];
     let out = bikedyn(&args);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.stdout.is_empty(), "{} bytes of table", out.stdout.len());
