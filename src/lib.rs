@@ -30,6 +30,7 @@ pub mod fit;
 pub mod frequency;
 pub mod identify;
 pub mod models;
+pub mod monte_carlo;
 pub mod progress;
 pub mod sensitivity;
 pub mod simulate;

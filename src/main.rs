@@ -60,7 +60,13 @@ fn run(cli: Cli) -> Result<bool> {
                 args: plot_args,
             },
         ),
-        Command::Stability { bike, speed_max, json } => cli::stability::run(bike, speed_max, json),
+        Command::Stability {
+            bike,
+            speed_max,
+            json,
+            monte_carlo,
+            seed,
+        } => cli::stability::run(bike, speed_max, json, monte_carlo.map(|n| (n, seed))),
         Command::Sweep(args) => cli::sweep::run(args),
         Command::Sensitivity {
             bike,

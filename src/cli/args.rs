@@ -193,8 +193,17 @@ pub enum Command {
         /// Upper end of the searched speed range (m/s).
         #[arg(long, default_value_t = 10.0)]
         speed_max: f64,
+        /// JSON output.
         #[arg(long)]
         json: bool,
+        /// Check the first-order standard deviations of the speeds with N
+        /// bicycles drawn about the file's values with its +/- standard
+        /// deviations (2 to 1000000; in parallel).
+        #[arg(long, value_name = "N", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(2..=1_000_000))]
+        monte_carlo: Option<usize>,
+        /// Seed of the --monte-carlo draws.
+        #[arg(long, default_value_t = 1, requires = "monte_carlo")]
+        seed: u64,
     },
     /// Stability over one parameter, or over a grid of two (a stability map).
     Sweep(SweepArgs),

@@ -586,6 +586,34 @@ impl<'s> Search<'s> {
         // it (a friction torque started at a tenth of its scale can lock a
         // damped response): fitted again from its absence, the better of
         // the two is kept.
+        // A law that is not smooth at the candidate's absence (Coulomb
+        // friction: a torque large enough to stick the steer changes the
+        // response in kind, not in degree) has minima a local search from
+        // a small start does not cross: it is fitted from starts at its
+        // scale and four times it as well, and the best by the criterion is
+        // kept.
+        if p.members.iter().any(|c| c.nonsmooth) {
+            for factor in [1.0, 4.0] {
+                let mut start = current.values.clone();
+                for c in &p.members {
+                    start.extend(c.parameters.iter().map(|q| {
+                        if c.nonsmooth {
+                            factor * q.scale
+                        } else {
+                            q.initial.unwrap_or(0.1 * q.scale)
+                        }
+                    }));
+                }
+                if let Ok(again) = fit_from(&start) {
+                    if fitted
+                        .as_ref()
+                        .map_or(true, |f| again.bic < f.bic || !f.bic.is_finite())
+                    {
+                        fitted = Ok(again);
+                    }
+                }
+            }
+        }
         if let Ok(f) = &fitted {
             if f.chi2 > current.chi2 * (1.0 + 1e-9) {
                 let mut from_absence = current.values.clone();
