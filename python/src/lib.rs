@@ -1079,6 +1079,14 @@ fn fit(
             nominal_clock,
         };
         let outcome = run_fit(&opts, &|p| progress.report(p)).map_err(|e| Failure::new("DataError", e))?;
+        // Nothing fitted and something skipped: the reasons are the answer
+        // (as `bikedyn fit` exits 1), not an empty result.
+        if outcome.reports.iter().all(|r| r.kicks.is_empty()) && !outcome.errors.is_empty() {
+            return Err(Failure::new(
+                "DataError",
+                format!("no kick was fitted: {}", outcome.errors.join("; ")),
+            ));
+        }
         // The figures name the bicycle (given, or the thesis default).
         let subject = Some(bikedyn::report::plot::subject(&outcome.bike, None));
         let linear = &outcome.linear as &dyn LinearBicycle;

@@ -30,6 +30,13 @@ def test_fit_returns_the_kicks_and_writes_plots(tmp_path):
     assert any(p.suffix == ".svg" for p in (tmp_path / "fit").iterdir())
 
 
+def test_fit_of_what_holds_no_kick_raises_with_the_reason():
+    # /dev/zero is no run, log or set: nothing is fitted, and the reason is
+    # the error (as `bikedyn fit` exits 1), not an empty result.
+    with pytest.raises(bikedyn.DataError, match="/dev/zero"):
+        bikedyn.fit("/dev/zero", bike="thesis")
+
+
 def test_fit_reports_progress_and_raises_the_callbacks_exception():
     seen = []
     bikedyn.fit(SET, progress=lambda step, done, total: seen.append((step, done, total)))
