@@ -424,7 +424,13 @@ class Bicycle:
         z = _array(values, (len(v), k, 2))
         return z[..., 0] + 1j * z[..., 1]
 
-    def stability(self, speed_max: float = 10.0, speed_min: float = 0.0) -> Dict[str, Any]:
+    def stability(
+        self,
+        speed_max: float = 10.0,
+        speed_min: float = 0.0,
+        monte_carlo: Optional[int] = None,
+        seed: int = 1,
+    ) -> Dict[str, Any]:
         """Weave and capsize speeds (m/s) between ``speed_min`` and
         ``speed_max``: the dict of ``bikedyn stability --json`` (
         ``weave_speed``, ``capsize_speed``, ``weave_real_pair_merge_speed``,
@@ -433,8 +439,20 @@ class Bicycle:
         when it is not in the range. A file with standard deviations
         (``value+/-sd``) also gives ``weave_speed_sd``, ``capsize_speed_sd``
         and ``uncertainty`` (first order, from ``speed_min = 0``; see
-        ``docs/design-questions.md``)."""
-        return json.loads(self._b.stability(float(speed_min), float(speed_max), self._model))
+        ``docs/design-questions.md``). ``monte_carlo = N`` also draws N
+        bicycles about the file's values with its standard deviations
+        (``seed``): ``monte_carlo`` holds each speed's drawn ``mean``,
+        ``standard_deviation`` and ``standard_error_of_sd`` (m/s), the check
+        of the first order."""
+        return json.loads(
+            self._b.stability(
+                float(speed_min),
+                float(speed_max),
+                self._model,
+                None if monte_carlo is None else int(monte_carlo),
+                int(seed),
+            )
+        )
 
     def sensitivity(
         self, speed: Optional[float] = None, speed_max: float = 10.0, form: Optional[str] = None

@@ -527,7 +527,16 @@ impl PyBicycle {
 
     /// Stability between `speed_min` and `speed_max` (m/s) as the JSON of
     /// `bikedyn stability --json`.
-    fn stability(&self, py: Python<'_>, speed_min: f64, speed_max: f64, model: Option<String>) -> PyResult<String> {
+    #[pyo3(signature = (speed_min, speed_max, model, monte_carlo = None, seed = 1))]
+    fn stability(
+        &self,
+        py: Python<'_>,
+        speed_min: f64,
+        speed_max: f64,
+        model: Option<String>,
+        monte_carlo: Option<usize>,
+        seed: u64,
+    ) -> PyResult<String> {
         detached(py, move || {
             if !(speed_min.is_finite() && speed_max.is_finite() && speed_min >= 0.0 && speed_max > speed_min) {
                 return Err(Failure::new(
@@ -553,6 +562,37 @@ impl PyBicycle {
                     v["weave_speed_sd"] = serde_json::json!(u.weave_speed.as_ref().map(|x| x.standard_deviation));
                     v["capsize_speed_sd"] = serde_json::json!(u.capsize_speed.as_ref().map(|x| x.standard_deviation));
                     v["uncertainty"] = serde_json::to_value(&u).map_err(|e| Failure::new("InternalError", e))?;
+                }
+            }
+            // The Monte Carlo check, as `bikedyn stability --monte-carlo N`.
+            if let Some(draws) = monte_carlo {
+                if draws < 2 {
+                    return Err(Failure::new(
+                        "InvalidArgumentError",
+                        format!("monte_carlo = {draws}: at least 2 draws"),
+                    ));
+                }
+                let options = bikedyn::monte_carlo::MonteCarloOptions {
+                    draws,
+                    seed,
+                    model: model.clone(),
+                    speed_max,
+                };
+                match bikedyn::monte_carlo::monte_carlo_speeds(&self.inner, &options)
+                    .map_err(|e| Failure::new("ModelError", e))?
+                {
+                    Some(m) => {
+                        v["monte_carlo"] = serde_json::to_value(&m).map_err(|e| Failure::new("InternalError", e))?
+                    }
+                    None => {
+                        return Err(Failure::new(
+                            "InvalidArgumentError",
+                            format!(
+                                "monte_carlo draws about the file's +/- standard deviations, and `{}` gives none",
+                                self.inner.name
+                            ),
+                        ))
+                    }
                 }
             }
             Ok(v.to_string())

@@ -181,3 +181,19 @@ def test_stability_gives_standard_deviations_from_a_files_uncertainties(tmp_path
     shares = s["uncertainty"]["weave_speed"]["shares"]
     assert abs(sum(x["share"] for x in shares) - 1) < 1e-12
     assert "weave_speed_sd" not in bikedyn.Bicycle("benchmark").stability()
+
+
+def test_stability_monte_carlo_draws_about_a_files_uncertainties():
+    import pathlib
+    src = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "Balanceassistv1Benchmark.txt"
+    b = bikedyn.Bicycle(str(src))
+    s = b.stability(monte_carlo=500, seed=7)
+    m = s["monte_carlo"]
+    assert m["draws"] == 500 and m["seed"] == 7
+    # The capsize speed is near linear over this file's spread: the drawn
+    # deviation is the first order's within four of its standard errors.
+    c = m["capsize_speed"]
+    assert abs(c["standard_deviation"] - s["capsize_speed_sd"]) < 4 * c["standard_error_of_sd"]
+    assert b.stability(monte_carlo=500, seed=7)["monte_carlo"] == m
+    with pytest.raises(bikedyn.InvalidArgumentError, match=r"\+/-"):
+        bikedyn.Bicycle("benchmark").stability(monte_carlo=10)
