@@ -24,6 +24,7 @@
 
 use crate::bicycle::{Bicycle, BicycleError};
 use crate::registry::ModelRegistry;
+use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::eigen::critical_speeds;
 use bikedyn_runtime::parameters::{Form, ParameterSet};
 use bikedyn_runtime::sensitivity::{
@@ -137,33 +138,7 @@ pub fn sensitivity<R: ModelRegistry>(
             speed_max: options.speed_max,
         });
     }
-    let lin = bike.linear_with(options.model.as_deref())?;
-    let Some(c) = lin.canonical else {
-        let why = bike
-            .canonical_with(options.model.as_deref())
-            .err()
-            .map(|e| e.to_string())
-            .unwrap_or_else(|| format!("model `{}` has no canonical form", lin.model));
-        return Err(SensitivityError::NotCanonical {
-            bike: bike.name.clone(),
-            why,
-        });
-    };
-    let form = options.form.unwrap_or(match bike.parameters {
-        ParameterSet::Thesis(_) => Form::Thesis,
-        ParameterSet::Benchmark(_) => Form::Benchmark,
-    });
-    let jac = match form {
-        Form::Benchmark => CanonicalJacobian::of(&bike.parameters.to_benchmark().map_err(BicycleError::from)?),
-        Form::Thesis => CanonicalJacobian::of_thesis(&bike.thesis()?).map_err(BicycleError::from)?,
-    };
-    let departure = jac.departure(&c);
-    if departure.is_nan() || departure > CLOSED_FORM_TOLERANCE {
-        return Err(SensitivityError::ClosedFormDisagrees {
-            bike: bike.name.clone(),
-            departure,
-        });
-    }
+    let (c, jac, model, form) = canonical_and_jacobian(bike, options.model.as_deref(), options.form)?;
     let runtime = |source| SensitivityError::Runtime {
         bike: bike.name.clone(),
         source,
@@ -185,14 +160,131 @@ pub fn sensitivity<R: ModelRegistry>(
     };
     Ok(Sensitivity {
         bike: bike.name.clone(),
-        model: lin.model,
+        model,
         parameter_form: form.name(),
         speed_max: options.speed_max,
         weave_speed: weave,
         capsize_speed: capsize,
         eigenvalues,
-        closed_form_departure: departure,
+        closed_form_departure: jac.departure(&c),
     })
+}
+
+/// The canonical matrices of `bike` through `model`, the Jacobian of the
+/// closed-form matrices with respect to the parameters of `form` (default:
+/// the bicycle's own), checked to agree with the generated model's.
+fn canonical_and_jacobian<R: ModelRegistry>(
+    bike: &Bicycle<R>,
+    model: Option<&str>,
+    form: Option<Form>,
+) -> Result<(CanonicalMatrices, CanonicalJacobian, &'static str, Form), SensitivityError> {
+    let lin = bike.linear_with(model)?;
+    let Some(c) = lin.canonical else {
+        let why = bike
+            .canonical_with(model)
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_else(|| format!("model `{}` has no canonical form", lin.model));
+        return Err(SensitivityError::NotCanonical {
+            bike: bike.name.clone(),
+            why,
+        });
+    };
+    let form = form.unwrap_or(match bike.parameters {
+        ParameterSet::Thesis(_) => Form::Thesis,
+        ParameterSet::Benchmark(_) => Form::Benchmark,
+    });
+    let jac = match form {
+        Form::Benchmark => CanonicalJacobian::of(&bike.parameters.to_benchmark().map_err(BicycleError::from)?),
+        Form::Thesis => CanonicalJacobian::of_thesis(&bike.thesis()?).map_err(BicycleError::from)?,
+    };
+    let departure = jac.departure(&c);
+    if departure.is_nan() || departure > CLOSED_FORM_TOLERANCE {
+        return Err(SensitivityError::ClosedFormDisagrees {
+            bike: bike.name.clone(),
+            departure,
+        });
+    }
+    Ok((c, jac, lin.model, form))
+}
+
+/// The standard deviations of a bicycle's eigenvalues that its file's
+/// standard deviations imply, to first order with the exact eigenvalue
+/// derivatives (parameters independent, as for [`speed_uncertainties`]).
+pub struct EigenvalueSpread {
+    canonical: CanonicalMatrices,
+    jacobian: CanonicalJacobian,
+    standard_deviations: std::collections::BTreeMap<String, f64>,
+}
+
+impl EigenvalueSpread {
+    /// The spread of `bike` through `model`; `None` when its file gives
+    /// no standard deviations.
+    pub fn of<R: ModelRegistry>(bike: &Bicycle<R>, model: Option<&str>) -> Result<Option<Self>, SensitivityError> {
+        if bike.uncertainties.is_empty() {
+            return Ok(None);
+        }
+        let (canonical, jacobian, _, _) = canonical_and_jacobian(bike, model, None)?;
+        Ok(Some(EigenvalueSpread {
+            canonical,
+            jacobian,
+            standard_deviations: bike.uncertainties.clone(),
+        }))
+    }
+
+    /// At speed `v` (m/s): one entry per real eigenvalue and per conjugate
+    /// pair (its root with positive imaginary part; the conjugate's are the
+    /// same); `None` where an eigenvalue is double (no derivative there).
+    pub fn at(&self, v: f64) -> Option<Vec<EigenvalueUncertainty>> {
+        let modes = eigenvalue_sensitivities(&self.canonical, &self.jacobian, v).ok()?;
+        Some(
+            modes
+                .iter()
+                .map(|m| {
+                    let mut var = [0.0f64; 2];
+                    for d in &m.derivatives {
+                        if let Some(sd) = self.standard_deviations.get(d.parameter) {
+                            var[0] += (d.derivative[0] * sd).powi(2);
+                            var[1] += (d.derivative[1] * sd).powi(2);
+                        }
+                    }
+                    EigenvalueUncertainty {
+                        mode: m.mode,
+                        eigenvalue: m.eigenvalue,
+                        standard_deviation: [var[0].sqrt(), var[1].sqrt()],
+                    }
+                })
+                .collect(),
+        )
+    }
+
+    /// The standard deviations `[re, im]` of each of `eigenvalues` at
+    /// speed `v` (`[NaN, NaN]` where there is none).
+    pub fn of_eigenvalues(&self, v: f64, eigenvalues: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        let at = self.at(v).unwrap_or_default();
+        eigenvalues
+            .iter()
+            .map(|z| {
+                let scale = 1.0 + z[0].abs() + z[1].abs();
+                at.iter()
+                    .map(|u| ((u.eigenvalue[0] - z[0]).abs() + (u.eigenvalue[1] - z[1].abs()).abs(), u))
+                    .filter(|(d, _)| *d < 1e-6 * scale)
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .map_or([f64::NAN; 2], |(_, u)| u.standard_deviation)
+            })
+            .collect()
+    }
+}
+
+/// An eigenvalue with its standard deviation.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EigenvalueUncertainty {
+    /// Mode name.
+    pub mode: &'static str,
+    /// The eigenvalue `[re, im]` (1/s).
+    pub eigenvalue: [f64; 2],
+    /// Standard deviations of its real and imaginary parts (1/s).
+    pub standard_deviation: [f64; 2],
 }
 
 /// One parameter's part in a critical speed's variance.

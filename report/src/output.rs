@@ -614,6 +614,32 @@ pub fn stream_eigen_sweep(
     format: StreamFormat,
     w: &mut dyn Write,
 ) -> Result<(), BoxError> {
+    stream_eigen_sweep_with(c, n, speed, format, w, None)
+}
+
+/// The standard deviations `[re, im]` (1/s) of a point's eigenvalues given
+/// at its speed in the order given ([`ordered_indices`]).
+pub type EigenSpread<'a> = &'a dyn Fn(f64, &[[f64; 2]]) -> Vec<[f64; 2]>;
+
+/// [`stream_eigen_sweep`] with each eigenvalue's standard deviation from
+/// `spread`: CSV columns `re_sd_k, im_sd_k` after the others, JSON
+/// `"standard_deviations": [[re, im], ..]` in the order of `eigenvalues`.
+pub fn stream_eigen_sweep_with(
+    c: &dyn bikedyn_runtime::eigen::LinearBicycle,
+    n: usize,
+    speed: impl Fn(usize) -> f64,
+    format: StreamFormat,
+    w: &mut dyn Write,
+    spread: Option<EigenSpread<'_>>,
+) -> Result<(), BoxError> {
+    let sd_of = |p: &EigenPoint| -> Option<Vec<[f64; 2]>> {
+        let f = spread?;
+        let z: Vec<[f64; 2]> = ordered_indices(p)
+            .iter()
+            .map(|&k| [p.eigenvalues[k].re, p.eigenvalues[k].im])
+            .collect();
+        Some(f(p.v, &z))
+    };
     // Fail before writing anything if the bicycle has no eigen analysis;
     // the first point also says how many extra eigenvalues each row has.
     let extra = if n > 0 {
@@ -641,15 +667,34 @@ pub fn stream_eigen_sweep(
     match format {
         StreamFormat::Csv => {
             let mut wr = csv::Writer::from_writer(w);
-            wr.write_record(eigen_sweep_csv_header_with(extra))?;
-            for_each_point(&mut |_, p| Ok(wr.write_record(eigen_point_csv_row(p))?))?;
+            let mut header = eigen_sweep_csv_header_with(extra);
+            if spread.is_some() {
+                for k in 1..=4 {
+                    header.push(format!("re_sd_{k}"));
+                    header.push(format!("im_sd_{k}"));
+                }
+            }
+            wr.write_record(header)?;
+            for_each_point(&mut |_, p| {
+                let mut row = eigen_point_csv_row(p);
+                for sd in sd_of(p).unwrap_or_default() {
+                    row.push(num(sd[0]));
+                    row.push(num(sd[1]));
+                }
+                Ok(wr.write_record(row)?)
+            })?;
             wr.flush()?;
         }
         StreamFormat::Json => {
             w.write_all(b"[")?;
             for_each_point(&mut |i, p| {
                 w.write_all(if i == 0 { b"\n  " } else { b",\n  " })?;
-                serde_json::to_writer(&mut *w, &eigen_point_json(p))?;
+                let mut v = eigen_point_json(p);
+                if let Some(sd) = sd_of(p) {
+                    let sd: Vec<[Option<f64>; 2]> = sd.iter().map(|s| s.map(|x| x.is_finite().then_some(x))).collect();
+                    v["standard_deviations"] = json!(sd);
+                }
+                serde_json::to_writer(&mut *w, &v)?;
                 Ok(())
             })?;
             w.write_all(b"\n]\n")?;

@@ -8,6 +8,7 @@ use bikedyn::report::output;
 use bikedyn::report::plot::locus::{plot_mode_shapes, plot_root_locus};
 use bikedyn::report::plot::{plot_continuation, subject};
 use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, LinearBicycle};
+use bikedyn::sensitivity::EigenvalueSpread;
 use std::path::PathBuf;
 
 /// The figures `eig` draws and their options.
@@ -71,13 +72,32 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
     eprintln!("model: {}", lin.model);
     opts.subject = Some(subject(&b.name, Some(lin.model)));
     let c: &dyn LinearBicycle = &lin;
+    // The eigenvalues' standard deviations from the file's +/- values
+    // (first order, exact derivatives), in CSV and JSON.
+    let spread = if b.uncertainties.is_empty() || matches!(format, Format::Table) {
+        None
+    } else {
+        match EigenvalueSpread::of(&b, model.as_deref()) {
+            Ok(s) => s,
+            Err(e) => {
+                eprintln!("note: no standard deviations of the eigenvalues from the file's +/- values: {e}");
+                None
+            }
+        }
+    };
+    let spread_fn = |v: f64, z: &[[f64; 2]]| spread.as_ref().map_or_else(Vec::new, |s| s.of_eigenvalues(v, z));
+    let spread_arg: Option<output::EigenSpread<'_>> = spread.as_ref().map(|_| &spread_fn as output::EigenSpread<'_>);
+    if !b.uncertainties.is_empty() && matches!(format, Format::Table) && write_table {
+        eprintln!("note: the eigenvalues' standard deviations from the file's +/- values are in --format csv (re_sd_k, im_sd_k) and json (standard_deviations)");
+    }
     let speed = |k: usize| start + k as f64 * step;
     let stream = |fmt: output::StreamFormat| -> Result<()> {
         match &out {
-            Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep(c, n, speed, fmt, w))?,
+            Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep_with(c, n, speed, fmt, w, spread_arg))?,
             None => {
                 let mut w = std::io::BufWriter::new(std::io::stdout().lock());
-                output::stream_eigen_sweep(c, n, speed, fmt, &mut w).map_err(super::stdout_error_of)?;
+                output::stream_eigen_sweep_with(c, n, speed, fmt, &mut w, spread_arg)
+                    .map_err(super::stdout_error_of)?;
                 std::io::Write::flush(&mut w).map_err(super::stdout_error)?;
             }
         }

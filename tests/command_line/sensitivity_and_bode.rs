@@ -262,3 +262,59 @@ fn stability_monte_carlo_agrees_with_the_first_order_standard_deviations() {
     assert!(!out.status.success());
     assert!(text(&out.stderr).contains("+/-"), "{}", text(&out.stderr));
 }
+
+/// `eig` on a file with `+/-` values gives each eigenvalue's standard
+/// deviation (first order, exact derivatives): the same as summing the
+/// squares of central differences over each parameter times its standard
+/// deviation.
+#[test]
+fn eig_gives_each_eigenvalues_standard_deviation_from_the_files_uncertainties() {
+    let original = std::fs::read_to_string(fixture("Balanceassistv1Benchmark.txt")).unwrap();
+    let eig = |text: &str, name: &str| -> serde_json::Value {
+        let file = tmp(name);
+        std::fs::write(&file, text).unwrap();
+        let v = ok_json(&[
+            "eig",
+            "--bike",
+            &file.to_string_lossy(),
+            "--speeds",
+            "4.5:4.5:1",
+            "--json",
+        ]);
+        v[0].clone()
+    };
+    let nominal = eig(&original, "eig_sd_nominal.txt");
+    let pair = |v: &serde_json::Value, k: usize| [v[k][0].as_f64().unwrap(), v[k][1].as_f64().unwrap()];
+    let mut variance = [[0.0f64; 2]; 4];
+    for line in original.lines() {
+        let Some((head, sd)) = line.split_once("+/-") else {
+            continue;
+        };
+        let (symbol, value) = head.split_once('=').unwrap();
+        let (value, sd): (f64, f64) = (value.trim().parse().unwrap(), sd.trim().parse().unwrap());
+        let h = 1e-5 * value.abs().max(1e-2);
+        let with = |x: f64| original.replace(line, &format!("{} = {x:e}+/-{sd}", symbol.trim()));
+        let up = eig(&with(value + h), "eig_sd_up.txt");
+        let down = eig(&with(value - h), "eig_sd_down.txt");
+        for (k, var) in variance.iter_mut().enumerate() {
+            let (a, b) = (pair(&up["eigenvalues"], k), pair(&down["eigenvalues"], k));
+            for c in 0..2 {
+                var[c] += ((a[c] - b[c]) / (2.0 * h) * sd).powi(2);
+            }
+        }
+    }
+    for (k, var) in variance.iter().enumerate() {
+        let sd = pair(&nominal["standard_deviations"], k);
+        for c in 0..2 {
+            let by_differences = var[c].sqrt();
+            assert!(
+                (sd[c] - by_differences).abs() <= 1e-5 * (1e-3 + by_differences),
+                "eigenvalue {k}, part {c}: {} exact, {by_differences} by differences",
+                sd[c]
+            );
+        }
+    }
+    // The built-in bicycles carry no standard deviations: no such field.
+    let v = ok_json(&["eig", "--bike", "benchmark", "--speeds", "4.5:4.5:1", "--json"]);
+    assert!(v[0].get("standard_deviations").is_none(), "{v}");
+}
