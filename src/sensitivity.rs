@@ -276,6 +276,36 @@ impl EigenvalueSpread {
     }
 }
 
+/// The standard deviations of the canonical matrices' entries (and of
+/// `g`, which no file gives one for: 0) that a file's standard deviations
+/// imply, to first order with the closed form's exact derivatives, the
+/// file's parameters taken as independent. `None` when the file gives none.
+pub fn canonical_uncertainties<R: ModelRegistry>(
+    bike: &Bicycle<R>,
+    model: Option<&str>,
+) -> Result<Option<CanonicalMatrices>, SensitivityError> {
+    if bike.uncertainties.is_empty() {
+        return Ok(None);
+    }
+    let (_, jac, _, _) = canonical_and_jacobian(bike, model, None)?;
+    let sd = |pick: &dyn Fn(&bikedyn_runtime::sensitivity::CanonicalDerivative) -> nalgebra::Matrix2<f64>| {
+        let mut var = nalgebra::Matrix2::zeros();
+        for (k, symbol) in jac.symbols.iter().enumerate() {
+            if let Some(s) = bike.uncertainties.get(*symbol) {
+                var += pick(&jac.d[k]).map(|x| (x * s).powi(2));
+            }
+        }
+        var.map(f64::sqrt)
+    };
+    Ok(Some(CanonicalMatrices {
+        m0: sd(&|d| d.m0),
+        c1: sd(&|d| d.c1),
+        k0: sd(&|d| d.k0),
+        k2: sd(&|d| d.k2),
+        g: 0.0,
+    }))
+}
+
 /// An eigenvalue with its standard deviation.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EigenvalueUncertainty {

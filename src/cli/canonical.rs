@@ -6,6 +6,7 @@ use super::text::{canonical_json, canonical_text, matrix_text, state_input_rows,
 use super::{load, parse_range};
 use anyhow::{Context, Result};
 use bikedyn::runtime::eigen::{LinearBicycle, StateSpaceBicycle};
+use bikedyn::sensitivity::canonical_uncertainties;
 
 /// Run `bikedyn canonical`.
 pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
@@ -14,13 +15,35 @@ pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
     let lin = b.linear_with(model.as_deref())?;
     match &lin.canonical {
         Some(c) => {
+            // The entries' standard deviations from the file's +/- values.
+            let sd = match canonical_uncertainties(&b, model.as_deref()) {
+                Ok(sd) => sd,
+                Err(e) => {
+                    eprintln!("note: no standard deviations of the matrices from the file's +/- values: {e}");
+                    None
+                }
+            };
             if json {
                 let mut v = canonical_json(c);
                 v["model"] = serde_json::json!(lin.model);
+                if let Some(sd) = &sd {
+                    let mut s = canonical_json(sd);
+                    if let Some(o) = s.as_object_mut() {
+                        o.remove("g");
+                    }
+                    v["standard_deviations"] = s;
+                }
                 outln!("{}", serde_json::to_string_pretty(&v)?);
             } else {
                 outln!("model: {}", lin.model);
                 out!("{}", canonical_text(c));
+                if let Some(sd) = &sd {
+                    outln!("standard deviations from the file's +/- values (first order, exact derivatives, parameters independent):");
+                    for (name, m) in [("M0", &sd.m0), ("C1", &sd.c1), ("K0", &sd.k0), ("K2", &sd.k2)] {
+                        let rows = [m[(0, 0)], m[(0, 1)], m[(1, 0)], m[(1, 1)]];
+                        out!("{}", matrix_text(&format!("sd({name})"), 2, &rows));
+                    }
+                }
             }
         }
         None => {

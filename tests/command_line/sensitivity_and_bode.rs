@@ -318,3 +318,53 @@ fn eig_gives_each_eigenvalues_standard_deviation_from_the_files_uncertainties() 
     let v = ok_json(&["eig", "--bike", "benchmark", "--speeds", "4.5:4.5:1", "--json"]);
     assert!(v[0].get("standard_deviations").is_none(), "{v}");
 }
+
+/// `canonical` on a file with `+/-` values gives each entry's standard
+/// deviation: the same as summing the squares of central differences over
+/// each parameter times its standard deviation.
+#[test]
+fn canonical_gives_each_entrys_standard_deviation_from_the_files_uncertainties() {
+    let original = std::fs::read_to_string(fixture("Balanceassistv1Benchmark.txt")).unwrap();
+    let canonical = |text: &str, name: &str| -> serde_json::Value {
+        let file = tmp(name);
+        std::fs::write(&file, text).unwrap();
+        ok_json(&["canonical", "--bike", &file.to_string_lossy(), "--json"])
+    };
+    let nominal = canonical(&original, "canonical_sd_nominal.txt");
+    let entry = |v: &serde_json::Value, m: &str, i: usize, j: usize| v[m][i][j].as_f64().unwrap();
+    let names = ["M0", "C1", "K0", "K2"];
+    let mut variance = [[[0.0f64; 2]; 2]; 4];
+    for line in original.lines() {
+        let Some((head, sd)) = line.split_once("+/-") else {
+            continue;
+        };
+        let (symbol, value) = head.split_once('=').unwrap();
+        let (value, sd): (f64, f64) = (value.trim().parse().unwrap(), sd.trim().parse().unwrap());
+        let h = 1e-5 * value.abs().max(1e-2);
+        let with = |x: f64| original.replace(line, &format!("{} = {x:e}+/-{sd}", symbol.trim()));
+        let up = canonical(&with(value + h), "canonical_sd_up.txt");
+        let down = canonical(&with(value - h), "canonical_sd_down.txt");
+        for (m, var) in names.iter().zip(variance.iter_mut()) {
+            for i in 0..2 {
+                for j in 0..2 {
+                    let d = (entry(&up, m, i, j) - entry(&down, m, i, j)) / (2.0 * h);
+                    var[i][j] += (d * sd).powi(2);
+                }
+            }
+        }
+    }
+    for (m, var) in names.iter().zip(&variance) {
+        for i in 0..2 {
+            for j in 0..2 {
+                let (exact, by_differences) = (entry(&nominal["standard_deviations"], m, i, j), var[i][j].sqrt());
+                assert!(
+                    (exact - by_differences).abs() <= 1e-5 * (1e-3 + by_differences),
+                    "{m}[{i}][{j}]: {exact} exact, {by_differences} by differences"
+                );
+            }
+        }
+    }
+    assert!(ok_json(&["canonical", "--bike", "benchmark", "--json"])
+        .get("standard_deviations")
+        .is_none());
+}
