@@ -263,6 +263,40 @@ fn stability_monte_carlo_agrees_with_the_first_order_standard_deviations() {
     assert!(text(&out.stderr).contains("+/-"), "{}", text(&out.stderr));
 }
 
+/// The first-order standard deviations of the figures `figures` computes
+/// from a parameter file's text, by central differences: for each line
+/// `symbol = value+/-sd` of `original`, the figures at `value +/- h`, and
+/// `sqrt(sum ((f(+h) - f(-h)) / 2h sd)^2)` per figure.
+fn spread_by_differences(original: &str, figures: &dyn Fn(&str, &str) -> Vec<f64>) -> Vec<f64> {
+    let mut variance: Vec<f64> = Vec::new();
+    for line in original.lines() {
+        let Some((head, sd)) = line.split_once("+/-") else {
+            continue;
+        };
+        let (symbol, value) = head.split_once('=').unwrap();
+        let (value, sd): (f64, f64) = (value.trim().parse().unwrap(), sd.trim().parse().unwrap());
+        let h = 1e-5 * value.abs().max(1e-2);
+        let with = |x: f64| original.replace(line, &format!("{} = {x:e}+/-{sd}", symbol.trim()));
+        let (up, down) = (figures(&with(value + h), "up"), figures(&with(value - h), "down"));
+        variance.resize(up.len(), 0.0);
+        for ((var, a), b) in variance.iter_mut().zip(&up).zip(&down) {
+            *var += ((a - b) / (2.0 * h) * sd).powi(2);
+        }
+    }
+    variance.iter().map(|v| v.sqrt()).collect()
+}
+
+/// Exact and by-differences standard deviations agree to 1e-5 relative.
+fn assert_spreads_agree(exact: &[f64], by_differences: &[f64], what: &str) {
+    assert_eq!(exact.len(), by_differences.len(), "{what}");
+    for (k, (e, d)) in exact.iter().zip(by_differences).enumerate() {
+        assert!(
+            (e - d).abs() <= 1e-5 * (1e-3 + d),
+            "{what} {k}: {e} exact, {d} by differences"
+        );
+    }
+}
+
 /// `eig` on a file with `+/-` values gives each eigenvalue's standard
 /// deviation (first order, exact derivatives): the same as summing the
 /// squares of central differences over each parameter times its standard
@@ -271,7 +305,7 @@ fn stability_monte_carlo_agrees_with_the_first_order_standard_deviations() {
 fn eig_gives_each_eigenvalues_standard_deviation_from_the_files_uncertainties() {
     let original = std::fs::read_to_string(fixture("Balanceassistv1Benchmark.txt")).unwrap();
     let eig = |text: &str, name: &str| -> serde_json::Value {
-        let file = tmp(name);
+        let file = tmp(&format!("eig_sd_{name}.txt"));
         std::fs::write(&file, text).unwrap();
         let v = ok_json(&[
             "eig",
@@ -283,37 +317,19 @@ fn eig_gives_each_eigenvalues_standard_deviation_from_the_files_uncertainties() 
         ]);
         v[0].clone()
     };
-    let nominal = eig(&original, "eig_sd_nominal.txt");
-    let pair = |v: &serde_json::Value, k: usize| [v[k][0].as_f64().unwrap(), v[k][1].as_f64().unwrap()];
-    let mut variance = [[0.0f64; 2]; 4];
-    for line in original.lines() {
-        let Some((head, sd)) = line.split_once("+/-") else {
-            continue;
-        };
-        let (symbol, value) = head.split_once('=').unwrap();
-        let (value, sd): (f64, f64) = (value.trim().parse().unwrap(), sd.trim().parse().unwrap());
-        let h = 1e-5 * value.abs().max(1e-2);
-        let with = |x: f64| original.replace(line, &format!("{} = {x:e}+/-{sd}", symbol.trim()));
-        let up = eig(&with(value + h), "eig_sd_up.txt");
-        let down = eig(&with(value - h), "eig_sd_down.txt");
-        for (k, var) in variance.iter_mut().enumerate() {
-            let (a, b) = (pair(&up["eigenvalues"], k), pair(&down["eigenvalues"], k));
-            for c in 0..2 {
-                var[c] += ((a[c] - b[c]) / (2.0 * h) * sd).powi(2);
-            }
-        }
-    }
-    for (k, var) in variance.iter().enumerate() {
-        let sd = pair(&nominal["standard_deviations"], k);
-        for c in 0..2 {
-            let by_differences = var[c].sqrt();
-            assert!(
-                (sd[c] - by_differences).abs() <= 1e-5 * (1e-3 + by_differences),
-                "eigenvalue {k}, part {c}: {} exact, {by_differences} by differences",
-                sd[c]
-            );
-        }
-    }
+    // Real and imaginary parts of the four eigenvalues, in order.
+    let flat = |v: &serde_json::Value| -> Vec<f64> {
+        (0..4)
+            .flat_map(|k| (0..2).map(move |c| v[k][c].as_f64().unwrap()))
+            .collect()
+    };
+    let nominal = eig(&original, "nominal");
+    let by_differences = spread_by_differences(&original, &|text, name| flat(&eig(text, name)["eigenvalues"]));
+    assert_spreads_agree(
+        &flat(&nominal["standard_deviations"]),
+        &by_differences,
+        "eigenvalue part",
+    );
     // The built-in bicycles carry no standard deviations: no such field.
     let v = ok_json(&["eig", "--bike", "benchmark", "--speeds", "4.5:4.5:1", "--json"]);
     assert!(v[0].get("standard_deviations").is_none(), "{v}");
@@ -326,44 +342,20 @@ fn eig_gives_each_eigenvalues_standard_deviation_from_the_files_uncertainties() 
 fn canonical_gives_each_entrys_standard_deviation_from_the_files_uncertainties() {
     let original = std::fs::read_to_string(fixture("Balanceassistv1Benchmark.txt")).unwrap();
     let canonical = |text: &str, name: &str| -> serde_json::Value {
-        let file = tmp(name);
+        let file = tmp(&format!("canonical_sd_{name}.txt"));
         std::fs::write(&file, text).unwrap();
         ok_json(&["canonical", "--bike", &file.to_string_lossy(), "--json"])
     };
-    let nominal = canonical(&original, "canonical_sd_nominal.txt");
-    let entry = |v: &serde_json::Value, m: &str, i: usize, j: usize| v[m][i][j].as_f64().unwrap();
-    let names = ["M0", "C1", "K0", "K2"];
-    let mut variance = [[[0.0f64; 2]; 2]; 4];
-    for line in original.lines() {
-        let Some((head, sd)) = line.split_once("+/-") else {
-            continue;
-        };
-        let (symbol, value) = head.split_once('=').unwrap();
-        let (value, sd): (f64, f64) = (value.trim().parse().unwrap(), sd.trim().parse().unwrap());
-        let h = 1e-5 * value.abs().max(1e-2);
-        let with = |x: f64| original.replace(line, &format!("{} = {x:e}+/-{sd}", symbol.trim()));
-        let up = canonical(&with(value + h), "canonical_sd_up.txt");
-        let down = canonical(&with(value - h), "canonical_sd_down.txt");
-        for (m, var) in names.iter().zip(variance.iter_mut()) {
-            for i in 0..2 {
-                for j in 0..2 {
-                    let d = (entry(&up, m, i, j) - entry(&down, m, i, j)) / (2.0 * h);
-                    var[i][j] += (d * sd).powi(2);
-                }
-            }
-        }
-    }
-    for (m, var) in names.iter().zip(&variance) {
-        for i in 0..2 {
-            for j in 0..2 {
-                let (exact, by_differences) = (entry(&nominal["standard_deviations"], m, i, j), var[i][j].sqrt());
-                assert!(
-                    (exact - by_differences).abs() <= 1e-5 * (1e-3 + by_differences),
-                    "{m}[{i}][{j}]: {exact} exact, {by_differences} by differences"
-                );
-            }
-        }
-    }
+    // The entries of M0, C1, K0, K2, row by row.
+    let flat = |v: &serde_json::Value| -> Vec<f64> {
+        ["M0", "C1", "K0", "K2"]
+            .iter()
+            .flat_map(|m| (0..4).map(move |e| v[m][e / 2][e % 2].as_f64().unwrap()))
+            .collect()
+    };
+    let nominal = canonical(&original, "nominal");
+    let by_differences = spread_by_differences(&original, &|text, name| flat(&canonical(text, name)));
+    assert_spreads_agree(&flat(&nominal["standard_deviations"]), &by_differences, "matrix entry");
     assert!(ok_json(&["canonical", "--bike", "benchmark", "--json"])
         .get("standard_deviations")
         .is_none());
