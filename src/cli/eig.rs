@@ -85,8 +85,10 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
             }
         }
     };
-    let spread_fn = |v: f64, z: &[[f64; 2]]| spread.as_ref().map_or_else(Vec::new, |s| s.of_eigenvalues(v, z));
-    let spread_arg: Option<output::EigenSpread<'_>> = spread.as_ref().map(|_| &spread_fn as output::EigenSpread<'_>);
+    let spread_fn = spread
+        .as_ref()
+        .map(|s| move |v: f64, z: &[[f64; 2]]| s.of_eigenvalues(v, z));
+    let spread_arg: Option<output::EigenSpread<'_>> = spread_fn.as_ref().map(|f| f as output::EigenSpread<'_>);
     if !b.uncertainties.is_empty() && matches!(format, Format::Table) && write_table {
         eprintln!("note: the eigenvalues' standard deviations from the file's +/- values are in --format csv (re_sd_k, im_sd_k) and json (standard_deviations)");
     }

@@ -42,8 +42,8 @@ pub use super::elimination::MemberCheck;
 use super::screen;
 use super::search_order::{first_passing, SearchOrder};
 use super::{
-    cross_validate, fit_candidate, Candidate, CandidateFit, Factory, IdentifyError, IdentifyOptions, ModelFactory,
-    RollChannel, Segment, SegmentError, Setup, Weights, NUISANCE,
+    cross_validate, fit_candidate, Candidate, CandidateFit, EffectParameter, Factory, IdentifyError, IdentifyOptions,
+    ModelFactory, RollChannel, Segment, SegmentError, Setup, Weights, NUISANCE,
 };
 use crate::model::MultibodyModel;
 use serde::Serialize;
@@ -563,10 +563,16 @@ impl<'s> Search<'s> {
             Some(f) => f.setup(self.segments, self.weights, &active)?,
             None => self.main.setup(self.segments, self.weights, &active)?,
         };
-        let mut g0 = current.values.clone();
-        for c in &p.members {
-            g0.extend(c.parameters.iter().map(|q| q.initial.unwrap_or(0.1 * q.scale)));
-        }
+        // A start: the current values, then each new parameter's.
+        let start_with = |value: &dyn Fn(&Candidate, &EffectParameter) -> f64| -> Vec<f64> {
+            let mut g = current.values.clone();
+            for c in &p.members {
+                g.extend(c.parameters.iter().map(|q| value(c, q)));
+            }
+            g
+        };
+        let small = |q: &EffectParameter| q.initial.unwrap_or(0.1 * q.scale);
+        let g0 = start_with(&|_, q| small(q));
         let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
         let fit_from = |g0: &[f64]| {
             fit_candidate(
@@ -580,12 +586,6 @@ impl<'s> Search<'s> {
             )
         };
         let mut fitted = fit_from(&g0);
-        // The candidate's model holds the current one (its parameters at
-        // their absence), so a fit that ends with a larger sum of squares
-        // than the current model's stopped in a local minimum away from
-        // it (a friction torque started at a tenth of its scale can lock a
-        // damped response): fitted again from its absence, the better of
-        // the two is kept.
         // A law that is not smooth at the candidate's absence (Coulomb
         // friction: a torque large enough to stick the steer changes the
         // response in kind, not in degree) has minima a local search from
@@ -594,16 +594,7 @@ impl<'s> Search<'s> {
         // kept.
         if p.members.iter().any(|c| c.nonsmooth) {
             for factor in [1.0, 4.0] {
-                let mut start = current.values.clone();
-                for c in &p.members {
-                    start.extend(c.parameters.iter().map(|q| {
-                        if c.nonsmooth {
-                            factor * q.scale
-                        } else {
-                            q.initial.unwrap_or(0.1 * q.scale)
-                        }
-                    }));
-                }
+                let start = start_with(&|c, q| if c.nonsmooth { factor * q.scale } else { small(q) });
                 if let Ok(again) = fit_from(&start) {
                     if fitted
                         .as_ref()
@@ -614,16 +605,15 @@ impl<'s> Search<'s> {
                 }
             }
         }
+        // The candidate's model holds the current one (its parameters at
+        // their absence), so a fit that ends with a larger sum of squares
+        // than the current model's stopped in a local minimum away from
+        // it (a friction torque started at a tenth of its scale can lock a
+        // damped response): fitted again from its absence, the better of
+        // the two is kept.
         if let Ok(f) = &fitted {
             if f.chi2 > current.chi2 * (1.0 + 1e-9) {
-                let mut from_absence = current.values.clone();
-                for c in &p.members {
-                    from_absence.extend(
-                        c.parameters
-                            .iter()
-                            .map(|q| q.prior.map_or(q.lower.unwrap_or(0.0), |m| m.0)),
-                    );
-                }
+                let from_absence = start_with(&|_, q| q.prior.map_or(q.lower.unwrap_or(0.0), |m| m.0));
                 if from_absence != g0 {
                     if let Ok(again) = fit_from(&from_absence) {
                         if again.chi2 < f.chi2 {
