@@ -414,6 +414,22 @@ class Bicycle:
         w = _array(vectors, (n, 4, 4, 2))
         return Eigen(v.copy(), eigenvalues, modes.astype(str), w[..., 0] + 1j * w[..., 1], model)
 
+    def eigenvalue_standard_deviations(self, speeds: Any) -> Optional[np.ndarray]:
+        """Standard deviations of the eigenvalues of :meth:`eig` at
+        ``speeds`` (m/s) that the file's ``+/-`` values imply (first order,
+        exact derivatives, parameters independent): shape ``(n, 4, 2)``,
+        ``[..., 0]`` of the real part and ``[..., 1]`` of the imaginary
+        part (1/s), in the order of ``eig(speeds).eigenvalues[:, :4]``; NaN
+        at a double eigenvalue (no derivative there). ``None`` for a
+        bicycle whose file gives no standard deviations."""
+        e = self.eig(speeds)
+        z = e.eigenvalues[:, :4]
+        pairs = np.stack([z.real, z.imag], axis=-1).ravel().tolist()
+        out = self._b.eigenvalue_spread(e.speeds.tolist(), pairs, self._model)
+        if out is None:
+            return None
+        return np.array(out, dtype=float).reshape(len(e.speeds), 4, 2)
+
     def eigenvalues(self, speeds: Any) -> np.ndarray:
         """Eigenvalues only (1/s), shape ``(n, k)`` complex, each row by
         descending real part: no mode labels or vectors, computed in

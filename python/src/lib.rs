@@ -525,6 +525,42 @@ impl PyBicycle {
         Ok((name.to_string(), k, PyBytes::new(py, &bytes_of(&values))))
     }
 
+    /// The standard deviations `[re, im]` (1/s) of `eigenvalues` (`[re,
+    /// im]` pairs, four per speed, as `eig` orders them) from the file's
+    /// +/- values, flat; `None` when the file gives none (see
+    /// `bikedyn eig --format json`'s `standard_deviations`).
+    fn eigenvalue_spread(
+        &self,
+        py: Python<'_>,
+        speeds: Vec<f64>,
+        eigenvalues: Vec<f64>,
+        model: Option<String>,
+    ) -> PyResult<Option<Vec<f64>>> {
+        detached(py, move || {
+            if eigenvalues.len() != speeds.len() * 8 {
+                return Err(Failure::new(
+                    "InvalidArgumentError",
+                    format!(
+                        "{} eigenvalue numbers for {} speeds: expected four [re, im] pairs per speed",
+                        eigenvalues.len(),
+                        speeds.len()
+                    ),
+                ));
+            }
+            let Some(spread) = bikedyn::sensitivity::EigenvalueSpread::of(&self.inner, model.as_deref())
+                .map_err(|e| Failure::new("ModelError", e))?
+            else {
+                return Ok(None);
+            };
+            let mut out = Vec::with_capacity(eigenvalues.len());
+            for (v, z) in speeds.iter().zip(eigenvalues.chunks(8)) {
+                let pairs: Vec<[f64; 2]> = z.chunks(2).map(|p| [p[0], p[1]]).collect();
+                out.extend(spread.of_eigenvalues(*v, &pairs).into_iter().flatten());
+            }
+            Ok(Some(out))
+        })
+    }
+
     /// Stability between `speed_min` and `speed_max` (m/s) as the JSON of
     /// `bikedyn stability --json`.
     #[pyo3(signature = (speed_min, speed_max, model, monte_carlo = None, seed = 1))]

@@ -197,3 +197,26 @@ def test_stability_monte_carlo_draws_about_a_files_uncertainties():
     assert b.stability(monte_carlo=500, seed=7)["monte_carlo"] == m
     with pytest.raises(bikedyn.InvalidArgumentError, match=r"\+/-"):
         bikedyn.Bicycle("benchmark").stability(monte_carlo=10)
+
+
+def test_eigenvalue_standard_deviations_are_the_first_order_propagation():
+    import pathlib
+    src = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "Balanceassistv1Benchmark.txt"
+    b = bikedyn.Bicycle(str(src))
+    speeds = [3.0, 4.5]
+    sd = b.eigenvalue_standard_deviations(speeds)
+    assert sd.shape == (2, 4, 2)
+    # Central differences over every parameter the file gives a +/- for.
+    var = np.zeros((2, 4, 2))
+    for line in src.read_text().splitlines():
+        if "+/-" not in line:
+            continue
+        symbol, rest = (x.strip() for x in line.split("=", 1))
+        value, s = (float(x) for x in rest.split("+/-"))
+        h = 1e-5 * max(abs(value), 1e-2)
+        up = b.with_parameters(**{symbol: value + h}).eig(speeds).eigenvalues[:, :4]
+        down = b.with_parameters(**{symbol: value - h}).eig(speeds).eigenvalues[:, :4]
+        d = (up - down) / (2 * h) * s
+        var += np.stack([d.real ** 2, d.imag ** 2], axis=-1)
+    np.testing.assert_allclose(sd, np.sqrt(var), rtol=1e-5, atol=1e-8)
+    assert bikedyn.Bicycle("benchmark").eigenvalue_standard_deviations([4.0]) is None
