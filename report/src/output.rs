@@ -891,11 +891,31 @@ pub fn parameter_sweep_csv_header(s: &ParameterSweep) -> Vec<String> {
 
 /// Write a parameter sweep as CSV, one row per parameter value.
 pub fn write_parameter_sweep_csv<W: Write>(w: W, s: &ParameterSweep) -> Result<(), csv::Error> {
+    write_parameter_sweep_csv_with(w, s, &[])
+}
+
+/// More columns of a sweep, one value per point (empty in CSV and `null`
+/// in JSON where `None`): e.g. the critical speeds' standard deviations.
+pub type SweepColumns<'a> = &'a [(&'a str, Vec<Option<f64>>)];
+
+/// [`write_parameter_sweep_csv`] with `extra` columns after the others.
+pub fn write_parameter_sweep_csv_with<W: Write>(
+    w: W,
+    s: &ParameterSweep,
+    extra: SweepColumns<'_>,
+) -> Result<(), csv::Error> {
     let mut wr = csv::Writer::from_writer(w);
-    wr.write_record(parameter_sweep_csv_header(s))?;
-    for (p, c) in s.param.values.iter().zip(&s.points) {
+    let mut header = parameter_sweep_csv_header(s);
+    header.extend(extra.iter().map(|(name, _)| name.to_string()));
+    wr.write_record(header)?;
+    for (i, (p, c)) in s.param.values.iter().zip(&s.points).enumerate() {
         let mut row = vec![num(*p)];
         row.extend(cell_fields(c));
+        row.extend(
+            extra
+                .iter()
+                .map(|(_, v)| v.get(i).copied().flatten().map_or(String::new(), num)),
+        );
         wr.write_record(&row)?;
     }
     wr.flush()?;
@@ -905,15 +925,24 @@ pub fn write_parameter_sweep_csv<W: Write>(w: W, s: &ParameterSweep) -> Result<(
 /// JSON value of a parameter sweep:
 /// `{"parameter": name, "speed_range": [lo, hi], "points": [{"value": p, ...cell fields}]}`.
 pub fn parameter_sweep_json(s: &ParameterSweep) -> Value {
+    parameter_sweep_json_with(s, &[])
+}
+
+/// [`parameter_sweep_json`] with `extra` fields in each point.
+pub fn parameter_sweep_json_with(s: &ParameterSweep, extra: SweepColumns<'_>) -> Value {
     let points: Vec<Value> = s
         .param
         .values
         .iter()
         .zip(&s.points)
-        .map(|(p, c)| {
+        .enumerate()
+        .map(|(i, (p, c))| {
             let mut m = serde_json::Map::new();
             m.insert("value".into(), json!(p));
             m.extend(cell_json(c));
+            for (name, v) in extra {
+                m.insert(name.to_string(), json!(v.get(i).copied().flatten()));
+            }
             Value::Object(m)
         })
         .collect();

@@ -360,3 +360,59 @@ fn canonical_gives_each_entrys_standard_deviation_from_the_files_uncertainties()
         .get("standard_deviations")
         .is_none());
 }
+
+/// `sweep` over one parameter of a file with `+/-` values gives the
+/// critical speeds' standard deviations at each value: those of the file
+/// with that value set and its own `+/-` left out (the swept parameter is
+/// set, not measured).
+#[test]
+fn sweep_gives_the_critical_speeds_standard_deviations_at_each_value() {
+    let original = std::fs::read_to_string(fixture("Balanceassistv1Benchmark.txt")).unwrap();
+    let file = fixture_arg("Balanceassistv1Benchmark.txt");
+    let sweep = ok_json(&[
+        "sweep",
+        "--bike",
+        &file,
+        "--param",
+        "c",
+        "--values",
+        "0.03:0.05:0.02",
+        "--json",
+    ]);
+    for point in sweep["points"].as_array().unwrap() {
+        let c = point["value"].as_f64().unwrap();
+        let line = original.lines().find(|l| l.starts_with("c =")).unwrap();
+        let set = tmp(&format!("sweep_sd_c_{c}.txt"));
+        std::fs::write(&set, original.replace(line, &format!("c = {c}"))).unwrap();
+        let st = ok_json(&["stability", "--bike", &set.to_string_lossy(), "--json"]);
+        for key in ["weave_speed_sd", "capsize_speed_sd"] {
+            let (a, b) = (point[key].as_f64().unwrap(), st[key].as_f64().unwrap());
+            assert!((a - b).abs() <= 1e-9 * b, "c = {c}, {key}: sweep {a}, stability {b}");
+        }
+    }
+    let csv = bikedyn(&[
+        "sweep",
+        "--bike",
+        &file,
+        "--param",
+        "c",
+        "--values",
+        "0.03:0.05:0.02",
+        "--format",
+        "csv",
+    ]);
+    let header = text(&csv.stdout).lines().next().unwrap().to_string();
+    assert!(header.ends_with("weave_speed_sd,capsize_speed_sd"), "{header}");
+    // The built-in bicycles carry no standard deviations: no such field.
+    let v = ok_json(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0.08:0.08:1",
+        "--json",
+    ]);
+    assert!(v["points"][0].get("weave_speed_sd").is_none(), "{v}");
+}
