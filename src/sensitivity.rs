@@ -306,6 +306,54 @@ pub fn canonical_uncertainties<R: ModelRegistry>(
     }))
 }
 
+/// The critical speeds' standard deviations (m/s) over a sweep of one
+/// parameter ([`speed_spread_over`]), one per value (`None` where a value
+/// leaves no exact derivative or no such speed).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SweepSpread {
+    pub weave_speed: Vec<Option<f64>>,
+    pub capsize_speed: Vec<Option<f64>>,
+}
+
+/// The standard deviations of the weave and capsize speeds of `bike` with
+/// `param` set to each of `values`, from the file's standard deviations
+/// without `param`'s own (a swept parameter is set, not measured), to
+/// first order as [`speed_uncertainties`]. `None` when setting `param`
+/// changes the file's form (a thesis symbol on a benchmark file: the
+/// deviations would no longer name the parameters differentiated).
+pub fn speed_spread_over<R: ModelRegistry>(
+    bike: &Bicycle<R>,
+    param: &str,
+    values: &[f64],
+    options: &SensitivityOptions,
+) -> Option<SweepSpread> {
+    let mut out = SweepSpread {
+        weave_speed: Vec::with_capacity(values.len()),
+        capsize_speed: Vec::with_capacity(values.len()),
+    };
+    for &x in values {
+        let u = match bike.with_parameter(param, x) {
+            Ok(mut b) => {
+                if b.parameters.form() != bike.parameters.form() {
+                    return None;
+                }
+                b.uncertainties.remove(param);
+                speed_uncertainties(&b, options).ok().flatten()
+            }
+            Err(_) => None,
+        };
+        out.weave_speed.push(
+            u.as_ref()
+                .and_then(|u| u.weave_speed.as_ref().map(|x| x.standard_deviation)),
+        );
+        out.capsize_speed.push(
+            u.as_ref()
+                .and_then(|u| u.capsize_speed.as_ref().map(|x| x.standard_deviation)),
+        );
+    }
+    Some(out)
+}
+
 /// An eigenvalue with its standard deviation.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct EigenvalueUncertainty {

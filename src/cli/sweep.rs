@@ -8,7 +8,7 @@ use bikedyn::report::output;
 use bikedyn::report::plot::sweep::plot_parameter_sweep;
 use bikedyn::report::plot::{plot_stability_map, subject, PlotOptions};
 use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
-use bikedyn::sensitivity::{speed_uncertainties, SensitivityOptions, StabilityUncertainty};
+use bikedyn::sensitivity::{speed_spread_over, SensitivityOptions};
 
 /// Run `bikedyn sweep`.
 pub fn run(a: SweepArgs) -> Result<bool> {
@@ -208,7 +208,18 @@ pub fn run(a: SweepArgs) -> Result<bool> {
             let spread = if b.uncertainties.is_empty() || matches!(format, Format::Table) {
                 Vec::new()
             } else {
-                speed_spread_over(&b, &param, &s.param.values, model.as_deref(), speed_max)
+                let options = SensitivityOptions {
+                    model: model.clone(),
+                    speed_max,
+                    ..SensitivityOptions::default()
+                };
+                match speed_spread_over(&b, &param, &s.param.values, &options) {
+                    Some(u) => vec![("weave_speed_sd", u.weave_speed), ("capsize_speed_sd", u.capsize_speed)],
+                    None => {
+                        eprintln!("note: no standard deviations in the sweep: `{param}` is not in the file's form, and setting it converts the file");
+                        Vec::new()
+                    }
+                }
             };
             match format {
                 Format::Table => output::format_parameter_table(&s, &describe),
@@ -247,45 +258,4 @@ fn refuse_failed_cells<'a>(
         "{} of the sweep's designs failed, no table written:\n{shown}{more}",
         failed.len()
     )
-}
-
-/// `weave_speed_sd` and `capsize_speed_sd` (m/s) of `bike` with `param`
-/// set to each of `values`, from the file's standard deviations without
-/// `param`'s own (first order, exact derivatives). None where a value
-/// leaves no exact derivative; no columns at all when setting `param`
-/// changes the file's form (a thesis symbol on a benchmark file: the
-/// deviations would no longer name the parameters differentiated).
-fn speed_spread_over(
-    bike: &Bicycle,
-    param: &str,
-    values: &[f64],
-    model: Option<&str>,
-    speed_max: f64,
-) -> Vec<(&'static str, Vec<Option<f64>>)> {
-    let options = SensitivityOptions {
-        model: model.map(str::to_string),
-        speed_max,
-        ..SensitivityOptions::default()
-    };
-    let mut weave = Vec::with_capacity(values.len());
-    let mut capsize = Vec::with_capacity(values.len());
-    for &x in values {
-        let Ok(mut b) = bike.with_parameter(param, x) else {
-            weave.push(None);
-            capsize.push(None);
-            continue;
-        };
-        if b.parameters.form() != bike.parameters.form() {
-            eprintln!(
-                "note: no standard deviations in the sweep: `{param}` is not in the file's form, and setting it converts the file"
-            );
-            return Vec::new();
-        }
-        b.uncertainties.remove(param);
-        let u = speed_uncertainties(&b, &options).ok().flatten();
-        let sd = |pick: fn(&StabilityUncertainty) -> Option<f64>| u.as_ref().and_then(pick);
-        weave.push(sd(|u| u.weave_speed.as_ref().map(|x| x.standard_deviation)));
-        capsize.push(sd(|u| u.capsize_speed.as_ref().map(|x| x.standard_deviation)));
-    }
-    vec![("weave_speed_sd", weave), ("capsize_speed_sd", capsize)]
 }
