@@ -369,17 +369,19 @@ fn canonical_gives_each_entrys_standard_deviation_from_the_files_uncertainties()
 fn sweep_gives_the_critical_speeds_standard_deviations_at_each_value() {
     let original = std::fs::read_to_string(fixture("Balanceassistv1Benchmark.txt")).unwrap();
     let file = fixture_arg("Balanceassistv1Benchmark.txt");
-    let sweep = ok_json(&[
-        "sweep",
-        "--bike",
-        &file,
-        "--param",
-        "c",
-        "--values",
-        "0.03:0.05:0.02",
-        "--json",
-    ]);
-    for point in sweep["points"].as_array().unwrap() {
+    // `sweep` of trail over `values` on `bike`, then the output flags.
+    let sweep = |bike: &str, values: &str, output: &[&str]| -> Vec<String> {
+        ["sweep", "--bike", bike, "--param", "c", "--values", values]
+            .iter()
+            .chain(output)
+            .map(|a| a.to_string())
+            .collect()
+    };
+    let call = |args: Vec<String>| bikedyn(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    let out = call(sweep(&file, "0.03:0.05:0.02", &["--json"]));
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let swept = stdout_json(&out);
+    for point in swept["points"].as_array().unwrap() {
         let c = point["value"].as_f64().unwrap();
         let line = original.lines().find(|l| l.starts_with("c =")).unwrap();
         let set = tmp(&format!("sweep_sd_c_{c}.txt"));
@@ -390,29 +392,10 @@ fn sweep_gives_the_critical_speeds_standard_deviations_at_each_value() {
             assert!((a - b).abs() <= 1e-9 * b, "c = {c}, {key}: sweep {a}, stability {b}");
         }
     }
-    let csv = bikedyn(&[
-        "sweep",
-        "--bike",
-        &file,
-        "--param",
-        "c",
-        "--values",
-        "0.03:0.05:0.02",
-        "--format",
-        "csv",
-    ]);
+    let csv = call(sweep(&file, "0.03:0.05:0.02", &["--format", "csv"]));
     let header = text(&csv.stdout).lines().next().unwrap().to_string();
     assert!(header.ends_with("weave_speed_sd,capsize_speed_sd"), "{header}");
     // The built-in bicycles carry no standard deviations: no such field.
-    let v = ok_json(&[
-        "sweep",
-        "--bike",
-        "benchmark",
-        "--param",
-        "c",
-        "--values",
-        "0.08:0.08:1",
-        "--json",
-    ]);
+    let v = stdout_json(&call(sweep("benchmark", "0.08:0.08:1", &["--json"])));
     assert!(v["points"][0].get("weave_speed_sd").is_none(), "{v}");
 }
