@@ -593,44 +593,47 @@ impl PyBicycle {
                 speed_max,
                 ..Default::default()
             };
-            if speed_min == 0.0 {
-                if let Ok(Some(u)) = bikedyn::sensitivity::speed_uncertainties(&self.inner, &options) {
-                    v["weave_speed_sd"] = serde_json::json!(u.weave_speed.as_ref().map(|x| x.standard_deviation));
-                    v["capsize_speed_sd"] = serde_json::json!(u.capsize_speed.as_ref().map(|x| x.standard_deviation));
-                    v["uncertainty"] = serde_json::to_value(&u).map_err(|e| Failure::new("InternalError", e))?;
-                }
-            }
+            let first_order = if speed_min == 0.0 {
+                bikedyn::sensitivity::speed_uncertainties(&self.inner, &options)
+                    .ok()
+                    .flatten()
+            } else {
+                None
+            };
             // The Monte Carlo check, as `bikedyn stability --monte-carlo N`.
-            if let Some(draws) = monte_carlo {
-                if draws < 2 {
-                    return Err(Failure::new(
-                        "InvalidArgumentError",
-                        format!("monte_carlo = {draws}: at least 2 draws"),
-                    ));
-                }
-                let options = bikedyn::monte_carlo::MonteCarloOptions {
-                    draws,
-                    seed,
-                    model: model.clone(),
-                    speed_max,
-                };
-                match bikedyn::monte_carlo::monte_carlo_speeds(&self.inner, &options)
-                    .map_err(|e| Failure::new("ModelError", e))?
-                {
-                    Some(m) => {
-                        v["monte_carlo"] = serde_json::to_value(&m).map_err(|e| Failure::new("InternalError", e))?
-                    }
-                    None => {
+            let sampled = match monte_carlo {
+                None => None,
+                Some(draws) => {
+                    if draws < 2 {
                         return Err(Failure::new(
                             "InvalidArgumentError",
-                            format!(
-                                "monte_carlo draws about the file's +/- standard deviations, and `{}` gives none",
-                                self.inner.name
-                            ),
-                        ))
+                            format!("monte_carlo = {draws}: at least 2 draws"),
+                        ));
+                    }
+                    let options = bikedyn::monte_carlo::MonteCarloOptions {
+                        draws,
+                        seed,
+                        model: model.clone(),
+                        speed_max,
+                    };
+                    match bikedyn::monte_carlo::monte_carlo_speeds(&self.inner, &options)
+                        .map_err(|e| Failure::new("ModelError", e))?
+                    {
+                        Some(m) => Some(m),
+                        None => {
+                            return Err(Failure::new(
+                                "InvalidArgumentError",
+                                format!(
+                                    "monte_carlo draws about the file's +/- standard deviations, and `{}` gives none",
+                                    self.inner.name
+                                ),
+                            ))
+                        }
                     }
                 }
-            }
+            };
+            bikedyn::monte_carlo::add_spread_json(&mut v, first_order.as_ref(), sampled.as_ref())
+                .map_err(|e| Failure::new("InternalError", e))?;
             Ok(v.to_string())
         })
     }

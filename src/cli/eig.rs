@@ -74,7 +74,7 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
     let c: &dyn LinearBicycle = &lin;
     // The eigenvalues' standard deviations from the file's +/- values
     // (first order, exact derivatives), in CSV and JSON.
-    let spread = if b.uncertainties.is_empty() || matches!(format, Format::Table) {
+    let spread = if b.uncertainties.is_empty() || matches!(format, Format::Table) || !write_table {
         None
     } else {
         match EigenvalueSpread::of(&b, model.as_deref()) {

@@ -4,7 +4,7 @@ use super::args::BikeArg;
 use super::load;
 use super::text::{stability_json, stability_text};
 use anyhow::{bail, Result};
-use bikedyn::monte_carlo::{monte_carlo_speeds, MonteCarloOptions, MonteCarloSpeeds};
+use bikedyn::monte_carlo::{add_spread_json, monte_carlo_speeds, MonteCarloOptions, MonteCarloSpeeds};
 use bikedyn::report::output::format_significant;
 use bikedyn::runtime::eigen::critical_speeds_of;
 use bikedyn::sensitivity::{speed_uncertainties, SensitivityError, SensitivityOptions, StabilityUncertainty};
@@ -55,14 +55,7 @@ pub fn run(bike: BikeArg, speed_max: f64, json: bool, monte_carlo: Option<(usize
     if json {
         let mut v = stability_json(&bike, &crit);
         v["model"] = serde_json::json!(lin.model);
-        if let Some(u) = &uncertainty {
-            v["weave_speed_sd"] = serde_json::json!(u.weave_speed.as_ref().map(|x| x.standard_deviation));
-            v["capsize_speed_sd"] = serde_json::json!(u.capsize_speed.as_ref().map(|x| x.standard_deviation));
-            v["uncertainty"] = serde_json::to_value(u)?;
-        }
-        if let Some(m) = &sampled {
-            v["monte_carlo"] = serde_json::to_value(m)?;
-        }
+        add_spread_json(&mut v, uncertainty.as_ref(), sampled.as_ref())?;
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         outln!("model: {}", lin.model);
