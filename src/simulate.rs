@@ -52,6 +52,7 @@ pub fn run<R: ModelRegistry>(
     duration: f64,
     options: &SimOptions,
 ) -> Result<Simulation, SimulationError> {
+    bike.refuse_feedback("simulate")?;
     let lookup = bike.lookup()?;
     R::with_model(
         model.name,

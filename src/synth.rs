@@ -246,6 +246,7 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
         return Err(SynthError::RunCount { runs: a.runs });
     }
     let mut bike = Bicycle::<R>::resolve_in(&a.bike)?;
+    bike.refuse_feedback("synth")?;
     for (sym, val) in &a.effects {
         bike = bike.with_parameter(sym, *val)?;
     }

@@ -220,3 +220,19 @@ def test_eigenvalue_standard_deviations_are_the_first_order_propagation():
         var += np.stack([d.real ** 2, d.imag ** 2], axis=-1)
     np.testing.assert_allclose(sd, np.sqrt(var), rtol=1e-5, atol=1e-8)
     assert bikedyn.Bicycle("benchmark").eigenvalue_standard_deviations([4.0]) is None
+
+
+def test_a_files_feedback_closes_the_loop_and_simulate_refuses_to_ignore_it():
+    import pathlib
+    src = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "balance_assist_gain_8.toml"
+    b = bikedyn.Bicycle(str(src))
+    s = b.stability()
+    # With its steer motor the balance-assist bicycle is stable from about
+    # 1.04 m/s (bicycleparameters' A - B K: -1.50 +- 8.48i, -0.83, -1.73
+    # at 1.66 m/s); the open loop is not below its weave speed.
+    lo, hi = s["stable_intervals"][0]
+    assert 1.0 < lo < 1.1 and 4.3 < hi < 4.4
+    weave = max(b.eig([1.66]).eigenvalues[0], key=lambda z: z.imag)
+    assert abs(weave - complex(-1.5025818770340327, 8.47937107316705)) < 1e-9
+    with pytest.raises(bikedyn.Error, match=r"\[feedback\]"):
+        bikedyn.simulate(b, duration=0.5, speed=3.0)

@@ -9,6 +9,7 @@ pub mod closed_form;
 pub mod constraints;
 pub mod eigen;
 pub mod experiment;
+pub mod feedback;
 pub mod frequency;
 pub mod geometry;
 pub mod identify;

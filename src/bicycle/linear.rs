@@ -6,6 +6,7 @@ use super::{default_model_of, Bicycle, BicycleError};
 use crate::registry::BuiltIn;
 use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::eigen::LinearBicycle;
+use bikedyn_runtime::feedback::WithFeedback;
 use bikedyn_runtime::linearize::{canonical_matrices, LinearModel, LinearizeError};
 use bikedyn_runtime::parameters::{ParameterSet, ThesisParameters};
 use bikedyn_runtime::registry::{ModelRegistry, ModelVisitor};
@@ -16,6 +17,16 @@ use std::marker::PhantomData;
 impl<R: ModelRegistry> Bicycle<R> {
     /// Canonical matrices through a chosen model (`None`: the default model).
     pub fn canonical_with(&self, model: Option<&str>) -> Result<CanonicalMatrices, BicycleError> {
+        if self.feedback.is_some() {
+            return Err(BicycleError::NotCanonical {
+                effects: "the [feedback] controller of the file".into(),
+            });
+        }
+        self.plant_canonical_with(model)
+    }
+
+    /// [`Bicycle::canonical_with`] of the bicycle without its feedback.
+    fn plant_canonical_with(&self, model: Option<&str>) -> Result<CanonicalMatrices, BicycleError> {
         if model.is_none() && self.effects.is_empty() {
             let t = self.thesis()?;
             if let Some(info) = default_model_of::<R>(&t) {
@@ -62,11 +73,35 @@ impl<R: ModelRegistry> Bicycle<R> {
     /// active), otherwise the model linearized at each speed (damping,
     /// controllers, drag: any effect).
     pub fn linear_with(&self, model: Option<&str>) -> Result<Linear, BicycleError> {
+        let open = self.open_loop_with(model)?;
+        let Some(schedule) = self.feedback.clone() else {
+            return Ok(open);
+        };
+        let info = self.model(model)?;
+        if !info.states.is_empty() {
+            return Err(BicycleError::FeedbackOnStates {
+                bike: self.name.clone(),
+                model: info.name.to_string(),
+                states: info.states.join(", "),
+            });
+        }
+        Ok(Linear {
+            model: open.model,
+            canonical: None,
+            equations: Box::new(WithFeedback {
+                bicycle: open.equations,
+                schedule,
+            }),
+        })
+    }
+
+    /// The equations without the file's feedback (the plant).
+    fn open_loop_with(&self, model: Option<&str>) -> Result<Linear, BicycleError> {
         let nonzero = self.nonzero_parameters()?;
         let info = self.model_for(model, &nonzero)?;
         // A model with extra states has no canonical form (nor M, C, K).
         let canonical = if info.states.is_empty() {
-            self.canonical_with(model)
+            self.plant_canonical_with(model)
         } else {
             Err(BicycleError::NotCanonical {
                 effects: info.states.join(", "),
@@ -176,6 +211,7 @@ pub fn canonical_of(p: &ThesisParameters) -> Result<CanonicalMatrices, BicycleEr
         warnings: Vec::new(),
         effects: BTreeMap::new(),
         uncertainties: BTreeMap::new(),
+        feedback: None,
         registry: PhantomData,
     }
     .canonical()

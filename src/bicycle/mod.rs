@@ -3,6 +3,7 @@
 
 use crate::models::{effect_parameters_in, fits, index};
 use crate::registry::BuiltIn;
+use bikedyn_runtime::feedback::GainSchedule;
 use bikedyn_runtime::linearize::LinearizeError;
 use bikedyn_runtime::parameters::{
     BenchmarkParameters, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
@@ -61,6 +62,14 @@ pub enum BicycleError {
     NoModelFits { bike: String, nonzero: String },
     #[error("the canonical form M0, C1, K0, K2 holds for the Whipple bicycle; with {effects} the linear equations depend on speed otherwise")]
     NotCanonical { effects: String },
+    #[error("{bike}: its [feedback] closes the loop on the roll-steer equations M, C, K, which model `{model}` does not have (its extra states: {states}); use a model without extra states")]
+    FeedbackOnStates {
+        bike: String,
+        model: String,
+        states: String,
+    },
+    #[error("{bike}: its [feedback] controller is applied by the linear analyses (stability, eig, sweep, bode, identify --eigenvalues); {job} does not apply it yet, so it would ignore the controller. Give {job} a file without [feedback] (the steer_controller effect parameters Kc_* express a steer-torque law linear in speed)")]
+    FeedbackNotApplied { bike: String, job: &'static str },
 }
 
 /// A resolved bicycle, against the models of registry `R` (the built-in
@@ -80,6 +89,11 @@ pub struct Bicycle<R: ModelRegistry = BuiltIn> {
     /// Standard deviations the file gives (`value+/-std`), by the file's
     /// symbols; empty when it gives none.
     pub uncertainties: BTreeMap<String, f64>,
+    /// Full-state feedback on the roll and steer torques, as the file's
+    /// `[feedback]` table declares it (a controller as the experiment ran
+    /// it, possibly scheduled over speed). The linear analyses close the
+    /// loop with it.
+    pub feedback: Option<GainSchedule>,
     registry: PhantomData<R>,
 }
 
@@ -156,6 +170,7 @@ impl<R: ModelRegistry> Bicycle<R> {
                     warnings: loaded.warnings,
                     effects: loaded.effects,
                     uncertainties: loaded.uncertainties,
+                    feedback: loaded.feedback,
                     registry: PhantomData,
                 });
             }
@@ -167,6 +182,7 @@ impl<R: ModelRegistry> Bicycle<R> {
             warnings,
             effects: BTreeMap::new(),
             uncertainties: BTreeMap::new(),
+            feedback: None,
             registry: PhantomData,
         })
     }
@@ -233,6 +249,7 @@ impl<R: ModelRegistry> Bicycle<R> {
             warnings,
             effects,
             uncertainties,
+            feedback: None,
             registry: PhantomData,
         })
     }
@@ -383,18 +400,42 @@ impl<R: ModelRegistry> Bicycle<R> {
             warnings,
             effects: self.effects.clone(),
             uncertainties: self.uncertainties.clone(),
+            feedback: self.feedback.clone(),
             registry: PhantomData,
         })
     }
 
+    /// Refuse a job that would silently ignore the file's `[feedback]`.
+    pub fn refuse_feedback(&self, job: &'static str) -> Result<(), BicycleError> {
+        match self.feedback {
+            Some(_) => Err(BicycleError::FeedbackNotApplied {
+                bike: self.name.clone(),
+                job,
+            }),
+            None => Ok(()),
+        }
+    }
+
     /// The effect parameters the file set, as TOML lines that any
     /// parameter file may end with (neither form's table holds them), so
-    /// that a converted or refitted file keeps them; empty when there are
-    /// none.
+    /// that a converted or refitted file keeps them, then its `[feedback]`
+    /// table; empty when there are none.
     pub fn effects_toml(&self) -> String {
         let mut s = String::new();
         for (k, v) in &self.effects {
             s.push_str(&format!("{k} = {v:e}\n"));
+        }
+        // The controller, as a table after every key (a table must come
+        // last in TOML); only its non-zero gains.
+        if let Some(f) = &self.feedback {
+            let list = |xs: Vec<f64>| xs.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", ");
+            s.push_str(&format!("\n[feedback]\nspeeds = [{}]\n", list(f.speeds().to_vec())));
+            for (j, name) in bikedyn_runtime::feedback::GAIN_NAMES.iter().enumerate() {
+                let values: Vec<f64> = f.gains().iter().map(|k| k[(j / 4, j % 4)]).collect();
+                if values.iter().any(|&x| x != 0.0) {
+                    s.push_str(&format!("{name} = [{}]\n", list(values)));
+                }
+            }
         }
         s
     }

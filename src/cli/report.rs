@@ -31,7 +31,7 @@ pub fn run(target: PathBuf) -> Result<bool> {
         let b = load(name)?;
         let c = b.canonical()?;
         let crit = critical_speeds(&c, 0.0, 10.0)?;
-        outln!("\n{}", stability_text(name, &crit));
+        outln!("\n{}", stability_text(name, &crit, false));
         outln!("{}", canonical_text(&c));
         let sweep = eigen_sweep(&c, &speeds)?;
         output::save_eigen_sweep_csv(out.join(format!("{name}_eigenvalues.csv")), &sweep)?;

@@ -59,7 +59,7 @@ pub fn run(bike: BikeArg, speed_max: f64, json: bool, monte_carlo: Option<(usize
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         outln!("model: {}", lin.model);
-        out!("{}", stability_text(&bike, &crit));
+        out!("{}", stability_text(&bike, &crit, b.feedback.is_some()));
         if let Some(u) = &uncertainty {
             out!("{}", uncertainty_text(u));
         }

@@ -10,7 +10,14 @@ use bikedyn::runtime::CanonicalMatrices;
 
 pub use bikedyn::report::output::stability_json;
 
-pub fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
+/// The stability of bicycle `name` in words; `controlled`: its file's
+/// `[feedback]` closes the loop, so it is stable with it, not self-stable.
+pub fn stability_text(name: &str, c: &CriticalSpeeds, controlled: bool) -> String {
+    let stable = if controlled {
+        "stable with its [feedback] controller"
+    } else {
+        "self-stable"
+    };
     let f = |x: Option<f64>| {
         x.map(|v| format!("{v:.10} m/s"))
             .unwrap_or_else(|| "none in range".into())
@@ -20,10 +27,10 @@ pub fn stability_text(name: &str, c: &CriticalSpeeds) -> String {
     s += &format!("  capsize speed v_c: {}\n", f(c.capsize_speed));
     s += &format!("  weave real-pair merge v_d: {}\n", f(c.weave_real_pair_merge));
     if c.stable_intervals.is_empty() {
-        s += "  self-stable: never in the searched range\n";
+        s += &format!("  {stable}: never in the searched range\n");
     }
     for [lo, hi] in &c.stable_intervals {
-        s += &format!("  self-stable from {lo:.4} to {hi:.4} m/s\n");
+        s += &format!("  {stable} from {lo:.4} to {hi:.4} m/s\n");
     }
     if !c.crossings.is_empty() {
         s += "  stability crossings (speed, mode, direction):\n";

@@ -181,6 +181,7 @@ pub fn plan(request: &IdentifyRequest) -> Result<Plan, IdentifyError> {
 pub fn plan_in<R: ModelRegistry>(request: &IdentifyRequest) -> Result<Plan<R>, IdentifyError> {
     let speed_imposed = segments::speed_imposed(&request.inputs)?;
     let bike = Bicycle::<R>::resolve_in(request.bicycle()?)?;
+    bike.refuse_feedback("identify")?;
     let (model, driven_model, alternative_model) = identification_models(&bike, speed_imposed)?;
     let candidates = candidates(model, alternative_model, &bike, &request.effects, speed_imposed)?;
     // A conclusion ("no effect warranted") means something only when

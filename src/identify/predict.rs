@@ -6,6 +6,7 @@
 use super::candidates::identification_models;
 use super::error::IdentifyError;
 use crate::bicycle::Bicycle;
+use bikedyn_runtime::feedback::GainSchedule;
 use bikedyn_runtime::linearize::{lateral_block, linearize_at_speed, parameter_vector, state_space_at_speed};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
 use bikedyn_runtime::parameters::BenchmarkParameters;
@@ -14,11 +15,21 @@ use bikedyn_runtime::MultibodyModel;
 use std::collections::BTreeMap;
 
 /// Weave eigenvalue `[re, im]` of a linearization (the complex pair with
-/// the highest frequency), if any.
-fn weave_of(l: &bikedyn_runtime::linearize::Linearization) -> Option<[f64; 2]> {
+/// the highest frequency), if any, with the bicycle's `[feedback]` at
+/// speed `v` closed around it.
+fn weave_of(l: &bikedyn_runtime::linearize::Linearization, feedback: Option<&GainSchedule>, v: f64) -> Option<[f64; 2]> {
     let m = nalgebra::Matrix2::from_fn(|i, j| l.mass[(i, j)]);
-    let c = nalgebra::Matrix2::from_fn(|i, j| l.damping[(i, j)]);
-    let k = nalgebra::Matrix2::from_fn(|i, j| l.stiffness[(i, j)]);
+    let mut c = nalgebra::Matrix2::from_fn(|i, j| l.damping[(i, j)]);
+    let mut k = nalgebra::Matrix2::from_fn(|i, j| l.stiffness[(i, j)]);
+    if let Some(f) = feedback {
+        // The gains are in the benchmark's signs (steer positive to the
+        // right); the models' steer is positive to the left: S K S with
+        // S = diag(1, -1), as the linear analyses convert.
+        let s = nalgebra::Matrix2::new(1.0, 0.0, 0.0, -1.0);
+        let g = f.at(v);
+        k += s * g.fixed_columns::<2>(0) * s;
+        c += s * g.fixed_columns::<2>(2) * s;
+    }
     let mi = m.try_inverse()?;
     let (a, b) = (-mi * k, -mi * c);
     let mut s = nalgebra::Matrix4::zeros();
@@ -40,6 +51,7 @@ fn weave_of(l: &bikedyn_runtime::linearize::Linearization) -> Option<[f64; 2]> {
 struct WeaveCurve<'a> {
     lookup: &'a dyn Fn(&str) -> Option<f64>,
     speeds: &'a [f64],
+    feedback: Option<&'a GainSchedule>,
 }
 
 impl ModelVisitor for WeaveCurve<'_> {
@@ -52,7 +64,7 @@ impl ModelVisitor for WeaveCurve<'_> {
             .map(|&v| {
                 linearize_at_speed::<M>(&p, v)
                     .ok()
-                    .and_then(|l| weave_of(&lateral_block::<M>(&l)))
+                    .and_then(|l| weave_of(&lateral_block::<M>(&l), self.feedback, v))
             })
             .collect())
     }
@@ -99,6 +111,7 @@ pub fn predict<R: ModelRegistry>(
         WeaveCurve {
             lookup: &lookup,
             speeds,
+            feedback: bike.feedback.as_ref(),
         },
     )
     .expect("registered model")?;
@@ -110,6 +123,14 @@ pub fn predict<R: ModelRegistry>(
         .then(|| identification_models(bike, false).ok().and_then(|m| m.2))
         .flatten()
     {
+        if bike.feedback.is_some() {
+            return Err(crate::bicycle::BicycleError::FeedbackOnStates {
+                bike: bike.name.clone(),
+                model: alt.name.to_string(),
+                states: alt.states.join(", "),
+            }
+            .into());
+        }
         return R::with_model(
             alt.name,
             StateSpaceWeave {

@@ -6,6 +6,8 @@
 //! one where both apply, and with independent eigenvalue computations where
 //! only it does.
 
+mod feedback;
+
 use crate::common::*;
 use bikedyn::bicycle::Bicycle;
 use bikedyn::generated::Extended;

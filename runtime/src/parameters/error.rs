@@ -96,6 +96,17 @@ pub enum ParameterError {
         fields: Vec<String>,
     },
 
+    /// The `[feedback]` table cannot be read.
+    #[error("{}:{line}: [feedback]: {why}", path.display())]
+    Feedback {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line of the offending key.
+        line: usize,
+        /// What is wrong.
+        why: String,
+    },
+
     /// A name that is not a parameter of the detected (or forced) form.
     #[error("{}:{line}: unknown parameter `{field}` ({why})", path.display())]
     UnknownField {

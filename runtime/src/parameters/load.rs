@@ -9,6 +9,9 @@ use std::path::{Path, PathBuf};
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
+use crate::feedback::{GainSchedule, GAIN_NAMES};
+use nalgebra::Matrix2x4;
+
 use super::{BenchmarkParameters, MeasuredBenchmark, ParameterError, ParameterWarning, ThesisParameters};
 
 /// Which parameterization a set uses.
@@ -86,6 +89,8 @@ pub struct LoadedSet {
     /// Standard deviations given as `value+/-std`, by symbol.
     pub uncertainties: BTreeMap<String, f64>,
     pub warnings: Vec<ParameterWarning>,
+    /// The controller a TOML file declares in its `[feedback]` table.
+    pub feedback: Option<GainSchedule>,
 }
 
 impl ParameterSet {
@@ -172,11 +177,13 @@ impl ParameterSet {
         let path = path.as_ref();
         let text = read(path)?;
         if is_toml(path, &text) {
+            let feedback = feedback_from_toml_str(&text, path)?;
             Self::from_toml_str_with_extra(&text, path, extra).map(|(set, effects, warnings)| LoadedSet {
                 set,
                 effects,
                 uncertainties: BTreeMap::new(),
                 warnings,
+                feedback,
             })
         } else {
             MeasuredBenchmark::from_text_str_with_extra(&text, path, extra).map(|(m, effects, warnings)| LoadedSet {
@@ -184,6 +191,7 @@ impl ParameterSet {
                 effects,
                 uncertainties: m.uncertainties,
                 warnings,
+                feedback: None,
             })
         }
     }
@@ -496,7 +504,7 @@ fn parse_toml_fields(text: &str, path: &Path, extra: &[&str]) -> Result<TomlFiel
     for (k, v) in entries {
         let name: &str = k.get_ref();
         let l = line(k.span());
-        if name == "form" {
+        if name == "form" || (name == "feedback" && matches!(v.get_ref(), DeValue::Table(_))) {
             continue;
         }
         if !form.symbols().contains(&name) && !extra.contains(&name) {
@@ -588,4 +596,120 @@ fn detect_form(
             path: PathBuf::from(path),
         }),
     }
+}
+
+/// The controller a TOML parameter file declares, if any: a top-level
+/// `[feedback]` table of full-state feedback gains `u = -K(v) x`
+/// ([`crate::feedback`]; bicycleparameters' gain names, benchmark signs).
+/// Each gain is a number (constant) or a list of its values at the
+/// table's `speeds` (m/s, increasing): linear between them, held beyond.
+/// Gains not given are zero.
+///
+/// ```toml
+/// [feedback]
+/// speeds = [0.0, 1.5, 4.7]
+/// kTdel_phid = [0.0, -12.48, 0.0]
+/// ```
+pub fn feedback_from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<Option<GainSchedule>, ParameterError> {
+    let path = path.as_ref();
+    let Ok(doc) = DeTable::parse(text) else {
+        // The parameters' own reading reports the syntax error.
+        return Ok(None);
+    };
+    let root = doc.get_ref();
+    let Some((key, value)) = root.get_key_value("feedback") else {
+        return Ok(None);
+    };
+    let at = |span: std::ops::Range<usize>| line_of_offset(text, span.start);
+    let bad = |line: usize, why: String| ParameterError::Feedback {
+        path: path.to_path_buf(),
+        line,
+        why,
+    };
+    let DeValue::Table(table) = value.get_ref() else {
+        return Err(bad(
+            at(key.span()),
+            format!("`feedback` must be a table, not {}", toml_type(value.get_ref())),
+        ));
+    };
+    let number = |v: &Spanned<DeValue<'_>>, name: &str| -> Result<f64, ParameterError> {
+        let x = match v.get_ref() {
+            DeValue::Float(f) => f.as_str().parse::<f64>().ok(),
+            DeValue::Integer(i) => i.as_str().parse::<f64>().ok(),
+            other => {
+                return Err(bad(
+                    at(v.span()),
+                    format!("`{name}` holds {}, not a number", toml_type(other)),
+                ))
+            }
+        };
+        match x {
+            Some(x) if x.is_finite() => Ok(x),
+            _ => Err(bad(at(v.span()), format!("`{name}` is not a finite number"))),
+        }
+    };
+    // A number, or a list of numbers, with the line of its name.
+    let values =
+        |k: &Spanned<std::borrow::Cow<'_, str>>, v: &Spanned<DeValue<'_>>| -> Result<Vec<f64>, ParameterError> {
+            let name: &str = k.get_ref();
+            match v.get_ref() {
+                DeValue::Array(items) => items.iter().map(|x| number(x, name)).collect(),
+                _ => Ok(vec![number(v, name)?]),
+            }
+        };
+    let mut speeds: Option<(Vec<f64>, usize)> = None;
+    let mut gains: Vec<(usize, Vec<f64>, usize, bool)> = Vec::new();
+    for (k, v) in table.iter() {
+        let name: &str = k.get_ref();
+        let line = at(k.span());
+        if name == "speeds" {
+            speeds = Some((values(k, v)?, line));
+        } else if let Some(j) = GAIN_NAMES.iter().position(|g| *g == name) {
+            let list = matches!(v.get_ref(), DeValue::Array(_));
+            gains.push((j, values(k, v)?, line, list));
+        } else {
+            return Err(bad(
+                line,
+                format!(
+                    "unknown key `{name}` (the table holds `speeds` and the gains {})",
+                    GAIN_NAMES.join(", ")
+                ),
+            ));
+        }
+    }
+    let knots = match &speeds {
+        Some((s, _)) => s.clone(),
+        None => vec![0.0],
+    };
+    let mut k = vec![Matrix2x4::<f64>::zeros(); knots.len()];
+    for (j, vals, line, list) in &gains {
+        if *list && speeds.is_none() {
+            return Err(bad(
+                *line,
+                format!(
+                    "`{}` is a list but the table has no `speeds` to give its knots",
+                    GAIN_NAMES[*j]
+                ),
+            ));
+        }
+        let at_knot = |i: usize| if *list { vals[i] } else { vals[0] };
+        if *list && vals.len() != knots.len() {
+            return Err(bad(
+                *line,
+                format!(
+                    "`{}` has {} values for {} speeds",
+                    GAIN_NAMES[*j],
+                    vals.len(),
+                    knots.len()
+                ),
+            ));
+        }
+        for (i, m) in k.iter_mut().enumerate() {
+            m[(j / 4, j % 4)] = at_knot(i);
+        }
+    }
+    let line = speeds.as_ref().map_or(at(key.span()), |(_, l)| *l);
+    GainSchedule::new(knots, k)
+        .map(Some)
+        .map_err(|e| bad(line, e.to_string()))
 }
