@@ -17,7 +17,11 @@ use std::collections::BTreeMap;
 /// Weave eigenvalue `[re, im]` of a linearization (the complex pair with
 /// the highest frequency), if any, with the bicycle's `[feedback]` at
 /// speed `v` closed around it.
-fn weave_of(l: &bikedyn_runtime::linearize::Linearization, feedback: Option<&GainSchedule>, v: f64) -> Option<[f64; 2]> {
+fn weave_of(
+    l: &bikedyn_runtime::linearize::Linearization,
+    feedback: Option<&GainSchedule>,
+    v: f64,
+) -> Option<[f64; 2]> {
     let m = nalgebra::Matrix2::from_fn(|i, j| l.mass[(i, j)]);
     let mut c = nalgebra::Matrix2::from_fn(|i, j| l.damping[(i, j)]);
     let mut k = nalgebra::Matrix2::from_fn(|i, j| l.stiffness[(i, j)]);
