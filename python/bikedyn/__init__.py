@@ -377,11 +377,18 @@ class Bicycle:
         """The canonical matrices of ``M q'' + v C1 q' + (g K0 + v² K2) q =
         f`` (Meijaard et al. 2007), ``q = [roll, steer]``: a dict with
         ``M0`` (kg m²), ``C1`` (kg m), ``K0`` (kg m), ``K2`` (kg) as 2x2
-        arrays and ``model``. ``ModelError`` when the model's linear
-        equations have no such form (damping, a controller, tyre lag)."""
+        arrays and ``model``, and ``standard_deviations``: the same four
+        matrices' standard deviations that the file's ``+/-`` values imply
+        (first order, exact derivatives, parameters independent; what
+        bicycleparameters' ``canonical(nominal=False)`` propagates), or
+        ``None`` for a file without them. ``ModelError`` when the model's
+        linear equations have no such form (damping, a controller, tyre
+        lag)."""
         model, (m0, c1, k0, k2) = self._b.canonical(self._model)
         r = lambda x: np.array(x, dtype=float).reshape(2, 2)  # noqa: E731
-        return {"M0": r(m0), "C1": r(c1), "K0": r(k0), "K2": r(k2), "model": model}
+        sd = self._b.canonical_standard_deviations(self._model)
+        spread = None if sd is None else dict(zip(("M0", "C1", "K0", "K2"), (r(x) for x in sd)))
+        return {"M0": r(m0), "C1": r(c1), "K0": r(k0), "K2": r(k2), "model": model, "standard_deviations": spread}
 
     def state_space(self, speeds: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """``A`` and ``B`` of ``x' = A(v) x + B(v) u`` at each speed (m/s),

@@ -151,6 +151,18 @@ impl PyBicycle {
         })
     }
 
+    /// Standard deviations of the canonical matrices' entries (M0, C1, K0,
+    /// K2, each row-major) that the file's `+/-` values imply (first
+    /// order, exact derivatives), or `None` for a file without them.
+    fn canonical_standard_deviations(&self, py: Python<'_>, model: Option<String>) -> PyResult<Option<Vec<[f64; 4]>>> {
+        detached(py, move || {
+            let sd = bikedyn::sensitivity::canonical_uncertainties(&self.inner, model.as_deref())
+                .map_err(|e| Failure::new("ModelError", e))?;
+            let flat = |m: &nalgebra::Matrix2<f64>| [m[(0, 0)], m[(0, 1)], m[(1, 0)], m[(1, 1)]];
+            Ok(sd.map(|c| vec![flat(&c.m0), flat(&c.c1), flat(&c.k0), flat(&c.k2)]))
+        })
+    }
+
     /// State-space matrices at each speed: `(model, n, states, inputs, A
     /// bytes (speeds, n, n), B bytes (speeds, n, 2) or None)`.
     #[allow(clippy::type_complexity)]

@@ -70,3 +70,50 @@ def test_eig_agrees_on_the_shared_real_bicycles(shared, name):
         a = np.sort_complex(np.round(mine[i], 12))
         b = np.sort_complex(np.round(theirs[i], 12))
         assert np.abs(a - b).max() < 1e-10 * max(1.0, np.abs(b).max()), (name, speeds[i], a, b)
+
+
+def test_canonical_standard_deviations_agree_with_canonical_nominal_false(tmp_path):
+    """The measured +/- of a bicycleparameters file propagated to the
+    canonical matrices: bicycleparameters' ``Bicycle.canonical(nominal=
+    False)`` (the ``uncertainties`` package, first order) against bikedyn's
+    exact first-order propagation, entry by entry, to 1e-10."""
+    import shutil
+
+    from uncertainties import unumpy
+
+    name = "Balanceassistv1"
+    folder = tmp_path / "bicycles" / name / "Parameters"
+    folder.mkdir(parents=True)
+    shutil.copy(REPO / "tests/data" / f"{name}Benchmark.txt", folder)
+    theirs = bp.Bicycle(name, pathToData=str(tmp_path)).canonical(nominal=False)
+    ours = bikedyn.Bicycle(str(REPO / "tests/data" / f"{name}Benchmark.txt")).canonical()
+    for key, m in zip(("M0", "C1", "K0", "K2"), theirs):
+        sd = unumpy.std_devs(m)
+        assert np.abs(ours["standard_deviations"][key] - sd).max() < 1e-10 * max(1.0, np.abs(sd).max()), key
+        assert np.abs(ours[key] - unumpy.nominal_values(m)).max() < 1e-10 * max(1.0, np.abs(ours[key]).max()), key
+    assert bikedyn.Bicycle("benchmark").canonical()["standard_deviations"] is None
+
+
+@pytest.mark.parametrize("name", ["benchmark"] + REAL[:2])
+def test_bode_agrees_with_bicycleparameters_state_space(name):
+    """bikedyn's frequency response against C (i omega I - A)^-1 B built
+    from bicycleparameters' own A and B (``form_state_space_matrices``) of
+    the same bicycle, every input-output pair, to 1e-10."""
+    if name == "benchmark":
+        par = dict(meijaard2007()["parameters"])
+        ours = bikedyn.Bicycle("benchmark")
+    else:
+        path = REPO / "tests/data" / name
+        par = nominal_values(path)
+        ours = bikedyn.Bicycle(str(path))
+    model = Meijaard2007Model(Meijaard2007ParameterSet(dict(par, v=0.0), True))
+    C = np.hstack([np.eye(2), np.zeros((2, 2))])
+    inputs, outputs = ["roll_torque", "steer_torque"], ["roll", "steer"]
+    for v in (2.0, 5.0, 8.0):
+        A, B = model.form_state_space_matrices(v=v)
+        r = ours.bode(v, omega_min=0.3, omega_max=30.0, points=9)
+        for k, w in enumerate(r["omega"]):
+            G = C @ np.linalg.solve(1j * w * np.eye(4) - A, B)
+            for g in r["responses"]:
+                i, j = outputs.index(g["output"]), inputs.index(g["input"])
+                assert abs(g["G"][k] - G[i, j]) < 1e-10 * abs(G).max(), (name, v, w, g["input"], g["output"])
