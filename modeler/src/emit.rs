@@ -871,11 +871,12 @@ fn effect_declaration_tokens(e: &crate::model::EffectInfo) -> TokenStream {
         Some(Identification::OptOut(why)) => quote!(Some(#rt::EffectIdentification::OptOut(#why))),
         Some(Identification::Candidate(c)) => {
             let fitted = c.fitted.iter().map(|f| {
-                let (sym, tied, dis, sad) = (f.symbol, f.tied, f.dissipative, f.start_at_default);
+                let (sym, tied, dis, sad, shape) = (f.symbol, f.tied, f.dissipative, f.start_at_default, f.shape);
                 let scale = proc_macro2::Literal::f64_suffixed(f.scale);
                 let floor = opt_f64(f.floor);
+                let ceiling = opt_f64(f.ceiling);
                 quote!(#rt::FittedParameter {
-                    symbol: #sym, tied: &[#(#tied),*], scale: #scale, dissipative: #dis, floor: #floor, start_at_default: #sad
+                    symbol: #sym, tied: &[#(#tied),*], scale: #scale, dissipative: #dis, floor: #floor, ceiling: #ceiling, start_at_default: #sad, shape: #shape
                 })
             });
             let held = c.held;

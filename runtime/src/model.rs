@@ -221,8 +221,14 @@ pub struct FittedParameter {
     pub dissipative: bool,
     /// Floor of the fit, if any.
     pub floor: Option<f64>,
+    /// Ceiling of the fit, if any.
+    pub ceiling: Option<f64>,
     /// The fit starts from the parameter's default.
     pub start_at_default: bool,
+    /// A parameter of the law's shape, not of the effect's size: it starts
+    /// from the bicycle's value, and a bicycle file setting it does not
+    /// declare the effect present.
+    pub shape: bool,
 }
 
 /// Residual patterns of the base model that the diagnosis tests.

@@ -109,9 +109,12 @@ pub fn candidates<R: ModelRegistry>(
         if !(only.is_empty() || only.iter().any(|o| o == effect)) {
             continue;
         }
+        // Its size, not the shape of its law (a friction's smoothing rate),
+        // says whether the file declares the effect.
         let declared_by_bike = d
             .fitted
             .iter()
+            .filter(|f| !f.shape)
             .any(|f| bike.effects.get(f.symbol).is_some_and(|&v| v != 0.0));
         if declared_by_bike || (speed_imposed && d.speed_decay) {
             continue;
@@ -135,11 +138,16 @@ pub fn candidates<R: ModelRegistry>(
                     scale: f.scale,
                     dissipative: f.dissipative,
                     unit: unit(f.symbol),
-                    initial: f
-                        .start_at_default
-                        .then(|| info.parameter(f.symbol).and_then(|p| p.default))
-                        .flatten(),
+                    initial: if f.shape {
+                        bike.value(f.symbol)
+                    } else if f.start_at_default {
+                        info.parameter(f.symbol).and_then(|p| p.default)
+                    } else {
+                        None
+                    },
                     lower: f.floor,
+                    upper: f.ceiling,
+                    shape: f.shape,
                     prior: None,
                     gross_beyond: bikedyn_runtime::identify::PLAUSIBLE_PRIOR_SDS,
                 })

@@ -241,6 +241,8 @@ pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
             unit: unit.clone(),
             initial: Some(c.value),
             lower: None,
+            upper: None,
+            shape: false,
             prior: Some((c.value, c.sd)),
             gross_beyond: bikedyn_runtime::identify::PLAUSIBLE_PRIOR_SDS,
         }],

@@ -217,9 +217,13 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
             .iter()
             .zip(id.after.values.iter().zip(&id.after.stderr))
         {
+            let interval = match p.on_bound(*v) {
+                Some(b) => super::report::bound_text(b),
+                None => format!("[{:.5}, {:.5}]", v - 1.96 * se, v + 1.96 * se),
+            };
             let _ = writeln!(
                 s,
-                "| `{}`{} | {:.5} | [{:.5}, {:.5}] | {} |",
+                "| `{}`{} | {:.5} | {interval} | {} |",
                 p.symbol,
                 if p.tied.is_empty() {
                     String::new()
@@ -227,8 +231,6 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
                     format!(" (= `{}`)", p.tied.join("`, `"))
                 },
                 v,
-                v - 1.96 * se,
-                v + 1.96 * se,
                 p.unit
             );
         }

@@ -89,6 +89,11 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
                 "value": v, "low": v - 1.96 * se, "high": v + 1.96 * se, "stderr": se, "unit": p.unit, "tied": p.tied,
                 "prior": stated_prior(o, &p.symbol).map(|(mean, sd)| json!({"mean": mean, "sd": sd})),
                 "prior_sds": stated_prior(o, &p.symbol).map(|(mean, sd)| (v - mean) / sd),
+                // A value on its floor or ceiling is a limit, not an estimate.
+                "on_bound": p.on_bound(*v).map(|b| match b {
+                    bikedyn_runtime::identify::Bound::Floor(lo) => json!({"floor": lo}),
+                    bikedyn_runtime::identify::Bound::Ceiling(hi) => json!({"ceiling": hi}),
+                }),
             }),
         );
     }
@@ -249,7 +254,10 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
             let prior = stated_prior(o, &p.symbol)
                 .map(|(mean, sd)| format!(" ({:+.1} prior sd from the measured {mean:.4})", (v - mean) / sd))
                 .unwrap_or_default();
-            format!("{} = {:.4} +- {:.4} {}{prior}", p.symbol, v, 1.96 * se, p.unit)
+            match p.on_bound(*v) {
+                Some(b) => format!("{} = {:.4} {} ({})", p.symbol, v, p.unit, bound_text(b)),
+                None => format!("{} = {:.4} +- {:.4} {}{prior}", p.symbol, v, 1.96 * se, p.unit),
+            }
         })
         .collect();
     let _ = writeln!(
@@ -526,4 +534,13 @@ pub fn stated_prior<R: ModelRegistry>(o: &Outcome<R>, symbol: &str) -> Option<(f
         .flat_map(|c| &c.parameters)
         .find(|p| p.symbol == symbol)
         .and_then(|p| p.prior)
+}
+
+/// A fitted value that ended on its floor or ceiling is a limit: the data
+/// asked for a value beyond it, and it has no interval.
+pub(crate) fn bound_text(b: bikedyn_runtime::identify::Bound) -> String {
+    match b {
+        bikedyn_runtime::identify::Bound::Floor(lo) => format!("on its floor {lo}: the data ask for less"),
+        bikedyn_runtime::identify::Bound::Ceiling(hi) => format!("on its ceiling {hi}: the data ask for more"),
+    }
 }

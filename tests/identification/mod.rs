@@ -199,6 +199,22 @@ fn hidden_steer_friction_is_found() {
     );
 }
 
+/// The friction's smoothing rate is fitted with its torque: runs made with
+/// a law sharper than the model's default (0.03 against 0.1 rad/s) give
+/// back both. Held at the default, the rate was wrong and the torque took
+/// up the difference.
+#[test]
+fn hidden_steer_friction_gives_back_its_smoothing_rate() {
+    let dir = synth_with("friction_sharp", None, "T_steer=0.1,w_steer=0.03", 31);
+    let j = identify_with(&dir, None, &[]);
+    assert_eq!(selected_effects(&j), vec!["steer_friction"], "{j:#}");
+    for (symbol, truth) in [("T_steer", 0.1), ("w_steer", 0.03)] {
+        let v = f(&j["parameters"][symbol]["value"]);
+        assert!(((v - truth) / truth).abs() < 0.2, "{symbol} = {v}, hidden {truth}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn hidden_lateral_mass_offset_is_found() {
     recovers("offset", "y3=0.02", 24, "lateral_mass_offset", "y3", 0.02, "roll_rms");
@@ -784,4 +800,37 @@ fn a_candidate_with_a_describing_function_is_fitted_not_screened() {
     assert_eq!(flag("steer_friction"), Some(true));
     assert_eq!(flag("steer_damping"), Some(false));
     assert_eq!(flag("rolling_resistance"), Some(false));
+}
+
+/// A friction's smoothing rate is the shape of its law, not its size: it
+/// is fitted between its floor and its ceiling from the bicycle's value,
+/// and a file that sets it (and no torque) still leaves friction a
+/// candidate, while a file that sets the torque declares it.
+#[test]
+fn the_friction_smoothing_rate_is_a_shape_fitted_from_the_files_value() {
+    use bikedyn::bicycle::Bicycle;
+    use bikedyn::identify::candidates::{candidates, identification_models};
+    let mut bike = Bicycle::resolve("thesis").expect("built-in bicycle");
+    bike.effects.insert("w_steer".into(), 0.04);
+    let (model, _, alt) = identification_models(&bike, false).expect("models");
+    let all = candidates(model, alt, &bike, &[], false).expect("candidates");
+    let friction = all
+        .iter()
+        .find(|c| c.name == "steer_friction")
+        .expect("friction is a candidate");
+    let w = friction
+        .parameters
+        .iter()
+        .find(|p| p.symbol == "w_steer")
+        .expect("the smoothing rate is fitted");
+    assert!(w.shape && !w.dissipative, "{w:?}");
+    assert_eq!(w.initial, Some(0.04));
+    assert!(
+        w.lower.is_some_and(|lo| lo > 0.0) && w.upper.is_some_and(|hi| hi > 0.04),
+        "{w:?}"
+    );
+    assert!(friction.fixed.iter().all(|(s, _)| s != "w_steer"));
+    bike.effects.insert("T_steer".into(), 0.05);
+    let all = candidates(model, alt, &bike, &[], false).expect("candidates");
+    assert!(all.iter().all(|c| c.name != "steer_friction"));
 }

@@ -141,9 +141,18 @@ pub struct Fitted {
     /// Floor of the fit, if any (a relaxation length toward zero is a stiff,
     /// rigid tyre).
     pub floor: Option<f64>,
+    /// Ceiling of the fit, if any (above it the law would become another
+    /// effect of the library).
+    pub ceiling: Option<f64>,
     /// The fit starts from the parameter's default rather than a tenth of
     /// its scale.
     pub start_at_default: bool,
+    /// A parameter of the law's shape (the smoothing rate of Coulomb
+    /// friction), not of the effect's size: the effect is absent when its
+    /// size parameters are, whatever the shape. The fit starts from the
+    /// bicycle's value (its file's, else the default), and a bicycle file
+    /// that sets it does not thereby declare the effect present.
+    pub shape: bool,
 }
 
 impl Fitted {
@@ -155,7 +164,9 @@ impl Fitted {
             scale,
             dissipative,
             floor: None,
+            ceiling: None,
             start_at_default: false,
+            shape: false,
         }
     }
 }

@@ -36,6 +36,14 @@ pub struct EffectParameter {
     /// there): for parameters the model is undefined or singular without,
     /// such as a relaxation length.
     pub lower: Option<f64>,
+    /// Largest value the model is simulated with (values above are held
+    /// there): a law's shape beyond which it would be another effect (a
+    /// friction smoothed so widely that it is a damper).
+    pub upper: Option<f64>,
+    /// A parameter of the law's shape (a friction's smoothing rate), not of
+    /// the effect's size: the effect is absent when its size parameters
+    /// are, and the fit starts it from `initial` in every start.
+    pub shape: bool,
     /// Gaussian prior `(mean, standard deviation)`: a measured parameter
     /// corrected by identification moves only as far as the data demand
     /// (the fit adds `((value - mean) / sd)^2` to its weighted sum).
@@ -48,6 +56,39 @@ pub struct EffectParameter {
     /// value back and spread the rest of the error over other parameters.
     /// (Scaled with the prior when the prior is put on the data's scale.)
     pub gross_beyond: f64,
+}
+
+/// A floor or ceiling of a fitted parameter, with its value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Bound {
+    Floor(f64),
+    Ceiling(f64),
+}
+
+impl EffectParameter {
+    /// The value the model is simulated with for fitted value `v`: `v`
+    /// held within the floor and the ceiling.
+    pub fn simulated(&self, v: f64) -> f64 {
+        let v = self.lower.map_or(v, |lo| v.max(lo));
+        self.upper.map_or(v, |hi| v.min(hi))
+    }
+
+    /// The bound a fitted value `v` ended on, if any: the data asked for a
+    /// value beyond it, so `v` is a limit, not an estimate.
+    pub fn on_bound(&self, v: f64) -> Option<Bound> {
+        let near = |b: f64| (v - b).abs() <= 1e-9 * b.abs().max(self.scale);
+        match (self.lower, self.upper) {
+            (Some(lo), _) if v <= lo || near(lo) => Some(Bound::Floor(lo)),
+            (_, Some(hi)) if v >= hi || near(hi) => Some(Bound::Ceiling(hi)),
+            _ => None,
+        }
+    }
+
+    /// Whether `v` lies beyond the floor or the ceiling, where the response
+    /// does not move with it.
+    pub fn held_at_bound(&self, v: f64) -> bool {
+        self.lower.is_some_and(|lo| v < lo) || self.upper.is_some_and(|hi| v > hi)
+    }
 }
 
 /// A candidate effect (or a combination): the parameters fitted when it is
@@ -72,4 +113,44 @@ pub struct Candidate {
     /// finite torque causes, so its prediction can miss the fitted gain by
     /// far: such a candidate is not screened, it is always fitted.
     pub nonsmooth: bool,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rate(lower: Option<f64>, upper: Option<f64>) -> EffectParameter {
+        EffectParameter {
+            symbol: "w_steer".into(),
+            tied: Vec::new(),
+            moves: Vec::new(),
+            scale: 0.05,
+            dissipative: false,
+            unit: "rad/s".into(),
+            initial: Some(0.1),
+            lower,
+            upper,
+            shape: true,
+            prior: None,
+            gross_beyond: crate::identify::PLAUSIBLE_PRIOR_SDS,
+        }
+    }
+
+    #[test]
+    fn a_value_beyond_a_floor_or_ceiling_is_simulated_at_it_and_a_value_on_it_still_moves() {
+        let w = rate(Some(0.002), Some(0.1));
+        assert_eq!(w.simulated(0.5), 0.1);
+        assert_eq!(w.simulated(-1.0), 0.002);
+        assert_eq!(w.simulated(0.03), 0.03);
+        assert!(w.held_at_bound(0.5) && w.held_at_bound(0.001));
+        // On the bound the response still moves with it (a fit started
+        // there can leave it).
+        assert!(!w.held_at_bound(0.1) && !w.held_at_bound(0.002) && !w.held_at_bound(0.03));
+        assert_eq!(w.on_bound(0.1), Some(Bound::Ceiling(0.1)));
+        assert_eq!(w.on_bound(0.002), Some(Bound::Floor(0.002)));
+        assert_eq!(w.on_bound(0.03), None);
+        let free = rate(None, None);
+        assert_eq!(free.simulated(-3.0), -3.0);
+        assert!(!free.held_at_bound(1e9));
+    }
 }

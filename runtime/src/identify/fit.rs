@@ -398,7 +398,15 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
                 }
                 continue;
             };
-            let trial: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
+            // A step beyond a parameter's floor or ceiling is projected back
+            // onto it (projected Levenberg-Marquardt): the parameter stays
+            // where the response still moves with it, so a later step can
+            // bring it back inside.
+            let mut trial: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
+            for (t, q) in trial.iter_mut().zip(&p.setup.parameters).take(k) {
+                *t = q.simulated(*t);
+            }
+            let dx: Vec<f64> = trial.iter().zip(&x).map(|(t, a)| t - a).collect();
             p.unpack(&trial);
             evals += 1;
             match cost(&p) {
@@ -463,12 +471,12 @@ pub fn fit_candidate(
         .map(|((r, s), w)| SegmentError::of(r, s, *w))
         .collect();
     let chi2: f64 = res.iter().flatten().map(|x| x * x).sum();
-    // Values below a parameter's floor were simulated at the floor.
+    // Values beyond a parameter's floor or ceiling were simulated at it.
     let g: Vec<f64> = full
         .g
         .iter()
         .zip(&setup.parameters)
-        .map(|(&v, p)| p.lower.map_or(v, |lo| v.max(lo)))
+        .map(|(&v, p)| p.simulated(v))
         .collect();
     let nuisance = full.x0.clone();
 

@@ -71,7 +71,7 @@ mod screen;
 mod search_order;
 mod segment;
 pub mod selection;
-pub use candidate::{Candidate, EffectParameter};
+pub use candidate::{Bound, Candidate, EffectParameter};
 pub use confounding::{Confounding, Design, CONFOUNDED};
 pub use cross_validation::{cross_validate, folds_by_run, paired_gain};
 pub use fit::{fit_candidate, pooled_rms, CandidateFit, IdentifyOptions, SegmentError};

@@ -367,7 +367,7 @@ impl<'a> Setup<'a> {
     pub fn param(&self, g: &[f64]) -> Vec<f64> {
         let mut p = self.base.clone();
         for ((slot, &v), info) in self.slots.iter().zip(g).zip(&self.parameters) {
-            let v = info.lower.map_or(v, |lo| v.max(lo));
+            let v = info.simulated(v);
             for &(i, c, offset) in slot {
                 p[i] = offset + c * v;
             }
@@ -419,9 +419,9 @@ impl<'a> Setup<'a> {
         let mut dirs = Directions::default();
         if shared {
             for (j, (slot, info)) in self.slots.iter().zip(&self.parameters).enumerate() {
-                // Below its floor the parameter is simulated at the floor:
-                // the response does not move with it.
-                if info.lower.is_some_and(|lo| g[j] < lo) {
+                // Beyond its floor or ceiling the parameter is simulated at
+                // the bound: the response does not move with it.
+                if info.held_at_bound(g[j]) {
                     continue;
                 }
                 dirs.parameters.extend(slot.iter().map(|&(p, c, _)| (p, j, c)));

@@ -193,7 +193,7 @@ pub(super) fn screen(s: &Screen<'_>) -> Screened {
         let mut nested = true;
         for p in &s.remaining[i].parameters {
             let v = setup.base_value(j);
-            nested &= !p.lower.is_some_and(|lo| v < lo);
+            nested &= !p.held_at_bound(v);
             j += 1;
         }
         if nested {

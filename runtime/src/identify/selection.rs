@@ -591,10 +591,17 @@ impl<'s> Search<'s> {
         // response in kind, not in degree) has minima a local search from
         // a small start does not cross: it is fitted from starts at its
         // scale and four times it as well, and the best by the criterion is
-        // kept.
+        // kept. The law's shape (its smoothing rate) starts from the
+        // bicycle's value in each.
         if p.members.iter().any(|c| c.nonsmooth) {
             for factor in [1.0, 4.0] {
-                let start = start_with(&|c, q| if c.nonsmooth { factor * q.scale } else { small(q) });
+                let start = start_with(&|c, q| {
+                    if c.nonsmooth && !q.shape {
+                        factor * q.scale
+                    } else {
+                        small(q)
+                    }
+                });
                 if let Ok(again) = fit_from(&start) {
                     if fitted
                         .as_ref()
@@ -613,7 +620,11 @@ impl<'s> Search<'s> {
         // the two is kept.
         if let Ok(f) = &fitted {
             if f.chi2 > current.chi2 * (1.0 + 1e-9) {
-                let from_absence = start_with(&|_, q| q.prior.map_or(q.lower.unwrap_or(0.0), |m| m.0));
+                let from_absence = start_with(&|_, q| match (q.shape, q.prior) {
+                    (true, _) => small(q),
+                    (false, Some((mean, _))) => mean,
+                    (false, None) => q.lower.unwrap_or(0.0),
+                });
                 if from_absence != g0 {
                     if let Ok(again) = fit_from(&from_absence) {
                         if again.chi2 < f.chi2 {

@@ -16,6 +16,8 @@ fn candidate(name: &str, symbol: &str, prior: Option<(f64, f64)>) -> Candidate {
             unit: String::new(),
             initial: None,
             lower: None,
+            upper: None,
+            shape: false,
             prior,
             gross_beyond: PLAUSIBLE_PRIOR_SDS,
         }],
