@@ -99,6 +99,17 @@ impl GainSchedule {
         &self.gains
     }
 
+    /// What the feedback adds at speed `v` to the stiffness and to the
+    /// damping matrix of `M q'' + C q' + K q = u` (benchmark signs): the
+    /// gains on the angles and those on the rates.
+    pub fn stiffness_and_damping(&self, v: f64) -> (Matrix2<f64>, Matrix2<f64>) {
+        let k = self.at(v);
+        (
+            k.fixed_columns::<2>(0).into_owned(),
+            k.fixed_columns::<2>(2).into_owned(),
+        )
+    }
+
     /// `K(v)`: linear between the knots, held beyond the ends.
     pub fn at(&self, v: f64) -> Matrix2x4<f64> {
         let n = self.speeds.len();
@@ -125,9 +136,7 @@ pub struct WithFeedback<B> {
 impl<B: LinearBicycle> LinearBicycle for WithFeedback<B> {
     fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError> {
         let mut s = self.bicycle.at_speed(v)?;
-        let k = self.schedule.at(v);
-        let kp: Matrix2<f64> = k.fixed_columns::<2>(0).into_owned();
-        let kd: Matrix2<f64> = k.fixed_columns::<2>(2).into_owned();
+        let (kp, kd) = self.schedule.stiffness_and_damping(v);
         s.stiffness += kp;
         s.damping += kd;
         Ok(s)

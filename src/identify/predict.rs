@@ -30,9 +30,9 @@ fn weave_of(
         // right); the models' steer is positive to the left: S K S with
         // S = diag(1, -1), as the linear analyses convert.
         let s = nalgebra::Matrix2::new(1.0, 0.0, 0.0, -1.0);
-        let g = f.at(v);
-        k += s * g.fixed_columns::<2>(0) * s;
-        c += s * g.fixed_columns::<2>(2) * s;
+        let (kp, kd) = f.stiffness_and_damping(v);
+        k += s * kp * s;
+        c += s * kd * s;
     }
     let mi = m.try_inverse()?;
     let (a, b) = (-mi * k, -mi * c);
