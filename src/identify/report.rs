@@ -503,6 +503,12 @@ pub fn verdict_text(v: &Verdict) -> String {
         Verdict::CriterionAboveAdded { bic_change, added } => {
             format!("not added: BIC {bic_change:+.1}, above that of {added} (not cross-validated)")
         }
+        Verdict::PassedHeldOutBelow { bic_change, cv, added, added_cv } => format!(
+            "passed (BIC {bic_change:+.1}, held-out error {cv:.4}), not added: {added} predicts the held-out runs consistently better ({added_cv:.4}; the gain run by run beyond two standard errors)"
+        ),
+        Verdict::PassedCriterionAbove { bic_change, cv, added } => format!(
+            "passed (BIC {bic_change:+.1}, held-out error {cv:.4}), not added: {added} is ahead in the criterion, and this one's held-out gain over it is not consistent run by run"
+        ),
         Verdict::FitFailed { reason } => format!("fit failed: {reason}"),
         Verdict::ImplausibleUnderPrior { symbol, value, prior_sds } => format!(
             "rejected: {symbol} = {value:.4} lies {prior_sds:.1} prior standard deviations from its measured value (beyond {PLAUSIBLE_PRIOR_SDS}: implausible under the measurement, more likely it absorbs a missing effect; tried only when no plausible candidate passes)"

@@ -7,7 +7,7 @@
 
 use super::normal::{Normal, SegmentJacobian};
 use super::nuisance::nuisance_scale;
-use super::{bic, cross_validate, EffectParameter, IdentifyError, Segment, Setup, Weights, NUISANCE};
+use super::{bic, cross_validate, Bound, EffectParameter, IdentifyError, Segment, Setup, Weights, NUISANCE};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -387,8 +387,27 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
         let (Some(blocks), Some(res)) = (p.jacobian_blocks(), p.all_residuals()) else {
             break;
         };
-        let prior = p.prior_normal_rows();
+        let mut prior = p.prior_normal_rows();
         let x = p.pack();
+        // Active set: a parameter on its floor or ceiling whose descent
+        // direction points beyond it is held there for this iteration (a
+        // stiff prior row), so the other parameters take a full step rather
+        // than one computed as if it could move and then cut by projection.
+        let descent: Vec<f64> = (0..k)
+            .map(|j| {
+                let data: f64 = blocks
+                    .iter()
+                    .zip(&res)
+                    .filter(|(b, _)| b.a.ncols() > j)
+                    .map(|(b, r)| b.a.column(j).iter().zip(r).map(|(a, r)| a * r).sum::<f64>())
+                    .sum();
+                let priors: f64 = prior.iter().filter(|row| row.0 == j).map(|&(_, sd, r)| r / sd).sum();
+                -(data + priors)
+            })
+            .collect();
+        for j in held_on_bound(&p.setup.parameters[..k], &x[..k], &descent) {
+            prior.push((j, 1e-9 * p.setup.parameters[j].scale, 0.0));
+        }
         loop {
             let step = Normal::new(&blocks, &res, &prior, k, lambda).and_then(|n| n.step());
             let Some(dx) = step.filter(|d| d.iter().all(|v| v.is_finite())) else {
@@ -432,6 +451,26 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
         }
     }
     p
+}
+
+/// The parameters to hold on their bound for one iteration: those on a
+/// floor or ceiling whose steepest-descent direction `descent` (minus the
+/// gradient of the cost) points beyond it. The test is the gradient's sign
+/// (projected Newton), not the Gauss-Newton step's, so a parameter the
+/// data pull back inside is released at the next iteration even when a
+/// correlated parameter would make the full step point outward.
+fn held_on_bound(parameters: &[EffectParameter], x: &[f64], descent: &[f64]) -> Vec<usize> {
+    parameters
+        .iter()
+        .zip(x.iter().zip(descent))
+        .enumerate()
+        .filter(|(_, (q, (&v, &d)))| match q.on_bound(v) {
+            Some(Bound::Floor(_)) => d < 0.0,
+            Some(Bound::Ceiling(_)) => d > 0.0,
+            None => false,
+        })
+        .map(|(j, _)| j)
+        .collect()
 }
 
 /// Fit a model with the setup's effect parameters free, starting from `g0`
@@ -544,6 +583,39 @@ pub fn pooled_rms(errors: &[SegmentError], channel: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn bounded(symbol: &str) -> EffectParameter {
+        EffectParameter {
+            symbol: symbol.into(),
+            tied: Vec::new(),
+            moves: Vec::new(),
+            scale: 0.05,
+            dissipative: false,
+            unit: "rad/s".into(),
+            initial: Some(0.1),
+            lower: Some(0.002),
+            upper: Some(0.1),
+            shape: true,
+            prior: None,
+            gross_beyond: crate::identify::PLAUSIBLE_PRIOR_SDS,
+        }
+    }
+
+    #[test]
+    fn a_parameter_on_its_bound_is_held_only_while_the_data_pull_it_outward() {
+        let q = vec![bounded("a"), bounded("b"), bounded("c"), bounded("d"), bounded("e")];
+        // a: on the ceiling, pulled up (outward): held. b: on the ceiling,
+        // pulled down (inward): released. c: on the floor, pulled down:
+        // held. d: on the floor, pulled up: released. e: inside: free.
+        let x = [0.1, 0.1, 0.002, 0.002, 0.03];
+        let descent = [1.0, -1.0, -1.0, 1.0, 1.0];
+        assert_eq!(held_on_bound(&q, &x, &descent), vec![0, 2]);
+        // Unbounded parameters are never held.
+        let mut free = bounded("f");
+        free.lower = None;
+        free.upper = None;
+        assert!(held_on_bound(&[free], &[0.1], &[1.0]).is_empty());
+    }
 
     #[test]
     fn residual_statistics_unweight_and_count_channels() {

@@ -11,9 +11,10 @@ pub(super) struct SearchOrder {
     pub(super) order: Vec<usize>,
     /// How many of `order` are fitted before any is cross-validated: the
     /// candidates predicted to gain at least [`CONTENDER_SHARE`] of the
-    /// best one's gain. Among those that pass, the criterion chooses, so
-    /// the score test's ranking decides only between candidates it
-    /// separates by more than its own error.
+    /// best one's gain. Among those that pass, the criterion and the
+    /// held-out error choose ([`added_of`]), so the score test's ranking
+    /// decides only between candidates it separates by more than its own
+    /// error.
     pub(super) contenders: usize,
 }
 
@@ -68,4 +69,28 @@ pub(super) fn first_passing<S, E>(
         }
     }
     Ok(None)
+}
+
+/// Of the candidates that passed every test (`passed`, indices in the
+/// order of the criterion; `held_out`, each one's held-out error), the one
+/// added. The criterion's first stands unless another that passed predicts
+/// the held-out runs better run by run, consistently
+/// (`consistently_better(first, other)`: the paired gain beyond two
+/// standard errors, the test a candidate passes to enter); of those that
+/// do, the lowest held-out error is added. A difference of held-out errors
+/// in the fourth digit (a nuisance-like drag beside rolling resistance)
+/// does not overturn the criterion; a consistent one does (a mass centre
+/// forward that the criterion mistook for one higher).
+pub(super) fn added_of(
+    passed: &[usize],
+    held_out: &[f64],
+    consistently_better: impl Fn(usize, usize) -> bool,
+) -> Option<usize> {
+    let &first = passed.first()?;
+    passed[1..]
+        .iter()
+        .copied()
+        .filter(|&c| held_out[c] < held_out[first] && consistently_better(first, c))
+        .min_by(|&a, &b| held_out[a].total_cmp(&held_out[b]))
+        .or(Some(first))
 }

@@ -40,7 +40,7 @@ use super::criterion::{farthest_from_prior, with_priors_on_the_data_scale};
 pub use super::cross_validation::{folds_by_run, paired_gain};
 pub use super::elimination::MemberCheck;
 use super::screen;
-use super::search_order::{first_passing, SearchOrder};
+use super::search_order::{added_of, first_passing, SearchOrder};
 use super::{
     cross_validate, fit_candidate, Candidate, CandidateFit, EffectParameter, Factory, IdentifyError, IdentifyOptions,
     ModelFactory, RollChannel, Segment, SegmentError, Setup, Weights, NUISANCE,
@@ -70,6 +70,18 @@ pub enum Verdict {
     /// Fitted, with a criterion above the added candidate's: not
     /// cross-validated.
     CriterionAboveAdded { bic_change: f64, added: String },
+    /// It passed every test and the criterion ranked it first, but another
+    /// that also passed predicts the held-out runs consistently better (run
+    /// by run, beyond two standard errors; `added_cv`) and was added.
+    PassedHeldOutBelow {
+        bic_change: f64,
+        cv: f64,
+        added: String,
+        added_cv: f64,
+    },
+    /// It passed every test, behind the added candidate in the criterion,
+    /// and its held-out gain over it is not consistent.
+    PassedCriterionAbove { bic_change: f64, cv: f64, added: String },
     /// The fit failed.
     FitFailed { reason: String },
     /// A dissipative parameter fitted at or below zero, or at its floor
@@ -495,8 +507,9 @@ impl<'s> Search<'s> {
         if let Some(w) = winner {
             let added = pending[w].name();
             for p in pending.iter_mut().filter(|p| p.verdict.is_none()) {
-                // A fitted one left without a verdict comes after the
-                // winner in the order of the criterion (see `validate`).
+                // `validate` gives every fitted single candidate its
+                // verdict; one still without is a fit the step made but
+                // did not cross-validate once it had its winner.
                 p.verdict = Some(match &p.fit {
                     Some((f, _)) => Verdict::CriterionAboveAdded {
                         bic_change: f.bic - base_bic,
@@ -592,15 +605,21 @@ impl<'s> Search<'s> {
         // a small start does not cross: it is fitted from starts at its
         // scale and four times it as well, and the best by the criterion is
         // kept. The law's shape (its smoothing rate) starts from the
-        // bicycle's value in each.
+        // bicycle's value in the first and from the middle of its range
+        // (on a log scale) in these: the criterion is not convex in the
+        // shape, and a fit started on a bound can end on it at a point
+        // where the data still pull it outward (a local minimum on the
+        // bound) while a better one lies inside.
         if p.members.iter().any(|c| c.nonsmooth) {
+            let mid_range = |q: &EffectParameter| match (q.lower, q.upper) {
+                (Some(lo), Some(hi)) if lo > 0.0 && hi > lo => (lo * hi).sqrt(),
+                _ => small(q),
+            };
             for factor in [1.0, 4.0] {
-                let start = start_with(&|c, q| {
-                    if c.nonsmooth && !q.shape {
-                        factor * q.scale
-                    } else {
-                        small(q)
-                    }
+                let start = start_with(&|c, q| match (c.nonsmooth, q.shape) {
+                    (true, false) => factor * q.scale,
+                    (true, true) => mid_range(q),
+                    _ => small(q),
                 });
                 if let Ok(again) = fit_from(&start) {
                     if fitted
@@ -661,7 +680,7 @@ impl<'s> Search<'s> {
     }
 
     /// Cross-validate the fitted trials without a verdict, in the order of
-    /// the criterion, until one passes: its index.
+    /// the criterion: the index of the one added, if any passes.
     fn validate(&self, pending: &mut [Pending<'s>], current: &CandidateFit) -> Result<Option<usize>, IdentifyError> {
         let mut order: Vec<usize> = (0..pending.len())
             .filter(|&i| pending[i].verdict.is_none() && pending[i].fit.is_some())
@@ -671,21 +690,63 @@ impl<'s> Search<'s> {
             bic(a).total_cmp(&bic(b))
         });
         let total = order.len();
+        let mut passed: Vec<usize> = Vec::new();
         for (done, i) in order.into_iter().enumerate() {
             let name = pending[i].name();
             let Some(verdict) = self.validate_one(&mut pending[i], current) else {
                 continue;
             };
-            // At most the fitted candidates waiting for it: the first that
-            // passes ends the stage.
             (self.progress)(&format!("cross-validated {name}"), Some((done + 1, total)));
-            let added = verdict.added();
-            pending[i].verdict = Some(verdict);
-            if added {
-                return Ok(Some(i));
+            if verdict.added() {
+                passed.push(i);
             }
+            pending[i].verdict = Some(verdict);
         }
-        Ok(None)
+        // Every fitted candidate waiting is cross-validated. Of those that
+        // pass, the criterion's first is added unless another predicts the
+        // held-out runs consistently better ([`added_of`]): the held-out
+        // error is the figure the report stands on, and the criterion (a
+        // log of each kick's misfit, with effective sample sizes that
+        // overstate the data of smooth residuals) can rank a wrong
+        // candidate first, but a difference of held-out errors within the
+        // runs' scatter does not overturn it.
+        let cvs: Vec<f64> = pending
+            .iter()
+            .map(|p| p.fit.as_ref().map_or(f64::INFINITY, |f| f.0.cv))
+            .collect();
+        let better = |a: usize, b: usize| match (&pending[a].fit, &pending[b].fit) {
+            (Some((fa, _)), Some((fb, _))) => {
+                paired_gain(fa, fb, self.weights).is_some_and(|(gain, stderr)| gain > 2.0 * stderr)
+            }
+            _ => false,
+        };
+        let Some(best) = added_of(&passed, &cvs, better) else {
+            return Ok(None);
+        };
+        let added = pending[best].name();
+        let added_cv = cvs[best];
+        let first = passed[0];
+        for &i in passed.iter().filter(|&&i| i != best) {
+            let bic_change = pending[i]
+                .fit
+                .as_ref()
+                .map_or(f64::NAN, |f| f.0.bic - bic(current, self.reference));
+            pending[i].verdict = Some(if i == first {
+                Verdict::PassedHeldOutBelow {
+                    bic_change,
+                    cv: cvs[i],
+                    added: added.clone(),
+                    added_cv,
+                }
+            } else {
+                Verdict::PassedCriterionAbove {
+                    bic_change,
+                    cv: cvs[i],
+                    added: added.clone(),
+                }
+            });
+        }
+        Ok(Some(best))
     }
 
     /// Cross-validate one fitted trial against `current`: its verdict
