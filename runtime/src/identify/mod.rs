@@ -71,6 +71,7 @@ mod screen;
 mod search_order;
 mod segment;
 pub mod selection;
+mod verdict;
 pub use candidate::{Bound, Candidate, EffectParameter};
 pub use confounding::{Confounding, Design, CONFOUNDED};
 pub use cross_validation::{cross_validate, folds_by_run, paired_gain};

@@ -49,75 +49,7 @@ use crate::model::MultibodyModel;
 use serde::Serialize;
 use std::sync::atomic::Ordering;
 
-/// Why a candidate of a step was or was not added, with the numbers behind
-/// it. Changes of the criterion are against the step's base model
-/// (negative: better).
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum Verdict {
-    /// Added: it lowers the criterion and the held-out error, consistently
-    /// over the runs.
-    Added { bic_change: f64, cv: f64, base_cv: f64 },
-    /// The score test's linearised fit does not lower the criterion: it
-    /// cannot win this step (not fitted).
-    NoPredictedGain { predicted_bic_change: f64 },
-    /// Not fitted: the step added another candidate before reaching it in
-    /// the order of the search (a contender, or one predicted to gain more).
-    BehindAdded { predicted_bic_change: f64, added: String },
-    /// Not fitted: the step had fitted its budget of candidates
-    /// ([`super::IdentifyOptions::max_fits_per_step`]) before reaching it.
-    BeyondBudget { predicted_bic_change: f64, budget: usize },
-    /// Fitted, with a criterion above the added candidate's: not
-    /// cross-validated.
-    CriterionAboveAdded { bic_change: f64, added: String },
-    /// It passed every test and the criterion ranked it first, but another
-    /// that also passed predicts the held-out runs consistently better (run
-    /// by run, beyond two standard errors; `added_cv`) and was added.
-    PassedHeldOutBelow {
-        bic_change: f64,
-        cv: f64,
-        added: String,
-        added_cv: f64,
-    },
-    /// It passed every test, behind the added candidate in the criterion,
-    /// and its held-out gain over it is not consistent.
-    PassedCriterionAbove { bic_change: f64, cv: f64, added: String },
-    /// The fit failed.
-    FitFailed { reason: String },
-    /// A dissipative parameter fitted at or below zero, or at its floor
-    /// (not physics; not cross-validated).
-    NotPhysical,
-    /// A correction fitted further from its measured value than
-    /// [`PLAUSIBLE_PRIOR_SDS`] standard deviations of its stated
-    /// uncertainty: the data ask for a value the measurement makes
-    /// implausible, so the correction more likely absorbs a missing effect.
-    /// It is cross-validated only when no plausible candidate passes.
-    ImplausibleUnderPrior { symbol: String, value: f64, prior_sds: f64 },
-    /// The fit does not lower the criterion beyond its added parameters
-    /// (not cross-validated).
-    NoCriterionGain { bic_change: f64 },
-    /// The held-out error does not fall: it does not generalise.
-    HeldOutNotLower { cv: f64, base_cv: f64 },
-    /// The held-out gain per run is within two standard errors of zero:
-    /// not a consistent improvement.
-    HeldOutGainNotConsistent { gain: f64, stderr: f64 },
-    /// It passed, but fitted together with a correction beyond its prior
-    /// that fits better, its parameters fall within two standard errors of
-    /// their absence (largest |shift / standard error| `t`) or keep less
-    /// than half of their shift alone (`remains`, the largest share), while
-    /// the correction's shift stays significant: it stood in for that
-    /// correction, which is added instead.
-    Encompassed { by: String, t: f64, remains: f64 },
-    /// A pair fitted for the encompassing test: not a candidate of its own.
-    NotAdded,
-}
-
-impl Verdict {
-    /// The candidate was added.
-    pub fn added(&self) -> bool {
-        matches!(self, Verdict::Added { .. })
-    }
-}
+pub use super::verdict::Verdict;
 
 /// One candidate (or a pair of candidates) of a step and its outcome.
 #[derive(Clone, Debug, Serialize)]
