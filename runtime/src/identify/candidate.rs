@@ -115,30 +115,32 @@ pub struct Candidate {
     pub nonsmooth: bool,
 }
 
+/// A test fixture: friction's smoothing rate between `lower` and `upper`.
+#[cfg(test)]
+pub(super) fn smoothing_rate(lower: Option<f64>, upper: Option<f64>) -> EffectParameter {
+    EffectParameter {
+        symbol: "w_steer".into(),
+        tied: Vec::new(),
+        moves: Vec::new(),
+        scale: 0.05,
+        dissipative: false,
+        unit: "rad/s".into(),
+        initial: Some(0.1),
+        lower,
+        upper,
+        shape: true,
+        prior: None,
+        gross_beyond: crate::identify::PLAUSIBLE_PRIOR_SDS,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn rate(lower: Option<f64>, upper: Option<f64>) -> EffectParameter {
-        EffectParameter {
-            symbol: "w_steer".into(),
-            tied: Vec::new(),
-            moves: Vec::new(),
-            scale: 0.05,
-            dissipative: false,
-            unit: "rad/s".into(),
-            initial: Some(0.1),
-            lower,
-            upper,
-            shape: true,
-            prior: None,
-            gross_beyond: crate::identify::PLAUSIBLE_PRIOR_SDS,
-        }
-    }
-
     #[test]
     fn a_value_beyond_a_floor_or_ceiling_is_simulated_at_it_and_a_value_on_it_still_moves() {
-        let w = rate(Some(0.002), Some(0.1));
+        let w = smoothing_rate(Some(0.002), Some(0.1));
         assert_eq!(w.simulated(0.5), 0.1);
         assert_eq!(w.simulated(-1.0), 0.002);
         assert_eq!(w.simulated(0.03), 0.03);
@@ -149,7 +151,7 @@ mod tests {
         assert_eq!(w.on_bound(0.1), Some(Bound::Ceiling(0.1)));
         assert_eq!(w.on_bound(0.002), Some(Bound::Floor(0.002)));
         assert_eq!(w.on_bound(0.03), None);
-        let free = rate(None, None);
+        let free = smoothing_rate(None, None);
         assert_eq!(free.simulated(-3.0), -3.0);
         assert!(!free.held_at_bound(1e9));
     }

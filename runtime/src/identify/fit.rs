@@ -393,8 +393,13 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
         // direction points beyond it is held there for this iteration (a
         // stiff prior row), so the other parameters take a full step rather
         // than one computed as if it could move and then cut by projection.
+        // The gradient is needed only for parameters on a bound (most fits
+        // have none): it is not computed for the others.
         let descent: Vec<f64> = (0..k)
             .map(|j| {
+                if p.setup.parameters[j].on_bound(x[j]).is_none() {
+                    return 0.0;
+                }
                 let data: f64 = blocks
                     .iter()
                     .zip(&res)
@@ -585,20 +590,9 @@ mod tests {
     use super::*;
 
     fn bounded(symbol: &str) -> EffectParameter {
-        EffectParameter {
-            symbol: symbol.into(),
-            tied: Vec::new(),
-            moves: Vec::new(),
-            scale: 0.05,
-            dissipative: false,
-            unit: "rad/s".into(),
-            initial: Some(0.1),
-            lower: Some(0.002),
-            upper: Some(0.1),
-            shape: true,
-            prior: None,
-            gross_beyond: crate::identify::PLAUSIBLE_PRIOR_SDS,
-        }
+        let mut q = super::super::candidate::smoothing_rate(Some(0.002), Some(0.1));
+        q.symbol = symbol.into();
+        q
     }
 
     #[test]
