@@ -11,7 +11,7 @@ pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
     let id = &o.identification;
     let mut out = Vec::new();
     for step in &id.steps {
-        for c in step.confounded.iter().filter(|c| c.correlation >= CONFOUNDED) {
+        for c in step.confounded.iter().filter(|c| c.not_separated()) {
             let values = |name: &str| {
                 step.trials
                     .iter()
@@ -48,13 +48,29 @@ pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
             } else {
                 format!("data that would separate them: {}", better.join("; "))
             };
+            // Why they are not separated: the information (their
+            // estimates correlate) or the held-out runs (both pass and
+            // neither predicts consistently better), or both.
+            let mut why = Vec::new();
+            if c.correlation >= CONFOUNDED {
+                why.push(format!(
+                    "move the responses alike (correlation {:.3} in the Fisher information)",
+                    c.correlation
+                ));
+            }
+            if let Some(h) = c.held_out_gain.filter(|h| h.within_scatter()) {
+                why.push(format!(
+                    "both pass cross-validation and neither predicts the held-out runs consistently better (the rival's paired gain {:+.4} +- {:.4}, 1 SE; correlation {:.3})",
+                    h.gain, h.stderr, c.correlation
+                ));
+            }
             out.push(format!(
-                "not separable: {} ({}) and {} ({}) move the responses alike (correlation {:.3} in the Fisher information); {separate}",
+                "not separable: {} ({}) and {} ({}) {}; {separate}",
                 c.chosen,
                 values(&c.chosen),
                 c.rival,
                 values(&c.rival),
-                c.correlation
+                why.join(", and ")
             ));
         }
     }

@@ -40,7 +40,11 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     }
     let _ = writeln!(s, "2. Each window was simulated with the full nonlinear equations from its own initial state (roll, steer, their rates, speed, and a tyre model's lagged lateral forces and their rates; fitted per kick as nuisance parameters), and compared with the measured {roll}, steer and speed.");
     let _ = writeln!(s, "3. The residual pattern of the model without any added effect was related to the effects of the library (below).");
-    let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all kicks (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run: each run's or log's kicks are predicted with the values fitted to the others), and its dissipative parameters are positive; of the candidates of a step that pass, the criterion's first is added unless another predicts the held-out runs consistently better (run by run, beyond two standard errors). The search stops when no candidate passes.\n", id.folds);
+    let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all kicks (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run: each run's or log's kicks are predicted with the values fitted to the others), and its dissipative parameters are positive; of the candidates of a step that pass, the criterion's first is added unless another predicts the held-out runs consistently better (run by run, beyond two standard errors). The search stops when no candidate passes.", id.folds);
+    if let Some(r) = &o.remaining {
+        let _ = writeln!(s, "5. The identified model's weave residuals (measured minus predicted eigenvalue of each kick counted) were regressed on the states a missing effect would act through ({}); an F test asks whether that pattern exceeds the kicks' own scatter about it, which is the floor a perfect model would reach. Outcome: {}.", super::remaining::regressors_text(r), super::remaining::remaining_sentence(r));
+    }
+    let _ = writeln!(s);
     let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| median(id.weights.iter().map(f));
     let _ = writeln!(s, "Channel scales (each kick's RMS residual under the base model, at least the best kick's; median over kicks): {roll} {:.3} {unit}, steer {:.3} deg, speed {:.3} m/s. Each kick and channel is weighed by its own scale, so a run that diverges toward a fall cannot outweigh the others.\n", med(&|w| w.roll).to_degrees(), med(&|w| w.steer).to_degrees(), med(&|w| w.speed));
     let _ = writeln!(s, "## Residual diagnosis (base model)\n");
@@ -145,11 +149,11 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
         if !step.confounded.is_empty() {
             let _ = writeln!(
                 s,
-                "How far the data tell the added candidate from each rival that also lowered the criterion (largest canonical correlation of their parameters in the Fisher information, after every kick's initial state is fitted; 1: indistinguishable, at or above {CONFOUNDED}: not separable):\n"
+                "How far the data tell the added candidate from each rival that also lowered the criterion. Correlation: the largest canonical correlation of their parameters in the Fisher information, after every kick's initial state is fitted (1: indistinguishable; at or above {CONFOUNDED}: not separable). Held-out gain: for a rival that passed cross-validation too, how much better it predicts the held-out runs, paired run by run, +- one standard error (within two standard errors of zero: not separated by these runs).\n"
             );
             let _ = writeln!(
                 s,
-                "| added | rival | correlation | kicks that would separate them (correlation) |\n|---|---|---|---|"
+                "| added | rival | correlation | held-out gain of the rival | kicks that would separate them (correlation) |\n|---|---|---|---|---|"
             );
             for c in &step.confounded {
                 let designs: Vec<String> = c
@@ -158,9 +162,18 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
                     .take(4)
                     .map(|d| format!("{} ({:.2})", d.description, d.correlation))
                     .collect();
+                let gain = match c.held_out_gain {
+                    Some(h) => format!(
+                        "{:+.4} +- {:.4} (1 SE){}",
+                        h.gain,
+                        h.stderr,
+                        if h.within_scatter() { " (not separated)" } else { "" }
+                    ),
+                    None => "-".to_string(),
+                };
                 let _ = writeln!(
                     s,
-                    "| `{}` | `{}` | {:.3}{} | {} |",
+                    "| `{}` | `{}` | {:.3}{} | {gain} | {} |",
                     c.chosen,
                     c.rival,
                     c.correlation,

@@ -18,6 +18,7 @@ mod error;
 mod fits;
 mod markdown;
 pub mod predict;
+mod remaining;
 pub mod report;
 pub mod segments;
 pub mod weave_errors;
@@ -156,6 +157,9 @@ pub struct Outcome<R: ModelRegistry = BuiltIn> {
     pub weave_kicks: Vec<bool>,
     /// The kicks kept out of the eigenvalue figures, with the reason.
     pub eigen_excluded: Vec<weave_errors::Excluded>,
+    /// What the library leaves in the weave eigenvalues: a pattern in the
+    /// kicks' states beyond their scatter, or none (`None`: too few kicks).
+    pub remaining: Option<bikedyn_runtime::identify::remaining::Remaining>,
     /// The model's speed was imposed (logs of a motor-held speed).
     pub speed_imposed: bool,
     run_plot: Option<RunPlot>,
@@ -363,6 +367,22 @@ pub fn run_plan<R: ModelRegistry>(
             )?[0];
         }
     }
+    // What the library leaves: the counted kicks' residuals after
+    // identification against their own scatter.
+    let weave_residuals: Vec<bikedyn_runtime::identify::remaining::KickWeave> = (0..segs.len())
+        .filter(|&i| weave_kicks[i])
+        .filter_map(|i| {
+            Some(bikedyn_runtime::identify::remaining::KickWeave {
+                speed: segs[i].mean_speed,
+                amplitude: Some(segs[i].roll.iter().fold(0.0f64, |a, b| a.max(b.abs()))),
+                measured: segs[i].weave?.0,
+                base: predicted_before[i]?,
+                after: predicted_after[i]?,
+                held_out: predicted_held_out[i]?,
+            })
+        })
+        .collect();
+    let remaining = bikedyn_runtime::identify::remaining::remaining(&weave_residuals);
     // Steady bias: the base model's roll residual over the second half of
     // each window.
     let bias: Vec<f64> = run_plot
@@ -411,6 +431,7 @@ pub fn run_plan<R: ModelRegistry>(
         steer_rate,
         weave_kicks,
         eigen_excluded,
+        remaining,
         speed_imposed: plan.speed_imposed,
         run_plot,
         registry: PhantomData,

@@ -13,7 +13,6 @@ use bikedyn_report::experiment::accept::rejected_text;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic};
 use bikedyn_report::staged::{FolderKind, StagedDir};
-use bikedyn_runtime::identify::confounding::CONFOUNDED;
 use bikedyn_runtime::identify::{pooled_rms, Candidate, Verdict, PLAUSIBLE_PRIOR_SDS};
 use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::{json, Value};
@@ -128,7 +127,10 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
                     "chosen": c.chosen,
                     "rival": c.rival,
                     "correlation": c.correlation,
-                    "confounded": c.correlation >= CONFOUNDED,
+                    "held_out_gain": c.held_out_gain.map(|h| h.gain),
+                    "held_out_gain_stderr": c.held_out_gain.map(|h| h.stderr),
+                    "predicts_alike": c.predicts_alike(),
+                    "confounded": c.not_separated(),
                     "designs": c.designs,
                 })
             })
@@ -166,6 +168,7 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
         "skipped": o.skipped,
         "eigen_excluded": o.eigen_excluded.iter().map(excluded_json).collect::<Vec<_>>(),
         "findings": o.findings,
+        "remaining": o.remaining,
         "weights": id.weights,
         "folds": id.folds,
         "simulations": id.simulations,
@@ -300,7 +303,10 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
         b["steer_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
         a["steer_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
     );
-
+    // Whether the library ran out: a pattern left beyond the kicks' scatter.
+    if let Some(r) = &o.remaining {
+        let _ = write!(s, "\n{}", super::remaining::remaining_sentence(r));
+    }
     s
 }
 
@@ -521,7 +527,7 @@ pub fn verdict_text(v: &Verdict) -> String {
             format!("rejected: held-out error {cv:.4} not below {base_cv:.4} (does not generalise)")
         }
         Verdict::HeldOutGainNotConsistent { gain, stderr } => format!(
-            "rejected: held-out gain per run {gain:.4} within two standard errors ({stderr:.4}) of zero (not a consistent improvement)"
+            "rejected: held-out gain per run {gain:.4}, within two standard errors of zero (standard error {stderr:.4}; not a consistent improvement)"
         ),
         Verdict::Encompassed { by, t, remains } => format!(
             "replaced by {by}: fitted together with it, its parameters keep {:.0} % of their shift alone ({t:.1} standard errors from their absence) while {by} stays significant; it stood in for {by}",

@@ -110,7 +110,36 @@ fn identify_with(dir: &Path, report: Option<&Path>, extra: &[&str]) -> Value {
     {
         assert!(l.contains(" of "), "a counted stage without its count: {l}");
     }
-    serde_json::from_slice(&out.stdout).expect("JSON output")
+    let j: Value = serde_json::from_slice(&out.stdout).expect("JSON output");
+    every_unseparated_pair_says_why(&j);
+    j
+}
+
+/// A pair is reported not separated only for a stated reason: estimates
+/// that correlate at or above 0.9, or a rival that passed cross-validation
+/// too and whose paired held-out gain over the added candidate is within
+/// two standard errors either way.
+fn every_unseparated_pair_says_why(j: &Value) {
+    for c in j["confounded"].as_array().expect("confounded list") {
+        let gain = c["held_out_gain"].as_f64();
+        let se = c["held_out_gain_stderr"].as_f64();
+        let alike = matches!((gain, se), (Some(g), Some(s)) if g.abs() <= 2.0 * s);
+        assert_eq!(c["predicts_alike"], alike, "{c:#}");
+        let correlated = f(&c["correlation"]) >= 0.9;
+        assert_eq!(c["confounded"], correlated || alike, "{c:#}");
+        if gain.is_some() {
+            let rival = j["candidates"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|t| t["name"] == c["rival"] && t["step"] == c["step"])
+                .expect("the rival's trial");
+            assert!(
+                rival["verdict"].as_str().unwrap().starts_with("passed"),
+                "a held-out gain for a rival that did not pass: {rival:#}"
+            );
+        }
+    }
 }
 
 /// A synthetic run's truth (synth's `truth/<run>_truth.json`): the mean

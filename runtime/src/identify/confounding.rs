@@ -11,6 +11,12 @@
 //! their estimates). Near one, a fit of either explains what the other
 //! would, and selection between them is arbitrary.
 //!
+//! Two candidates that both pass cross-validation are also not separated
+//! by these runs when neither predicts the held-out runs consistently
+//! better than the other (their paired held-out gain is within two
+//! standard errors): the data then support either, whatever their
+//! correlation, and the report says so rather than name one as the cause.
+//!
 //! Which data would separate them is answered the same way on kicks that
 //! were not measured: the measured median kick repeated at other speeds,
 //! with three times its amplitude, and as a steer kick (the same initial
@@ -34,9 +40,48 @@ pub struct Confounding {
     /// Largest canonical correlation of their reduced Fisher information
     /// on the measured kicks (0: independent, 1: indistinguishable).
     pub correlation: f64,
+    /// When the rival also passed cross-validation: its held-out gain over
+    /// the chosen candidate, paired run by run (weighted mean square of
+    /// the held-out residuals, chosen minus rival: positive when the rival
+    /// predicts better), and that gain's standard error.
+    pub held_out_gain: Option<HeldOutGain>,
     /// Designs of further kicks and the correlation each would give on its
     /// own, best separating first.
     pub designs: Vec<Design>,
+}
+
+/// A paired held-out gain and its standard error (weighted mean square of
+/// the held-out residuals, dimensionless).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct HeldOutGain {
+    pub gain: f64,
+    pub stderr: f64,
+}
+
+impl HeldOutGain {
+    /// Whether the gain is within two standard errors of zero, either way:
+    /// the runs' scatter hides any difference (the test selection applies
+    /// to a candidate's gain over the base). A gain that is not a number
+    /// is not within anything.
+    pub fn within_scatter(&self) -> bool {
+        self.gain.is_finite() && self.stderr.is_finite() && self.gain.abs() <= 2.0 * self.stderr
+    }
+}
+
+impl Confounding {
+    /// Whether the data leave the two candidates unseparated: their
+    /// estimates correlate at or above [`CONFOUNDED`], or both passed
+    /// cross-validation and neither predicts the held-out runs
+    /// consistently better.
+    pub fn not_separated(&self) -> bool {
+        self.correlation >= CONFOUNDED || self.predicts_alike()
+    }
+
+    /// Whether both passed cross-validation and their held-out errors
+    /// differ within the runs' scatter.
+    pub fn predicts_alike(&self) -> bool {
+        self.held_out_gain.is_some_and(|h| h.within_scatter())
+    }
 }
 
 /// A kick that was not measured and how well it would separate two
@@ -90,7 +135,8 @@ pub fn canonical_correlation(f: &DMatrix<f64>, a: &[usize], b: &[usize]) -> Opti
 /// The correlation of candidates whose parameters are the columns `a` and
 /// `b` of `setup` (made by `factory` with `active`, values `g`) on the
 /// measured segments with initial states `x0`; and, when at least
-/// [`CONFOUNDED`], the designs built from the median measured kick over
+/// [`CONFOUNDED`] or when `designs_wanted` (the pair is not separated
+/// otherwise), the designs built from the median measured kick over
 /// `speeds`.
 #[allow(clippy::too_many_arguments)]
 pub fn confounding(
@@ -102,11 +148,12 @@ pub fn confounding(
     a: &[usize],
     b: &[usize],
     speeds: &[f64],
+    designs_wanted: bool,
 ) -> Option<(f64, Vec<Design>)> {
     let all: Vec<usize> = (0..setup.segments.len()).collect();
     let f = reduced_information(setup, g, &all, x0)?;
     let measured = canonical_correlation(&f, a, b)?;
-    if measured < CONFOUNDED {
+    if measured < CONFOUNDED && !designs_wanted {
         return Some((measured, Vec::new()));
     }
     // The median kick by duration, at its fitted initial state.
@@ -163,6 +210,32 @@ mod tests {
     fn information(columns: &[Vec<f64>]) -> DMatrix<f64> {
         let j = DMatrix::from_fn(columns[0].len(), columns.len(), |r, c| columns[c][r]);
         j.tr_mul(&j)
+    }
+
+    #[test]
+    fn two_candidates_are_not_separated_when_correlated_or_when_both_pass_and_predict_alike() {
+        let pair = |correlation: f64, held_out_gain: Option<HeldOutGain>| Confounding {
+            chosen: "correct z3".into(),
+            rival: "correct x3".into(),
+            correlation,
+            held_out_gain,
+            designs: Vec::new(),
+        };
+        let gain = |gain: f64, stderr: f64| Some(HeldOutGain { gain, stderr });
+        // Correlated estimates: not separable, whatever the held-out runs.
+        assert!(pair(0.95, None).not_separated());
+        assert!(pair(0.95, gain(0.01, 0.001)).not_separated());
+        // Below the mark, a rival that did not pass (no gain) is separated.
+        assert!(!pair(0.884, None).not_separated());
+        // Both passed: a gain within two standard errors either way leaves
+        // them unseparated; beyond, the runs tell them apart.
+        assert!(pair(0.884, gain(0.0016, 0.0010)).not_separated());
+        assert!(pair(0.884, gain(-0.0019, 0.0010)).predicts_alike());
+        assert!(!pair(0.884, gain(0.0021, 0.0010)).not_separated());
+        assert!(!pair(0.5, gain(-0.0030, 0.0010)).not_separated());
+        // A gain that could not be computed is no evidence that they
+        // predict alike.
+        assert!(!pair(0.5, gain(f64::NAN, f64::NAN)).not_separated());
     }
 
     #[test]

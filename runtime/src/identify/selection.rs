@@ -34,7 +34,7 @@
 //! the whole search), so the steps' figures add up: a step's base is the
 //! previous step's base plus the change it selected.
 
-use super::confounding::{self, Confounding};
+use super::confounding::Confounding;
 pub use super::criterion::{bic, PLAUSIBLE_PRIOR_SDS};
 use super::criterion::{farthest_from_prior, with_priors_on_the_data_scale};
 pub use super::cross_validation::{folds_by_run, paired_gain};
@@ -703,81 +703,10 @@ impl<'s> Search<'s> {
         })
     }
 
-    /// The candidate a step adds against each fitted rival that also
-    /// lowered the information criterion and is plausible under its
-    /// prior: their correlation on the measured kicks, and for a
-    /// confounded pair the designs of kicks that would separate them (at
-    /// speeds from 1.5 m/s below the slowest kick to 1.5 m/s above the
-    /// fastest).
-    fn rivals(
-        &self,
-        pending: &[Pending<'s>],
-        best: usize,
-        selected: &[&'s Candidate],
-        base_bic: f64,
-    ) -> Vec<Confounding> {
-        let chosen = pending[best].members[0];
-        let Some((fit, _)) = &pending[best].fit else {
-            return Vec::new();
-        };
-        let speeds: Vec<f64> = {
-            let v = self.segments.iter().map(|s| s.mean_speed).filter(|v| v.is_finite());
-            let (lo, hi) = v.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
-            if lo.is_finite() {
-                let (lo, hi) = ((lo - 1.5).max(1.0), hi + 1.5);
-                (0..6).map(|i| lo + (hi - lo) * i as f64 / 5.0).collect()
-            } else {
-                Vec::new()
-            }
-        };
-        let ks: usize = selected.iter().map(|c| c.parameters.len()).sum();
-        let kc = chosen.parameters.len();
-        let mut out = Vec::new();
-        for (i, p) in pending.iter().enumerate() {
-            let Some((rival_fit, _)) = &p.fit else { continue };
-            if i == best || p.members.len() != 1 || !rival_fit.physical || !(rival_fit.bic < base_bic) {
-                continue;
-            }
-            let rival = p.members[0];
-            if !self.plausible(rival, &rival_fit.values[ks..]) {
-                continue;
-            }
-            let mut active: Vec<&Candidate> = selected.to_vec();
-            active.push(chosen);
-            active.push(rival);
-            let factory = match self.alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
-                Some(f) => f,
-                None if active.iter().any(|a| a.alternative_model) => continue,
-                None => self.main,
-            };
-            let Ok(setup) = factory.setup(self.segments, self.weights, &active) else {
-                continue;
-            };
-            let mut g = fit.values.clone();
-            g.extend(rival_fit.values.iter().skip(ks));
-            if g.len() != setup.k() {
-                continue;
-            }
-            let a: Vec<usize> = (ks..ks + kc).collect();
-            let b: Vec<usize> = (ks + kc..setup.k()).collect();
-            if let Some((correlation, designs)) =
-                confounding::confounding(&setup, factory, &active, &g, &fit.nuisance, &a, &b, &speeds)
-            {
-                out.push(Confounding {
-                    chosen: chosen.name.clone(),
-                    rival: rival.name.clone(),
-                    correlation,
-                    designs,
-                });
-            }
-        }
-        out
-    }
-
     /// Whether a candidate's fitted values are plausible under its stated
     /// prior: within [`PLAUSIBLE_PRIOR_SDS`] prior standard deviations of the
     /// measured value (a candidate without a prior, an effect, always is).
-    fn plausible(&self, candidate: &Candidate, values: &[f64]) -> bool {
+    pub(super) fn plausible(&self, candidate: &Candidate, values: &[f64]) -> bool {
         farthest_from_prior(self.stated, &[candidate], values).is_none_or(|(_, _, sds)| sds <= PLAUSIBLE_PRIOR_SDS)
     }
 

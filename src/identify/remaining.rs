@@ -1,0 +1,83 @@
+//! The report's words for what the library leaves
+//! (`identify::remaining` in the runtime computes it).
+
+use bikedyn_runtime::identify::remaining::{Part, PatternTerm, Remaining, State};
+
+fn state_text(s: State) -> &'static str {
+    match s {
+        State::Speed => "speed",
+        State::SpeedSquared => "speed squared",
+        State::LogAmplitude => "log amplitude",
+    }
+}
+
+fn term_text(t: &PatternTerm) -> String {
+    let (part, unit) = match t.part {
+        Part::Real => ("real part", "1/s"),
+        Part::Imaginary => ("imaginary part", "rad/s"),
+    };
+    match t.state {
+        None => format!("{part} {:+.3} +- {:.3} {unit} on average", t.coefficient, t.stderr),
+        Some(s) => format!(
+            "{part} {:+.3} +- {:.3} {unit} per standard deviation of {}",
+            t.coefficient,
+            t.stderr,
+            state_text(s)
+        ),
+    }
+}
+
+/// The states the pattern was sought in, in words.
+pub fn regressors_text(r: &Remaining) -> String {
+    std::iter::once("a constant")
+        .chain(r.regressors.iter().map(|s| state_text(*s)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The finding in words: whether a structured residual remains, and what
+/// share of a perfect model's gain the library made (`+-`: one standard
+/// error).
+pub fn remaining_sentence(r: &Remaining) -> String {
+    let pct = |x: f64| {
+        if x.is_finite() {
+            format!("{:.0} %", 100.0 * x)
+        } else {
+            "- (the base model is already within the scatter)".to_string()
+        }
+    };
+    let figures = format!(
+        "weave eigenvalue RMS: base model {:.3}, with the library {:.3} (held out {:.3}), floor of the kicks' scatter {:.3} 1/s over {} kicks; pattern in {} tested: F = {:.2} on {} and {} degrees of freedom, p = {:.2e}",
+        r.base_rms,
+        r.after_rms,
+        r.held_out_rms,
+        r.floor_rms,
+        r.kicks,
+        regressors_text(r),
+        r.f,
+        r.df[0],
+        r.df[1],
+        r.p_value,
+    );
+    if r.structured {
+        let what = if r.pattern.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; it shows as {} (1 SE)",
+                r.pattern.iter().map(term_text).collect::<Vec<_>>().join(", ")
+            )
+        };
+        format!(
+            "a structured residual remains: the library explains {} of what a perfect model would ({} held out){what} ({figures})",
+            pct(r.explained),
+            pct(r.explained_held_out),
+        )
+    } else {
+        format!(
+            "no structured residual remains in the weave: what the library leaves is within the kicks' scatter; it explains {} of what a perfect model would ({} held out) ({figures})",
+            pct(r.explained),
+            pct(r.explained_held_out),
+        )
+    }
+}
