@@ -20,6 +20,7 @@ use bikedyn_report::experiment::synth::{write_run, WriteRunError};
 use bikedyn_report::output::{save_json, write_atomic, OutputError};
 use bikedyn_report::staged::{FolderKind, StagedDir};
 use bikedyn_runtime::eigen::{eigenvalues_of, EigenError};
+use bikedyn_runtime::experiment::read::MAX_SPEED_M_S;
 use bikedyn_runtime::experiment::synth::{rest_trajectory, RunKind, SensorModel};
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
 use bikedyn_runtime::model::CoordinateRole;
@@ -99,8 +100,8 @@ pub enum SynthError {
     /// The number of runs is outside 1 to 1000.
     #[error("--runs must be between 1 and 1000")]
     RunCount { runs: usize },
-    /// The release speeds are not `0 < LO <= HI`.
-    #[error("release speeds must be 0 < LO <= HI (m/s), found {lo}:{hi}")]
+    /// The release speeds are not `0 < LO <= HI <= 30` m/s.
+    #[error("release speeds must be 0 < LO <= HI <= {MAX_SPEED_M_S} (m/s), found {lo}:{hi}: no measured run is ridden faster, and `fit` refuses such speeds")]
     Speeds { lo: f64, hi: f64 },
     /// The bicycle could not be resolved, or an effect value set on it.
     #[error(transparent)]
@@ -251,7 +252,9 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
         bike = bike.with_parameter(sym, *val)?;
     }
     let [lo, hi] = a.speeds;
-    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo) {
+    // A set no measurement could be (100 m/s) would only test the model
+    // where no bicycle is ridden.
+    if !(lo.is_finite() && hi.is_finite() && lo > 0.0 && hi >= lo && hi <= MAX_SPEED_M_S) {
         return Err(SynthError::Speeds { lo, hi });
     }
     let p = bike.thesis()?;

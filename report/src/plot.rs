@@ -54,6 +54,11 @@ pub mod sweep;
 /// Environment variable naming a TTF/OTF font file for plot text.
 pub const FONT_ENV: &str = "BIKEDYN_FONT";
 
+/// The largest font file read (bytes): the largest common fonts (CJK
+/// collections) are about 30 MB; a larger file is not a font and would be
+/// held in memory for good.
+pub const MAX_FONT_BYTES: u64 = 64 << 20;
+
 /// Errors of the plot functions; all name the offending path where there is one.
 #[derive(Debug, thiserror::Error)]
 pub enum PlotError {
@@ -381,12 +386,24 @@ fn scan_fonts(dir: &Path, depth: u32, out: &mut Vec<PathBuf>) {
 /// scan of the system font directories (preferring regular sans-serif faces).
 pub fn find_font() -> Result<PathBuf, PlotError> {
     let mut searched = Vec::new();
-    if let Some(p) = std::env::var_os(FONT_ENV) {
+    if let Some(p) = std::env::var_os(FONT_ENV).filter(|p| !p.is_empty()) {
+        // A font the user named is used or refused, never passed over for
+        // another one without a word.
         let p = PathBuf::from(p);
-        if p.is_file() {
-            return Ok(p);
-        }
-        searched.push(p);
+        let why = match std::fs::metadata(&p) {
+            Err(e) => e.to_string(),
+            Ok(m) if m.is_dir() => "a folder, not a font file".into(),
+            Ok(m) if !m.is_file() => "a device or pipe, not a font file".into(),
+            Ok(m) if m.len() > MAX_FONT_BYTES => format!(
+                "{} bytes, more than a font file holds ({MAX_FONT_BYTES} at most)",
+                m.len()
+            ),
+            Ok(_) => return Ok(p),
+        };
+        return Err(PlotError::Font {
+            path: p,
+            message: format!("{why} (named by {FONT_ENV}: give a .ttf or .otf file, or unset it to use a system font)"),
+        });
     }
     for c in FONT_CANDIDATES {
         let p = PathBuf::from(c);

@@ -163,6 +163,7 @@ impl<R: ModelRegistry> Bicycle<R> {
                 for (name, &value) in &loaded.effects {
                     check_effect_value_in::<R>(name, value, path)?;
                 }
+                check_effect_windows_in::<R>(&loaded.effects, path)?;
                 refuse_millimetres(&loaded.warnings, path)?;
                 return Ok(Bicycle {
                     name: spec.to_string(),
@@ -232,6 +233,7 @@ impl<R: ModelRegistry> Bicycle<R> {
                 uncertainties.insert(key.to_string(), *sd);
             }
         }
+        check_effect_windows_in::<R>(&effects, name)?;
         // The form is the one whose symbols are given: a thesis-only symbol
         // makes it the thesis form (the two share `g` and a few names).
         let thesis = geometry
@@ -380,6 +382,7 @@ impl<R: ModelRegistry> Bicycle<R> {
             check_effect_value_in::<R>(symbol, value, &self.name)?;
             let mut b = self.clone();
             b.effects.insert(symbol.to_string(), value);
+            check_effect_windows_in::<R>(&b.effects, &self.name)?;
             b.name = format!("{} ({symbol} = {value})", self.name);
             return Ok(b);
         }
@@ -475,6 +478,43 @@ pub fn check_effect_value_in<R: ModelRegistry>(name: &str, value: f64, file: &st
         }),
         None => Ok(()),
     }
+}
+
+/// Refuse a speed window of an effect that is empty: a parameter
+/// `X_v_min` at or above its `X_v_max` (each as given in `effects`, else
+/// its default), so the effect never acts (a steer controller with
+/// `Kc_v_min = 6`, `Kc_v_max = 2` m/s would be analysed as absent without a
+/// word). Named by `file` and both fields.
+pub fn check_effect_windows_in<R: ModelRegistry>(
+    effects: &BTreeMap<String, f64>,
+    file: &str,
+) -> Result<(), BicycleError> {
+    let params = effect_parameters_in::<R>();
+    let value = |name: &str| {
+        effects
+            .get(name)
+            .copied()
+            .or_else(|| params.iter().find(|p| p.name == name).and_then(|p| p.default))
+    };
+    for min in params.iter().filter(|p| p.name.ends_with("_v_min")) {
+        let max = format!("{}_v_max", min.name.trim_end_matches("_v_min"));
+        // Only a window the file sets (a bound of its own) can be its slip.
+        if !effects.contains_key(min.name) && !effects.contains_key(&max) {
+            continue;
+        }
+        if let (Some(lo), Some(hi)) = (value(min.name), value(&max)) {
+            if lo >= hi {
+                return Err(BicycleError::EffectParameter {
+                    file: file.to_string(),
+                    why: format!(
+                        "`{}` = {lo} m/s is not below `{max}` = {hi} m/s: the effect would act at no speed; the window is {} to {max}",
+                        min.name, min.name
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// The error for a symbol that names no parameter, listing the effect

@@ -11,6 +11,9 @@ use bikedyn::sensitivity::canonical_uncertainties;
 /// Run `bikedyn canonical`.
 pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
     let BikeArg { spec: bike, model } = bike;
+    // Checked even when the bicycle has a canonical form and the speeds are
+    // not used: a bad value is a slip to show, not to pass over.
+    let speeds = parse_range(&speeds, "--speeds")?;
     let b = load(&bike)?;
     let lin = b.linear_with(model.as_deref())?;
     match &lin.canonical {
@@ -53,7 +56,6 @@ pub fn run(bike: BikeArg, speeds: String, json: bool) -> Result<bool> {
                 .err()
                 .map(|e| e.to_string())
                 .unwrap_or_default();
-            let speeds = parse_range(&speeds, "--speeds")?;
             if let Some(first) = lin.first_order() {
                 return first_order(lin.model, first, &speeds, json);
             }

@@ -8,7 +8,7 @@ use bikedyn::bicycle::Bicycle;
 use bikedyn::report::simulate::plot::plot_simulation;
 use bikedyn::report::simulate::save_simulation_csv;
 use bikedyn::runtime::simulate::{
-    Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, TorquePulse,
+    Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, TorquePulse, MIN_RTOL,
 };
 use bikedyn::simulate;
 use std::time::Instant;
@@ -34,6 +34,9 @@ pub fn parse_kick(spec: &str) -> Result<Kick> {
     const FORMAT: &str = "TIME:IMPULSE or TIME:IMPULSE:AHEAD:HEIGHT, e.g. 1.0:3";
     match numbers(spec, "--kick", FORMAT)?.as_slice() {
         [t, j] => Ok(Kick::at_saddle(*t, *j)),
+        // A point below the ground is no place to kick a bicycle (a sign
+        // slip: heights are up from the ground).
+        [_, _, _, h] if *h < 0.0 => bail!("--kick `{spec}`: HEIGHT {h} m is below the ground; the point's height above the ground is positive, e.g. 0.95 for a saddle"),
         [t, j, a, h] => Ok(Kick {
             time: *t,
             impulse: *j,
@@ -89,6 +92,13 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
     let bike = Bicycle::resolve(&a.bike)?;
     super::show_warnings(&bike);
     let info = simulate::choose_model(&bike, a.model.as_deref(), a.free_speed)?;
+    if let Some(m) = a.model.as_deref().filter(|m| *m != info.name) {
+        // The named model is not the one run: say which is.
+        eprintln!(
+            "note: --free-speed runs {}, the free-speed variant of --model {m}",
+            info.name
+        );
+    }
     if !(a.speed.is_finite()) {
         bail!("--speed must be a finite number");
     }
@@ -113,6 +123,16 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
         }
     }
     let limit = |deg: f64| (deg > 0.0).then(|| deg.to_radians());
+    // Refused rather than clamped: the run would be less accurate than asked.
+    if !(a.rtol >= MIN_RTOL && a.rtol < 1.0) {
+        bail!(
+            "--rtol {:?}: a relative tolerance from {MIN_RTOL:.1e} (ten units of rounding, the integrators' floor) to below 1",
+            a.rtol
+        );
+    }
+    if !(a.atol > 0.0 && a.atol.is_finite()) {
+        bail!("--atol {:?}: a positive, finite absolute tolerance", a.atol);
+    }
     let opts = SimOptions {
         rtol: a.rtol,
         atol: a.atol,

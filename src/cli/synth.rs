@@ -5,6 +5,7 @@
 use super::args::SynthArgs;
 use anyhow::{Context, Result};
 use bikedyn::progress::Progress;
+use bikedyn::runtime::experiment::read::MAX_SPEED_M_S;
 use bikedyn::synth::{synth, SynthOptions, SynthRun};
 use std::path::Path;
 
@@ -41,8 +42,8 @@ fn speeds(s: &str) -> Result<[f64; 2]> {
     let (lo, hi) = s
         .split_once(':')
         .and_then(|(l, h)| Some((l.trim().parse::<f64>().ok()?, h.trim().parse::<f64>().ok()?)))
-        .filter(|(l, h)| l.is_finite() && h.is_finite() && *l > 0.0 && h >= l)
-        .with_context(|| format!("--speeds `{s}`: expected LO:HI with 0 < LO <= HI (m/s)"))?;
+        .filter(|(l, h)| l.is_finite() && h.is_finite() && *l > 0.0 && h >= l && *h <= MAX_SPEED_M_S)
+        .with_context(|| format!("--speeds `{s}`: expected LO:HI with 0 < LO <= HI <= {MAX_SPEED_M_S} (m/s)"))?;
     Ok([lo, hi])
 }
 

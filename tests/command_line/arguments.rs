@@ -121,3 +121,143 @@ fn a_stop_angle_that_is_not_an_angle_is_refused() {
     let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", "--roll-limit", "0"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
 }
+
+/// `simulate --kick T:J:AHEAD:-1` kicked the bicycle a metre below the
+/// ground without a word: a height below the ground is refused, naming the
+/// flag.
+#[test]
+fn a_kick_below_the_ground_is_refused() {
+    let out = bikedyn(&[
+        "simulate",
+        "--speed",
+        "5",
+        "--duration",
+        "0.1",
+        "--kick",
+        "0.05:3:0.25:-1",
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("--kick") && stderr.contains("below the ground"),
+        "{stderr}"
+    );
+    let out = bikedyn(&[
+        "simulate",
+        "--speed",
+        "5",
+        "--duration",
+        "0.1",
+        "--kick",
+        "0.05:3:0.25:0.95",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+/// `simulate --rtol 1e-300` was clamped silently to what the integrator
+/// can meet: a tolerance below ten units of rounding (and a non-positive
+/// absolute one) is refused, naming the flag and the floor.
+#[test]
+fn a_tolerance_below_rounding_is_refused_not_clamped() {
+    for (flag, v) in [
+        ("--rtol", "1e-300"),
+        ("--rtol", "0"),
+        ("--atol", "-1"),
+        ("--atol", "inf"),
+    ] {
+        let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", flag, v]);
+        let stderr = text(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{flag} {v}: {stderr}");
+        assert!(stderr.contains(flag), "{flag} {v}: {stderr}");
+    }
+    let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", "--rtol", "1e-300"]);
+    assert!(text(&out.stderr).contains("2.2e-15"), "{}", text(&out.stderr));
+    let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", "--rtol", "1e-14"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}
+
+/// `--free-speed` with `--model thesis_whipple` ran another model than the
+/// one named, saying so only in the first line of the output: a note on
+/// standard error names both.
+#[test]
+fn free_speed_says_which_model_it_runs_for_the_one_named() {
+    let out = bikedyn(&[
+        "simulate",
+        "--speed",
+        "5",
+        "--duration",
+        "0.1",
+        "--free-speed",
+        "--model",
+        "thesis_whipple",
+    ]);
+    let stderr = text(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("--free-speed runs thesis_whipple_free") && stderr.contains("--model thesis_whipple"),
+        "{stderr}"
+    );
+}
+
+/// `synth --speeds 100:200` made a set at speeds no bicycle is measured at
+/// (and `fit` refuses): release speeds above 30 m/s are refused.
+#[test]
+fn synth_refuses_release_speeds_no_bicycle_rides_at() {
+    let out_dir = scratch("arguments").join("synth-fast");
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let out = bikedyn(&[
+        "synth",
+        "--runs",
+        "1",
+        "--speeds",
+        "100:200",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--speeds") && stderr.contains("30"), "{stderr}");
+    assert!(!out_dir.exists());
+}
+
+/// `canonical --speeds foo` was ignored for a bicycle with a canonical form
+/// (the speeds are used only without one): it is refused, naming the flag.
+#[test]
+fn canonical_checks_its_speeds_even_when_they_are_not_used() {
+    let out = bikedyn(&["canonical", "--bike", "benchmark", "--speeds", "foo"]);
+    let stderr = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--speeds"), "{stderr}");
+    assert!(out.stdout.is_empty());
+}
+
+/// A `BIKEDYN_FONT` that names no font file (missing, a folder, a device)
+/// was passed over for a system font without a word: the figure is
+/// refused, naming the variable and the path.
+#[test]
+fn a_font_named_by_bikedyn_font_is_used_or_refused() {
+    let dir = scratch("arguments").join("font");
+    std::fs::create_dir_all(&dir).unwrap();
+    let plot = dir.join("eig.svg");
+    for font in ["/nonexistent/font.ttf", dir.to_str().unwrap(), "/dev/zero"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_bikedyn"))
+            .args([
+                "eig",
+                "--bike",
+                "benchmark",
+                "--speeds",
+                "0:10:1",
+                "--plot",
+                plot.to_str().unwrap(),
+            ])
+            .env("BIKEDYN_FONT", font)
+            .output()
+            .unwrap();
+        let stderr = text(&out.stderr);
+        assert!(!out.status.success(), "{font}: {stderr}");
+        assert!(
+            stderr.contains("BIKEDYN_FONT") && stderr.contains(font),
+            "{font}: {stderr}"
+        );
+    }
+}

@@ -549,3 +549,32 @@ fn a_real_log_in_degrees_or_doubled_states_the_cause() {
     let err = fails(&["fit", arg(&p), "--bike", arg(&bike)]);
     assert!(err.contains("doubled.log:3") && err.contains("repeats line 2"), "{err}");
 }
+
+/// A steer controller whose speed window is empty (`Kc_v_min` = 6 m/s at
+/// or above `Kc_v_max` = 2 m/s) never acts, and was analysed as absent
+/// without a word: the file is refused, naming both fields; a window in
+/// order passes.
+#[test]
+fn an_empty_speed_window_of_a_controller_is_refused_naming_both_fields() {
+    let dir = tmp("controller-window");
+    std::fs::create_dir_all(&dir).unwrap();
+    let thesis = text(&bikedyn(&["params", "show", "--bike", "thesis"]).stdout);
+    let file = |name: &str, lo: f64, hi: f64| {
+        let p = dir.join(name);
+        std::fs::write(
+            &p,
+            format!("{thesis}\nKc_roll_rate = 5\nKc_v_min = {lo}\nKc_v_max = {hi}\n"),
+        )
+        .unwrap();
+        p
+    };
+    let bad = file("empty.toml", 6.0, 2.0);
+    let err = fails(&["stability", "--bike", arg(&bad)]);
+    assert!(
+        err.contains("empty.toml") && err.contains("Kc_v_min") && err.contains("Kc_v_max"),
+        "{err}"
+    );
+    let ok = file("window.toml", 2.0, 6.0);
+    let out = bikedyn(&["stability", "--bike", arg(&ok)]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+}

@@ -11,6 +11,8 @@ use crate::common::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
+mod eigenvalue_tables;
+
 fn synth(name: &str, effects: &str, seed: u64) -> PathBuf {
     synth_with(name, None, effects, seed)
 }

@@ -2,5 +2,6 @@
 //! which fitted eigenvalues it accepts as measured ones.
 
 mod acceptance;
+mod calibration_and_sensors;
 mod fit_command;
 mod synthetic_runs;

@@ -190,6 +190,45 @@ pub enum RunError {
         /// How it moved.
         motion: angles::CalibrationMotion,
     },
+    /// The calibration record settles for too short a time to show
+    /// whether the bicycle was at rest ([`Calibration::motion`] needs four
+    /// half-second blocks): a record cut short.
+    #[error(
+        "{}: the calibration record is settled for {settled:.2} s only ({samples} samples); at least {:.0} s at rest are needed to tell the mounting from motion and noise: record the bicycle at rest for a few seconds, or give another with --calibration",
+        run.display(),
+        MIN_SETTLED_S
+    )]
+    CalibrationTooShort {
+        /// The calibration run.
+        run: PathBuf,
+        /// Length of its settled part (s).
+        settled: f64,
+        /// Samples in the record.
+        samples: usize,
+    },
+    /// A sensor's estimated mounting misalignment is far beyond the few
+    /// degrees of a sensor fixed along the body axes: the calibration or the
+    /// runs are of sensors mounted otherwise (rotated, swapped), or of
+    /// another bicycle.
+    #[error(
+        "{}: the {sensor} sensor's mounting misalignment comes out at {:.1} deg (about x y z: {:+.1} {:+.1} {:+.1}); sensors fixed along the body axes are off by a few degrees (at most {:.0}): check that the calibration record belongs to these runs, is not rotated, and that the two sensors' files are not swapped",
+        run.display(),
+        angle.to_degrees(),
+        euler[0].to_degrees(),
+        euler[1].to_degrees(),
+        euler[2].to_degrees(),
+        MAX_MISALIGNMENT_RAD.to_degrees()
+    )]
+    ImplausibleMisalignment {
+        /// The calibration run.
+        run: PathBuf,
+        /// "frame" or "handlebar".
+        sensor: &'static str,
+        /// Rotation angle of the misalignment (rad).
+        angle: f64,
+        /// Its angles about x, y, z (rad).
+        euler: [f64; 3],
+    },
     /// The named path is neither a run, a set nor a log.
     #[error("{}: not a run folder (run.toml), a set of runs, or a log file", path.display())]
     NotARun {
@@ -624,6 +663,35 @@ fn looks_like_a_run(p: &Path) -> Option<&'static str> {
     has_records.then_some("it holds a run's records (IMU or speed-switch CSV) but no run.toml")
 }
 
+/// Shortest settled calibration record (s): four of
+/// [`Calibration::MOTION_BLOCK`], what [`Calibration::motion`] needs to
+/// tell rest from motion.
+pub const MIN_SETTLED_S: f64 = 4.0 * Calibration::MOTION_BLOCK;
+
+/// Largest mounting misalignment of a sensor (rad): the sensors are fixed
+/// along the body axes, off by a few degrees (the example set's handlebar
+/// sensor by 11); a calibration rotated half a turn gave 155 deg and was
+/// used without a word.
+pub const MAX_MISALIGNMENT_RAD: f64 = 30.0 * std::f64::consts::PI / 180.0;
+
+/// Refuse a calibration whose estimated misalignment of either sensor is
+/// beyond [`MAX_MISALIGNMENT_RAD`].
+fn check_misalignment(cal: &Calibration, run: &Path) -> Result<(), RunError> {
+    let (frame, handlebar) = cal.misalignment_angles();
+    for (sensor, rotation, euler) in [("frame", &cal.frame, frame), ("handlebar", &cal.handlebar, handlebar)] {
+        let angle = rotation.angle();
+        if angle > MAX_MISALIGNMENT_RAD {
+            return Err(RunError::ImplausibleMisalignment {
+                run: run.to_path_buf(),
+                sensor,
+                angle,
+                euler,
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Process a set of thesis-style runs: calibration (completed with the
 /// steer axis seen in the runs), then every run; a corrupt run gives its
 /// error and the others go on. `progress` is called after each run.
@@ -637,16 +705,30 @@ pub fn process_set(
     let read: Vec<Result<ThesisRun, RunError>> =
         runs.iter().map(|r| read::read_run(r).map_err(RunError::from)).collect();
     let mut cal = Calibration::estimate(&cal_run, opt.frame_pitch);
-    if let Some(motion) = cal.motion(&cal_run).filter(|m| !m.at_rest()) {
-        return Err(RunError::NotAtRest {
-            run: calibration.to_path_buf(),
-            motion,
-        });
+    match cal.motion(&cal_run) {
+        Some(motion) if !motion.at_rest() => {
+            return Err(RunError::NotAtRest {
+                run: calibration.to_path_buf(),
+                motion,
+            })
+        }
+        Some(_) => {}
+        // Too short to tell rest from motion: a record cut to a few rows
+        // gave a misalignment from noise, silently.
+        None => {
+            let t = &cal_run.frame.t;
+            return Err(RunError::CalibrationTooShort {
+                run: calibration.to_path_buf(),
+                settled: t.last().map_or(0.0, |e| e - cal.settled_from),
+                samples: t.len(),
+            });
+        }
     }
     let good: Vec<&ThesisRun> = read.iter().filter_map(|r| r.as_ref().ok()).collect();
     if let Some(axis) = cal.steer_axis(&good) {
         cal = cal.with_steer_axis(&cal_run, &axis);
     }
+    check_misalignment(&cal, calibration)?;
     let out = read
         .into_iter()
         .map(|r| {

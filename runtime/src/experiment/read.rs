@@ -167,6 +167,9 @@ pub enum ReadError {
         /// Its rows.
         other_rows: usize,
     },
+    /// The handlebar record is the frame's, sample for sample (a copy).
+    #[error("{}: the same orientations as {other}, sample for sample: one sensor's file given for both (the steer angle would be zero throughout); give each sensor's own record", path.display())]
+    SameImuRecord { path: PathBuf, other: String },
     /// A row that repeats the one before it in every field: a sample
     /// logged twice. In a log without a time column the times come from the
     /// row count, so repeated rows would stretch them (every row twice
@@ -599,6 +602,13 @@ pub fn read_meta(path: &Path) -> Result<RunMeta, ReadError> {
         Some(_) => return Err(meta("[imu] files must list two file names (frame, handlebar)".into())),
         None => ["imu_frame.csv".into(), "imu_handlebar.csv".into()],
     };
+    // One sensor read as both: a steer of zero throughout.
+    if imu_files[0] == imu_files[1] {
+        return Err(meta(format!(
+            "[imu] files names \"{}\" twice: give the frame sensor's file, then the handlebar sensor's",
+            imu_files[0]
+        )));
+    }
     // Counts and rates in plausible ranges: a count sizes the arrays built
     // from it (`magnets = 1e9` would ask for gigabytes).
     let magnets = num("speed_switch", "magnets")?;
@@ -686,6 +696,13 @@ pub fn read_run(dir: &Path) -> Result<ThesisRun, ReadError> {
             rows: short.t.len(),
             other: long.path.display().to_string(),
             other_rows: long.t.len(),
+        });
+    }
+    // One sensor's file copied under both names: a steer of zero throughout.
+    if frame.q == handlebar.q {
+        return Err(ReadError::SameImuRecord {
+            path: handlebar.path.clone(),
+            other: frame.path.display().to_string(),
         });
     }
     // Same clock: stamps agree to the printed resolution.

@@ -141,6 +141,11 @@ pub enum SimulateError {
     Integrator { t: f64, message: String },
 }
 
+/// The smallest relative tolerance the integrators can meet (Hairer's floor
+/// of DOP853, ten units of rounding): below it the rounding of each step
+/// exceeds the tolerance, so a smaller request could only be clamped.
+pub const MIN_RTOL: f64 = 10.0 * f64::EPSILON;
+
 /// Integration options, with documented defaults.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct SimOptions {
@@ -853,6 +858,9 @@ fn solve_free_rates<M: MultibodyModel>(
 
 /// Simulate model `M` with parameters `param` from `ic` for `duration`
 /// seconds with the perturbations `inputs`.
+///
+/// A relative tolerance below [`MIN_RTOL`] is refused rather than clamped:
+/// the run would not be as accurate as asked.
 pub fn simulate<M: MultibodyModel>(
     param: &[f64],
     ic: &InitialConditions,
@@ -865,9 +873,9 @@ pub fn simulate<M: MultibodyModel>(
             "duration must be positive, got {duration}"
         )));
     }
-    if !(opts.rtol > 0.0 && opts.rtol < 1.0 && opts.atol > 0.0) {
+    if !(opts.rtol >= MIN_RTOL && opts.rtol < 1.0 && opts.atol > 0.0 && opts.atol.is_finite()) {
         return Err(SimulateError::InvalidInput(format!(
-            "tolerances must be positive (rtol {} in (0, 1), atol {})",
+            "tolerances out of range (rtol {} in [{MIN_RTOL:.1e}, 1), atol {} positive and finite)",
             opts.rtol, opts.atol
         )));
     }

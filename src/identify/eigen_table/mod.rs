@@ -97,6 +97,11 @@ struct Fit {
     chi2: f64,
 }
 
+/// The most folds of a table's cross-validation: tables up to this many
+/// rows leave one row out at a time; longer ones are split into this many
+/// folds.
+pub const MAX_TABLE_FOLDS: usize = 10;
+
 /// Identify effects and corrections from a measured eigenvalue table.
 pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError> {
     let points = read_eigen_table(&req.path)?;
@@ -155,22 +160,29 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
     let n = 2.0 * points.len() as f64;
     let bic = |chi2: f64, k: usize| n * (chi2 / n).max(1e-300).ln() + k as f64 * n.ln();
     let chi2_of = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
-    // Leave one speed out: each row predicted with the values fitted to the others.
+    // Held-out rows: each row predicted with the values fitted to the rows
+    // of the other folds. Up to MAX_TABLE_FOLDS rows this is leave one speed
+    // out; beyond, rows are dealt to that many folds in turn, so the cost
+    // grows with the rows rather than with their square (leaving each of 300
+    // rows out took over 300 s).
+    let folds = points.len().min(MAX_TABLE_FOLDS);
     let held_out = |set: &[&Candidate]| -> Result<(f64, Vec<f64>), IdentifyError> {
-        let mut ss = Vec::new();
-        let mut d2 = Vec::new();
-        for i in 0..points.len() {
-            let train: Vec<usize> = all.iter().copied().filter(|&j| j != i).collect();
+        let mut ss = vec![0.0; points.len()];
+        let mut d2 = vec![f64::NAN; points.len()];
+        for fold in 0..folds {
+            let (test, train): (Vec<usize>, Vec<usize>) = all.iter().partition(|&&j| j % folds == fold);
             let vals = if set.is_empty() {
                 BTreeMap::new()
             } else {
                 values_map(set, &fit(set, &|v| residuals(v, &train))?.values)
             };
-            let r = residuals(&vals, &[i])?;
-            ss.push(chi2_of(&r) / 2.0);
-            let p = predict(driven, &bike, &vals, &[speeds[i]])?[0];
-            let m = points[i].eigenvalue;
-            d2.push(p.map_or(f64::NAN, |p| (m[0] - p[0]).powi(2) + (m[1] - p[1]).powi(2)));
+            let test_speeds: Vec<f64> = test.iter().map(|&i| speeds[i]).collect();
+            let predicted = predict(driven, &bike, &vals, &test_speeds)?;
+            for (&i, p) in test.iter().zip(predicted) {
+                ss[i] = chi2_of(&residuals(&vals, &[i])?) / 2.0;
+                let m = points[i].eigenvalue;
+                d2[i] = p.map_or(f64::NAN, |p| (m[0] - p[0]).powi(2) + (m[1] - p[1]).powi(2));
+            }
         }
         Ok((ss.iter().sum::<f64>() / ss.len() as f64, d2))
     };
