@@ -37,8 +37,8 @@ pub fn regressors_text(r: &Remaining) -> String {
 
 /// The finding in words: whether a structured residual remains, and what
 /// share of a perfect model's gain the library made (`+-`: one standard
-/// error).
-pub fn remaining_sentence(r: &Remaining) -> String {
+/// error). `what` names the measurements: "kicks", or a table's "rows".
+pub fn remaining_sentence(r: &Remaining, what: &str) -> String {
     let pct = |x: f64| {
         if x.is_finite() {
             format!("{:.0} %", 100.0 * x)
@@ -47,7 +47,7 @@ pub fn remaining_sentence(r: &Remaining) -> String {
         }
     };
     let figures = format!(
-        "weave eigenvalue RMS: base model {:.3}, with the library {:.3} (held out {:.3}), floor of the kicks' scatter {:.3} 1/s over {} kicks; pattern in {} tested: F = {:.2} on {} and {} degrees of freedom, p = {:.2e}",
+        "weave eigenvalue RMS: base model {:.3}, with the library {:.3} (held out {:.3}), floor of the {what}' scatter {:.3} 1/s over {} {what}; pattern in {} tested: F = {:.2} on {} and {} degrees of freedom, p = {:.2e}",
         r.base_rms,
         r.after_rms,
         r.held_out_rms,
@@ -60,7 +60,7 @@ pub fn remaining_sentence(r: &Remaining) -> String {
         r.p_value,
     );
     if r.structured {
-        let what = if r.pattern.is_empty() {
+        let shows = if r.pattern.is_empty() {
             String::new()
         } else {
             format!(
@@ -69,13 +69,13 @@ pub fn remaining_sentence(r: &Remaining) -> String {
             )
         };
         format!(
-            "a structured residual remains: the library explains {} of what a perfect model would ({} held out){what} ({figures})",
+            "a structured residual remains: the library explains {} of what a perfect model would ({} held out){shows} ({figures})",
             pct(r.explained),
             pct(r.explained_held_out),
         )
     } else {
         format!(
-            "no structured residual remains in the weave: what the library leaves is within the kicks' scatter; it explains {} of what a perfect model would ({} held out) ({figures})",
+            "no structured residual remains in the weave: what the library leaves is within the {what}' scatter; it explains {} of what a perfect model would ({} held out) ({figures})",
             pct(r.explained),
             pct(r.explained_held_out),
         )

@@ -305,7 +305,7 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     );
     // Whether the library ran out: a pattern left beyond the kicks' scatter.
     if let Some(r) = &o.remaining {
-        let _ = write!(s, "\n{}", super::remaining::remaining_sentence(r));
+        let _ = write!(s, "\n{}", super::remaining::remaining_sentence(r, "kicks"));
     }
     s
 }

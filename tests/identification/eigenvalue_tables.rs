@@ -5,23 +5,29 @@
 
 use crate::common::*;
 
-/// A table of the thesis bicycle's weave with 0.3 N m s/rad of steer
-/// damping at `speeds` (`START:STOP:STEP`), perturbed by 0.05 1/s in turn.
-fn damped_table(name: &str, speeds: &str) -> std::path::PathBuf {
-    let dir = scratch("identify-long-tables");
-    let bike = dir.join("damped.toml");
-    let thesis = text(&bikedyn(&["params", "show", "--bike", "thesis"]).stdout);
-    std::fs::write(&bike, format!("{thesis}\nc_steer = 0.3\n")).unwrap();
+/// A table of the thesis bicycle's weave, with `c_steer` N m s/rad of
+/// steer damping when given, at `speeds` (`START:STOP:STEP`), perturbed by
+/// a fixed, sign-alternating 0.05 1/s (measurement noise), under the header
+/// line `header` (a table's authors choose its words).
+pub(super) fn weave_table(name: &str, c_steer: Option<f64>, speeds: &str, header: &str) -> std::path::PathBuf {
+    let dir = scratch("identify-eigen-tables");
+    let mut bike = text(&bikedyn(&["params", "show", "--bike", "thesis"]).stdout);
+    if let Some(c) = c_steer {
+        bike += &format!("\nc_steer = {c}\n");
+    }
+    let bike_path = dir.join(format!("{name}.toml"));
+    std::fs::write(&bike_path, bike).unwrap();
     let points = ok_json(&[
         "eig",
         "--bike",
-        bike.to_str().unwrap(),
+        bike_path.to_str().unwrap(),
         "--speeds",
         speeds,
         "--format",
         "json",
     ]);
-    let mut csv = String::from("v,re,im,sd_re,sd_im\n");
+    let sep = if header.contains(';') { "; " } else { "," };
+    let mut csv = format!("{header}\n");
     for (k, p) in points.as_array().unwrap().iter().enumerate() {
         let w = p["eigenvalues"]
             .as_array()
@@ -32,20 +38,28 @@ fn damped_table(name: &str, speeds: &str) -> std::path::PathBuf {
             .map(|(e, _)| [e[0].as_f64().unwrap(), e[1].as_f64().unwrap()])
             .unwrap();
         let d = if k % 2 == 0 { 0.05 } else { -0.05 };
-        csv += &format!("{},{:.4},{:.4},0.05,0.05\n", p["v"], w[0] + d, w[1] - d);
+        csv += &[
+            p["v"].to_string(),
+            format!("{:.4}", w[0] + d),
+            format!("{:.4}", w[1] - d),
+            "0.05".into(),
+            "0.05".into(),
+        ]
+        .join(sep);
+        csv += "\n";
     }
-    let path = dir.join(name);
+    let path = dir.join(format!("{name}.csv"));
     std::fs::write(&path, csv).unwrap();
     path
 }
 
 /// A table of 100 speeds is identified as its nine-row sample is (steer
 /// damping, c_steer within 1 %), with a held-out error of the same size as
-/// the fitted one, and in well under the 29 s leaving each row out took
-/// (3.6 s on an idle 2-core machine; the bound leaves room for a busy one).
+/// the fitted one. Its time is printed, not asserted (3.6 s on an idle
+/// 2-core machine, against 29 s when each row was left out in turn).
 #[test]
 fn a_long_eigenvalue_table_is_identified_in_time_growing_with_its_rows() {
-    let table = damped_table("hundred.csv", "2.5:7.45:0.05");
+    let table = weave_table("hundred", Some(0.3), "2.5:7.45:0.05", "v,re,im,sd_re,sd_im");
     let start = std::time::Instant::now();
     let v = ok_json(&[
         "identify",
@@ -65,5 +79,5 @@ fn a_long_eigenvalue_table_is_identified_in_time_growing_with_its_rows() {
         v["eigen_rms_held_out"].as_f64().unwrap(),
     );
     assert!(held < 1.5 * after && held < 0.1, "held out {held}, after {after}");
-    assert!(took < 20.0, "{took:.1} s");
+    eprintln!("a table of 100 speeds identified in {took:.1} s");
 }

@@ -122,6 +122,12 @@ fn identify_with(dir: &Path, report: Option<&Path>, extra: &[&str]) -> Value {
 /// too and whose paired held-out gain over the added candidate is within
 /// two standard errors either way.
 fn every_unseparated_pair_says_why(j: &Value) {
+    // And the remaining-residual verdict agrees with its own test.
+    if let Some(r) = j["remaining"].as_object() {
+        let p = f(&r["p_value"]);
+        assert_eq!(r["structured"], p < 0.01, "{r:#?}");
+        assert!(f(&r["floor_rms"]) >= 0.0 && r["kicks"].as_u64().unwrap() >= 4, "{r:#?}");
+    }
     for c in j["confounded"].as_array().expect("confounded list") {
         let gain = c["held_out_gain"].as_f64();
         let se = c["held_out_gain_stderr"].as_f64();
@@ -322,6 +328,10 @@ fn control_set_gets_no_effect() {
     assert_eq!(j["parameters"].as_object().unwrap().len(), 0);
     let md = std::fs::read_to_string(report.join("report.md")).unwrap();
     assert!(md.contains("No effect warranted"), "{md}");
+    // The base model is the right one: what it leaves is the kicks'
+    // scatter, and the report says so.
+    assert_eq!(j["remaining"]["structured"], false, "{:#}", j["remaining"]);
+    assert!(md.contains("no structured residual remains in the weave"), "{md}");
     // Every candidate was tried and got a score.
     let n = j["candidates"].as_array().unwrap().len();
     assert!(n >= 7, "{n} candidates");
@@ -670,40 +680,9 @@ fn the_tudelft_logs_are_identified_with_their_assist_declared() {
 #[test]
 fn measured_eigenvalue_tables_are_identified() {
     let dir = scratch("identify-eigen-table");
-    let table = |name: &str, c_steer: Option<f64>| -> std::path::PathBuf {
-        let mut bike = text(&bikedyn(&["params", "show", "--bike", "thesis"]).stdout);
-        if let Some(c) = c_steer {
-            bike += &format!("\nc_steer = {c}\n");
-        }
-        let bike_path = dir.join(format!("{name}.toml"));
-        std::fs::write(&bike_path, bike).unwrap();
-        let points = ok_json(&[
-            "eig",
-            "--bike",
-            bike_path.to_str().unwrap(),
-            "--speeds",
-            "3:7:0.5",
-            "--format",
-            "json",
-        ]);
-        let mut csv = String::from("Geschwindigkeit [m/s]; Realteil; Imaginaerteil; sigma Re; sigma Im\n");
-        // A fixed, sign-alternating perturbation of 0.05 1/s (measurement noise).
-        for (k, p) in points.as_array().unwrap().iter().enumerate() {
-            let w = p["eigenvalues"]
-                .as_array()
-                .unwrap()
-                .iter()
-                .zip(p["modes"].as_array().unwrap())
-                .find(|(e, m)| *m == "weave" && e[1].as_f64().unwrap() > 0.0)
-                .map(|(e, _)| [e[0].as_f64().unwrap(), e[1].as_f64().unwrap()])
-                .unwrap();
-            let d = if k % 2 == 0 { 0.05 } else { -0.05 };
-            csv += &format!("{}; {:.4}; {:.4}; 0.05; 0.05\n", p["v"], w[0] + d, w[1] - d);
-        }
-        let path = dir.join(format!("{name}.csv"));
-        std::fs::write(&path, csv).unwrap();
-        path
-    };
+    // Headers in whatever words the table's authors chose.
+    let header = "Geschwindigkeit [m/s]; Realteil; Imaginaerteil; sigma Re; sigma Im";
+    let table = |name: &str, c_steer: Option<f64>| eigenvalue_tables::weave_table(name, c_steer, "3:7:0.5", header);
     let damped = table("damped", Some(0.3));
     let v = ok_json(&[
         "identify",
@@ -718,6 +697,30 @@ fn measured_eigenvalue_tables_are_identified() {
     assert!((c - 0.3).abs() < 0.015, "c_steer {c}");
     assert!(v["eigen_rms_after"].as_f64().unwrap() < 0.5 * v["eigen_rms_before"].as_f64().unwrap());
     assert!(v["eigen_rms_held_out"].as_f64().unwrap() < 0.5 * v["eigen_rms_before"].as_f64().unwrap());
+    // With the damping found, what remains is the rows' scatter.
+    assert_eq!(v["remaining"]["structured"], false, "{:#}", v["remaining"]);
+    // A library without damping cannot explain it: a lateral mass offset
+    // takes up most of the shift, and what it leaves is a pattern over
+    // speed beyond the rows' scatter, which the summary says in words.
+    let args = [
+        "identify",
+        "--eigenvalues",
+        damped.to_str().unwrap(),
+        "--bike",
+        "thesis",
+        "--effects",
+        "lateral_mass_offset",
+    ];
+    let v = ok_json(&[&args[..], &["--json"]].concat());
+    let r = &v["remaining"];
+    assert_eq!(r["structured"], true, "{r:#}");
+    assert!(f(&r["p_value"]) < 0.01 && f(&r["explained"]) < 1.0, "{r:#}");
+    assert!(f(&r["after_rms"]) > 1.5 * f(&r["floor_rms"]), "{r:#}");
+    let summary = text(&bikedyn(&args).stdout);
+    assert!(
+        summary.contains("a structured residual remains: the library explains"),
+        "{summary}"
+    );
 
     let plain = table("plain", None);
     let v = ok_json(&[

@@ -24,6 +24,7 @@ use super::corrections;
 use super::predict::predict;
 use super::IdentifyError;
 use crate::bicycle::Bicycle;
+use bikedyn_runtime::identify::remaining::{remaining, KickWeave, Remaining};
 use bikedyn_runtime::identify::{Candidate, Verdict};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
 use bikedyn_runtime::registry::ModelInfo;
@@ -89,6 +90,9 @@ pub struct TableOutcome {
     pub eigen_rms_before: f64,
     pub eigen_rms_after: f64,
     pub eigen_rms_held_out: f64,
+    /// What the library leaves in the table: a pattern in speed beyond the
+    /// rows' scatter, or none (`None`: too few rows).
+    pub remaining: Option<Remaining>,
 }
 
 struct Fit {
@@ -166,9 +170,9 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
     // grows with the rows rather than with their square (leaving each of 300
     // rows out took over 300 s).
     let folds = points.len().min(MAX_TABLE_FOLDS);
-    let held_out = |set: &[&Candidate]| -> Result<(f64, Vec<f64>), IdentifyError> {
+    let held_out = |set: &[&Candidate]| -> Result<(f64, Vec<Option<[f64; 2]>>), IdentifyError> {
         let mut ss = vec![0.0; points.len()];
-        let mut d2 = vec![f64::NAN; points.len()];
+        let mut held = vec![None; points.len()];
         for fold in 0..folds {
             let (test, train): (Vec<usize>, Vec<usize>) = all.iter().partition(|&&j| j % folds == fold);
             let vals = if set.is_empty() {
@@ -180,16 +184,15 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
             let predicted = predict(driven, &bike, &vals, &test_speeds)?;
             for (&i, p) in test.iter().zip(predicted) {
                 ss[i] = chi2_of(&residuals(&vals, &[i])?) / 2.0;
-                let m = points[i].eigenvalue;
-                d2[i] = p.map_or(f64::NAN, |p| (m[0] - p[0]).powi(2) + (m[1] - p[1]).powi(2));
+                held[i] = p;
             }
         }
-        Ok((ss.iter().sum::<f64>() / ss.len() as f64, d2))
+        Ok((ss.iter().sum::<f64>() / ss.len() as f64, held))
     };
     let mut selected: Vec<&Candidate> = Vec::new();
     let mut current_chi2 = chi2_of(&residuals(&BTreeMap::new(), &all)?);
     let mut current_bic = bic(current_chi2, 0);
-    let (mut current_cv, mut held_d2) = held_out(&[])?;
+    let (mut current_cv, mut held_pred) = held_out(&[])?;
     let mut current_fit = Fit {
         values: vec![],
         stderr: vec![],
@@ -197,7 +200,7 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
     };
     let mut trials = Vec::new();
     for step in 1..=3 {
-        let mut best: Option<(usize, Fit, f64, f64, Vec<f64>)> = None;
+        let mut best: Option<(usize, Fit, f64, f64, Vec<Option<[f64; 2]>>)> = None;
         for (ci, c) in cands.iter().enumerate() {
             if selected.iter().any(|s| s.name == c.name) {
                 continue;
@@ -211,7 +214,7 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
                 .flat_map(|c| &c.parameters)
                 .zip(&f.values)
                 .all(|(p, v)| !p.dissipative || *v > p.lower.unwrap_or(0.0));
-            let (cv, d2) = if physical && db < 0.0 {
+            let (cv, held) = if physical && db < 0.0 {
                 held_out(&set)?
             } else {
                 (f64::NAN, vec![])
@@ -248,10 +251,10 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
             });
             let passes = physical && db < 0.0 && cv < current_cv;
             if passes && best.as_ref().is_none_or(|b| db < b.2) {
-                best = Some((ci, f, db, cv, d2));
+                best = Some((ci, f, db, cv, held));
             }
         }
-        let Some((ci, f, db, cv, d2)) = best else { break };
+        let Some((ci, f, db, cv, held)) = best else { break };
         // The step's other passing candidates came after the best in the
         // order of the criterion.
         for t in trials.iter_mut().filter(|t| t.step == step && t.name != cands[ci].name) {
@@ -266,7 +269,7 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
         current_bic += db;
         current_cv = cv;
         current_chi2 = f.chi2;
-        held_d2 = d2;
+        held_pred = held;
         current_fit = f;
     }
     let _ = current_chi2;
@@ -280,10 +283,25 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
             .collect();
         (d.iter().sum::<f64>() / d.len().max(1) as f64).sqrt()
     };
-    let held = {
-        let d: Vec<f64> = held_d2.iter().copied().filter(|x| x.is_finite()).collect();
-        (d.iter().sum::<f64>() / d.len().max(1) as f64).sqrt()
-    };
+    let held_pred = if selected.is_empty() { before.clone() } else { held_pred };
+    // What the library leaves: the rows' residuals against their scatter
+    // about a pattern in speed (a table gives no amplitudes).
+    let remaining = remaining(
+        &points
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| {
+                Some(KickWeave {
+                    speed: speeds[i],
+                    amplitude: None,
+                    measured: p.eigenvalue,
+                    base: before[i]?,
+                    after: after[i]?,
+                    held_out: held_pred[i]?,
+                })
+            })
+            .collect::<Vec<_>>(),
+    );
     let names = selected
         .iter()
         .flat_map(|c| c.parameters.iter().map(|p| p.symbol.clone()));
@@ -304,7 +322,8 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
         not_tried,
         eigen_rms_before: rms(&before),
         eigen_rms_after: rms(&after),
-        eigen_rms_held_out: if selected.is_empty() { rms(&before) } else { held },
+        eigen_rms_held_out: rms(&held_pred),
+        remaining,
         predicted_before: before,
         predicted_after: after,
         points,

@@ -33,6 +33,9 @@ pub fn table_summary(o: &TableOutcome) -> String {
         "weave eigenvalue RMS {:.3} -> {:.3} 1/s (leave one speed out: {:.3})",
         o.eigen_rms_before, o.eigen_rms_after, o.eigen_rms_held_out
     );
+    if let Some(r) = &o.remaining {
+        s += &format!("\n{}", super::super::remaining::remaining_sentence(r, "rows"));
+    }
     for (name, why) in &o.not_tried {
         s += &format!("\nnot tried: {name}: {why}");
     }
