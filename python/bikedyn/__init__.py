@@ -35,6 +35,7 @@ from ._errors import (
     DataError,
     Error,
     InternalError,
+    TooLargeError,
     InvalidArgumentError,
     ModelError,
     NotFoundError,
@@ -67,6 +68,7 @@ __all__ = [
     "OutputError",
     "NotFoundError",
     "InternalError",
+    "TooLargeError",
 ]
 
 PathLike = Union[str, "os.PathLike[str]"]

@@ -46,6 +46,11 @@ class NotFoundError(Error, FileNotFoundError):
     """A parameter file, run folder or log that does not exist."""
 
 
+class TooLargeError(Error, MemoryError):
+    """A request whose result would exceed the size bikedyn allows (the
+    message gives the limit); split it into smaller calls."""
+
+
 class InternalError(Error, RuntimeError):
     """A defect in bikedyn itself (a caught Rust panic); please report it."""
 
@@ -59,5 +64,6 @@ __all__ = [
     "ComputationError",
     "OutputError",
     "NotFoundError",
+    "TooLargeError",
     "InternalError",
 ]

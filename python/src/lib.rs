@@ -167,9 +167,28 @@ fn bytes_of(xs: &[f64]) -> Vec<u8> {
     xs.iter().flat_map(|x| x.to_ne_bytes()).collect()
 }
 
+/// Most speeds one call takes: an eigen analysis returns about 330 bytes
+/// per speed (eigenvalues, eigenvectors, mode codes) and Python copies them
+/// once more, so a million speeds stay near a gigabyte; 10^7 speeds peaked
+/// at 11.4 GB and aborted the interpreter under a memory limit.
+const MAX_SPEEDS: usize = 1_000_000;
+
+/// Most values a sweep returns (cells times speeds, 8 bytes each, held
+/// twice while they are gathered): about 800 MB.
+pub(crate) const MAX_SWEEP_VALUES: usize = 50_000_000;
+
 fn finite_speeds(speeds: &[f64], what: &str) -> Result<(), Failure> {
     if speeds.is_empty() {
         return Err(Failure::new("InvalidArgumentError", format!("{what}: no speeds given")));
+    }
+    if speeds.len() > MAX_SPEEDS {
+        return Err(Failure::new(
+            "TooLargeError",
+            format!(
+                "{what}: {} speeds, more than the {MAX_SPEEDS} one call takes; split them into several calls",
+                speeds.len()
+            ),
+        ));
     }
     match speeds.iter().position(|v| !v.is_finite()) {
         Some(i) => Err(Failure::new(

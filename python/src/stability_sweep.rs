@@ -75,6 +75,18 @@ pub(crate) fn sweep<'py>(
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)));
         let ns = speeds.len();
+        let total = xs.len().saturating_mul(ys.len()).saturating_mul(ns);
+        if total > crate::MAX_SWEEP_VALUES {
+            return Err(Failure::new(
+                "TooLargeError",
+                format!(
+                    "a sweep of {} x {} designs at {ns} speeds gives {total} values, more than the {} one call returns; split it into several calls",
+                    xs.len(),
+                    ys.len(),
+                    crate::MAX_SWEEP_VALUES
+                ),
+            ));
+        }
         let cells: Vec<(f64, Option<f64>)> = xs.iter().flat_map(|&x| ys.iter().map(move |&y| (x, y))).collect();
         let results: Vec<Result<(Vec<f64>, f64, f64), Failure>> = cells
             .par_iter()

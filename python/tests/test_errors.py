@@ -121,3 +121,22 @@ def test_a_rust_panic_is_an_exception_with_its_message():
     assert isinstance(e.value, bikedyn.Error) and isinstance(e.value, RuntimeError)
     # The interpreter goes on.
     assert bikedyn.Bicycle("benchmark").stability()["weave_speed"] > 4
+
+
+def test_a_result_too_large_for_memory_is_refused_before_computing():
+    # Issue 35, reproducer 12: ten million speeds peaked at 11.4 GB and
+    # aborted the interpreter under a memory limit. Past a million speeds,
+    # or fifty million swept values, the call raises a MemoryError that
+    # says to split it, at once.
+    b = bikedyn.Bicycle("benchmark")
+    many = np.full(1_000_001, 5.0)
+    for call in (b.eig, b.eigenvalues):
+        with pytest.raises(MemoryError) as e:
+            call(many)
+        assert isinstance(e.value, bikedyn.TooLargeError)
+        assert "1000001 speeds" in str(e.value) and "split" in str(e.value)
+    grid = np.linspace(0.0, 0.2, 1000)
+    with pytest.raises(bikedyn.TooLargeError, match="more than the 50000000"):
+        bikedyn.sweep(b, "c", grid, np.linspace(1.0, 8.0, 100), param2="lam", values2=np.linspace(0.2, 0.4, 1000))
+    # At the limit, a call still answers.
+    assert b.eigenvalues(np.full(1000, 5.0)).shape[0] == 1000
