@@ -4,6 +4,12 @@
 
 use crate::common::*;
 
+/// `bikedyn simulate` of a tenth of a second at 5 m/s with `extra`
+/// arguments: the short run every flag check below needs.
+fn short_simulation(extra: &[&str]) -> std::process::Output {
+    bikedyn(&[&["simulate", "--speed", "5", "--duration", "0.1"][..], extra].concat())
+}
+
 /// `sweep --param c --param2 c` labelled its rows wrongly (every cell was
 /// the second value's): refused, naming both flags.
 #[test]
@@ -112,13 +118,13 @@ fn a_stop_angle_that_is_not_an_angle_is_refused() {
         ("--roll-limit", "-5"),
         ("--steer-limit", "inf"),
     ] {
-        let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", flag, v]);
+        let out = short_simulation(&[flag, v]);
         let stderr = text(&out.stderr);
         assert!(!out.status.success(), "{flag} {v}: {stderr}");
         assert!(stderr.contains(flag), "{stderr}");
     }
     // 0 still disables the stop.
-    let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", "--roll-limit", "0"]);
+    let out = short_simulation(&["--roll-limit", "0"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
 }
 
@@ -127,30 +133,14 @@ fn a_stop_angle_that_is_not_an_angle_is_refused() {
 /// flag.
 #[test]
 fn a_kick_below_the_ground_is_refused() {
-    let out = bikedyn(&[
-        "simulate",
-        "--speed",
-        "5",
-        "--duration",
-        "0.1",
-        "--kick",
-        "0.05:3:0.25:-1",
-    ]);
+    let out = short_simulation(&["--kick", "0.05:3:0.25:-1"]);
     let stderr = text(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{stderr}");
     assert!(
         stderr.contains("--kick") && stderr.contains("below the ground"),
         "{stderr}"
     );
-    let out = bikedyn(&[
-        "simulate",
-        "--speed",
-        "5",
-        "--duration",
-        "0.1",
-        "--kick",
-        "0.05:3:0.25:0.95",
-    ]);
+    let out = short_simulation(&["--kick", "0.05:3:0.25:0.95"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
 }
 
@@ -165,14 +155,14 @@ fn a_tolerance_below_rounding_is_refused_not_clamped() {
         ("--atol", "-1"),
         ("--atol", "inf"),
     ] {
-        let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", flag, v]);
+        let out = short_simulation(&[flag, v]);
         let stderr = text(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{flag} {v}: {stderr}");
         assert!(stderr.contains(flag), "{flag} {v}: {stderr}");
     }
-    let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", "--rtol", "1e-300"]);
+    let out = short_simulation(&["--rtol", "1e-300"]);
     assert!(text(&out.stderr).contains("2.2e-15"), "{}", text(&out.stderr));
-    let out = bikedyn(&["simulate", "--speed", "5", "--duration", "0.1", "--rtol", "1e-14"]);
+    let out = short_simulation(&["--rtol", "1e-14"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
 }
 
@@ -181,16 +171,7 @@ fn a_tolerance_below_rounding_is_refused_not_clamped() {
 /// standard error names both.
 #[test]
 fn free_speed_says_which_model_it_runs_for_the_one_named() {
-    let out = bikedyn(&[
-        "simulate",
-        "--speed",
-        "5",
-        "--duration",
-        "0.1",
-        "--free-speed",
-        "--model",
-        "thesis_whipple",
-    ]);
+    let out = short_simulation(&["--free-speed", "--model", "thesis_whipple"]);
     let stderr = text(&out.stderr);
     assert!(out.status.success(), "{stderr}");
     assert!(
