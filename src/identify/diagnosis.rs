@@ -20,6 +20,12 @@ pub struct Finding {
     pub significant: bool,
 }
 
+/// A kick's amplitude: the peak of its measured roll channel (rad, or
+/// rad/s for a roll-rate channel).
+pub(super) fn peak_roll(s: &Segment) -> f64 {
+    s.roll.iter().fold(0.0f64, |a, b| a.max(b.abs()))
+}
+
 fn mean_se(x: &[f64]) -> (f64, f64) {
     let n = x.len() as f64;
     if n < 1.0 {
@@ -91,10 +97,7 @@ pub fn diagnose(
         },
         significant: mre < -2.0 * sre && mim < -2.0 * sim,
     });
-    let amp: Vec<f64> = pairs
-        .iter()
-        .map(|p| segs[p.0].roll.iter().fold(0.0f64, |a, b| a.max(b.abs())).max(1e-6).ln())
-        .collect();
+    let amp: Vec<f64> = pairs.iter().map(|p| peak_roll(&segs[p.0]).max(1e-6).ln()).collect();
     let (b, sb) = slope(&amp, &dre);
     f.push(Finding {
         pattern: "damping that depends on amplitude".into(),

@@ -374,7 +374,7 @@ pub fn run_plan<R: ModelRegistry>(
         .filter_map(|i| {
             Some(bikedyn_runtime::identify::remaining::KickWeave {
                 speed: segs[i].mean_speed,
-                amplitude: Some(segs[i].roll.iter().fold(0.0f64, |a, b| a.max(b.abs()))),
+                amplitude: Some(diagnosis::peak_roll(&segs[i])),
                 measured: segs[i].weave?.0,
                 base: predicted_before[i]?,
                 after: predicted_after[i]?,
