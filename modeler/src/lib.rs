@@ -10,6 +10,11 @@
 //! with the command that re-derives a model that changed. The generated
 //! code and the runtime never depend on Symbolica.
 
+// Effect files name the modeler by its crate path, so that one file works
+// in `modeler/src/effects/` and in a user's `build.rs` alike (identify
+// writes discovered effects so).
+extern crate self as bikedyn_modeler;
+
 pub mod codegen;
 #[cfg(feature = "derive")]
 pub mod derive;

@@ -701,6 +701,7 @@ def identify(
     corrections: Optional[int] = None,
     calibration: Optional[PathLike] = None,
     progress: Optional[ProgressCallback] = None,
+    discover: bool = True,
 ) -> IdentifyResult:
     """Close the loop (``bikedyn identify``): fit the base model to measured
     runs, diagnose the residual, select effects and parameter corrections
@@ -714,7 +715,11 @@ def identify(
     parameter corrections (0: effects only). ``progress``: called as
     ``progress(step, done, total)`` after each step of the selection (see
     :data:`ProgressCallback`; the eigenvalue table form takes seconds and
-    does not report). Returns an :class:`IdentifyResult`."""
+    does not report). ``discover``: after the library, search a dictionary
+    of generalized forces on the roll and steer equations, on the table or
+    on the kicks' weave eigenvalues (``result.discovery``; the command
+    line's ``--no-discover`` is ``discover=False``). Returns an
+    :class:`IdentifyResult`."""
     # As the command line's --folds and --corrections: named, with their range
     # (an int beyond the machine's would be an OverflowError naming nothing).
     folds = _count("folds", folds, 2, 1000)
@@ -724,11 +729,18 @@ def identify(
     single = isinstance(paths_or_eigen_table, (str, os.PathLike))
     if single and os.fspath(paths_or_eigen_table).lower().endswith(".csv"):
         table = _paths(paths_or_eigen_table, "identify")[0]
-        return IdentifyResult(_bikedyn.identify_eigenvalues(table, spec, list(effects), corrections))
+        return IdentifyResult(_bikedyn.identify_eigenvalues(table, spec, list(effects), corrections, bool(discover)))
     cal = None if calibration is None else _paths(calibration, "calibration")[0]
     return IdentifyResult(
         _bikedyn.identify(
-            _paths(paths_or_eigen_table, "identify"), cal, spec, list(effects), folds, corrections, progress
+            _paths(paths_or_eigen_table, "identify"),
+            cal,
+            spec,
+            list(effects),
+            folds,
+            corrections,
+            progress,
+            bool(discover),
         )
     )
 

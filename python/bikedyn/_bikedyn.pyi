@@ -95,9 +95,14 @@ def identify(
     folds: int = 4,
     corrections: Optional[int] = None,
     progress: Optional[Callable[[str, int, Optional[int]], None]] = None,
+    discover: bool = True,
 ) -> _IdentifyResult: ...
 def identify_eigenvalues(
-    table: str, bike: Optional[str] = None, effects: List[str] = ..., corrections: Optional[int] = None
+    table: str,
+    bike: Optional[str] = None,
+    effects: List[str] = ...,
+    corrections: Optional[int] = None,
+    discover: bool = True,
 ) -> _TableResult: ...
 def models() -> str: ...
 def allow_implausible_units(allow: bool) -> None: ...

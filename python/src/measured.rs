@@ -140,7 +140,7 @@ impl PyIdentifyResult {
 
 /// Run `bikedyn identify` on run folders, set folders or logs.
 #[pyfunction]
-#[pyo3(signature = (inputs, calibration=None, bike=None, effects=Vec::new(), folds=4, corrections=None, progress=None))]
+#[pyo3(signature = (inputs, calibration=None, bike=None, effects=Vec::new(), folds=4, corrections=None, progress=None, discover=true))]
 pub(crate) fn identify(
     py: Python<'_>,
     inputs: Vec<PathBuf>,
@@ -150,6 +150,7 @@ pub(crate) fn identify(
     folds: usize,
     corrections: Option<usize>,
     progress: Option<Py<PyAny>>,
+    discover: bool,
 ) -> PyResult<PyIdentifyResult> {
     if !(2..=1000).contains(&folds) {
         return Err(Failure::new("InvalidArgumentError", format!("folds = {folds}: expected 2 to 1000")).into_py(py));
@@ -161,6 +162,7 @@ pub(crate) fn identify(
         effects,
         folds,
         corrections,
+        discover,
     };
     let progress = PyProgress::new(progress);
     let outcome = detached(py, || {
@@ -205,13 +207,14 @@ impl PyTableResult {
 
 /// Run `bikedyn identify --eigenvalues TABLE`.
 #[pyfunction]
-#[pyo3(signature = (table, bike=None, effects=Vec::new(), corrections=None))]
+#[pyo3(signature = (table, bike=None, effects=Vec::new(), corrections=None, discover=true))]
 pub(crate) fn identify_eigenvalues(
     py: Python<'_>,
     table: PathBuf,
     bike: Option<String>,
     effects: Vec<String>,
     corrections: Option<usize>,
+    discover: bool,
 ) -> PyResult<PyTableResult> {
     detached(py, move || {
         // A table is no thesis-format run: its bicycle must be named.
@@ -228,6 +231,7 @@ pub(crate) fn identify_eigenvalues(
             bike,
             effects,
             corrections,
+            discover,
         })
         .map_err(|e| Failure::new("DataError", e))?;
         Ok(PyTableResult { outcome })

@@ -91,3 +91,9 @@ def test_identify_from_a_measured_eigenvalue_table(tmp_path):
     assert r.parameters["c_steer"][0] == pytest.approx(0.3, abs=0.015)
     r.write_report(tmp_path / "table-report")
     assert any((tmp_path / "table-report").iterdir())
+    # After the library, the dictionary of generalized forces: steer
+    # damping explains the table, so no structured residual is left and
+    # the search does not run; discover=False skips it outright.
+    assert r.discovery["status"] == "not_run", r.summary()
+    assert "discovery beyond the library not run: the library leaves no structured residual" in r.summary()
+    assert bikedyn.identify(table, bike="thesis", discover=False).discovery is None

@@ -376,6 +376,11 @@ pub struct IdentifyArgs {
     /// every one that could explain some of it)
     #[arg(long)]
     pub corrections: Option<usize>,
+    /// Skip the search, after the library, of a dictionary of generalized
+    /// forces on the roll and steer equations (what no library effect
+    /// names), on the table or on the kicks' weave eigenvalues.
+    #[arg(long)]
+    pub no_discover: bool,
     /// Size and resolution of the report's plots; the limits apply to the
     /// continuation diagram.
     #[command(flatten)]

@@ -16,6 +16,7 @@ pub fn request(a: &IdentifyArgs) -> IdentifyRequest {
         effects: a.effects.clone(),
         folds: a.folds,
         corrections: a.corrections,
+        discover: !a.no_discover,
     }
 }
 
@@ -58,6 +59,7 @@ pub fn run(a: &IdentifyArgs) -> Result<bool> {
             bike,
             effects: a.effects.clone(),
             corrections: a.corrections,
+            discover: !a.no_discover,
         })?;
         if let Some(dir) = &a.report {
             eigen_table::write_table_report(&o, dir)?;

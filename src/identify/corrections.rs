@@ -221,6 +221,18 @@ pub fn screen_points<R: ModelRegistry>(
 }
 
 /// The candidate of a screened correction.
+/// Whether a parameter is physical only when positive: a mass (kg) or a
+/// principal moment of inertia (kg m^2; `I3x`, `IBxx`; not a product such
+/// as `I3zx` or `IBxz`, whose sign is free).
+pub fn positive_quantity(symbol: &str, unit: &str) -> bool {
+    let axes: Vec<char> = symbol.chars().rev().take_while(|c| c.is_ascii_lowercase()).collect();
+    match unit {
+        "kg" => true,
+        "kg m^2" => !axes.is_empty() && axes.iter().all(|&a| a == axes[0]),
+        _ => false,
+    }
+}
+
 pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
     // A model parameter's doc, or the file quantity's description.
     let doc = free
@@ -237,7 +249,10 @@ pub fn candidate(free: &ModelInfo, c: &Screened) -> Candidate {
             tied: Vec::new(),
             moves: c.moves.clone(),
             scale: c.sd,
-            dissipative: false,
+            // A mass or a principal moment of inertia below zero is no
+            // bicycle: such a fit is refused as not physical (it absorbs
+            // something the library lacks).
+            dissipative: positive_quantity(&c.symbol, &unit),
             unit: unit.clone(),
             initial: Some(c.value),
             lower: None,

@@ -44,6 +44,9 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     if let Some(r) = &o.remaining {
         let _ = writeln!(s, "5. The identified model's weave residuals (measured minus predicted eigenvalue of each kick counted) were regressed on the states a missing effect would act through ({}); an F test asks whether that pattern exceeds the kicks' own scatter about it, which is the floor a perfect model would reach. Outcome: {}.", super::remaining::regressors_text(r), super::remaining::remaining_sentence(r, "kicks"));
     }
+    if let Some(d) = &o.discovery {
+        let _ = writeln!(s, "6. Where a structured residual remains, a dictionary of generalized forces on the roll and steer equations (angles, rates and accelerations, times 1, v or v^2, at once or through a first-order lag) was searched on the counted kicks' weave eigenvalues, with the library's values as fitted; a term is kept when it lowers the criterion and the held-out error of the same folds of runs, consistently over the kicks. Outcome: {}.", super::discovery::kicks_sentence(d).replace('\n', "; "));
+    }
     let _ = writeln!(s);
     let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| median(id.weights.iter().map(f));
     let _ = writeln!(s, "Channel scales (each kick's RMS residual under the base model, at least the best kick's; median over kicks): {roll} {:.3} {unit}, steer {:.3} deg, speed {:.3} m/s. Each kick and channel is weighed by its own scale, so a run that diverges toward a fall cannot outweigh the others.\n", med(&|w| w.roll).to_degrees(), med(&|w| w.steer).to_degrees(), med(&|w| w.speed));

@@ -13,6 +13,7 @@ pub mod candidates;
 mod confounded;
 pub mod corrections;
 pub mod diagnosis;
+pub mod discovery;
 pub mod eigen_table;
 mod error;
 mod fits;
@@ -67,6 +68,9 @@ pub struct IdentifyRequest {
     /// (`None`, the default: every one that could explain some of it;
     /// `Some(0)`: effects only; see [`corrections`]).
     pub corrections: Option<usize>,
+    /// After the library, search the dictionary of generalized forces on
+    /// the kicks' measured weave eigenvalues ([`discovery`]; default true).
+    pub discover: bool,
 }
 
 impl Default for IdentifyRequest {
@@ -78,6 +82,7 @@ impl Default for IdentifyRequest {
             effects: Vec::new(),
             folds: 4,
             corrections: None,
+            discover: true,
         }
     }
 }
@@ -160,6 +165,9 @@ pub struct Outcome<R: ModelRegistry = BuiltIn> {
     /// What the library leaves in the weave eigenvalues: a pattern in the
     /// kicks' states beyond their scatter, or none (`None`: too few kicks).
     pub remaining: Option<bikedyn_runtime::identify::remaining::Remaining>,
+    /// What the dictionary of generalized forces found beyond the library
+    /// on the kicks' weave eigenvalues (`None`: not requested).
+    pub discovery: Option<discovery::DiscoveryOutcome>,
     /// The model's speed was imposed (logs of a motor-held speed).
     pub speed_imposed: bool,
     run_plot: Option<RunPlot>,
@@ -383,6 +391,35 @@ pub fn run_plan<R: ModelRegistry>(
         })
         .collect();
     let remaining = bikedyn_runtime::identify::remaining::remaining(&weave_residuals);
+    // Beyond the library: the dictionary of generalized forces on the
+    // counted kicks' weave eigenvalues, held out by the identification's
+    // own folds of runs.
+    let discovery = if let (true, Some(why)) = (request.discover, discovery::not_warranted(remaining.as_ref())) {
+        Some(why)
+    } else if request.discover {
+        let kicks: Vec<usize> = (0..segs.len()).filter(|&i| weave_kicks[i]).collect();
+        let mut rows = Vec::new();
+        let mut values = Vec::new();
+        let mut folds = Vec::new();
+        for &i in &kicks {
+            let Some((m, se)) = segs[i].weave else { continue };
+            rows.push(bikedyn_runtime::identify::discovery::Row {
+                speed: segs[i].mean_speed,
+                measured: m,
+                stderr: se,
+            });
+            values.push(linear_equivalent(driven, &values_after, steer_rate[i]));
+            folds.push(id.fold_of[i]);
+        }
+        // The library's result stands whatever the search meets: a failure
+        // of the search is its outcome, not the identification's.
+        Some(
+            discovery::discover_on_kicks(driven, bike, &rows, &values, &folds)
+                .unwrap_or_else(|e| discovery::DiscoveryOutcome::NotRun { reason: e.to_string() }),
+        )
+    } else {
+        None
+    };
     // Steady bias: the base model's roll residual over the second half of
     // each window.
     let bias: Vec<f64> = run_plot
@@ -432,6 +469,7 @@ pub fn run_plan<R: ModelRegistry>(
         weave_kicks,
         eigen_excluded,
         remaining,
+        discovery,
         speed_imposed: plan.speed_imposed,
         run_plot,
         registry: PhantomData,

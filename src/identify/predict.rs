@@ -7,6 +7,7 @@ use super::candidates::identification_models;
 use super::error::IdentifyError;
 use crate::bicycle::Bicycle;
 use bikedyn_runtime::feedback::GainSchedule;
+use bikedyn_runtime::identify::discovery::PlantAt;
 use bikedyn_runtime::linearize::{lateral_block, linearize_at_speed, parameter_vector, state_space_at_speed};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
 use bikedyn_runtime::parameters::BenchmarkParameters;
@@ -146,6 +147,78 @@ pub fn predict<R: ModelRegistry>(
         .expect("registered model");
     }
     Ok(guide)
+}
+
+struct PlantCurve<'a> {
+    lookup: &'a dyn Fn(&str) -> Option<f64>,
+    speeds: &'a [f64],
+    feedback: Option<&'a GainSchedule>,
+}
+
+impl ModelVisitor for PlantCurve<'_> {
+    type Output = Result<Vec<Option<PlantAt>>, IdentifyError>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        let p = parameter_vector::<M>(self.lookup, 1.0)?;
+        // The models' steer is positive to the left; the benchmark's (and
+        // the gains') to the right: S X S with S = diag(1, -1).
+        let s = nalgebra::Matrix2::new(1.0, 0.0, 0.0, -1.0);
+        Ok(self
+            .speeds
+            .iter()
+            .map(|&v| {
+                let l = linearize_at_speed::<M>(&p, v).ok()?;
+                let l = lateral_block::<M>(&l);
+                let m = |x: &nalgebra::DMatrix<f64>| s * nalgebra::Matrix2::from_fn(|i, j| x[(i, j)]) * s;
+                Some(PlantAt {
+                    mass: m(&l.mass),
+                    damping: m(&l.damping),
+                    stiffness: m(&l.stiffness),
+                    feedback: self.feedback.map_or(nalgebra::Matrix2x4::zeros(), |f| f.at(v)),
+                })
+            })
+            .collect())
+    }
+}
+
+/// The linear roll-steer equations of the driven model with effect values
+/// `values` on top of the bicycle, in the benchmark's signs, with the
+/// bicycle's `[feedback]` gains apart, at each of `speeds` (m/s); `None`
+/// where the model cannot be linearized. Only for effects the driven model
+/// holds (a model with extra states has no `M, C, K`): `None` for all when
+/// a value is of another model.
+pub fn plants<R: ModelRegistry>(
+    driven: &ModelInfo,
+    bike: &Bicycle<R>,
+    values: &BTreeMap<String, f64>,
+    speeds: &[f64],
+) -> Result<Option<Vec<Option<PlantAt>>>, IdentifyError> {
+    if values
+        .keys()
+        .any(|k| driven.parameter(k).is_none() && !BenchmarkParameters::SYMBOLS.contains(&k.as_str()))
+    {
+        return Ok(None);
+    }
+    let mut b = bike.clone();
+    let mut own = BTreeMap::new();
+    for (k, v) in values {
+        if driven.parameter(k).is_none() {
+            b = b.with_parameter(k, *v)?;
+        } else {
+            own.insert(k.clone(), *v);
+        }
+    }
+    let base = b.lookup()?;
+    let lookup = |s: &str| own.get(s).copied().or_else(|| base(s));
+    R::with_model(
+        driven.name,
+        PlantCurve {
+            lookup: &lookup,
+            speeds,
+            feedback: b.feedback.as_ref(),
+        },
+    )
+    .expect("registered model")
+    .map(Some)
 }
 
 /// Effect values for a linear (eigenvalue) prediction: each effect whose

@@ -169,6 +169,7 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
         "eigen_excluded": o.eigen_excluded.iter().map(excluded_json).collect::<Vec<_>>(),
         "findings": o.findings,
         "remaining": o.remaining,
+        "discovery": o.discovery,
         "weights": id.weights,
         "folds": id.folds,
         "simulations": id.simulations,
@@ -306,6 +307,9 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     // Whether the library ran out: a pattern left beyond the kicks' scatter.
     if let Some(r) = &o.remaining {
         let _ = write!(s, "\n{}", super::remaining::remaining_sentence(r, "kicks"));
+    }
+    if let Some(d) = &o.discovery {
+        let _ = write!(s, "\n{}", super::discovery::kicks_sentence(d));
     }
     s
 }
@@ -485,7 +489,20 @@ pub fn write_report<R: ModelRegistry>(
             )?;
         }
     }
-    write_string_atomic(out.join("report.md"), &report_markdown(o, a, dir))?;
+    let mut md = report_markdown(o, a, dir);
+    if let Some(super::discovery::DiscoveryOutcome::Ran(d)) = &o.discovery {
+        md += &super::discovery::trials_markdown(d);
+        if !d.discovery.terms.is_empty() {
+            match super::discovery::effect_file("discovered", &d.discovery.terms) {
+                Ok(file) => {
+                    md += "\nThe discovered terms are written as an effect file in the modeler's form: `discovered.rs` (for `modeler/src/effects/` or a crate of your own).\n";
+                    write_string_atomic(out.join("discovered.rs"), &file)?;
+                }
+                Err(e) => md += &format!("\nNo effect file was written: {e}.\n"),
+            }
+        }
+    }
+    write_string_atomic(out.join("report.md"), &md)?;
     staged.commit()?;
     Ok(())
 }

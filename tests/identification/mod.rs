@@ -11,6 +11,7 @@ use crate::common::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
+mod discovery;
 mod eigenvalue_tables;
 
 fn synth(name: &str, effects: &str, seed: u64) -> PathBuf {
@@ -332,6 +333,8 @@ fn control_set_gets_no_effect() {
     // scatter, and the report says so.
     assert_eq!(j["remaining"]["structured"], false, "{:#}", j["remaining"]);
     assert!(md.contains("no structured residual remains in the weave"), "{md}");
+    // So no force beyond the library is searched for.
+    assert_eq!(j["discovery"]["status"], "not_run", "{:#}", j["discovery"]);
     // Every candidate was tried and got a score.
     let n = j["candidates"].as_array().unwrap().len();
     assert!(n >= 7, "{n} candidates");

@@ -26,7 +26,8 @@ pub struct EffectParameter {
     pub moves: Vec<(String, f64)>,
     /// Typical magnitude (difference step and LM scaling).
     pub scale: f64,
-    /// Physical only when positive (dissipation).
+    /// Physical only when positive: a dissipation, or a corrected mass or
+    /// principal moment of inertia.
     pub dissipative: bool,
     /// Unit, for reports.
     pub unit: String,

@@ -61,6 +61,7 @@ mod candidate;
 pub mod confounding;
 mod criterion;
 mod cross_validation;
+pub mod discovery;
 mod elimination;
 mod encompassing;
 mod fit;

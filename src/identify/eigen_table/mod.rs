@@ -21,11 +21,13 @@
 
 use super::candidates::{candidates, identification_models};
 use super::corrections;
+use super::discovery::{discover_on_table, DiscoveryOutcome};
 use super::predict::predict;
 use super::IdentifyError;
 use crate::bicycle::Bicycle;
+use bikedyn_runtime::identify::discovery::Row;
 use bikedyn_runtime::identify::remaining::{remaining, KickWeave, Remaining};
-use bikedyn_runtime::identify::{Candidate, Verdict};
+use bikedyn_runtime::identify::{Candidate, Verdict, PLAUSIBLE_PRIOR_SDS};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
 use bikedyn_runtime::registry::ModelInfo;
 use nalgebra::{DMatrix, DVector};
@@ -50,6 +52,9 @@ pub struct TableRequest {
     /// Largest number of parameter corrections tried beside the effects
     /// (`None`: every one that could explain some of the misfit).
     pub corrections: Option<usize>,
+    /// After the library, search the dictionary of generalized forces for
+    /// what it leaves (`super::discovery`).
+    pub discover: bool,
 }
 
 /// One candidate tried at one step.
@@ -93,6 +98,9 @@ pub struct TableOutcome {
     /// What the library leaves in the table: a pattern in speed beyond the
     /// rows' scatter, or none (`None`: too few rows).
     pub remaining: Option<Remaining>,
+    /// What the dictionary of generalized forces found beyond the library
+    /// (`None`: not requested).
+    pub discovery: Option<DiscoveryOutcome>,
 }
 
 struct Fit {
@@ -108,8 +116,16 @@ pub const MAX_TABLE_FOLDS: usize = 10;
 
 /// Identify effects and corrections from a measured eigenvalue table.
 pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError> {
+    identify_table_in::<crate::registry::BuiltIn>(req)
+}
+
+/// [`identify_table`] with the models of registry `R` (a user's crate with
+/// effects of its own, such as an effect file that identify wrote).
+pub fn identify_table_in<R: bikedyn_runtime::registry::ModelRegistry>(
+    req: &TableRequest,
+) -> Result<TableOutcome, IdentifyError> {
     let points = read_eigen_table(&req.path)?;
-    let bike = Bicycle::resolve(&req.bike)?;
+    let bike = Bicycle::<R>::resolve_in(&req.bike)?;
     let (_, driven, _) = identification_models(&bike, false)?;
     let mut not_tried: Vec<(String, String)> = Vec::new();
     let mut cands: Vec<Candidate> = Vec::new();
@@ -201,6 +217,7 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
     let mut trials = Vec::new();
     for step in 1..=3 {
         let mut best: Option<(usize, Fit, f64, f64, Vec<Option<[f64; 2]>>)> = None;
+        let mut best_implausible: Option<(usize, Fit, f64, f64, Vec<Option<[f64; 2]>>)> = None;
         for (ci, c) in cands.iter().enumerate() {
             if selected.iter().any(|s| s.name == c.name) {
                 continue;
@@ -219,6 +236,18 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
             } else {
                 (f64::NAN, vec![])
             };
+            // A correction further from its measured value than
+            // PLAUSIBLE_PRIOR_SDS of its uncertainty more likely absorbs
+            // what the library lacks (the discovery's business): as in the
+            // runs' search, it is added only when no plausible candidate
+            // passes the step.
+            let farthest = set
+                .iter()
+                .flat_map(|c| &c.parameters)
+                .zip(&f.values)
+                .filter_map(|(p, v)| p.prior.map(|(m, sd)| (p.symbol.clone(), *v, (v - m).abs() / sd)))
+                .max_by(|a, b| a.2.total_cmp(&b.2))
+                .filter(|far| far.2 > PLAUSIBLE_PRIOR_SDS);
             // A candidate that passes is `Added` until the step's best is
             // known (below).
             let verdict = if !physical {
@@ -229,6 +258,12 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
                 Verdict::HeldOutNotLower {
                     cv,
                     base_cv: current_cv,
+                }
+            } else if let Some((symbol, value, prior_sds)) = farthest.clone() {
+                Verdict::ImplausibleUnderPrior {
+                    symbol,
+                    value,
+                    prior_sds,
                 }
             } else {
                 Verdict::Added {
@@ -250,9 +285,17 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
                 verdict,
             });
             let passes = physical && db < 0.0 && cv < current_cv;
-            if passes && best.as_ref().is_none_or(|b| db < b.2) {
-                best = Some((ci, f, db, cv, held));
+            let slot = if farthest.is_some() {
+                &mut best_implausible
+            } else {
+                &mut best
+            };
+            if passes && slot.as_ref().is_none_or(|b| db < b.2) {
+                *slot = Some((ci, f, db, cv, held));
             }
+        }
+        if best.is_none() {
+            best = best_implausible;
         }
         let Some((ci, f, db, cv, held)) = best else { break };
         // The step's other passing candidates came after the best in the
@@ -262,6 +305,17 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
                 t.verdict = Verdict::CriterionAboveAdded {
                     bic_change,
                     added: cands[ci].name.clone(),
+                };
+            }
+        }
+        // A correction beyond its prior added because no plausible
+        // candidate passed.
+        if let Some(t) = trials.iter_mut().find(|t| t.step == step && t.name == cands[ci].name) {
+            if matches!(t.verdict, Verdict::ImplausibleUnderPrior { .. }) {
+                t.verdict = Verdict::Added {
+                    bic_change: db,
+                    cv,
+                    base_cv: current_cv,
                 };
             }
         }
@@ -302,10 +356,30 @@ pub fn identify_table(req: &TableRequest) -> Result<TableOutcome, IdentifyError>
             })
             .collect::<Vec<_>>(),
     );
+    let discovery = if let (true, Some(why)) = (req.discover, super::discovery::not_warranted(remaining.as_ref())) {
+        Some(why)
+    } else if req.discover {
+        let rows: Vec<Row> = points
+            .iter()
+            .map(|p| Row {
+                speed: p.speed,
+                measured: p.eigenvalue,
+                stderr: se(p),
+            })
+            .collect();
+        // The library's result stands whatever the search meets.
+        Some(
+            discover_on_table(driven, &bike, &rows, &selected, &current_fit.values, folds)
+                .unwrap_or_else(|e| DiscoveryOutcome::NotRun { reason: e.to_string() }),
+        )
+    } else {
+        None
+    };
     let names = selected
         .iter()
         .flat_map(|c| c.parameters.iter().map(|p| p.symbol.clone()));
     Ok(TableOutcome {
+        discovery,
         table: req.path.clone(),
         driven_model: driven.name,
         selected: selected.iter().map(|c| c.name.clone()).collect(),
@@ -346,7 +420,7 @@ fn needs_amplitude(info: &ModelInfo, effect: &str) -> bool {
 
 /// The values of a candidate set's parameters (tied symbols and held
 /// companions included) by symbol.
-fn values_map(set: &[&Candidate], values: &[f64]) -> BTreeMap<String, f64> {
+pub(super) fn values_map(set: &[&Candidate], values: &[f64]) -> BTreeMap<String, f64> {
     let mut m = BTreeMap::new();
     let mut it = values.iter();
     for c in set {

@@ -2,6 +2,7 @@
 
 use super::super::IdentifyError;
 use super::TableOutcome;
+use crate::identify::discovery::DiscoveryOutcome;
 use std::path::Path;
 
 /// The summary printed by `identify --eigenvalues`.
@@ -35,6 +36,12 @@ pub fn table_summary(o: &TableOutcome) -> String {
     );
     if let Some(r) = &o.remaining {
         s += &format!("\n{}", super::super::remaining::remaining_sentence(r, "rows"));
+    }
+    if let Some(d) = &o.discovery {
+        s += &format!(
+            "\n{}",
+            crate::identify::discovery::table_sentence(d, o.eigen_rms_before)
+        );
     }
     for (name, why) in &o.not_tried {
         s += &format!("\nnot tried: {name}: {why}");
@@ -84,6 +91,9 @@ pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyEr
             crate::identify::report::verdict_text(&t.verdict)
         );
     }
+    if let Some(DiscoveryOutcome::Ran(d)) = &o.discovery {
+        s += &crate::identify::discovery::trials_markdown(d);
+    }
     let _ = writeln!(s, "\n## Per speed\n\n| line | speed (m/s) | measured | predicted before | predicted after |\n|---|---|---|---|---|");
     let c = |z: Option<[f64; 2]>| z.map_or("-".to_string(), |z| format!("{:.3}{:+.3}i", z[0], z[1]));
     for (i, p) in o.points.iter().enumerate() {
@@ -96,6 +106,22 @@ pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyEr
             c(o.predicted_before[i]),
             c(o.predicted_after[i])
         );
+    }
+    if let Some(DiscoveryOutcome::Ran(d)) = &o.discovery {
+        if !d.discovery.terms.is_empty() {
+            match crate::identify::discovery::effect_file("discovered", &d.discovery.terms) {
+                Ok(file) => {
+                    let _ = writeln!(
+                        s,
+                        "\nThe discovered terms are written as an effect file in the modeler's form: `discovered.rs` (for `modeler/src/effects/` or a crate of your own)."
+                    );
+                    write_string_atomic(out.join("discovered.rs"), &file)?;
+                }
+                Err(e) => {
+                    let _ = writeln!(s, "\nNo effect file was written: {e}.");
+                }
+            }
+        }
     }
     write_string_atomic(out.join("report.md"), &s)?;
     staged.commit()?;

@@ -1,0 +1,939 @@
+//! Discovering a force no library effect names (issue 37): generalized
+//! forces on the roll and steer equations, built from a dictionary of
+//! physically plausible terms, selected sparsely by the criteria the library
+//! search uses, and fitted together with the library's parameters.
+//!
+//! # The terms
+//!
+//! The linear equations about upright straight running, in the benchmark's
+//! signs (roll positive to the right, steer positive to the right), with the
+//! bicycle's declared controller `u = -K_fb(v) x`:
+//!
+//! `M q'' + C q' + K q = u + Q`, `q = [roll, steer]`, `x = [q, q']`.
+//!
+//! A [`Term`] adds to the generalized force `Q_e` of one equation `e` a
+//! coefficient times `v^p` (forward speed to the power 0, 1 or 2) times one
+//! signal: a roll or steer angle or rate, or an acceleration (an added
+//! inertia; no speed power). A lagged term passes its signal through a
+//! first-order lag with its own fitted time constant `tau`:
+//! `tau z' = -z + theta v^p s`, `Q_e += z` (an actuator, a tyre or a
+//! controller with its own dynamics). When the bicycle declares a
+//! controller, one more term passes the controller's whole torque through a
+//! lag (a motor that follows its command late). A constant bias or a
+//! Coulomb term leaves the linear equations unchanged; they need the time
+//! series (not this stage).
+//!
+//! # The search
+//!
+//! Data are weave eigenvalues (measured, with standard errors, at known
+//! speeds). Forward stepwise: at each step every term not yet selected is
+//! fitted together with those selected and with the library's parameters
+//! (their priors as extra residual rows); a term is added when it lowers
+//! the BIC (unknown residual scale, `n ln(chi2 / n) + k ln n`) and the
+//! held-out error (folds of rows: each row predicted with the values fitted
+//! to the rows of the other folds), as the library's table search requires.
+//! Of the passing terms the lowest criterion is added. A dictionary offers
+//! many terms to one table, so a term must also predict the held-out rows
+//! consistently better, row by row beyond two standard errors. Derivatives
+//! are forward differences of the weave eigenvalue (a simple eigenvalue of
+//! a matrix of at most eight rows, cheap and smooth), as the library's
+//! table fits take them.
+
+use super::Verdict;
+use nalgebra::{Complex, DMatrix, DVector, Matrix2, Matrix2x4};
+use rayon::prelude::*;
+use serde::Serialize;
+
+/// A coordinate of the lateral equations (benchmark signs).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Coordinate {
+    Roll,
+    Steer,
+}
+
+impl Coordinate {
+    fn index(self) -> usize {
+        match self {
+            Coordinate::Roll => 0,
+            Coordinate::Steer => 1,
+        }
+    }
+}
+
+/// What a term multiplies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", content = "of", rename_all = "snake_case")]
+pub enum Signal {
+    /// An angle (rad).
+    Angle(Coordinate),
+    /// An angular rate (rad/s).
+    Rate(Coordinate),
+    /// An angular acceleration (rad/s^2): an added inertia.
+    Acceleration(Coordinate),
+    /// The declared controller's torque (N m), passed through a lag in
+    /// place of acting at once.
+    ControllerTorque,
+}
+
+/// One term of the dictionary: `Q_equation += theta v^speed_power signal`,
+/// through a first-order lag when `lagged`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub struct Term {
+    pub equation: Coordinate,
+    pub signal: Signal,
+    pub speed_power: u8,
+    pub lagged: bool,
+}
+
+impl Term {
+    /// Every term the linear stage can fit. With `controller`, also the lag
+    /// of the declared controller's torque.
+    pub fn dictionary(controller: bool) -> Vec<Term> {
+        use Coordinate::*;
+        use Signal::*;
+        let mut terms = Vec::new();
+        for equation in [Roll, Steer] {
+            for signal in [Angle(Roll), Angle(Steer), Rate(Roll), Rate(Steer)] {
+                for lagged in [false, true] {
+                    for speed_power in 0..=2 {
+                        terms.push(Term {
+                            equation,
+                            signal,
+                            speed_power,
+                            lagged,
+                        });
+                    }
+                }
+            }
+            for of in [Roll, Steer] {
+                terms.push(Term {
+                    equation,
+                    signal: Acceleration(of),
+                    speed_power: 0,
+                    lagged: false,
+                });
+            }
+        }
+        if controller {
+            terms.push(Term {
+                equation: Steer,
+                signal: Signal::ControllerTorque,
+                speed_power: 0,
+                lagged: true,
+            });
+        }
+        terms
+    }
+
+    /// A name for reports and JSON: the equation's torque, the signal, the
+    /// speed power and the lag, as `steer_torque_roll_rate_v2` or
+    /// `steer_torque_controller_lagged`.
+    pub fn name(&self) -> String {
+        let coordinate = |c: Coordinate| match c {
+            Coordinate::Roll => "roll",
+            Coordinate::Steer => "steer",
+        };
+        let signal = match self.signal {
+            Signal::Angle(c) => coordinate(c).to_string(),
+            Signal::Rate(c) => format!("{}_rate", coordinate(c)),
+            Signal::Acceleration(c) => format!("{}_acceleration", coordinate(c)),
+            Signal::ControllerTorque => "controller".to_string(),
+        };
+        let power = match self.speed_power {
+            0 => String::new(),
+            1 => "_v".to_string(),
+            p => format!("_v{p}"),
+        };
+        format!(
+            "{}_torque_{signal}{power}{}",
+            coordinate(self.equation),
+            if self.lagged { "_lagged" } else { "" }
+        )
+    }
+
+    /// Fitted values: the coefficient (absent for the controller's lag),
+    /// then the time constant of a lag.
+    pub fn parameter_count(&self) -> usize {
+        usize::from(self.signal != Signal::ControllerTorque) + usize::from(self.lagged)
+    }
+
+    /// The coefficient's unit (SI).
+    pub fn unit(&self) -> String {
+        let base = match self.signal {
+            Signal::Angle(_) => "N m/rad",
+            Signal::Rate(_) => "N m s/rad",
+            Signal::Acceleration(_) => "kg m^2",
+            Signal::ControllerTorque => "",
+        };
+        match self.speed_power {
+            0 => base.to_string(),
+            1 => format!("{base} per m/s"),
+            p => format!("{base} per (m/s)^{p}"),
+        }
+    }
+}
+
+/// The linear equations at one speed with the declared controller apart:
+/// `M q'' + C q' + K q = -K_fb x` (benchmark signs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlantAt {
+    pub mass: Matrix2<f64>,
+    pub damping: Matrix2<f64>,
+    pub stiffness: Matrix2<f64>,
+    /// `K_fb`: the controller's gains on `[roll, steer, roll rate, steer
+    /// rate]` for `[roll torque, steer torque]` (zero without one).
+    pub feedback: Matrix2x4<f64>,
+}
+
+/// A lag's time constant is fitted as its logarithm (it stays positive).
+fn time_constant(log_tau: f64) -> f64 {
+    log_tau.exp()
+}
+
+/// The state matrix of the plant with `terms` at values `theta` (each
+/// term's coefficient then, for a lag, the logarithm of its time constant)
+/// at speed `v`; `None` when the mass matrix with the added inertias is
+/// singular.
+pub fn state_matrix(plant: &PlantAt, terms: &[Term], theta: &[f64], v: f64) -> Option<DMatrix<f64>> {
+    let (mut m, mut c, mut k) = (plant.mass, plant.damping, plant.stiffness);
+    let controller_lagged = terms.iter().any(|t| t.signal == Signal::ControllerTorque);
+    if !controller_lagged {
+        k += plant.feedback.fixed_columns::<2>(0);
+        c += plant.feedback.fixed_columns::<2>(2);
+    }
+    // Lags: (equation, signal column in x, coefficient, time constant).
+    let mut lags: Vec<(usize, usize, f64, f64)> = Vec::new();
+    let mut it = theta.iter();
+    for t in terms {
+        if t.signal == Signal::ControllerTorque {
+            let tau = time_constant(*it.next()?);
+            for e in 0..2 {
+                // Each torque's lag state follows -K_fb x.
+                lags.push((e, usize::MAX, 1.0, tau));
+            }
+            continue;
+        }
+        let coefficient = *it.next()? * v.powi(i32::from(t.speed_power));
+        let (e, col) = match t.signal {
+            Signal::Angle(s) => (t.equation.index(), s.index()),
+            Signal::Rate(s) => (t.equation.index(), 2 + s.index()),
+            Signal::Acceleration(s) => {
+                m[(t.equation.index(), s.index())] -= coefficient;
+                continue;
+            }
+            Signal::ControllerTorque => unreachable!(),
+        };
+        if t.lagged {
+            lags.push((e, col, coefficient, time_constant(*it.next()?)));
+        } else if col < 2 {
+            k[(e, col)] -= coefficient;
+        } else {
+            c[(e, col - 2)] -= coefficient;
+        }
+    }
+    let mi = m.try_inverse()?;
+    let n = 4 + lags.len();
+    let mut a = DMatrix::zeros(n, n);
+    a[(0, 2)] = 1.0;
+    a[(1, 3)] = 1.0;
+    let (mk, mc) = (-mi * k, -mi * c);
+    for i in 0..2 {
+        for j in 0..2 {
+            a[(2 + i, j)] = mk[(i, j)];
+            a[(2 + i, 2 + j)] = mc[(i, j)];
+        }
+    }
+    for (j, &(e, col, coefficient, tau)) in lags.iter().enumerate() {
+        let z = 4 + j;
+        a[(z, z)] = -1.0 / tau;
+        if col == usize::MAX {
+            for s in 0..4 {
+                a[(z, s)] = -plant.feedback[(e, s)] / tau;
+            }
+        } else {
+            a[(z, col)] += coefficient / tau;
+        }
+        for i in 0..2 {
+            a[(2 + i, z)] += mi[(i, e)];
+        }
+    }
+    Some(a)
+}
+
+/// The eigenvalues of `a`; `None` when an entry is not finite or the
+/// Schur iteration does not converge (a fit's trial step can make either;
+/// nalgebra's unbounded iteration would not return).
+fn eigenvalues(a: &DMatrix<f64>) -> Option<Vec<Complex<f64>>> {
+    if !a.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let n = a.nrows();
+    let schur = nalgebra::linalg::Schur::try_new(a.clone(), f64::EPSILON, 100 * n * n)?;
+    Some(schur.complex_eigenvalues().iter().copied().collect())
+}
+
+/// The complex eigenvalue of `a` with positive imaginary part nearest
+/// `guide` (the weave a model without the terms predicts).
+pub fn weave_near(a: &DMatrix<f64>, guide: Complex<f64>) -> Option<Complex<f64>> {
+    eigenvalues(a)?
+        .iter()
+        .filter(|z| z.im > 1e-9)
+        .min_by(|x, y| (*x - guide).norm().total_cmp(&(*y - guide).norm()))
+        .copied()
+}
+
+/// A measured weave eigenvalue.
+#[derive(Clone, Copy, Debug)]
+pub struct Row {
+    /// Forward speed (m/s).
+    pub speed: f64,
+    /// `[real (1/s), imaginary (rad/s)]`.
+    pub measured: [f64; 2],
+    /// Standard errors of the two parts (one when unknown).
+    pub stderr: [f64; 2],
+}
+
+/// A library parameter fitted beside the terms.
+#[derive(Clone, Debug)]
+pub struct LibraryParameter {
+    pub name: String,
+    /// Where its fit starts (the library's estimate).
+    pub start: f64,
+    /// Gaussian prior `(mean, standard deviation)`.
+    pub prior: Option<(f64, f64)>,
+    /// Typical magnitude (difference step).
+    pub scale: f64,
+}
+
+/// The plant at every row (in the rows' order, at each row's speed) for
+/// library values (`None` at a row where it cannot be linearized).
+pub type Plant<'a> = dyn Fn(&[f64]) -> Vec<Option<PlantAt>> + Sync + 'a;
+
+/// The problem: rows, the plant as a function of the library's values, and
+/// those values.
+pub struct Problem<'a> {
+    pub rows: &'a [Row],
+    pub plant: &'a Plant<'a>,
+    pub library: &'a [LibraryParameter],
+    /// The dictionary (see [`Term::dictionary`]).
+    pub dictionary: Vec<Term>,
+    /// Most terms added.
+    pub max_terms: usize,
+    /// Most folds of the held-out error: rows are dealt to them in turn
+    /// (up to this many rows, each row is its own fold).
+    pub max_folds: usize,
+    /// The fold of each row, when the rows come in groups that must be
+    /// held out together (the kicks of one run or log); overrides
+    /// `max_folds`.
+    pub folds: Option<&'a [usize]>,
+}
+
+/// One term tried at one step.
+#[derive(Clone, Debug, Serialize)]
+pub struct TermTrial {
+    pub step: usize,
+    pub term: Term,
+    /// The term's fitted values `(value, standard error)`: its coefficient
+    /// (SI, see [`Term::unit`]), then a lag's time constant (s).
+    pub values: Vec<(f64, f64)>,
+    pub bic_change: f64,
+    /// Held-out error (mean squared weighted residual per row; NaN when not
+    /// cross-validated).
+    pub cv: f64,
+    pub base_cv: f64,
+    #[serde(rename = "outcome")]
+    pub verdict: Verdict,
+}
+
+/// A selected term with its values.
+#[derive(Clone, Debug, Serialize)]
+pub struct FoundTerm {
+    pub term: Term,
+    /// Coefficient `(value, standard error)` in [`Term::unit`]; absent for
+    /// the controller's lag.
+    pub coefficient: Option<(f64, f64)>,
+    /// A lag's time constant `(value, standard error)` (s).
+    pub time_constant: Option<(f64, f64)>,
+    /// The step's other terms that lower the criterion within
+    /// [`ALIKE_BIC`] of this one: the rows do not tell them apart.
+    pub alike: Vec<Term>,
+}
+
+/// Terms whose criteria differ by less than this explain the rows alike
+/// (a BIC difference below 2 is "not worth more than a bare mention":
+/// Kass and Raftery 1995, J. Am. Stat. Assoc. 90:773).
+pub const ALIKE_BIC: f64 = 2.0;
+
+/// What the discovery found.
+#[derive(Clone, Debug, Serialize)]
+pub struct Discovery {
+    pub terms: Vec<FoundTerm>,
+    pub trials: Vec<TermTrial>,
+    /// The library's parameters refitted with the terms `(value, stderr)`.
+    pub library: Vec<(String, f64, f64)>,
+    /// Weave eigenvalue per row with the library alone and with the terms
+    /// (all rows fitted), and each row held out with the terms.
+    pub predicted_library: Vec<Option<[f64; 2]>>,
+    pub predicted_after: Vec<Option<[f64; 2]>>,
+    pub predicted_held_out: Vec<Option<[f64; 2]>>,
+    /// Held-out prediction of each row with the library alone (its
+    /// parameters refitted to the other folds).
+    pub predicted_library_held_out: Vec<Option<[f64; 2]>>,
+}
+
+struct Fitted {
+    x: Vec<f64>,
+    stderr: Vec<f64>,
+    chi2: f64,
+}
+
+/// Library values and the plant at every row for them.
+type PlantCache = (Vec<f64>, Vec<Option<PlantAt>>);
+
+struct Search<'a> {
+    p: &'a Problem<'a>,
+    /// The library model's weave at each row (the eigenvalue the terms'
+    /// weave is followed from).
+    guide: Vec<Complex<f64>>,
+    /// The plant at every row for the library values last asked for: the
+    /// terms' own derivatives and most trial steps leave them unchanged,
+    /// and a linearization costs far more than the eigenvalues.
+    plants: std::cell::RefCell<Option<PlantCache>>,
+}
+
+impl Search<'_> {
+    /// Predicted weave at rows `idx` for parameter vector `x` (library
+    /// values, then the terms' values).
+    fn predict(&self, terms: &[Term], x: &[f64], idx: &[usize]) -> Vec<Option<Complex<f64>>> {
+        let nl = self.p.library.len();
+        let mut cache = self.plants.borrow_mut();
+        if cache.as_ref().is_none_or(|(lib, _)| lib[..] != x[..nl]) {
+            *cache = Some((x[..nl].to_vec(), (self.p.plant)(&x[..nl])));
+        }
+        let plants = &cache.as_ref().expect("filled above").1;
+        idx.iter()
+            .map(|&i| {
+                let a = state_matrix(plants[i].as_ref()?, terms, &x[nl..], self.p.rows[i].speed)?;
+                weave_near(&a, self.guide[i])
+            })
+            .collect()
+    }
+
+    fn residuals(&self, terms: &[Term], x: &[f64], idx: &[usize]) -> Vec<f64> {
+        let mut r = Vec::with_capacity(2 * idx.len());
+        for (&i, p) in idx.iter().zip(self.predict(terms, x, idx)) {
+            let row = &self.p.rows[i];
+            let m = row.measured;
+            // No weave predicted: as far off as the measured eigenvalue's size.
+            let p = p.map_or([m[0] + m[1].abs(), 0.0], |z| [z.re, z.im]);
+            r.extend([(m[0] - p[0]) / row.stderr[0], (m[1] - p[1]) / row.stderr[1]]);
+        }
+        r
+    }
+
+    fn with_priors(&self, terms: &[Term], x: &[f64], idx: &[usize]) -> Vec<f64> {
+        let mut r = self.residuals(terms, x, idx);
+        for (lp, v) in self.p.library.iter().zip(x) {
+            if let Some((m, sd)) = lp.prior {
+                r.push((v - m) / sd);
+            }
+        }
+        r
+    }
+
+    /// Levenberg-Marquardt from each start; the lowest cost wins.
+    fn fit(&self, terms: &[Term], starts: &[Vec<f64>], idx: &[usize]) -> Option<Fitted> {
+        starts
+            .iter()
+            .filter_map(|x0| self.fit_from(terms, x0.clone(), idx))
+            .min_by(|a, b| a.chi2.total_cmp(&b.chi2))
+    }
+
+    fn fit_from(&self, terms: &[Term], mut x: Vec<f64>, idx: &[usize]) -> Option<Fitted> {
+        let k = x.len();
+        let scales: Vec<f64> = self
+            .p
+            .library
+            .iter()
+            .map(|l| l.scale)
+            .chain(std::iter::repeat(1.0))
+            .take(k)
+            .collect();
+        let cost = |r: &[f64]| r.iter().map(|a| a * a).sum::<f64>();
+        let mut r = self.with_priors(terms, &x, idx);
+        let mut c = cost(&r);
+        if !c.is_finite() {
+            return None;
+        }
+        let jac = |x: &[f64], r0: &[f64]| {
+            let mut j = DMatrix::zeros(r0.len(), k);
+            for col in 0..k {
+                let h = 1e-7 * scales[col].max(x[col].abs());
+                let mut xp = x.to_vec();
+                xp[col] += h;
+                let rp = self.with_priors(terms, &xp, idx);
+                for (i, (a, b)) in rp.iter().zip(r0).enumerate() {
+                    j[(i, col)] = (a - b) / h;
+                }
+            }
+            j
+        };
+        let mut lambda = 1e-3;
+        // Nothing free (no library parameter, no term): the cost as it is.
+        for _ in 0..if k == 0 { 0 } else { 100 } {
+            let j = jac(&x, &r);
+            let h = j.tr_mul(&j);
+            let g = j.tr_mul(&DVector::from_column_slice(&r));
+            let mut improved = false;
+            while lambda < 1e12 {
+                let mut a = h.clone();
+                for d in 0..k {
+                    a[(d, d)] += lambda * h[(d, d)].max(1e-12);
+                }
+                let Some(dx) = a.lu().solve(&(-&g)) else {
+                    lambda *= 10.0;
+                    continue;
+                };
+                let xt: Vec<f64> = x.iter().zip(dx.iter()).map(|(a, b)| a + b).collect();
+                let rt = self.with_priors(terms, &xt, idx);
+                let ct = cost(&rt);
+                if ct < c {
+                    let done = (c - ct) <= 1e-10 * c;
+                    (x, r, c) = (xt, rt, ct);
+                    lambda = (lambda / 3.0).max(1e-12);
+                    improved = !done;
+                    break;
+                }
+                lambda *= 4.0;
+            }
+            if !improved {
+                break;
+            }
+        }
+        let data = self.residuals(terms, &x, idx);
+        let chi2 = cost(&data);
+        let s2 = chi2 / (data.len() as f64 - k as f64).max(1.0);
+        let j = jac(&x, &r);
+        let stderr = match j.tr_mul(&j).try_inverse() {
+            Some(inv) => (0..k).map(|i| (inv[(i, i)].max(0.0) * s2).sqrt()).collect(),
+            None => vec![f64::NAN; k],
+        };
+        Some(Fitted { x, stderr, chi2 })
+    }
+
+    /// Starts: the library's values, each term's coefficient at zero and a
+    /// lag's time constant at 0.03, 0.1 and 0.3 s (one start per choice
+    /// when a lag is new; the selected terms keep their values).
+    fn starts(&self, terms: &[Term], kept: &[f64]) -> Vec<Vec<f64>> {
+        let mut base: Vec<f64> = self.p.library.iter().map(|l| l.start).collect();
+        base.extend_from_slice(kept);
+        let last = terms.last().copied();
+        match last {
+            Some(t) if t.lagged => [0.03f64, 0.1, 0.3]
+                .iter()
+                .map(|tau| {
+                    let mut x = base.clone();
+                    if t.signal != Signal::ControllerTorque {
+                        x.push(0.0);
+                    }
+                    x.push(tau.ln());
+                    x
+                })
+                .collect(),
+            Some(_) => {
+                let mut x = base;
+                x.push(0.0);
+                vec![x]
+            }
+            None => vec![base],
+        }
+    }
+
+    /// Held-out error: each row predicted with the values fitted to the
+    /// other folds; its squared weighted residual (half the sum over the
+    /// real and imaginary parts) and its prediction.
+    fn held_out(&self, terms: &[Term], full: &Fitted) -> HeldOut {
+        let n = self.p.rows.len();
+        let fold_of: Vec<usize> = match self.p.folds {
+            Some(f) => f.to_vec(),
+            None => {
+                let folds = n.min(self.p.max_folds).max(2);
+                (0..n).map(|j| j % folds).collect()
+            }
+        };
+        let folds = fold_of.iter().max().map_or(0, |m| m + 1);
+        let mut ss = vec![f64::NAN; n];
+        let mut pred = vec![None; n];
+        for fold in 0..folds {
+            let (test, train): (Vec<usize>, Vec<usize>) = (0..n).partition(|&j| fold_of[j] == fold);
+            if test.is_empty() {
+                continue;
+            }
+            let Some(f) = self.fit(terms, std::slice::from_ref(&full.x), &train) else {
+                continue;
+            };
+            for (&i, p) in test.iter().zip(self.predict(terms, &f.x, &test)) {
+                ss[i] = self.residuals(terms, &f.x, &[i]).iter().map(|r| r * r).sum::<f64>() / 2.0;
+                pred[i] = p.map(|z| [z.re, z.im]);
+            }
+        }
+        HeldOut { ss, pred }
+    }
+}
+
+/// Each row's held-out squared weighted residual and prediction.
+#[derive(Clone)]
+struct HeldOut {
+    ss: Vec<f64>,
+    pred: Vec<Option<[f64; 2]>>,
+}
+
+impl HeldOut {
+    /// The mean over the rows (NaN when a fold failed).
+    fn cv(&self) -> f64 {
+        if self.ss.iter().all(|s| s.is_finite()) {
+            self.ss.iter().sum::<f64>() / self.ss.len() as f64
+        } else {
+            f64::NAN
+        }
+    }
+
+    /// The paired gain over `base`, row by row: mean and standard error.
+    fn gain_over(&self, base: &HeldOut) -> (f64, f64) {
+        let d: Vec<f64> = base.ss.iter().zip(&self.ss).map(|(a, b)| a - b).collect();
+        let n = d.len() as f64;
+        let m = d.iter().sum::<f64>() / n;
+        let var = d.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0).max(1.0);
+        (m, (var / n).sqrt())
+    }
+}
+
+/// Why the discovery cannot run.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DiscoveryError {
+    #[error("too few rows: {rows} (at least 3 are needed to hold some out)")]
+    TooFewRows { rows: usize },
+    #[error("the model with the library's values has no weave at {speed} m/s")]
+    NoWeave { speed: f64 },
+    #[error("{folds} fold indices for {rows} rows")]
+    Folds { folds: usize, rows: usize },
+}
+
+/// Run the search.
+pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
+    let n_rows = p.rows.len();
+    if n_rows < 3 {
+        return Err(DiscoveryError::TooFewRows { rows: n_rows });
+    }
+    let start: Vec<f64> = p.library.iter().map(|l| l.start).collect();
+    // The guide: the library model's weave, the complex pair of highest
+    // frequency (as the table's prediction picks it).
+    let mut guide = Vec::with_capacity(n_rows);
+    if p.folds.is_some_and(|f| f.len() != n_rows) {
+        return Err(DiscoveryError::Folds {
+            folds: p.folds.map_or(0, <[usize]>::len),
+            rows: n_rows,
+        });
+    }
+    for (row, plant) in p.rows.iter().zip((p.plant)(&start)) {
+        let a = plant.and_then(|pl| state_matrix(&pl, &[], &[], row.speed));
+        let w = a.and_then(|a| {
+            eigenvalues(&a)?
+                .iter()
+                .filter(|z| z.im > 1e-9)
+                .max_by(|x, y| x.im.total_cmp(&y.im))
+                .copied()
+        });
+        guide.push(w.ok_or(DiscoveryError::NoWeave { speed: row.speed })?);
+    }
+    let s = Search {
+        p,
+        guide,
+        plants: std::cell::RefCell::new(None),
+    };
+    let all: Vec<usize> = (0..n_rows).collect();
+    let n = 2.0 * n_rows as f64;
+    let bic = |chi2: f64, k: usize| n * (chi2 / n).max(1e-300).ln() + k as f64 * n.ln();
+    let nl = p.library.len();
+    let base = s.fit(&[], std::slice::from_ref(&start), &all).unwrap_or(Fitted {
+        x: start.clone(),
+        stderr: vec![f64::NAN; nl],
+        chi2: f64::INFINITY,
+    });
+    let library_held = s.held_out(&[], &base);
+    let as_pairs = |v: Vec<Option<Complex<f64>>>| v.into_iter().map(|z| z.map(|z| [z.re, z.im])).collect::<Vec<_>>();
+    let predicted_library = as_pairs(s.predict(&[], &base.x, &all));
+    let (mut terms, mut current) = (Vec::<Term>::new(), base);
+    let mut current_bic = bic(current.chi2, nl);
+    let mut current_held = library_held.clone();
+    let mut trials = Vec::new();
+    for step in 1..=p.max_terms {
+        let current_cv = current_held.cv();
+        // Every term of the step is fitted (in parallel, each with its own
+        // search and plant cache); the best that passes is added.
+        let guide = &s.guide;
+        let results: Vec<(TermTrial, Option<(Fitted, HeldOut)>)> = p
+            .dictionary
+            .par_iter()
+            .filter(|t| !terms.contains(t))
+            .map(|&t| {
+                let s = Search {
+                    p,
+                    guide: guide.clone(),
+                    plants: std::cell::RefCell::new(None),
+                };
+                let set: Vec<Term> = terms.iter().copied().chain([t]).collect();
+                let k = nl + set.iter().map(Term::parameter_count).sum::<usize>();
+                let trial = |values, bic_change, cv, verdict| TermTrial {
+                    step,
+                    term: t,
+                    values,
+                    bic_change,
+                    cv,
+                    base_cv: current_cv,
+                    verdict,
+                };
+                let Some(f) = s.fit(&set, &s.starts(&set, &current.x[nl..]), &all) else {
+                    let reason = "no start gives a finite fit".to_string();
+                    return (trial(vec![], f64::NAN, f64::NAN, Verdict::FitFailed { reason }), None);
+                };
+                let db = bic(f.chi2, k) - current_bic;
+                let held = (db < 0.0).then(|| s.held_out(&set, &f));
+                let cv = held.as_ref().map_or(f64::NAN, HeldOut::cv);
+                // A dictionary offers many terms to one table: a term must
+                // also predict the held-out rows consistently better, row
+                // by row beyond two standard errors (as the runs' search
+                // asks of the library), not only on average.
+                let (gain, stderr) = held
+                    .as_ref()
+                    .map_or((f64::NAN, f64::NAN), |h| h.gain_over(&current_held));
+                let verdict = if db >= 0.0 {
+                    Verdict::NoCriterionGain { bic_change: db }
+                } else if !(cv < current_cv) {
+                    Verdict::HeldOutNotLower {
+                        cv,
+                        base_cv: current_cv,
+                    }
+                } else if !(gain > 2.0 * stderr) {
+                    Verdict::HeldOutGainNotConsistent { gain, stderr }
+                } else {
+                    Verdict::Added {
+                        bic_change: db,
+                        cv,
+                        base_cv: current_cv,
+                    }
+                };
+                let added = verdict.added();
+                let values = term_values(&f, t);
+                (trial(values, db, cv, verdict), held.filter(|_| added).map(|h| (f, h)))
+            })
+            .collect();
+        let mut best: Option<(Term, Fitted, f64, HeldOut)> = None;
+        for (trial, passed) in results {
+            if let Some((f, held)) = passed {
+                if best.as_ref().is_none_or(|b| trial.bic_change < b.2) {
+                    best = Some((trial.term, f, trial.bic_change, held));
+                }
+            }
+            trials.push(trial);
+        }
+        let Some((t, f, db, held)) = best else { break };
+        for tr in trials.iter_mut().filter(|tr| tr.step == step && tr.term != t) {
+            if let Verdict::Added { bic_change, .. } = tr.verdict {
+                tr.verdict = Verdict::CriterionAboveAdded {
+                    bic_change,
+                    added: t.name(),
+                };
+            }
+        }
+        terms.push(t);
+        current_bic += db;
+        current_held = held;
+        current = f;
+    }
+    let mut found = Vec::new();
+    let mut at = nl;
+    for &t in &terms {
+        let coefficient = (t.signal != Signal::ControllerTorque).then(|| {
+            at += 1;
+            (current.x[at - 1], current.stderr[at - 1])
+        });
+        let time_constant = t.lagged.then(|| {
+            at += 1;
+            // The standard error of the logarithm, carried to the time
+            // constant to first order.
+            let tau = time_constant(current.x[at - 1]);
+            (tau, tau * current.stderr[at - 1])
+        });
+        let step = found.len() + 1;
+        let added_bic = trials
+            .iter()
+            .find(|tr: &&TermTrial| tr.step == step && tr.term == t)
+            .map_or(f64::NAN, |tr| tr.bic_change);
+        let alike = trials
+            .iter()
+            .filter(|tr| tr.step == step && tr.term != t && tr.bic_change < added_bic + ALIKE_BIC)
+            .map(|tr| tr.term)
+            .collect();
+        found.push(FoundTerm {
+            term: t,
+            coefficient,
+            time_constant,
+            alike,
+        });
+    }
+    Ok(Discovery {
+        library: p
+            .library
+            .iter()
+            .enumerate()
+            .map(|(i, l)| (l.name.clone(), current.x[i], current.stderr[i]))
+            .collect(),
+        predicted_after: as_pairs(s.predict(&terms, &current.x, &all)),
+        predicted_held_out: current_held.pred,
+        predicted_library_held_out: library_held.pred,
+        predicted_library,
+        terms: found,
+        trials,
+    })
+}
+
+/// A trial's values of its newest term (the last of the fitted vector):
+/// the coefficient, then a lag's time constant (s).
+fn term_values(f: &Fitted, t: Term) -> Vec<(f64, f64)> {
+    let start = f.x.len() - t.parameter_count();
+    let mut v = Vec::new();
+    let mut i = start;
+    if t.signal != Signal::ControllerTorque {
+        v.push((f.x[i], f.stderr[i]));
+        i += 1;
+    }
+    if t.lagged {
+        let tau = time_constant(f.x[i]);
+        v.push((tau, tau * f.stderr[i]));
+    }
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The benchmark bicycle's canonical matrices (Meijaard et al. 2007,
+    /// Table 2 values rounded as published in its equation 12).
+    fn benchmark(v: f64) -> PlantAt {
+        let m0 = Matrix2::new(80.81722, 2.31941332208709, 2.31941332208709, 0.29784188199686);
+        let c1 = Matrix2::new(0.0, 33.86641391492494, -0.85035641456978, 1.68540397397560);
+        let k0 = Matrix2::new(-80.95, -2.59951685249872, -2.59951685249872, -0.80329488458618);
+        let k2 = Matrix2::new(0.0, 76.59734589573222, 0.0, 2.65431523794604);
+        PlantAt {
+            mass: m0,
+            damping: c1 * v,
+            stiffness: k0 * 9.81 + k2 * v * v,
+            feedback: Matrix2x4::zeros(),
+        }
+    }
+
+    /// The benchmark bicycle at the rows' speeds (as `rows_with` makes
+    /// them).
+    fn plant(_: &[f64]) -> Vec<Option<PlantAt>> {
+        (0..9).map(|i| Some(benchmark(4.0 + 0.5 * i as f64))).collect()
+    }
+
+    fn rows_with(terms: &[Term], theta: &[f64]) -> Vec<Row> {
+        (0..9)
+            .map(|i| {
+                let v = 4.0 + 0.5 * i as f64;
+                let a = state_matrix(&benchmark(v), terms, theta, v).unwrap();
+                let guide = state_matrix(&benchmark(v), &[], &[], v).unwrap();
+                let g = weave_near(&guide, Complex::new(0.0, 100.0)).unwrap();
+                let w = weave_near(&a, g).unwrap();
+                Row {
+                    speed: v,
+                    measured: [w.re, w.im],
+                    stderr: [0.01, 0.01],
+                }
+            })
+            .collect()
+    }
+
+    /// Measurement scatter of about one standard error (fixed
+    /// pseudo-random values).
+    fn scattered(mut rows: Vec<Row>) -> Vec<Row> {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut uniform = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for r in &mut rows {
+            r.measured[0] += 0.02 * uniform();
+            r.measured[1] += 0.02 * uniform();
+        }
+        rows
+    }
+
+    #[test]
+    fn a_term_on_the_rate_enters_the_damping_and_a_lag_adds_a_state() {
+        let steer_damper = Term {
+            equation: Coordinate::Steer,
+            signal: Signal::Rate(Coordinate::Steer),
+            speed_power: 0,
+            lagged: false,
+        };
+        let p = benchmark(5.0);
+        let a = state_matrix(&p, &[steer_damper], &[-2.0], 5.0).unwrap();
+        let mut damped = p;
+        damped.damping[(1, 1)] += 2.0;
+        let b = state_matrix(&damped, &[], &[], 5.0).unwrap();
+        assert!((&a - &b).norm() < 1e-12);
+        let lagged = Term {
+            lagged: true,
+            ..steer_damper
+        };
+        assert_eq!(
+            state_matrix(&p, &[lagged], &[-2.0, 0.1f64.ln()], 5.0).unwrap().nrows(),
+            5
+        );
+        // A very fast lag is the direct term.
+        let fast = state_matrix(&p, &[lagged], &[-2.0, 1e-7f64.ln()], 5.0).unwrap();
+        let w = weave_near(&fast, Complex::new(-1.0, 5.0)).unwrap();
+        let d = weave_near(&b, Complex::new(-1.0, 5.0)).unwrap();
+        assert!((w - d).norm() < 1e-4, "{w} vs {d}");
+    }
+
+    #[test]
+    fn an_added_steer_inertia_is_found_with_its_value_and_the_control_gets_nothing() {
+        let inertia = Term {
+            equation: Coordinate::Steer,
+            signal: Signal::Acceleration(Coordinate::Steer),
+            speed_power: 0,
+            lagged: false,
+        };
+        // Q = theta delta'': an added inertia of 0.05 kg m^2 is theta = -0.05.
+        let rows = scattered(rows_with(&[inertia], &[-0.05]));
+        let problem = Problem {
+            rows: &rows,
+            plant: &plant,
+            library: &[],
+            dictionary: Term::dictionary(false),
+            max_terms: 2,
+            max_folds: 10,
+            folds: None,
+        };
+        let d = discover(&problem).unwrap();
+        assert_eq!(d.terms.len(), 1, "{:?}", d.terms);
+        assert_eq!(d.terms[0].term, inertia);
+        let (value, _) = d.terms[0].coefficient.unwrap();
+        assert!((value + 0.05).abs() < 0.05 * 0.25, "{value}");
+        let control = scattered(rows_with(&[], &[]));
+        let d = discover(&Problem {
+            rows: &control,
+            ..problem
+        })
+        .unwrap();
+        assert!(d.terms.is_empty(), "{:?}", d.terms);
+    }
+}
