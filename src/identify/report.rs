@@ -537,6 +537,9 @@ pub fn verdict_text(v: &Verdict) -> String {
             "rejected: {symbol} = {value:.4} lies {prior_sds:.1} prior standard deviations from its measured value (beyond {PLAUSIBLE_PRIOR_SDS}: implausible under the measurement, more likely it absorbs a missing effect; tried only when no plausible candidate passes)"
         ),
         Verdict::NotPhysical => "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".into(),
+        Verdict::LagNotResolved { time_constant } => {
+            format!("rejected: its lag fitted to {time_constant:.2e} s, shorter than the data resolve (the direct term, tried on its own)")
+        }
         Verdict::NoCriterionGain { bic_change } => {
             format!("rejected: BIC {bic_change:+.1} (no gain beyond its added parameters; not cross-validated)")
         }

@@ -699,6 +699,20 @@ pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
                     return (trial(vec![], f64::NAN, f64::NAN, Verdict::FitFailed { reason }), None);
                 };
                 let db = bic(f.chi2, k) - current_bic;
+                // A lag far shorter than the fastest motion the rows see
+                // (a hundredth of the shortest weave period) is the direct
+                // term with one parameter more: not a lag the data show.
+                let shortest_period = s
+                    .guide
+                    .iter()
+                    .map(|g| std::f64::consts::TAU / g.im.abs().max(1e-9))
+                    .fold(f64::INFINITY, f64::min);
+                if let Some(&(tau, _)) = t.lagged.then(|| term_values(&f, t).last().copied()).flatten().as_ref() {
+                    if tau < 0.01 * shortest_period {
+                        let verdict = Verdict::LagNotResolved { time_constant: tau };
+                        return (trial(term_values(&f, t), db, f64::NAN, verdict), None);
+                    }
+                }
                 let held = (db < 0.0).then(|| s.held_out(&set, &f));
                 let cv = held.as_ref().map_or(f64::NAN, HeldOut::cv);
                 // A dictionary offers many terms to one table: a term must

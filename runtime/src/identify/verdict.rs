@@ -65,6 +65,9 @@ pub enum Verdict {
     Encompassed { by: String, t: f64, remains: f64 },
     /// A pair fitted for the encompassing test: not a candidate of its own.
     NotAdded,
+    /// A lagged term whose time constant (s) fitted shorter than the data
+    /// can resolve: it is the direct term, which the dictionary also holds.
+    LagNotResolved { time_constant: f64 },
 }
 
 impl Verdict {
