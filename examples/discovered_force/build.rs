@@ -11,26 +11,33 @@ use std::path::PathBuf;
 
 #[path = "effects/discovered.rs"]
 mod discovered;
+#[path = "effects/discovered_lag.rs"]
+mod discovered_lag;
 
 const SOURCE: &str = "examples/discovered_force/build.rs";
 
-fn bicycle(name: &str, speed: Speed) -> Result<Model, ModelError> {
+fn bicycle(name: &str, speed: Speed, effect: effects::Effect) -> Result<Model, ModelError> {
     let (mut m, parts) = whipple_offset::declare(name, SOURCE, speed);
     m.set_doc(match speed {
-        Speed::Driven => "Whipple bicycle of any geometry with the force identify discovered, driven speed",
-        Speed::Free => "Whipple bicycle of any geometry with the force identify discovered, free forward speed",
+        Speed::Driven => "Whipple bicycle of any geometry with a force identify discovered, driven speed",
+        Speed::Free => "Whipple bicycle of any geometry with a force identify discovered, free forward speed",
     });
-    effects::apply(&mut m, &parts, &discovered::effect());
+    effects::apply(&mut m, &parts, &effect);
     m.build()
 }
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=effects/discovered.rs");
+    println!("cargo:rerun-if-changed=effects/discovered_lag.rs");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
+    // The steer torque from the roll angle (refitted in the tests), and a
+    // lagged steer torque from the roll rate (a first-order state).
     let models = [
-        bicycle("discovered_bicycle", Speed::Driven),
-        bicycle("discovered_bicycle_free", Speed::Free),
+        bicycle("discovered_bicycle", Speed::Driven, discovered::effect()),
+        bicycle("discovered_bicycle_free", Speed::Free, discovered::effect()),
+        bicycle("discovered_lag_bicycle", Speed::Driven, discovered_lag::effect()),
+        bicycle("discovered_lag_bicycle_free", Speed::Free, discovered_lag::effect()),
     ]
     .into_iter()
     .collect::<Result<Vec<Model>, ModelError>>()

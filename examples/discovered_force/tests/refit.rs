@@ -54,6 +54,12 @@ fn weave(a: &nalgebra::DMatrix<f64>) -> Complex<f64> {
 /// The table: nine speeds, 3-7 m/s, with scatter of about 0.02 1/s (a
 /// fixed pseudo-random sequence), which its standard-error columns state.
 fn table() -> PathBuf {
+    table_with(&[hidden_term()], &[HIDDEN])
+}
+
+/// The table with `terms` at `theta` (a lag's time constant as its
+/// logarithm, as the dictionary takes it).
+fn table_with(terms: &[Term], theta: &[f64]) -> PathBuf {
     let mut state = 0x2545_f491_4f6c_dd1du64;
     let mut uniform = || {
         state ^= state << 13;
@@ -64,7 +70,7 @@ fn table() -> PathBuf {
     let mut csv = "speed,re,im,sd_re,sd_im\n".to_string();
     for i in 0..9 {
         let v = 3.0 + 0.5 * f64::from(i);
-        let w = weave(&state_matrix(&plant(v), &[hidden_term()], &[HIDDEN], v).unwrap());
+        let w = weave(&state_matrix(&plant(v), terms, theta, v).unwrap());
         csv += &format!(
             "{v},{:.5},{:.5},0.02,0.02\n",
             w.re + 0.07 * uniform(),
@@ -80,8 +86,12 @@ fn table() -> PathBuf {
 }
 
 fn request(effects: &[&str], discover: bool) -> TableRequest {
+    request_for(table(), effects, discover)
+}
+
+fn request_for(path: PathBuf, effects: &[&str], discover: bool) -> TableRequest {
     TableRequest {
-        path: table(),
+        path,
         bike: "thesis".into(),
         effects: effects.iter().map(|s| s.to_string()).collect(),
         corrections: Some(0),
@@ -91,7 +101,11 @@ fn request(effects: &[&str], discover: bool) -> TableRequest {
 
 /// identify with the built-in library, then its discovery.
 fn discovered() -> (TableOutcome, TableDiscovery) {
-    let o = identify_table(&request(&[], true)).unwrap();
+    discovered_in(request(&[], true))
+}
+
+fn discovered_in(request: TableRequest) -> (TableOutcome, TableDiscovery) {
+    let o = identify_table(&request).unwrap();
     let Some(DiscoveryOutcome::Ran(d)) = o.discovery.clone() else {
         panic!("no discovery: {:?}", o.discovery)
     };
@@ -164,7 +178,15 @@ fn the_derived_model_has_the_eigenvalues_of_the_discovered_force() {
 fn the_refit_with_the_derived_model_gives_the_discovered_value_and_the_error_of_each_stage() {
     let (library, d) = discovered();
     let found = &d.discovery.terms[0];
-    let refit = identify_table_in::<Registry>(&request(&["discovered"], false)).unwrap();
+    // The thesis bicycle declaring the effect (at zero), so that the
+    // registry's models with it are chosen (the registry also holds the
+    // lagged effect's).
+    let bike = std::env::temp_dir().join(format!("discovered-force-bike-{}.toml", std::process::id()));
+    let text = Bicycle::resolve("thesis").unwrap().parameters.to_toml_string();
+    std::fs::write(&bike, format!("{text}\ndiscovered_k0 = 0.0\n")).unwrap();
+    let mut req = request(&["discovered"], false);
+    req.bike = bike.to_str().unwrap().into();
+    let refit = identify_table_in::<Registry>(&req).unwrap();
     assert_eq!(refit.selected, ["discovered"]);
     let (value, stderr) = refit.parameters["discovered_k0"];
     let expected = model_coefficient(found).unwrap();
@@ -186,4 +208,73 @@ fn the_refit_with_the_derived_model_gives_the_discovered_value_and_the_error_of_
     );
     assert!((refit.eigen_rms_after - d.rms_after).abs() < 1e-3 * d.rms_after.max(1e-3));
     assert!(refit.eigen_rms_held_out <= 0.5 * library.eigen_rms_held_out);
+}
+
+/// A lagged steer torque from the roll rate (6 N m s/rad through 0.15 s, a
+/// controller with its own dynamics): the table with it, the discovery
+/// (steer damping the only library candidate, which takes none of it), the
+/// effect file identify writes (committed as `effects/discovered_lag.rs`,
+/// its lag a first-order state of the derived model) and the derived
+/// model's spectrum against the dictionary's, to 1e-10, at 0.5-10 m/s.
+#[test]
+fn a_lagged_term_derived_as_a_state_has_the_eigenvalues_of_the_dictionary() {
+    let lagged = Term {
+        equation: Coordinate::Steer,
+        signal: Signal::Rate(Coordinate::Roll),
+        speed_power: 0,
+        lagged: true,
+    };
+    let path = table_with(&[lagged], &[6.0, 0.15f64.ln()]);
+    let (o, d) = discovered_in(request_for(path, &["steer_damping"], true));
+    assert!(o.selected.is_empty(), "the library took {:?}", o.selected);
+    assert_eq!(d.discovery.terms.len(), 1, "{:#?}", d.discovery.terms);
+    let found = &d.discovery.terms[0];
+    assert_eq!(found.term, lagged);
+    let written = effect_file("discovered_lag", &d.discovery.terms).unwrap();
+    if std::env::var_os("DISCOVERED_FORCE_WRITE").is_some() {
+        std::fs::write(
+            concat!(env!("CARGO_MANIFEST_DIR"), "/effects/discovered_lag.rs"),
+            &written,
+        )
+        .unwrap();
+    }
+    let layout = |text: &str| prettyplease::unparse(&syn::parse_file(text).unwrap());
+    assert_eq!(layout(&written), layout(include_str!("../effects/discovered_lag.rs")));
+    let (tau, _) = found.time_constant.unwrap();
+    let derived = Bicycle::<Registry>::resolve_in("thesis")
+        .unwrap()
+        .with_parameter("discovered_lag_k0", model_coefficient(found).unwrap())
+        .unwrap()
+        .with_parameter("discovered_lag_tau0", tau)
+        .unwrap();
+    assert_eq!(derived.model(None).unwrap().name, "discovered_lag_bicycle");
+    let theta = [found.coefficient.unwrap().0, tau.ln()];
+    let linear = derived.linear_with(None).unwrap();
+    let states = linear.first_order().expect("the lag is a first-order state");
+    for v in [0.5, 2.0, 4.0, 6.0, 8.0, 10.0] {
+        let ls = states.lateral_states(v).unwrap();
+        // The derived spectrum without the eigenvalues that vanish at every
+        // speed (a free heading), against the dictionary's.
+        let mut of_derived: Vec<Complex<f64>> = ls.a.complex_eigenvalues().iter().copied().collect();
+        of_derived.sort_by(|x, y| x.norm().total_cmp(&y.norm()));
+        let of_derived: Vec<Complex<f64>> = of_derived.split_off(ls.neutral);
+        let mut of_dictionary: Vec<Complex<f64>> = state_matrix(&plant(v), &[lagged], &theta, v)
+            .unwrap()
+            .complex_eigenvalues()
+            .iter()
+            .copied()
+            .collect();
+        assert_eq!(
+            of_derived.len(),
+            of_dictionary.len(),
+            "{v} m/s: {of_derived:?} against {of_dictionary:?}"
+        );
+        let mut of_derived = of_derived;
+        let order = |x: &Complex<f64>, y: &Complex<f64>| x.re.total_cmp(&y.re).then(x.im.total_cmp(&y.im));
+        of_derived.sort_by(order);
+        of_dictionary.sort_by(order);
+        for (a, b) in of_derived.iter().zip(&of_dictionary) {
+            assert!((a - b).norm() <= 1e-10 * b.norm().max(1.0), "{v} m/s: {a} against {b}");
+        }
+    }
 }
