@@ -44,6 +44,9 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     if let Some(r) = &o.remaining {
         let _ = writeln!(s, "5. The identified model's weave residuals (measured minus predicted eigenvalue of each kick counted) were regressed on the states a missing effect would act through ({}); an F test asks whether that pattern exceeds the kicks' own scatter about it, which is the floor a perfect model would reach. Outcome: {}.", super::remaining::regressors_text(r), super::remaining::remaining_sentence(r, "kicks"));
     }
+    if !o.state_correlation.is_empty() {
+        let _ = writeln!(s, "5b. Each channel's residual after identification (every sample of every kick) was regressed on the simulated states (the roll channel and its rate, the steer angle and its rate), with an F test on the effective sample size of correlated samples; its lag-1 autocorrelation measures how far it is from white noise. Outcome: {}.", super::remaining::state_correlation_sentence(&o.state_correlation));
+    }
     if let Some(d) = &o.discovery {
         let _ = writeln!(s, "6. Where a structured residual remains, a dictionary of generalized forces on the roll and steer equations (angles, rates and accelerations, times 1, v or v^2, at once or through a first-order lag) was searched on the counted kicks' weave eigenvalues, with the library's values as fitted; a term is kept when it lowers the criterion and the held-out error of the same folds of runs, consistently over the kicks. Outcome: {}.", super::discovery::kicks_sentence(d).replace('\n', "; "));
     }

@@ -165,6 +165,9 @@ pub struct Outcome<R: ModelRegistry = BuiltIn> {
     /// What the library leaves in the weave eigenvalues: a pattern in the
     /// kicks' states beyond their scatter, or none (`None`: too few kicks).
     pub remaining: Option<bikedyn_runtime::identify::remaining::Remaining>,
+    /// Whether each channel's residual after identification follows the
+    /// simulated states (empty without simulations).
+    pub state_correlation: Vec<bikedyn_runtime::identify::state_correlation::StateCorrelation>,
     /// What the dictionary of generalized forces found beyond the library
     /// on the kicks' weave eigenvalues (`None`: not requested).
     pub discovery: Option<discovery::DiscoveryOutcome>,
@@ -391,6 +394,26 @@ pub fn run_plan<R: ModelRegistry>(
         })
         .collect();
     let remaining = bikedyn_runtime::identify::remaining::remaining(&weave_residuals);
+    // And in the time series: whether each channel's residual after
+    // identification follows the simulated states.
+    let state_correlation = run_plot
+        .as_ref()
+        .map(|rp| {
+            let kicks: Vec<bikedyn_runtime::identify::state_correlation::KickSeries> = segs
+                .iter()
+                .zip(&rp.after)
+                .filter_map(|(s, sim)| {
+                    let sim = sim.as_ref()?;
+                    Some(bikedyn_runtime::identify::state_correlation::KickSeries {
+                        t: &s.t,
+                        measured: [&s.roll, &s.steer],
+                        simulated: [&sim.roll, &sim.steer],
+                    })
+                })
+                .collect();
+            bikedyn_runtime::identify::state_correlation::state_correlation(&kicks)
+        })
+        .unwrap_or_default();
     // Beyond the library: the dictionary of generalized forces on the
     // counted kicks' weave eigenvalues, held out by the identification's
     // own folds of runs.
@@ -469,6 +492,7 @@ pub fn run_plan<R: ModelRegistry>(
         weave_kicks,
         eigen_excluded,
         remaining,
+        state_correlation,
         discovery,
         speed_imposed: plan.speed_imposed,
         run_plot,

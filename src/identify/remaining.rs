@@ -81,3 +81,47 @@ pub fn remaining_sentence(r: &Remaining, what: &str) -> String {
         )
     }
 }
+
+/// Whether the time series' residual follows the motion, in words, one
+/// clause per channel.
+pub fn state_correlation_sentence(c: &[bikedyn_runtime::identify::state_correlation::StateCorrelation]) -> String {
+    use bikedyn_runtime::identify::state_correlation::{Channel, StateSignal};
+    let state = |s: StateSignal| match s {
+        StateSignal::Roll => "roll channel",
+        StateSignal::RollRate => "roll channel's rate",
+        StateSignal::Steer => "steer angle",
+        StateSignal::SteerRate => "steer rate",
+    };
+    let clauses: Vec<String> = c
+        .iter()
+        .map(|x| {
+            let channel = match x.channel {
+                Channel::Roll => "roll",
+                Channel::Steer => "steer",
+            };
+            let along: Vec<String> = x
+                .coefficients
+                .iter()
+                .filter(|(_, b, se)| b.abs() > 2.0 * se)
+                .map(|(s, b, se)| format!("{} {b:+.3e} +- {se:.1e} per standard deviation", state(*s)))
+                .collect();
+            let test = format!(
+                "R^2 = {:.3}, F = {:.2} on {:.0} and {:.0} effective degrees of freedom, p = {:.2e}; lag-1 autocorrelation {:.2}",
+                x.r_squared, x.f, x.dof.0, x.dof.1, x.p_value, x.whiteness_lag1
+            );
+            if x.significant {
+                format!(
+                    "the {channel} residual follows the simulated states ({test}){}",
+                    if along.is_empty() {
+                        String::new()
+                    } else {
+                        format!(", along the {}", along.join(", "))
+                    }
+                )
+            } else {
+                format!("the {channel} residual does not follow the simulated states beyond chance ({test})")
+            }
+        })
+        .collect();
+    format!("in the time series, {}", clauses.join("; "))
+}

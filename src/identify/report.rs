@@ -169,6 +169,7 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
         "eigen_excluded": o.eigen_excluded.iter().map(excluded_json).collect::<Vec<_>>(),
         "findings": o.findings,
         "remaining": o.remaining,
+        "state_correlation": o.state_correlation,
         "discovery": o.discovery,
         "weights": id.weights,
         "folds": id.folds,
@@ -307,6 +308,13 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     // Whether the library ran out: a pattern left beyond the kicks' scatter.
     if let Some(r) = &o.remaining {
         let _ = write!(s, "\n{}", super::remaining::remaining_sentence(r, "kicks"));
+    }
+    if !o.state_correlation.is_empty() {
+        let _ = write!(
+            s,
+            "\n{}",
+            super::remaining::state_correlation_sentence(&o.state_correlation)
+        );
     }
     if let Some(d) = &o.discovery {
         let _ = write!(s, "\n{}", super::discovery::kicks_sentence(d));
@@ -537,8 +545,11 @@ pub fn verdict_text(v: &Verdict) -> String {
             "rejected: {symbol} = {value:.4} lies {prior_sds:.1} prior standard deviations from its measured value (beyond {PLAUSIBLE_PRIOR_SDS}: implausible under the measurement, more likely it absorbs a missing effect; tried only when no plausible candidate passes)"
         ),
         Verdict::NotPhysical => "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".into(),
+        Verdict::TakenOver { z } => format!(
+            "dropped: refitted with the terms added after it, its coefficient is {z:.2} standard errors from zero; they took it over"
+        ),
         Verdict::LagNotResolved { time_constant } => {
-            format!("rejected: its lag fitted to {time_constant:.2e} s, shorter than the data resolve (the direct term, tried on its own)")
+            format!("rejected: a lag fitted to {time_constant:.2e} s, outside what the data resolve (from a hundredth of the shortest weave period, where it is the direct term tried on its own, to ten of the longest)")
         }
         Verdict::NoCriterionGain { bic_change } => {
             format!("rejected: BIC {bic_change:+.1} (no gain beyond its added parameters; not cross-validated)")
@@ -547,7 +558,7 @@ pub fn verdict_text(v: &Verdict) -> String {
             format!("rejected: held-out error {cv:.4} not below {base_cv:.4} (does not generalise)")
         }
         Verdict::HeldOutGainNotConsistent { gain, stderr } => format!(
-            "rejected: held-out gain per run {gain:.4}, within two standard errors of zero (standard error {stderr:.4}; not a consistent improvement)"
+            "rejected: mean held-out gain per run (per row or kick in the dictionary's search) {gain:.4}, within two standard errors of zero (standard error {stderr:.4}; not a consistent improvement)"
         ),
         Verdict::Encompassed { by, t, remains } => format!(
             "replaced by {by}: fitted together with it, its parameters keep {:.0} % of their shift alone ({t:.1} standard errors from their absence) while {by} stays significant; it stood in for {by}",

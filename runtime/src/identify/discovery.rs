@@ -707,11 +707,31 @@ pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
                     .iter()
                     .map(|g| std::f64::consts::TAU / g.im.abs().max(1e-9))
                     .fold(f64::INFINITY, f64::min);
-                if let Some(&(tau, _)) = t.lagged.then(|| term_values(&f, t).last().copied()).flatten().as_ref() {
-                    if tau < 0.01 * shortest_period {
-                        let verdict = Verdict::LagNotResolved { time_constant: tau };
-                        return (trial(term_values(&f, t), db, f64::NAN, verdict), None);
-                    }
+                let longest_period = s
+                    .guide
+                    .iter()
+                    .map(|g| std::f64::consts::TAU / g.im.abs().max(1e-9))
+                    .fold(0.0, f64::max);
+                // Every lag of the set counts: refitted with the new term,
+                // an earlier term's lag may collapse or run away too. A lag
+                // far longer than the slowest weave period (ten of them)
+                // never builds its torque within a response: no lag the
+                // data show either.
+                if let Some(tau) = lag_time_constants(&set, &f.x[nl..])
+                    .into_iter()
+                    .find(|&tau| !(0.01 * shortest_period..=10.0 * longest_period).contains(&tau))
+                {
+                    let verdict = Verdict::LagNotResolved { time_constant: tau };
+                    return (trial(term_values(&f, t), db, f64::NAN, verdict), None);
+                }
+                // A fit whose values the data do not determine (a singular
+                // information matrix) is no finding.
+                if f.stderr.iter().any(|e| !e.is_finite()) {
+                    let reason = "the data do not determine its values (singular fit)".to_string();
+                    return (
+                        trial(term_values(&f, t), db, f64::NAN, Verdict::FitFailed { reason }),
+                        None,
+                    );
                 }
                 let held = (db < 0.0).then(|| s.held_out(&set, &f));
                 let cv = held.as_ref().map_or(f64::NAN, HeldOut::cv);
@@ -766,6 +786,44 @@ pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
         current_held = held;
         current = f;
     }
+    // Backward: a term added early may be taken over by a later one in the
+    // joint fit (its coefficient then within two standard errors of zero).
+    // Such a term is dropped and the rest refitted, as long as one is.
+    while terms.len() > 1 {
+        let mut at = nl;
+        let mut weakest: Option<(usize, f64)> = None;
+        for (i, t) in terms.iter().enumerate() {
+            if t.signal != Signal::ControllerTorque {
+                let z = (current.x[at] / current.stderr[at]).abs();
+                if z < 2.0 && weakest.is_none_or(|w| z < w.1) {
+                    weakest = Some((i, z));
+                }
+            }
+            at += t.parameter_count();
+        }
+        let Some((i, z)) = weakest else { break };
+        let mut kept_x: Vec<f64> = current.x[..nl].to_vec();
+        let mut at = nl;
+        for (j, t) in terms.iter().enumerate() {
+            if j != i {
+                kept_x.extend_from_slice(&current.x[at..at + t.parameter_count()]);
+            }
+            at += t.parameter_count();
+        }
+        let kept: Vec<Term> = terms
+            .iter()
+            .enumerate()
+            .filter(|&(j, _)| j != i)
+            .map(|(_, t)| *t)
+            .collect();
+        let Some(f) = s.fit(&kept, &[kept_x], &all) else { break };
+        if let Some(tr) = trials.iter_mut().find(|tr| tr.term == terms[i] && tr.verdict.added()) {
+            tr.verdict = Verdict::TakenOver { z };
+        }
+        current_held = s.held_out(&kept, &f);
+        current = f;
+        terms = kept;
+    }
     let mut found = Vec::new();
     let mut at = nl;
     for &t in &terms {
@@ -780,11 +838,10 @@ pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
             let tau = time_constant(current.x[at - 1]);
             (tau, tau * current.stderr[at - 1])
         });
-        let step = found.len() + 1;
-        let added_bic = trials
+        let (step, added_bic) = trials
             .iter()
-            .find(|tr: &&TermTrial| tr.step == step && tr.term == t)
-            .map_or(f64::NAN, |tr| tr.bic_change);
+            .find(|tr: &&TermTrial| tr.term == t && tr.verdict.added())
+            .map_or((0, f64::NAN), |tr| (tr.step, tr.bic_change));
         let alike = trials
             .iter()
             .filter(|tr| tr.step == step && tr.term != t && tr.bic_change < added_bic + ALIKE_BIC)
@@ -811,6 +868,20 @@ pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
         terms: found,
         trials,
     })
+}
+
+/// The time constants (s) of the lagged terms of `terms` at the terms'
+/// values `theta`.
+fn lag_time_constants(terms: &[Term], theta: &[f64]) -> Vec<f64> {
+    let mut at = 0;
+    let mut taus = Vec::new();
+    for t in terms {
+        at += t.parameter_count();
+        if t.lagged {
+            taus.push(time_constant(theta[at - 1]));
+        }
+    }
+    taus
 }
 
 /// A trial's values of its newest term (the last of the fitted vector):

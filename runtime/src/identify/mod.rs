@@ -74,6 +74,7 @@ mod screen;
 mod search_order;
 mod segment;
 pub mod selection;
+pub mod state_correlation;
 mod verdict;
 pub use candidate::{Bound, Candidate, EffectParameter};
 pub use confounding::{Confounding, Design, HeldOutGain, CONFOUNDED};

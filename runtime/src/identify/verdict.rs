@@ -65,8 +65,13 @@ pub enum Verdict {
     Encompassed { by: String, t: f64, remains: f64 },
     /// A pair fitted for the encompassing test: not a candidate of its own.
     NotAdded,
-    /// A lagged term whose time constant (s) fitted shorter than the data
-    /// can resolve: it is the direct term, which the dictionary also holds.
+    /// Added, then dropped: refitted with the terms added after it, its
+    /// coefficient is within two standard errors of zero (`z`, its ratio to
+    /// its standard error); they took it over.
+    TakenOver { z: f64 },
+    /// A lagged term whose time constant (s) fitted outside what the data
+    /// resolve: far shorter than a weave period (the direct term, which the
+    /// dictionary also holds) or far longer (a torque that never builds).
     LagNotResolved { time_constant: f64 },
 }
 
