@@ -362,12 +362,6 @@ pub fn reading(f: &FoundTerm) -> String {
     format!("{what}{speed}{lag}{alike}")
 }
 
-/// The values by symbol of a library selection (see
-/// `eigen_table::values_map`).
-pub fn library_values(d: &Discovery) -> BTreeMap<String, (f64, f64)> {
-    d.library.iter().map(|(k, v, se)| (k.clone(), (*v, *se))).collect()
-}
-
 /// A found term's coefficient in the models' signs (the thesis's: steer
 /// positive to the left): a benchmark term from coordinate `c` on equation
 /// `e` changes sign when exactly one of them is the steer. `None` for the
@@ -408,7 +402,6 @@ fn effect_source(name: &str, found: &[FoundTerm]) -> String {
     );
     let mut body = String::new();
     let mut fitted = Vec::new();
-    let mut uses_state = false;
     for (i, f) in found.iter().enumerate() {
         let t = f.term;
         let _ = writeln!(doc, "//! - {}", reading(f));
@@ -459,7 +452,6 @@ fn effect_source(name: &str, found: &[FoundTerm]) -> String {
         let force = format!("k{i}{power} * {source}");
         let coordinate_of_equation = format!("parts.{}.clone()", coordinate(t.equation));
         if let Some((tau, _)) = f.time_constant {
-            uses_state = true;
             let state = format!("{name}_z{i}");
             let _ = writeln!(
                 body,
@@ -488,7 +480,6 @@ fn effect_source(name: &str, found: &[FoundTerm]) -> String {
     s += "#[allow(unused_imports)]\nuse bikedyn_modeler::expr::{coord, rate, Expr};\nuse bikedyn_modeler::model::{Force, ModelBuilder};\n\n";
     s += "#[allow(unused_variables)]\npub fn apply(m: &mut ModelBuilder, parts: &BicycleParts) {\n";
     s += "    let v = m\n        .model()\n        .forward_speed\n        .clone()\n        .expect(\"bicycle models declare their forward speed before effects\");\n";
-    let _ = uses_state;
     s += &body;
     s += "}\n\n";
     let _ = writeln!(s, "const FITTED: &[Fitted] = &[{}];\n", fitted.join(", "));

@@ -65,6 +65,7 @@ pub mod discovery;
 mod elimination;
 mod encompassing;
 mod fit;
+pub mod least_squares;
 mod normal;
 mod nuisance;
 pub mod remaining;

@@ -26,11 +26,11 @@ use super::predict::predict;
 use super::IdentifyError;
 use crate::bicycle::Bicycle;
 use bikedyn_runtime::identify::discovery::Row;
+use bikedyn_runtime::identify::least_squares::levenberg_marquardt;
 use bikedyn_runtime::identify::remaining::{remaining, KickWeave, Remaining};
 use bikedyn_runtime::identify::{Candidate, Verdict, PLAUSIBLE_PRIOR_SDS};
 use bikedyn_runtime::model::{CandidateDeclaration, EffectIdentification, LinearEquivalent};
 use bikedyn_runtime::registry::ModelInfo;
-use nalgebra::{DMatrix, DVector};
 use serde::Serialize;
 
 mod read;
@@ -441,7 +441,8 @@ pub(super) fn values_map(set: &[&Candidate], values: &[f64]) -> BTreeMap<String,
 
 /// Levenberg-Marquardt over the parameters of `set` (a few), with their
 /// priors as extra residual rows; forward-difference Jacobian (a
-/// prediction costs microseconds). Standard errors from `(J^T J)^-1 s^2`.
+/// prediction costs microseconds; `least_squares`). Standard errors from
+/// `(J^T J)^-1 s^2`.
 fn fit(
     set: &[&Candidate],
     residuals: &dyn Fn(&BTreeMap<String, f64>) -> Result<Vec<f64>, IdentifyError>,
@@ -457,64 +458,19 @@ fn fit(
         }
         Ok(r)
     };
-    let mut x: Vec<f64> = params
+    let x0: Vec<f64> = params
         .iter()
         .map(|p| p.prior.map(|(m, _)| m).or(p.initial).unwrap_or(0.1 * p.scale))
         .collect();
-    let mut r = eval(&x)?;
+    let scales: Vec<f64> = params.iter().map(|p| p.scale).collect();
     let cost = |r: &[f64]| r.iter().map(|a| a * a).sum::<f64>();
-    let mut c = cost(&r);
-    let mut lambda = 1e-3;
-    let jac = |x: &[f64], r: &[f64]| -> Result<DMatrix<f64>, IdentifyError> {
-        let mut j = DMatrix::zeros(r.len(), k);
-        for (col, p) in params.iter().enumerate() {
-            let h = 1e-6 * p.scale.max(x[col].abs());
-            let mut xh = x.to_vec();
-            xh[col] += h;
-            let rh = eval(&xh)?;
-            for (i, (a, b)) in rh.iter().zip(r).enumerate() {
-                j[(i, col)] = (a - b) / h;
-            }
-        }
-        Ok(j)
-    };
-    for _ in 0..100 {
-        let j = jac(&x, &r)?;
-        let h = j.tr_mul(&j);
-        let g = j.tr_mul(&DVector::from_column_slice(&r));
-        let mut improved = false;
-        while lambda < 1e12 {
-            let mut a = h.clone();
-            for d in 0..k {
-                a[(d, d)] += lambda * h[(d, d)].max(1e-12);
-            }
-            let Some(dx) = a.lu().solve(&(-&g)) else {
-                lambda *= 10.0;
-                continue;
-            };
-            let xt: Vec<f64> = x.iter().zip(dx.iter()).map(|(a, b)| a + b).collect();
-            let rt = eval(&xt)?;
-            let ct = cost(&rt);
-            if ct < c {
-                let done = (c - ct) <= 1e-10 * c;
-                x = xt;
-                r = rt;
-                c = ct;
-                lambda = (lambda / 3.0).max(1e-12);
-                improved = !done;
-                break;
-            }
-            lambda *= 4.0;
-        }
-        if !improved {
-            break;
-        }
-    }
-    let j = jac(&x, &r)?;
-    let n_data = residuals(&values_map(set, &x))?.len();
-    let chi2 = cost(&residuals(&values_map(set, &x))?);
+    let f = levenberg_marquardt(x0, &scales, 1e-6, &eval)?;
+    let x = f.x;
+    let data = residuals(&values_map(set, &x))?;
+    let n_data = data.len();
+    let chi2 = cost(&data);
     let s2 = chi2 / (n_data as f64 - k as f64).max(1.0);
-    let stderr = match j.tr_mul(&j).try_inverse() {
+    let stderr = match f.jacobian.tr_mul(&f.jacobian).try_inverse() {
         Some(inv) => (0..k).map(|i| (inv[(i, i)] * s2).sqrt()).collect(),
         None => vec![f64::NAN; k],
     };

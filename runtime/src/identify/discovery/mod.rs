@@ -39,8 +39,9 @@
 //! a matrix of at most eight rows, cheap and smooth), as the library's
 //! table fits take them.
 
+use super::least_squares::levenberg_marquardt;
 use super::Verdict;
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::Complex;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -215,7 +216,7 @@ impl Search<'_> {
             .min_by(|a, b| a.chi2.total_cmp(&b.chi2))
     }
 
-    fn fit_from(&self, terms: &[Term], mut x: Vec<f64>, idx: &[usize]) -> Option<Fitted> {
+    fn fit_from(&self, terms: &[Term], x: Vec<f64>, idx: &[usize]) -> Option<Fitted> {
         let k = x.len();
         let scales: Vec<f64> = self
             .p
@@ -226,65 +227,19 @@ impl Search<'_> {
             .take(k)
             .collect();
         let cost = |r: &[f64]| r.iter().map(|a| a * a).sum::<f64>();
-        let mut r = self.with_priors(terms, &x, idx);
-        let mut c = cost(&r);
-        if !c.is_finite() {
+        if !cost(&self.with_priors(terms, &x, idx)).is_finite() {
             return None;
         }
-        let jac = |x: &[f64], r0: &[f64]| {
-            let mut j = DMatrix::zeros(r0.len(), k);
-            for col in 0..k {
-                let h = 1e-7 * scales[col].max(x[col].abs());
-                let mut xp = x.to_vec();
-                xp[col] += h;
-                let rp = self.with_priors(terms, &xp, idx);
-                for (i, (a, b)) in rp.iter().zip(r0).enumerate() {
-                    j[(i, col)] = (a - b) / h;
-                }
-            }
-            j
-        };
-        let mut lambda = 1e-3;
-        // Nothing free (no library parameter, no term): the cost as it is.
-        for _ in 0..if k == 0 { 0 } else { 100 } {
-            let j = jac(&x, &r);
-            let h = j.tr_mul(&j);
-            let g = j.tr_mul(&DVector::from_column_slice(&r));
-            let mut improved = false;
-            while lambda < 1e12 {
-                let mut a = h.clone();
-                for d in 0..k {
-                    a[(d, d)] += lambda * h[(d, d)].max(1e-12);
-                }
-                let Some(dx) = a.lu().solve(&(-&g)) else {
-                    lambda *= 10.0;
-                    continue;
-                };
-                let xt: Vec<f64> = x.iter().zip(dx.iter()).map(|(a, b)| a + b).collect();
-                let rt = self.with_priors(terms, &xt, idx);
-                let ct = cost(&rt);
-                if ct < c {
-                    let done = (c - ct) <= 1e-10 * c;
-                    (x, r, c) = (xt, rt, ct);
-                    lambda = (lambda / 3.0).max(1e-12);
-                    improved = !done;
-                    break;
-                }
-                lambda *= 4.0;
-            }
-            if !improved {
-                break;
-            }
-        }
-        let data = self.residuals(terms, &x, idx);
+        let eval = |x: &[f64]| Ok::<_, std::convert::Infallible>(self.with_priors(terms, x, idx));
+        let Ok(f) = levenberg_marquardt(x, &scales, 1e-7, &eval);
+        let data = self.residuals(terms, &f.x, idx);
         let chi2 = cost(&data);
         let s2 = chi2 / (data.len() as f64 - k as f64).max(1.0);
-        let j = jac(&x, &r);
-        let stderr = match j.tr_mul(&j).try_inverse() {
+        let stderr = match f.jacobian.tr_mul(&f.jacobian).try_inverse() {
             Some(inv) => (0..k).map(|i| (inv[(i, i)].max(0.0) * s2).sqrt()).collect(),
             None => vec![f64::NAN; k],
         };
-        Some(Fitted { x, stderr, chi2 })
+        Some(Fitted { x: f.x, stderr, chi2 })
     }
 
     /// Starts: the library's values, each term's coefficient at zero and a
