@@ -3,15 +3,18 @@
 //! Optimisation is our own common-subexpression elimination: every output of
 //! one function is converted into a single hash-consed DAG (identical
 //! subexpressions, including `sin`/`cos` of the same angle, become one node),
-//! and each node is emitted once as a `let`. Tokens are built with `quote`,
-//! checked by `syn::parse2`, and formatted by `prettyplease`, so the output is
-//! stable and diffable. The functions are generic over the runtime's `Scalar`
+//! and each node is emitted once as a `let`, named by a hash of what it
+//! computes (`temporary_names`) so that a model change renames only the
+//! expressions it changes. Tokens are built with `quote`, checked by
+//! `syn::parse2`, and formatted by `prettyplease`, so the output is stable
+//! and diffs like the change. The functions are generic over the runtime's `Scalar`
 //! trait so that dual numbers can flow through them (exact derivatives for the
 //! linearization without emitting derivative code).
 
 use crate::derive::{Derived, Quantity, Shape};
 use crate::model::Role;
 use crate::registry::camel;
+use crate::registry::fnv1a;
 pub use crate::registry::{emit_registry, EmitError};
 use proc_macro2::{Ident, Span, TokenStream};
 use quote::{format_ident, quote};
@@ -244,6 +247,78 @@ struct Names {
     rates: Vec<Ident>,
 }
 
+/// Content hashes of the DAG's nodes: what each computes, written with the
+/// names of its inputs, children before parents (a node's children have
+/// lower indices). Sums and products hash their operands as a sorted set,
+/// so the hash does not depend on the order in which derivation visited
+/// them.
+fn content_hashes(nodes: &[Node], names: &Names) -> Vec<u64> {
+    let mut hashes: Vec<u64> = Vec::with_capacity(nodes.len());
+    for n in nodes {
+        let mut text: Vec<u8> = Vec::new();
+        let mut children = |tag: &str, c: &[usize], commutative: bool| {
+            let mut h: Vec<u64> = c.iter().map(|&i| hashes[i]).collect();
+            if commutative {
+                h.sort_unstable();
+            }
+            text.extend_from_slice(tag.as_bytes());
+            for x in h {
+                text.extend_from_slice(&x.to_le_bytes());
+            }
+        };
+        match n {
+            Node::Input(Input::Param(k)) => text.extend_from_slice(names.params[*k].to_string().as_bytes()),
+            Node::Input(Input::Coord(k)) => text.extend_from_slice(names.coords[*k].to_string().as_bytes()),
+            Node::Input(Input::Rate(k)) => text.extend_from_slice(names.rates[*k].to_string().as_bytes()),
+            Node::Input(Input::Time) => text.extend_from_slice(b"t"),
+            Node::Const(b) => {
+                text.extend_from_slice(b"const");
+                text.extend_from_slice(&b.to_le_bytes());
+            }
+            Node::Add(v) => children("add", v, true),
+            Node::Mul(v) => children("mul", v, true),
+            Node::Neg(a) => children("neg", &[*a], false),
+            Node::Recip(a) => children("recip", &[*a], false),
+            Node::Sin(a) => children("sin", &[*a], false),
+            Node::Cos(a) => children("cos", &[*a], false),
+            Node::Sqrt(a) => children("sqrt", &[*a], false),
+            Node::Exp(a) => children("exp", &[*a], false),
+            Node::Acos(a) => children("acos", &[*a], false),
+            Node::Atan(a) => children("atan", &[*a], false),
+        }
+        hashes.push(fnv1a(&text));
+    }
+    hashes
+}
+
+/// Names of the temporaries, from what they compute ([`content_hashes`]):
+/// `t_` and ten hexadecimal digits. A model change then renames only the
+/// expressions it changes, and the emitted file diffs like the change; with
+/// running numbers, one new term renumbered every later temporary. A
+/// collision (two expressions, one name) takes the next free name by
+/// rehashing, in the order of the nodes.
+fn temporary_names(nodes: &[Node], hashes: &[u64]) -> Vec<Ident> {
+    let mut taken = std::collections::HashSet::new();
+    hashes
+        .iter()
+        .zip(nodes)
+        .map(|(&h, n)| {
+            if matches!(n, Node::Input(_) | Node::Const(_)) {
+                // Inputs and constants are written by name or value.
+                return format_ident!("unused");
+            }
+            let mut h = h;
+            loop {
+                let name = format!("t_{:010x}", h & 0xff_ffff_ffff);
+                if taken.insert(name.clone()) {
+                    return ident(&name);
+                }
+                h = fnv1a(&h.to_le_bytes());
+            }
+        })
+        .collect()
+}
+
 fn ident(s: &str) -> Ident {
     Ident::new(s, Span::call_site())
 }
@@ -271,6 +346,16 @@ fn emit_function(
         before: dag.tree_ops,
         after: count_dag(&dag.nodes),
     };
+    let hashes = content_hashes(&dag.nodes, names);
+    let temp = temporary_names(&dag.nodes, &hashes);
+    // Operands of sums and products in the order of their content hashes
+    // (constants first), which, unlike the order of derivation, a model
+    // change does not shuffle.
+    let canonical = |v: &[usize], nodes: &[Node]| -> Vec<usize> {
+        let mut v = v.to_vec();
+        v.sort_by_key(|&c| (!matches!(nodes[c], Node::Const(_)), hashes[c]));
+        v
+    };
     let var = |i: usize, nodes: &[Node]| -> TokenStream {
         match &nodes[i] {
             Node::Input(Input::Param(k)) => {
@@ -288,7 +373,7 @@ fn emit_function(
             Node::Input(Input::Time) => quote!(t),
             Node::Const(b) => lit(f64::from_bits(*b)),
             _ => {
-                let n = format_ident!("t{}", i);
+                let n = &temp[i];
                 quote!(#n)
             }
         }
@@ -339,7 +424,7 @@ fn emit_function(
         }
     }
     for (i, n) in dag.nodes.iter().enumerate() {
-        let t = format_ident!("t{}", i);
+        let t = &temp[i];
         if let Some(&(si, ci)) = partner.get(&i) {
             if si == usize::MAX {
                 continue;
@@ -347,13 +432,14 @@ fn emit_function(
             let Node::Sin(a) = dag.nodes[si] else {
                 unreachable!("paired node is a sine")
             };
-            let (s_id, c_id, a) = (format_ident!("t{}", si), format_ident!("t{}", ci), var(a, &dag.nodes));
+            let (s_id, c_id, a) = (&temp[si], &temp[ci], var(a, &dag.nodes));
             body.push(quote!(let (#s_id, #c_id): (T, T) = #a.sin_cos();));
             continue;
         }
         let e = match n {
             Node::Input(_) | Node::Const(_) => continue,
             Node::Add(v) => {
+                let v = canonical(v, &dag.nodes);
                 let mut it = v.iter().map(|&c| (c, matches!(dag.nodes[c], Node::Neg(_))));
                 let mut pos: Vec<TokenStream> = Vec::new();
                 let mut neg: Vec<TokenStream> = Vec::new();
@@ -376,7 +462,7 @@ fn emit_function(
                 quote!(#first #(+ #pos)* #(- #neg)*)
             }
             Node::Mul(v) => {
-                let f: Vec<_> = v.iter().map(|&c| var(c, &dag.nodes)).collect();
+                let f: Vec<_> = canonical(v, &dag.nodes).iter().map(|&c| var(c, &dag.nodes)).collect();
                 let (h, rest) = f.split_first().expect("products have factors");
                 quote!(#h #(* #rest)*)
             }
