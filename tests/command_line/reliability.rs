@@ -574,3 +574,26 @@ fn an_endless_input_file_is_refused_at_its_cap() {
     assert!(!out.status.success());
     assert!(err.contains("speed_switch.csv") && err.contains("is a device"), "{err}");
 }
+
+/// A log of one 2 MiB line (no table at all) was refused with the whole
+/// line echoed as the header it lacked: megabytes on the terminal. The
+/// message names the file, the line and the missing column, and echoes the
+/// line's start with the count of what it leaves out.
+#[test]
+fn a_file_of_one_long_line_is_refused_with_its_start_echoed() {
+    let dir = tmp("one-long-line");
+    std::fs::create_dir_all(&dir).unwrap();
+    let log = dir.join("log.csv");
+    std::fs::write(&log, "x".repeat(2 << 20)).unwrap();
+    let bike = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/tudelft_sbw_bicycle.toml");
+    let out = bikedyn(&["fit", log.to_str().unwrap(), "--bike", bike.to_str().unwrap()]);
+    let err = text(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("log.csv:1: header has no column `speed`"),
+        "{}",
+        &err[..err.len().min(500)]
+    );
+    assert!(err.contains("more characters)"), "{}", &err[..err.len().min(500)]);
+    assert!(err.len() < 2000, "{} bytes of messages", err.len());
+}

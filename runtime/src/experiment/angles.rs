@@ -252,6 +252,22 @@ impl Calibration {
     /// that much.
     pub const AT_REST_LIMIT: f64 = 2.0 * std::f64::consts::PI / 180.0;
 
+    /// The share of a run's relative rotation that must be about one axis
+    /// for the run to show the steer axis ([`Self::steer_axis_consensus`]).
+    /// A steer motion puts nearly all of it about the steer axis; sensor
+    /// noise spreads it evenly over three axes (a share of 1/3). Half lies
+    /// well between: a run at one half has as much rotation off the axis as
+    /// about it.
+    pub const ONE_AXIS_SHARE: f64 = 0.5;
+
+    /// The least angle (rad) between a run's steer axis and the set's that
+    /// sets the run aside: 5 deg. Both sensors are clamped to their bodies,
+    /// so all runs of a set turn about one axis; runs with steer motion give
+    /// it to a fraction of a degree. A sensor moved or turned on its mount,
+    /// or the two sensors' files swapped, tilts it by the mounting's own
+    /// misalignment, several degrees.
+    pub const STEER_AXIS_TOLERANCE: f64 = 5.0 * std::f64::consts::PI / 180.0;
+
     fn finish(&mut self, cal: &ThesisRun, k0: usize) {
         let direct = angles(cal, self, AngleMethod::Direct);
         self.noise = (robust_sigma(&direct.roll[k0..]), robust_sigma(&direct.steer[k0..]));
@@ -261,45 +277,42 @@ impl Calibration {
         self.thesis_offsets = (median(&th.roll[k0..]), median(&th.steer[k0..]));
     }
 
-    /// The steer axis in frame-sensor coordinates, from the relative rotations
-    /// of runs with steer motion: `R_f^T R_h M_h^T M_f = M_f^T Rz(steer) M_f`,
-    /// a rotation about `M_f^T z`. The units drift in heading independently,
-    /// which adds a slow relative rotation about the vertical; so the axis is
-    /// the principal direction of the rotation *increments* over a tenth of a
-    /// second (steer moves fast during a response, drift does not). `None`
-    /// without enough steer motion.
-    pub fn steer_axis(&self, runs: &[&ThesisRun]) -> Option<Vector3<f64>> {
+    /// The rotations of the handlebar sensor relative to the frame sensor
+    /// over a run's settled record (its `frame` and `handlebar` records), each relative to the run's mean
+    /// (scaled axis, rad), in frame-sensor coordinates:
+    /// `R_f^T R_h M_h^T M_f = M_f^T Rz(steer) M_f` is a rotation about
+    /// `M_f^T z`. The units drift in heading independently, which adds a slow
+    /// relative rotation about the vertical; relative to the run's mean the
+    /// steer amplitudes are full (much larger than the noise) while the drift
+    /// stays small within a run.
+    pub fn relative_rotations(&self, frame: &ImuRecord, handlebar: &ImuRecord) -> Vec<Vector3<f64>> {
         let c = self.handlebar.inverse() * self.frame;
-        let mut incs: Vec<Vector3<f64>> = Vec::new();
-        for run in runs {
-            let n = run.frame.q.len();
-            let k0 = run.frame.t.partition_point(|&t| t < self.settled_from);
-            if n < k0 + 10 {
-                continue;
-            }
-            let rel: Vec<UnitQuaternion<f64>> = (k0..n)
-                .map(|k| run.frame.q[k].inverse() * run.handlebar.q[k] * UnitQuaternion::from_rotation_matrix(&c))
-                .collect();
-            // Relative to the run's mean: full steer amplitudes (much larger
-            // than the noise), while the drift stays small within a run.
-            let reference = mean_rotation(&rel);
-            for q in &rel {
-                incs.push((reference.inverse() * q).scaled_axis());
-            }
+        let n = frame.q.len().min(handlebar.q.len());
+        let k0 = frame.t.partition_point(|&t| t < self.settled_from);
+        if n < k0 + 10 {
+            return Vec::new();
         }
-        // Most increments are sensor noise; keep those well above it (three
-        // median increment sizes).
-        let sizes: Vec<f64> = incs.iter().map(|r| r.norm()).collect();
-        let noise = median(&sizes);
+        let rel: Vec<UnitQuaternion<f64>> = (k0..n)
+            .map(|k| frame.q[k].inverse() * handlebar.q[k] * UnitQuaternion::from_rotation_matrix(&c))
+            .collect();
+        let reference = mean_rotation(&rel);
+        rel.iter().map(|q| (reference.inverse() * q).scaled_axis()).collect()
+    }
+
+    /// The principal direction of the rotations `incs` well above the noise
+    /// (three times `noise`, the median rotation size: most samples are
+    /// sensor noise), with the share of their squared size it carries.
+    /// `None` with fewer than five such rotations.
+    fn principal_axis(incs: &[Vector3<f64>], noise: f64) -> Option<RunSteerAxis> {
         let mut s = Matrix3::zeros();
         let mut count = 0usize;
-        for r in &incs {
+        for r in incs {
             if r.norm() > 3.0 * noise {
                 s += r * r.transpose();
                 count += 1;
             }
         }
-        if count < 5 {
+        if count < 5 || s.trace() <= 0.0 {
             return None;
         }
         let eig = s.symmetric_eigen();
@@ -308,7 +321,101 @@ impl Calibration {
         if a.z < 0.0 {
             a = -a;
         }
-        Some(a)
+        Some(RunSteerAxis {
+            axis: a,
+            share: eig.eigenvalues[k] / s.trace(),
+            samples: count,
+        })
+    }
+
+    /// The steer axis in frame-sensor coordinates, from the relative
+    /// rotations of runs with steer motion ([`Self::relative_rotations`] of
+    /// each run), pooled. `None` without enough steer motion. A set's runs
+    /// are first screened by [`Self::steer_axis_consensus`].
+    pub fn steer_axis(runs: &[&[Vector3<f64>]]) -> Option<Vector3<f64>> {
+        let incs: Vec<Vector3<f64>> = runs.iter().flat_map(|r| r.iter().copied()).collect();
+        let sizes: Vec<f64> = incs.iter().map(|r| r.norm()).collect();
+        Self::principal_axis(&incs, median(&sizes)).map(|a| a.axis)
+    }
+
+    /// One run's own steer axis ([`Self::steer_axis`] on that run's
+    /// relative rotations alone), with how much of its relative rotation is
+    /// about that axis.
+    pub fn run_steer_axis(rotations: &[Vector3<f64>]) -> Option<RunSteerAxis> {
+        let sizes: Vec<f64> = rotations.iter().map(|r| r.norm()).collect();
+        Self::principal_axis(rotations, median(&sizes))
+    }
+
+    /// Which runs the set's steer axis is estimated from. The two sensors
+    /// are fixed to the frame and the fork, so every run turns the handlebar
+    /// sensor about one and the same axis relative to the frame sensor. A
+    /// run whose relative rotation is not about one axis (noise, a frozen or
+    /// foreign record) would turn a pooled estimate, and through it every
+    /// run's angles: it is left out of the estimate. A run turning about an
+    /// axis of its own (its sensors swapped or moved) is set aside: its
+    /// angles would be wrong. The consensus is the axis of the run closest
+    /// to the others (the medoid: it stands while fewer than half the runs
+    /// are bad); a run is inconsistent when its axis is further from it than
+    /// [`Self::STEER_AXIS_TOLERANCE`] and than three times the runs' median
+    /// distance from it. The set's axis is pooled over the runs that agree.
+    /// The test needs three runs with an axis of their own; with fewer, those
+    /// runs are pooled untested.
+    /// `runs` holds each run's [`Self::relative_rotations`].
+    pub fn steer_axis_consensus(runs: &[&[Vector3<f64>]]) -> SteerAxisConsensus {
+        let axes: Vec<Option<RunSteerAxis>> = runs.iter().map(|r| Self::run_steer_axis(r)).collect();
+        let mut verdicts: Vec<RunAxisVerdict> = axes
+            .iter()
+            .map(|a| match a {
+                Some(a) if a.share >= Self::ONE_AXIS_SHARE => RunAxisVerdict::Used,
+                Some(a) => RunAxisVerdict::NotAboutOneAxis { share: a.share },
+                None => RunAxisVerdict::NoSteerMotion,
+            })
+            .collect();
+        let with_axis: Vec<usize> = (0..runs.len())
+            .filter(|&i| verdicts[i] == RunAxisVerdict::Used)
+            .collect();
+        let angle = |i: usize, j: usize| {
+            let (a, b) = (
+                axes[i].as_ref().expect("has an axis").axis,
+                axes[j].as_ref().expect("has an axis").axis,
+            );
+            a.dot(&b).abs().min(1.0).acos()
+        };
+        let mut consensus = None;
+        if with_axis.len() >= 3 {
+            let medoid = *with_axis
+                .iter()
+                .min_by(|&&i, &&j| {
+                    let mi = median(&with_axis.iter().map(|&k| angle(i, k)).collect::<Vec<_>>());
+                    let mj = median(&with_axis.iter().map(|&k| angle(j, k)).collect::<Vec<_>>());
+                    mi.total_cmp(&mj)
+                })
+                .expect("three runs");
+            let distances: Vec<f64> = with_axis.iter().map(|&k| angle(medoid, k)).collect();
+            let limit = Self::STEER_AXIS_TOLERANCE.max(3.0 * median(&distances));
+            for (&k, &d) in with_axis.iter().zip(&distances) {
+                if d > limit {
+                    verdicts[k] = RunAxisVerdict::Inconsistent { angle: d, limit };
+                }
+            }
+            consensus = axes[medoid].as_ref().map(|a| a.axis);
+        }
+        // The runs that show the axis, pooled; a run without an axis of its
+        // own would add only its noise, and a noise record can outweigh the
+        // rest. Without any such run, every run is pooled: together they
+        // may show what none shows alone.
+        let used: Vec<&[Vector3<f64>]> = runs
+            .iter()
+            .zip(&verdicts)
+            .filter(|(_, v)| matches!(v, RunAxisVerdict::Used))
+            .map(|(r, _)| *r)
+            .collect();
+        let pooled = if used.is_empty() { runs.to_vec() } else { used };
+        SteerAxisConsensus {
+            axis: Self::steer_axis(&pooled),
+            medoid: consensus,
+            runs: verdicts,
+        }
     }
 
     /// Complete the frame misalignment with the rotation about the vertical
@@ -413,4 +520,51 @@ pub fn angles(run: &ThesisRun, cal: &Calibration, method: AngleMethod) -> Angles
     }
     unwrap(&mut out.yaw);
     out
+}
+
+/// One run's steer axis ([`Calibration::run_steer_axis`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RunSteerAxis {
+    /// The axis in frame-sensor coordinates (unit, z up).
+    pub axis: Vector3<f64>,
+    /// Share of the run's relative rotation (squared, above the noise)
+    /// about that axis: 1 for a pure steer motion, about 1/3 for noise.
+    pub share: f64,
+    /// Samples above the noise.
+    pub samples: usize,
+}
+
+/// What a run gives the set's steer axis ([`Calibration::steer_axis_consensus`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RunAxisVerdict {
+    /// Its axis agrees with the others and enters the estimate.
+    Used,
+    /// Too little steer motion above its noise for an axis of its own (a
+    /// straight run, or a record of noise): left out of the estimate.
+    NoSteerMotion,
+    /// Its relative rotation is not about one axis: left out of the
+    /// estimate.
+    NotAboutOneAxis {
+        /// Share about its principal axis.
+        share: f64,
+    },
+    /// It turns about an axis of its own: set aside.
+    Inconsistent {
+        /// Its axis's angle from the consensus (rad).
+        angle: f64,
+        /// The largest angle accepted (rad).
+        limit: f64,
+    },
+}
+
+/// The set's steer axis with each run's part in it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SteerAxisConsensus {
+    /// The axis pooled over the runs used (`None` without steer motion).
+    pub axis: Option<Vector3<f64>>,
+    /// The consensus run axis the others were judged against (with three
+    /// runs or more with an axis).
+    pub medoid: Option<Vector3<f64>>,
+    /// One verdict per run, in order.
+    pub runs: Vec<RunAxisVerdict>,
 }

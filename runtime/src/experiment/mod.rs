@@ -24,6 +24,7 @@ pub mod synth;
 use angles::{AngleMethod, Angles, Calibration};
 use fit::{FitForm, FitResult};
 use kicks::{Kick, KickOptions};
+use nalgebra::Vector3;
 use read::{ReadError, RunKind, ThesisRun, TudelftLog};
 use serde::Serialize;
 use speed::SpeedProfile;
@@ -228,6 +229,25 @@ pub enum RunError {
         angle: f64,
         /// Its angles about x, y, z (rad).
         euler: [f64; 3],
+    },
+    /// The run's handlebar sensor turns, relative to its frame sensor,
+    /// about an axis of its own, not the steer axis the set's other runs
+    /// share: its sensors were swapped, moved or turned on their mounts, or
+    /// its files belong to another set. It is set aside, and the set's steer
+    /// axis is estimated without it.
+    #[error(
+        "{}: set aside: its handlebar sensor turns about an axis {:.1} deg from the steer axis the set's other runs share (at most {:.1} deg between runs of one set); check that its frame and handlebar files are not swapped and that both sensors sat on their mounts as in the other runs",
+        run.display(),
+        angle.to_degrees(),
+        limit.to_degrees()
+    )]
+    SteerAxisInconsistent {
+        /// The run.
+        run: PathBuf,
+        /// Its axis's angle from the set's (rad).
+        angle: f64,
+        /// The largest angle accepted (rad).
+        limit: f64,
     },
     /// The named path is neither a run, a set nor a log.
     #[error("{}: not a run folder (run.toml), a set of runs, or a log file", path.display())]
@@ -695,6 +715,11 @@ fn check_misalignment(cal: &Calibration, run: &Path) -> Result<(), RunError> {
 /// Process a set of thesis-style runs: calibration (completed with the
 /// steer axis seen in the runs), then every run; a corrupt run gives its
 /// error and the others go on. `progress` is called after each run.
+///
+/// Runs are read one at a time, twice: first their orientations alone, of
+/// which only the relative rotations that show the steer axis are kept,
+/// then each whole run, processed and dropped before the next is read. So
+/// memory holds one run's records at a time, whatever the set's size.
 pub fn process_set(
     runs: &[PathBuf],
     calibration: &Path,
@@ -702,8 +727,6 @@ pub fn process_set(
     progress: &(dyn Fn() + Sync),
 ) -> Result<(Calibration, Vec<Result<RunReport, RunError>>), RunError> {
     let cal_run = read::read_run(calibration)?;
-    let read: Vec<Result<ThesisRun, RunError>> =
-        runs.iter().map(|r| read::read_run(r).map_err(RunError::from)).collect();
     let mut cal = Calibration::estimate(&cal_run, opt.frame_pitch);
     match cal.motion(&cal_run) {
         Some(motion) if !motion.at_rest() => {
@@ -724,15 +747,50 @@ pub fn process_set(
             });
         }
     }
-    let good: Vec<&ThesisRun> = read.iter().filter_map(|r| r.as_ref().ok()).collect();
-    if let Some(axis) = cal.steer_axis(&good) {
+    // The steer axis from the runs that agree on it: a bad run must not
+    // turn it, and through it every other run's angles.
+    let rotations: Vec<Result<Vec<Vector3<f64>>, RunError>> = runs
+        .iter()
+        .map(|r| {
+            read::read_run_orientations(r)
+                .map(|(_, frame, handlebar)| cal.relative_rotations(&frame, &handlebar))
+                .map_err(RunError::from)
+        })
+        .collect();
+    let readable: Vec<(usize, &[Vector3<f64>])> = rotations
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r.as_slice())))
+        .collect();
+    let consensus = Calibration::steer_axis_consensus(&readable.iter().map(|(_, r)| *r).collect::<Vec<_>>());
+    let mut set_aside: Vec<Option<(f64, f64)>> = vec![None; runs.len()];
+    for ((i, _), v) in readable.iter().zip(&consensus.runs) {
+        if let angles::RunAxisVerdict::Inconsistent { angle, limit } = *v {
+            set_aside[*i] = Some((angle, limit));
+        }
+    }
+    let unreadable: Vec<Option<RunError>> = rotations.into_iter().map(|r| r.err()).collect();
+    if let Some(axis) = consensus.axis {
         cal = cal.with_steer_axis(&cal_run, &axis);
     }
+    drop(cal_run);
     check_misalignment(&cal, calibration)?;
-    let out = read
-        .into_iter()
-        .map(|r| {
-            let rep = r.map(|run| process_thesis_run(&run, &cal, opt));
+    let out = runs
+        .iter()
+        .zip(set_aside)
+        .zip(unreadable)
+        .map(|((path, aside), unreadable)| {
+            let rep = match (unreadable, aside) {
+                (Some(e), _) => Err(e),
+                (None, Some((angle, limit))) => Err(RunError::SteerAxisInconsistent {
+                    run: path.clone(),
+                    angle,
+                    limit,
+                }),
+                (None, None) => read::read_run(path)
+                    .map(|run| process_thesis_run(&run, &cal, opt))
+                    .map_err(RunError::from),
+            };
             progress();
             rep
         })

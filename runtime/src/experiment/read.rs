@@ -271,8 +271,10 @@ fn read_table(path: &Path, wanted: &[&[&'static str]], limit: u64, no_repeats: b
                             path: path.to_path_buf(),
                             line: line_no,
                             column: w[0],
-                            found: l.to_string(),
-                        })
+                            // A "header" of a file that is no table can be
+                            // megabytes long: echo its start.
+                            found: clip_lines(l, MAX_ECHOED_CHARS),
+                        });
                     }
                 }
             }
@@ -681,6 +683,22 @@ pub struct ThesisRun {
 
 /// Read a run folder (or the calibration folder).
 pub fn read_run(dir: &Path) -> Result<ThesisRun, ReadError> {
+    let (meta, frame, handlebar) = read_run_orientations(dir)?;
+    let switch = read_switch(&dir.join(&meta.switch_file), meta.switch_rate_hz)?;
+    Ok(ThesisRun {
+        dir: dir.to_path_buf(),
+        meta,
+        frame,
+        handlebar,
+        switch,
+    })
+}
+
+/// Read a run folder's `run.toml` and its two IMU records, checked against
+/// each other as [`read_run`] checks them, without the reed switch's
+/// record (the largest file of a run: a set's steer axis needs only the
+/// orientations).
+pub fn read_run_orientations(dir: &Path) -> Result<(RunMeta, ImuRecord, ImuRecord), ReadError> {
     let meta = read_meta(&dir.join("run.toml"))?;
     let frame = read_imu(&dir.join(&meta.imu_files[0]), meta.imu_rate_hz)?;
     let handlebar = read_imu(&dir.join(&meta.imu_files[1]), meta.imu_rate_hz)?;
@@ -717,14 +735,7 @@ pub fn read_run(dir: &Path) -> Result<ThesisRun, ReadError> {
             });
         }
     }
-    let switch = read_switch(&dir.join(&meta.switch_file), meta.switch_rate_hz)?;
-    Ok(ThesisRun {
-        dir: dir.to_path_buf(),
-        meta,
-        frame,
-        handlebar,
-        switch,
-    })
+    Ok((meta, frame, handlebar))
 }
 
 /// Highest forward speed read from a log or an eigenvalue table (m/s, 108
