@@ -11,10 +11,13 @@ its exit status and its wall time. The cases:
   one does;
 - `identify --eigenvalues /dev/zero`: a device, refused before reading;
 - a sparse 1 GiB TU Delft log: refused from its size before reading;
-- a 100 MiB log of one line: refused from its size.
+- a 100 MiB log of one line: refused from its size;
+- with --python PY (an interpreter with bikedyn installed): `eig` over a
+  million speeds (the most one call takes) and over ten million (refused
+  with a MemoryError before computing).
 
 Usage: python3 scripts/memory_bench.py [--bikedyn target/release/bikedyn]
-       [--size MIB] [--work DIR]
+       [--size MIB] [--work DIR] [--python PY]
 Needs a Unix system (os.wait4). Writes about 4 x SIZE MiB under --work
 (default: a temporary folder, removed at the end).
 """
@@ -70,6 +73,7 @@ def main():
     ap.add_argument("--bikedyn", default=os.path.join(ROOT, "target", "release", "bikedyn"))
     ap.add_argument("--size", type=int, default=100, help="MiB per reed-switch record (default 100)")
     ap.add_argument("--work", help="folder for the inputs (default: a temporary one)")
+    ap.add_argument("--python", help="a Python with the bikedyn package, for its cases")
     a = ap.parse_args()
     if not os.path.exists(a.bikedyn):
         sys.exit(f"error: {a.bikedyn} not found: build it with cargo build --release --bin bikedyn")
@@ -97,6 +101,17 @@ def main():
             ("fit of a sparse 1 GiB log", [a.bikedyn, "fit", sparse, "--bike", LOG_BIKE]),
             ("fit of a 100 MiB one-line log", [a.bikedyn, "fit", one_line, "--bike", LOG_BIKE]),
         ]
+        if a.python:
+            for n in (1_000_000, 10_000_000):
+                code = (
+                    "import sys, numpy as np, bikedyn\n"
+                    "b = bikedyn.Bicycle('benchmark')\n"
+                    "try:\n"
+                    f"    b.eig(np.linspace(0.0, 10.0, {n}))\n"
+                    "except MemoryError:\n"
+                    "    sys.exit(1)\n"
+                )
+                cases.append((f"Python eig over {n:,} speeds", [a.python, "-c", code]))
         print(f"{'case':<48} {'exit':>4} {'peak RSS (MiB)':>15} {'time (s)':>9}")
         for label, cmd in cases:
             code, rss, secs = peak(cmd)

@@ -222,3 +222,77 @@ fn a_run_with_its_sensor_files_swapped_is_set_aside() {
     assert_eq!(without.len(), 5);
     assert_eq!(swapped, without, "{err}");
 }
+
+/// A logger that keeps recording after the wheel stops writes the reed
+/// switch's level for as long as it runs, and a converter at rest repeats
+/// one value exactly. Such seconds after run04 broke its speed:
+/// - at the open level, the record's robust spread became zero, so noise a
+///   step above the open level was taken for the closed one; the pulses
+///   came from noise and the kick was lost ("no kick found");
+/// - with a magnet stopped at the switch (the closed level repeated), the
+///   record's median, taken as the open level, was the closed one; the
+///   speed came out at 18-27 m/s.
+/// The noise is now at least a 10-bit converter's step over the record's
+/// span (between its tenth lowest and tenth highest samples, so a rest of
+/// any length leaves it), a record that sits mostly closed finds its open
+/// level below the span's middle, and the run's fit is what it was, after
+/// twenty seconds at rest or a thousand.
+#[test]
+fn a_switch_record_that_goes_on_at_rest_keeps_the_run_as_it_was() {
+    let others = ["run01", "run02", "run03", "run05", "run06"];
+    let fit_run04 = |set: &Path| {
+        let (status, err, fits) = fits_by_run(set);
+        assert_eq!(status, Some(0), "{err}");
+        fits["run04"].clone()
+    };
+    let reference = fit_run04(&whole_set("run04-as-recorded", &others));
+    for (name, level, rest_s) in [
+        ("open", "last", 20),
+        ("closed", "highest", 20),
+        ("open-long", "last", 1000),
+    ] {
+        let d = whole_set(&format!("run04-at-rest-{name}"), &others);
+        let switch = d.join("run04").join("speed_switch.csv");
+        let text = std::fs::read_to_string(&switch).unwrap();
+        let rows: Vec<(f64, &str)> = text
+            .lines()
+            .skip(1)
+            .map(|l| {
+                let (t, v) = l.split_once(',').unwrap();
+                (t.parse().unwrap(), v)
+            })
+            .collect();
+        let t_end = rows.last().unwrap().0;
+        let volts = if level == "last" {
+            rows.last().unwrap().1
+        } else {
+            rows.iter()
+                .max_by(|a, b| a.1.parse::<f64>().unwrap().total_cmp(&b.1.parse().unwrap()))
+                .unwrap()
+                .1
+        };
+        // At 1 kHz; a thousand seconds are 99 % of the record.
+        let mut more = text.clone();
+        for k in 1..=rest_s * 1000 {
+            more += &format!("{:.3},{volts}\n", t_end + 0.001 * k as f64);
+        }
+        std::fs::write(&switch, more).unwrap();
+        let extended = fit_run04(&d);
+        let (a, b) = (
+            reference["weave"].as_array().unwrap(),
+            extended["weave"].as_array().unwrap(),
+        );
+        let se = reference["weave_stderr"].as_array().unwrap();
+        for k in 0..2 {
+            let (x, y, s) = (a[k].as_f64().unwrap(), b[k].as_f64().unwrap(), se[k].as_f64().unwrap());
+            assert!(
+                (x - y).abs() < 0.01 * s,
+                "at rest {name}: weave {a:?} as recorded, {b:?} with the rest after"
+            );
+        }
+        assert_eq!(
+            reference["speed_interval"], extended["speed_interval"],
+            "at rest {name}"
+        );
+    }
+}

@@ -67,8 +67,34 @@ impl SpeedProfile {
 
 /// Pulses and bounce count from a voltage record.
 fn detect_pulses(sw: &SwitchRecord) -> (Vec<(usize, usize)>, (f64, f64), usize) {
-    let open = median(&sw.volts);
-    let noise = robust_sigma(&sw.volts).max(1e-9);
+    // The open level is the record's usual one (magnets pass the switch a
+    // small part of each turn), its median; unless the wheel stopped with a
+    // magnet at the switch and the logger went on: the record then sits
+    // mostly closed, its median is the closed level, and the open one is
+    // the median of the samples below the middle of the record's span. The
+    // span runs from the tenth lowest to the tenth highest sample: levels
+    // the switch held (a pulse lasts several samples, and a run has
+    // hundreds), not a spike, however long the wheel rested.
+    let mut sorted: Vec<f64> = sw.volts.iter().copied().filter(|v| v.is_finite()).collect();
+    sorted.sort_by(|a, b| a.total_cmp(b));
+    if sorted.is_empty() {
+        return (Vec::new(), (f64::NAN, f64::NAN), 0);
+    }
+    let k = 9.min(sorted.len() / 2);
+    let (bottom, top) = (sorted[k], sorted[sorted.len() - 1 - k]);
+    let middle = 0.5 * (bottom + top);
+    let mut open = median(&sw.volts);
+    if open > middle {
+        let below = sorted.partition_point(|&v| v < middle);
+        open = median(&sorted[..below]);
+    }
+    drop(sorted);
+    // A converter's record of a switch at rest can sit on one value for a
+    // long time: its robust spread is then zero, and every sample a step
+    // above the open level would count as closed. The noise is taken as at
+    // least one step of a 10-bit converter over the record's span, so the
+    // closed level is looked for well above the open one.
+    let noise = robust_sigma(&sw.volts).max(1e-3 * (top - open)).max(1e-9);
     // Closed level: the median of samples far above the open level.
     let high: Vec<f64> = sw.volts.iter().copied().filter(|&v| v > open + 10.0 * noise).collect();
     if high.len() < 2 {
