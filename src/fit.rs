@@ -351,6 +351,13 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
             errors.push(format!("{}: {why}", r.run.display()));
         }
     }
+    // A run whose steer axis lies apart from the set's was fitted with the
+    // set's axis: say so, it may hold swapped or moved sensors.
+    for r in &reports {
+        for n in r.notes.iter().filter(|n| n.starts_with(experiment::STEER_AXIS_APART)) {
+            warnings.push(format!("{}: {n}", r.run.display()));
+        }
+    }
     // Which fitted eigenvalues are measured weave eigenvalues, and which
     // form is reported, judged against the bicycle's model (the outlier
     // test over every kick of the inputs).

@@ -59,7 +59,8 @@ pub fn run(args: &FitArgs) -> Result<bool> {
         eprintln!("skipped: {e}");
     }
     for r in &out.reports {
-        for n in &r.notes {
+        // A steer axis apart is among the warnings already.
+        for n in r.notes.iter().filter(|n| !n.starts_with(bikedyn::runtime::experiment::STEER_AXIS_APART)) {
             eprintln!("{}: {n}", r.run.display());
         }
         show_gaps(&r.gaps);

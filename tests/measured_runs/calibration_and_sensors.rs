@@ -202,21 +202,33 @@ fn a_run_of_noise_leaves_the_other_runs_fits_unchanged() {
 
 /// A run whose frame and handlebar files are swapped turns its handlebar
 /// "sensor" about an axis several degrees from the steer axis of the other
-/// runs (by the two mountings' difference). It used to be accepted and to
-/// shift the other runs' weaves through the pooled steer axis. It is set
-/// aside with the reason, and the other runs' fits are those of the set
-/// without it.
+/// runs (by the two mountings' difference). It used to be accepted silently
+/// and to shift the other runs' weaves through the pooled steer axis. It is
+/// now left out of the set's steer axis and flagged with a warning that
+/// names the run and what to check, and the other runs' fits are bit for bit
+/// those of the set without it. (It is fitted, not dropped: on realistic
+/// sensors a good run's own axis can lie as far out, so dropping would lose
+/// good runs.)
 #[test]
-fn a_run_with_its_sensor_files_swapped_is_set_aside() {
+fn a_run_with_its_sensor_files_swapped_is_flagged_and_left_out_of_the_steer_axis() {
     let d = whole_set("swapped", &[]);
     let run = d.join("run03");
     std::fs::rename(run.join("imu_frame.csv"), run.join("swap.csv")).unwrap();
     std::fs::rename(run.join("imu_handlebar.csv"), run.join("imu_frame.csv")).unwrap();
     std::fs::rename(run.join("swap.csv"), run.join("imu_handlebar.csv")).unwrap();
-    let (status, err, swapped) = fits_by_run(&d);
-    assert_eq!(status, Some(1), "{err}");
-    assert!(err.contains("run03: set aside"), "{err}");
-    assert!(err.contains("files are not swapped"), "{err}");
+    let (_, err, mut swapped) = fits_by_run(&d);
+    let warning = err
+        .lines()
+        .find(|l| l.contains("run03") && l.contains("steer axis apart"))
+        .unwrap_or_else(|| panic!("no steer-axis warning for run03:\n{err}"));
+    assert!(warning.starts_with("warning:"), "{warning}");
+    assert!(warning.contains("files are not swapped"), "{warning}");
+    assert!(
+        !err.lines()
+            .any(|l| l.contains("steer axis apart") && !l.contains("run03")),
+        "only run03 is flagged:\n{err}"
+    );
+    swapped.remove("run03");
     let (status, without_err, without) = fits_by_run(&whole_set("without-run03", &["run03"]));
     assert_eq!(status, Some(0), "{without_err}");
     assert_eq!(without.len(), 5);

@@ -321,6 +321,103 @@ fn the_plotted_fit_follows_the_measured_points() {
     assert!(d.join("continuation_measured.png").is_file() || !d.join("continuation_measured.svg").is_file());
 }
 
+/// A calibration run whose handlebar is turned back and forth (6 deg at
+/// 0.3 Hz about the handlebar sensor's own z axis, nominally the steer
+/// axis) while the frame stays still is refused: the handlebar sensor
+/// tilts against gravity by the steer times the sine of the axis's tilt.
+#[test]
+fn a_calibration_run_with_the_handlebar_turning_is_refused() {
+    let d = scratch("fit").join("steering-calibration");
+    let _ = std::fs::remove_dir_all(&d);
+    for r in ["calibration", "run01"] {
+        std::fs::create_dir_all(d.join(r)).unwrap();
+        for f in std::fs::read_dir(example_set().join(r)).unwrap() {
+            let f = f.unwrap().path();
+            std::fs::copy(&f, d.join(r).join(f.file_name().unwrap())).unwrap();
+        }
+    }
+    let f = d.join("calibration").join("imu_handlebar.csv");
+    let s = std::fs::read_to_string(&f).unwrap();
+    let mut out = String::new();
+    for (i, line) in s.lines().enumerate() {
+        if i == 0 {
+            out += line;
+            out += "\n";
+            continue;
+        }
+        let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap()).collect();
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(v[1], v[2], v[3], v[4]));
+        let a = 6f64.to_radians() * (2.0 * std::f64::consts::PI * 0.3 * v[0]).sin();
+        // A rotation about the sensor's own z axis (applied on the right).
+        let r = q * nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), a);
+        out += &format!("{:.4},{:.7},{:.7},{:.7},{:.7}\n", v[0], r.w, r.i, r.j, r.k);
+    }
+    std::fs::write(&f, out).unwrap();
+    let bad = bikedyn(&["fit", d.to_str().unwrap(), "--json"]);
+    assert_eq!(bad.status.code(), Some(1));
+    let err = text(&bad.stderr);
+    assert!(
+        err.contains("not at rest") && err.contains("handlebar sensor by"),
+        "{err}"
+    );
+    assert_eq!(stdout_json(&bad).as_array().unwrap().len(), 0, "{err}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Real units drift in heading (the oracle simulator's by up to 2.5 deg
+/// relative to each other over a ten-second calibration), which reads as
+/// a steer that moves while the bicycle stands still. A calibration check
+/// on the steer angle refused two of five oracle control sets made with
+/// random seeds. The check is on each sensor's tilt against gravity, which
+/// the calibration measures and heading drift leaves alone: the committed
+/// calibration with 4 deg of heading drift in its handlebar sensor (and 3
+/// deg the other way in its frame sensor) is accepted, and the run's fit is
+/// what it was to a tenth of its standard error. (Not bit for bit: the
+/// calibration takes steer zero from the sensors' mean relative heading,
+/// which the drift moves by 3.5 deg; the fit, whose steer has its own
+/// offset, moves by 0.07 standard errors.)
+#[test]
+fn a_calibration_run_whose_sensors_drift_in_heading_is_accepted() {
+    let d = scratch("fit").join("drifting-calibration");
+    let _ = std::fs::remove_dir_all(&d);
+    for r in ["calibration", "run01"] {
+        std::fs::create_dir_all(d.join(r)).unwrap();
+        for f in std::fs::read_dir(example_set().join(r)).unwrap() {
+            let f = f.unwrap().path();
+            std::fs::copy(&f, d.join(r).join(f.file_name().unwrap())).unwrap();
+        }
+    }
+    let fit = |d: &std::path::Path| {
+        let out = bikedyn(&["fit", d.to_str().unwrap(), "--json"]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        stdout_json(&out)[0].clone()
+    };
+    let before = fit(&d);
+    for (sensor, drift_deg) in [("imu_frame.csv", -3.0), ("imu_handlebar.csv", 4.0)] {
+        let f = d.join("calibration").join(sensor);
+        let s = std::fs::read_to_string(&f).unwrap();
+        let rows: Vec<&str> = s.lines().collect();
+        let t_end: f64 = rows.last().unwrap().split(',').next().unwrap().trim().parse().unwrap();
+        let mut out = String::from(rows[0]) + "\n";
+        for line in &rows[1..] {
+            let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap()).collect();
+            let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(v[1], v[2], v[3], v[4]));
+            // A heading turn about the global Z axis, growing over the record.
+            let a = f64::to_radians(drift_deg) * v[0] / t_end;
+            let r = nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), a) * q;
+            out += &format!("{:.4},{:.7},{:.7},{:.7},{:.7}\n", v[0], r.w, r.i, r.j, r.k);
+        }
+        std::fs::write(&f, out).unwrap();
+    }
+    let after = fit(&d);
+    let (a, b, se) = (&before["weave"], &after["weave"], &before["weave_stderr"]);
+    for k in 0..2 {
+        let (x, y, s) = (a[k].as_f64().unwrap(), b[k].as_f64().unwrap(), se[k].as_f64().unwrap());
+        assert!((x - y).abs() < 0.1 * s, "weave {a} at rest, {b} with heading drift");
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 /// A calibration run whose bicycle sways (the whole bicycle rolling 3 deg
 /// back and forth at 0.3 Hz, applied to both sensors' orientations) is
 /// refused with the reason and how much it moved; the runs it calibrates
@@ -362,7 +459,7 @@ fn a_calibration_run_that_is_not_at_rest_is_refused() {
     assert_eq!(bad.status.code(), Some(1));
     let err = text(&bad.stderr);
     assert!(err.contains("not at rest") && err.contains("calibration"), "{err}");
-    assert!(err.contains("roll moves by"), "{err}");
+    assert!(err.contains("frame sensor tilts by"), "{err}");
     assert_eq!(stdout_json(&bad).as_array().unwrap().len(), 0, "{err}");
     let _ = std::fs::remove_dir_all(&d);
 }
