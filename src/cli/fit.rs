@@ -60,7 +60,11 @@ pub fn run(args: &FitArgs) -> Result<bool> {
     }
     for r in &out.reports {
         // A steer axis apart is among the warnings already.
-        for n in r.notes.iter().filter(|n| !n.starts_with(bikedyn::runtime::experiment::STEER_AXIS_APART)) {
+        for n in r
+            .notes
+            .iter()
+            .filter(|n| !n.starts_with(bikedyn::runtime::experiment::STEER_AXIS_APART))
+        {
             eprintln!("{}: {n}", r.run.display());
         }
         show_gaps(&r.gaps);

@@ -307,6 +307,31 @@ impl Calibration {
         self.thesis_offsets = (median(&th.roll[k0..]), median(&th.steer[k0..]));
     }
 
+    /// Each sensor's typical direction of global up in its own axes over a
+    /// record from `from` (s) on: the component-wise median, normalised
+    /// (a fall or a lean at the end moves it little). At rest and in
+    /// upright running alike it is fixed by the sensor's mounting, up to
+    /// the roll and the steer (times the sine of the steer axis's tilt) of
+    /// the moment, so it tells a run's frame sensor from its handlebar
+    /// sensor whenever the two are mounted a few degrees apart. `None`
+    /// with fewer than ten samples.
+    pub fn typical_up(frame: &ImuRecord, handlebar: &ImuRecord, from: f64) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        let n = frame.q.len().min(handlebar.q.len());
+        let k0 = frame.t[..n.min(frame.t.len())].partition_point(|&t| t < from);
+        if n < k0 + 10 {
+            return None;
+        }
+        let up = |q: &[UnitQuaternion<f64>]| {
+            let v: Vec<Vector3<f64>> = q[k0..n]
+                .iter()
+                .map(|q| q.inverse_transform_vector(&Vector3::z()))
+                .collect();
+            let c = |i: usize| median(&v.iter().map(|v| v[i]).collect::<Vec<_>>());
+            Vector3::new(c(0), c(1), c(2)).normalize()
+        };
+        Some((up(&frame.q), up(&handlebar.q)))
+    }
+
     /// The rotations of the handlebar sensor relative to the frame sensor
     /// over a run's settled record (its `frame` and `handlebar` records), each relative to the run's mean
     /// (scaled axis, rad), in frame-sensor coordinates:

@@ -235,6 +235,32 @@ pub enum RunError {
         /// Its angles about x, y, z (rad).
         euler: [f64; 3],
     },
+    /// The run's frame and handlebar files are swapped: its handlebar
+    /// sensor turns about an axis of its own (not the set's steer axis),
+    /// and each file's tilt against gravity matches the calibration's other
+    /// sensor. It is set aside: its angles would be wrong, and the set's
+    /// results are those of the set without it.
+    #[error(
+        "{}: set aside: its frame and handlebar files look swapped: its handlebar sensor turns about an axis {:.1} deg from the steer axis the set's other runs share (beyond {:.1} deg), and the tilts against gravity its two files show lie {:.1} deg from the calibration's handlebar and frame sensors but {:.1} deg from its frame and handlebar sensors; swap them back (imu_files in run.toml) to use the run",
+        run.display(),
+        angle.to_degrees(),
+        limit.to_degrees(),
+        as_swapped.to_degrees(),
+        as_named.to_degrees()
+    )]
+    SensorsSwapped {
+        /// The run.
+        run: PathBuf,
+        /// Its steer axis's angle from the set's (rad).
+        angle: f64,
+        /// The largest angle accepted (rad).
+        limit: f64,
+        /// Sum of the two files' tilt distances from the calibration's
+        /// other sensor (rad).
+        as_swapped: f64,
+        /// The same from the calibration's sensor of the same name (rad).
+        as_named: f64,
+    },
     /// The named path is neither a run, a set nor a log.
     #[error("{}: not a run folder (run.toml), a set of runs, or a log file", path.display())]
     NotARun {
@@ -738,14 +764,31 @@ pub fn process_set(
     // axis lies apart is left out of it and flagged, not dropped: on
     // realistic sensors a good run's axis, from few samples above the
     // noise and with heading drift, can lie several medians out.
-    let rotations: Vec<Result<Vec<Vector3<f64>>, RunError>> = runs
+    // A run apart whose two files' tilts against gravity match the
+    // calibration's sensors the other way round has its files swapped: it
+    // is set aside, since its angles would be wrong.
+    type Up = Option<(Vector3<f64>, Vector3<f64>)>;
+    let rest_up = Calibration::typical_up(&cal_run.frame, &cal_run.handlebar, cal.settled_from);
+    let read: Vec<Result<(Vec<Vector3<f64>>, Up), RunError>> = runs
         .iter()
         .map(|r| {
             read::read_run_orientations(r)
-                .map(|(_, frame, handlebar)| cal.relative_rotations(&frame, &handlebar))
+                .map(|(_, frame, handlebar)| {
+                    (
+                        cal.relative_rotations(&frame, &handlebar),
+                        Calibration::typical_up(&frame, &handlebar, cal.settled_from),
+                    )
+                })
                 .map_err(RunError::from)
         })
         .collect();
+    let (rotations, ups): (Vec<Result<Vec<Vector3<f64>>, RunError>>, Vec<Up>) = read
+        .into_iter()
+        .map(|r| match r {
+            Ok((rot, up)) => (Ok(rot), up),
+            Err(e) => (Err(e), None),
+        })
+        .unzip();
     let readable: Vec<(usize, &[Vector3<f64>])> = rotations
         .iter()
         .enumerate()
@@ -758,7 +801,24 @@ pub fn process_set(
             set_aside[*i] = Some((angle, limit));
         }
     }
-    let unreadable: Vec<Option<RunError>> = rotations.into_iter().map(|r| r.err()).collect();
+    let mut unreadable: Vec<Option<RunError>> = rotations.into_iter().map(|r| r.err()).collect();
+    if let Some((rest_f, rest_h)) = rest_up {
+        for i in 0..runs.len() {
+            if let (Some((angle, limit)), Some((f, h))) = (set_aside[i], ups[i]) {
+                let as_named = f.angle(&rest_f) + h.angle(&rest_h);
+                let as_swapped = f.angle(&rest_h) + h.angle(&rest_f);
+                if as_swapped < as_named {
+                    unreadable[i] = Some(RunError::SensorsSwapped {
+                        run: runs[i].clone(),
+                        angle,
+                        limit,
+                        as_swapped,
+                        as_named,
+                    });
+                }
+            }
+        }
+    }
     if let Some(axis) = consensus.axis {
         cal = cal.with_steer_axis(&cal_run, &axis);
     }
