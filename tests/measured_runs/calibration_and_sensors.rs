@@ -100,7 +100,7 @@ fn one_sensor_record_given_for_both_is_refused() {
 
 /// The example set copied whole into a fresh folder, without the runs in
 /// `leave_out`.
-fn whole_set(name: &str, leave_out: &[&str]) -> PathBuf {
+pub(super) fn whole_set(name: &str, leave_out: &[&str]) -> PathBuf {
     let d = scratch("calibration-and-sensors").join(name);
     let _ = std::fs::remove_dir_all(&d);
     for entry in std::fs::read_dir(example_set()).unwrap() {
@@ -121,7 +121,7 @@ fn whole_set(name: &str, leave_out: &[&str]) -> PathBuf {
 }
 
 /// `fit --json` of a set: exit status, stderr and the fits by run name.
-fn fits_by_run(
+pub(super) fn fits_by_run(
     set: &Path,
 ) -> (
     Option<i32>,

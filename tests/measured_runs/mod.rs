@@ -4,4 +4,5 @@
 mod acceptance;
 mod calibration_and_sensors;
 mod fit_command;
+mod kick_detection;
 mod synthetic_runs;

@@ -183,6 +183,7 @@ pub fn find_kicks(
     if let Some(quiet) = score.iter().position(|s| s.abs() <= thr) {
         score[..quiet].iter_mut().for_each(|s| *s = 0.0);
     }
+    let detection = thr;
     if opt.single {
         // One kick: the first change of at least half the largest one (the
         // response that follows changes the rate less than the kick did).
@@ -196,6 +197,13 @@ pub fn find_kicks(
     }
     let mut out = Vec::new();
     let mut pos = 0;
+    // In a run of one kick, a change after which the record holds no free
+    // response (not one half-cycle of the roll rate) cannot be the kick: a
+    // fall (its change can exceed twice the kick's) or a launch's last
+    // wobble (more than half a small kick) that decays at once. The next change standing out of the noise (the
+    // detection threshold) is tried instead, and the first choice is kept
+    // only if none has a response.
+    let mut first_choice: Option<Kick> = None;
     while pos < n - w {
         let Some(first) = (pos..n - w).find(|&k| score[k].abs() > thr) else {
             break;
@@ -230,10 +238,27 @@ pub fn find_kicks(
         let mut k = window(t, roll, &r, steer, gaps, kick, start, sigma, opt);
         k.jump = jump;
         pos = k.end.max(start + w);
-        out.push(k);
         if opt.single {
-            break;
+            if k.half_cycles > 0 {
+                out.push(k);
+                break;
+            }
+            // No response after it: try the changes beyond the detection
+            // threshold, from the record's start, other than this one.
+            if first_choice.is_none() {
+                score[first..=last].iter_mut().for_each(|s| *s = 0.0);
+                first_choice = Some(k);
+                thr = detection;
+                pos = 0;
+            } else {
+                score[first..=last].iter_mut().for_each(|s| *s = 0.0);
+            }
+            continue;
         }
+        out.push(k);
+    }
+    if opt.single && out.is_empty() {
+        out.extend(first_choice);
     }
     // A later kick bounds the window of the one before.
     for i in 1..out.len() {
