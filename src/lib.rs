@@ -26,6 +26,7 @@ pub mod registry {
 }
 
 pub mod bicycle;
+pub mod canonical;
 pub mod fit;
 pub mod frequency;
 pub mod identify;

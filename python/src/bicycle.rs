@@ -180,57 +180,26 @@ impl PyBicycle {
         Option<Bound<'py, PyBytes>>,
     )> {
         let speeds = doubles(speeds, "speeds").map_err(|e| e.into_py(py))?;
-        let (name, n, states, a, b) = detached(py, || {
+        let ss = detached(py, || {
             finite_speeds(&speeds, "speeds")?;
-            let lin = self.linear(model.as_deref())?;
-            let eig = |e: bikedyn::runtime::eigen::EigenError| Failure::new("ComputationError", e);
-            if let Some(first) = lin.first_order() {
-                let mut a = Vec::new();
-                let mut names = Vec::new();
-                let mut n = 0;
-                for &v in &speeds {
-                    let ls = first.lateral_states(v).map_err(eig)?;
-                    n = ls.a.nrows();
-                    names = ls.names.clone();
-                    for i in 0..n {
-                        for j in 0..n {
-                            a.push(ls.a[(i, j)]);
-                        }
-                    }
-                }
-                return Ok((lin.model, n, names, a, None));
-            }
-            let mut a = Vec::with_capacity(16 * speeds.len());
-            let mut b = Vec::with_capacity(8 * speeds.len());
-            for &v in &speeds {
-                let m = lin.at_speed(v).map_err(eig)?;
-                let (am, minv) = m
-                    .state_matrix()
-                    .zip(m.mass.try_inverse())
-                    .ok_or_else(|| Failure::new("ComputationError", format!("singular mass matrix at {v} m/s")))?;
-                for i in 0..4 {
-                    for j in 0..4 {
-                        a.push(am[(i, j)]);
-                    }
-                }
-                b.extend([
-                    0.0,
-                    0.0,
-                    0.0,
-                    0.0,
-                    minv[(0, 0)],
-                    minv[(0, 1)],
-                    minv[(1, 0)],
-                    minv[(1, 1)],
-                ]);
-            }
-            let names = ["roll", "steer", "roll_rate", "steer_rate"].map(String::from).to_vec();
-            Ok((lin.model, 4, names, a, Some(b)))
+            bikedyn::canonical::state_space(&self.inner, model.as_deref(), &speeds).map_err(|e| match e {
+                bikedyn::canonical::CanonicalError::Bicycle(e) => Failure::from(e),
+                e => Failure::new("ComputationError", e),
+            })
         })?;
+        let n = ss.states.len();
+        let a: Vec<f64> = ss.at.iter().flat_map(|at| at.a.iter().flatten().copied()).collect();
+        let b: Option<Vec<f64>> = ss
+            .at
+            .iter()
+            .map(|at| at.b.as_ref().map(|b| b.iter().flatten().copied().collect::<Vec<f64>>()))
+            .collect::<Option<Vec<_>>>()
+            .filter(|_| !ss.inputs.is_empty())
+            .map(|rows| rows.concat());
         Ok((
-            name.to_string(),
+            ss.model,
             n,
-            states,
+            ss.states,
             vec!["roll_torque".into(), "steer_torque".into()],
             PyBytes::new(py, &bytes_of(&a)),
             b.map(|b| PyBytes::new(py, &bytes_of(&b))),

@@ -129,25 +129,6 @@ pub fn canonical_text(c: &CanonicalMatrices) -> String {
     )
 }
 
-/// Rows of `B = [0; M^-1]` (inputs roll and steer torque).
-pub fn state_input_rows(minv: &nalgebra::Matrix2<f64>) -> Vec<[f64; 2]> {
-    vec![
-        [0.0, 0.0],
-        [0.0, 0.0],
-        [minv[(0, 0)], minv[(0, 1)]],
-        [minv[(1, 0)], minv[(1, 1)]],
-    ]
-}
-
-pub fn state_space_text(v: f64, a: &nalgebra::Matrix4<f64>, minv: &nalgebra::Matrix2<f64>) -> String {
-    let mut s = format!("v = {v} m/s\n");
-    let e: Vec<f64> = (0..4).flat_map(|i| (0..4).map(move |j| a[(i, j)])).collect();
-    s += &matrix_text("A", 4, &e);
-    let b: Vec<f64> = state_input_rows(minv).iter().flatten().copied().collect();
-    s += &matrix_text("B", 2, &b);
-    s
-}
-
 /// `NAME = [[a, b],\n       [c, d]]`: a matrix given row by row
 /// (`entries`, `cols` per row), 10 significant digits, columns aligned.
 pub fn matrix_text(name: &str, cols: usize, entries: &[f64]) -> String {
@@ -166,21 +147,4 @@ pub fn matrix_text(name: &str, cols: usize, entries: &[f64]) -> String {
         s += &format!("{open}{}{close}\n", cells.join(", "));
     }
     s
-}
-
-pub fn canonical_json(c: &CanonicalMatrices) -> serde_json::Value {
-    serde_json::json!({
-        "M0": rows_without_round_off(&c.m0), "C1": rows_without_round_off(&c.c1),
-        "K0": rows_without_round_off(&c.k0), "K2": rows_without_round_off(&c.k2), "g": c.g,
-    })
-}
-
-/// Rows of a canonical matrix with entries at the round-off of its largest
-/// one written as 0: the generated expressions reach a structural zero
-/// (the benchmark's `C1[0][0]`) as a difference of products, e.g.
-/// -4.4e-15 beside 33.9, and a value that small relative to the matrix
-/// cannot be told from zero in double precision anyway.
-fn rows_without_round_off(m: &nalgebra::Matrix2<f64>) -> [[f64; 2]; 2] {
-    let tol = 8.0 * f64::EPSILON * m.amax();
-    CanonicalMatrices::rows(&m.map(|x| if x.abs() <= tol { 0.0 } else { x }))
 }

@@ -3,6 +3,7 @@
 
 mod basu_mandal;
 mod benchmark;
+mod canonical_job;
 mod constraints;
 mod fast_path;
 mod free_speed;

@@ -768,8 +768,10 @@ pub fn process_set(
     // calibration's sensors the other way round has its files swapped: it
     // is set aside, since its angles would be wrong.
     type Up = Option<(Vector3<f64>, Vector3<f64>)>;
+    type Rotations = Result<Vec<Vector3<f64>>, RunError>;
     let rest_up = Calibration::typical_up(&cal_run.frame, &cal_run.handlebar, cal.settled_from);
-    let read: Vec<Result<(Vec<Vector3<f64>>, Up), RunError>> = runs
+    type Read = Result<(Vec<Vector3<f64>>, Up), RunError>;
+    let read: Vec<Read> = runs
         .iter()
         .map(|r| {
             read::read_run_orientations(r)
@@ -782,7 +784,7 @@ pub fn process_set(
                 .map_err(RunError::from)
         })
         .collect();
-    let (rotations, ups): (Vec<Result<Vec<Vector3<f64>>, RunError>>, Vec<Up>) = read
+    let (rotations, ups): (Vec<Rotations>, Vec<Up>) = read
         .into_iter()
         .map(|r| match r {
             Ok((rot, up)) => (Ok(rot), up),
