@@ -35,4 +35,5 @@ pub mod monte_carlo;
 pub mod progress;
 pub mod sensitivity;
 pub mod simulate;
+pub mod stability;
 pub mod synth;

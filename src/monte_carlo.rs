@@ -142,23 +142,3 @@ pub fn monte_carlo_speeds<R: ModelRegistry>(
         capsize_speed: sampled(|s| s.1),
     }))
 }
-
-/// Add a stability result's standard deviations to its JSON (`bikedyn
-/// stability --json`, Python's `Bicycle.stability`): `weave_speed_sd`,
-/// `capsize_speed_sd` and `uncertainty` from the first order, and
-/// `monte_carlo` from the draws, each where given.
-pub fn add_spread_json(
-    v: &mut serde_json::Value,
-    first_order: Option<&crate::sensitivity::StabilityUncertainty>,
-    sampled: Option<&MonteCarloSpeeds>,
-) -> serde_json::Result<()> {
-    if let Some(u) = first_order {
-        v["weave_speed_sd"] = serde_json::json!(u.weave_speed.as_ref().map(|x| x.standard_deviation));
-        v["capsize_speed_sd"] = serde_json::json!(u.capsize_speed.as_ref().map(|x| x.standard_deviation));
-        v["uncertainty"] = serde_json::to_value(u)?;
-    }
-    if let Some(m) = sampled {
-        v["monte_carlo"] = serde_json::to_value(m)?;
-    }
-    Ok(())
-}

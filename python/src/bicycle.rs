@@ -384,68 +384,27 @@ impl PyBicycle {
         monte_carlo: Option<usize>,
         seed: u64,
     ) -> PyResult<String> {
+        use bikedyn::stability::{stability, StabilityError as E, StabilityOptions};
         detached(py, move || {
-            if !(speed_min.is_finite() && speed_max.is_finite() && speed_min >= 0.0 && speed_max > speed_min) {
-                return Err(Failure::new(
-                    "InvalidArgumentError",
-                    format!("speed range [{speed_min}, {speed_max}] m/s: expected 0 <= speed_min < speed_max, finite"),
-                ));
-            }
-            let lin = self.linear(model.as_deref())?;
-            let crit =
-                critical_speeds_of(&lin, speed_min, speed_max).map_err(|e| Failure::new("ComputationError", e))?;
-            let mut v = stability_json(&self.inner.name, &crit);
-            v["model"] = serde_json::json!(lin.model);
-            // The speeds' standard deviations from the file's +/- values,
-            // as `bikedyn stability --json` gives them (none where the file
-            // gives none or no exact derivative exists).
-            let options = bikedyn::sensitivity::SensitivityOptions {
-                model: model.clone(),
-                speed_max,
-                ..Default::default()
-            };
-            let first_order = if speed_min == 0.0 {
-                bikedyn::sensitivity::speed_uncertainties(&self.inner, &options)
-                    .ok()
-                    .flatten()
-            } else {
-                None
-            };
-            // The Monte Carlo check, as `bikedyn stability --monte-carlo N`.
-            let sampled = match monte_carlo {
-                None => None,
-                Some(draws) => {
-                    if draws < 2 {
-                        return Err(Failure::new(
-                            "InvalidArgumentError",
-                            format!("monte_carlo = {draws}: at least 2 draws"),
-                        ));
-                    }
-                    let options = bikedyn::monte_carlo::MonteCarloOptions {
-                        draws,
-                        seed,
-                        model: model.clone(),
-                        speed_max,
-                    };
-                    match bikedyn::monte_carlo::monte_carlo_speeds(&self.inner, &options)
-                        .map_err(|e| Failure::new("ModelError", e))?
-                    {
-                        Some(m) => Some(m),
-                        None => {
-                            return Err(Failure::new(
-                                "InvalidArgumentError",
-                                format!(
-                                    "monte_carlo draws about the file's +/- standard deviations, and `{}` gives none",
-                                    self.inner.name
-                                ),
-                            ))
-                        }
-                    }
+            let report = stability(
+                &self.inner,
+                &StabilityOptions {
+                    model,
+                    speed_min,
+                    speed_max,
+                    monte_carlo: monte_carlo.map(|draws| (draws, seed)),
+                    label: None,
+                },
+            )
+            .map_err(|e| match e {
+                E::Bicycle(e) => Failure::from(e),
+                E::Eigen(e) => Failure::new("ComputationError", e),
+                E::Sensitivity(e) => Failure::new("ModelError", e),
+                e @ (E::SpeedRange(..) | E::TooFewDraws(_) | E::NoUncertainties(_)) => {
+                    Failure::new("InvalidArgumentError", e)
                 }
-            };
-            bikedyn::monte_carlo::add_spread_json(&mut v, first_order.as_ref(), sampled.as_ref())
-                .map_err(|e| Failure::new("InternalError", e))?;
-            Ok(v.to_string())
+            })?;
+            serde_json::to_string(&report).map_err(|e| Failure::new("InternalError", e))
         })
     }
 

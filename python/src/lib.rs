@@ -16,7 +16,7 @@ use bikedyn::bicycle::{Bicycle, BicycleError, Linear};
 use bikedyn::fit::{kick_json, plots_into, run_fit, FitOptions, FitOutcome};
 use bikedyn::identify::eigen_table::{identify_table, write_table_report, TableOutcome, TableRequest};
 use bikedyn::identify::{report as identify_report, run as identify_run, IdentifyRequest, Outcome};
-use bikedyn::report::output::{stability_json, write_atomic};
+use bikedyn::report::output::write_atomic;
 use bikedyn::report::plot::PlotOptions;
 use bikedyn::report::staged::{FolderKind, StagedDir};
 use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, eigenvalues_of, LinearBicycle};

@@ -2,69 +2,47 @@
 
 use super::args::BikeArg;
 use super::load;
-use super::text::{stability_json, stability_text};
-use anyhow::{bail, Result};
-use bikedyn::monte_carlo::{add_spread_json, monte_carlo_speeds, MonteCarloOptions, MonteCarloSpeeds};
+use super::text::stability_text;
+use anyhow::Result;
+use bikedyn::monte_carlo::MonteCarloSpeeds;
 use bikedyn::report::output::format_significant;
-use bikedyn::runtime::eigen::critical_speeds_of;
-use bikedyn::sensitivity::{speed_uncertainties, SensitivityError, SensitivityOptions, StabilityUncertainty};
+use bikedyn::sensitivity::StabilityUncertainty;
+use bikedyn::stability::{stability, StabilityOptions};
 
-/// Run `bikedyn stability`.
+/// Run `bikedyn stability`. The job is [`bikedyn::stability::stability`];
+/// this prints its result.
 pub fn run(bike: BikeArg, speed_max: f64, json: bool, monte_carlo: Option<(usize, u64)>) -> Result<bool> {
     let BikeArg { spec: bike, model } = bike;
     let speed_max = super::check_speed_max(speed_max)?;
     let b = load(&bike)?;
-    let lin = b.linear_with(model.as_deref())?;
-    let crit = critical_speeds_of(&lin, 0.0, speed_max)?;
-    // The standard deviations of v_w and v_c the file's `+/-` values imply
-    // (none for a file without them; a bicycle without canonical form, or
-    // where a derivative does not exist, says why on standard error).
-    let uncertainty = match speed_uncertainties(
+    if monte_carlo.is_some() && b.uncertainties.is_empty() {
+        anyhow::bail!("--monte-carlo draws about the file's +/- standard deviations, and `{bike}` gives none");
+    }
+    let report = stability(
         &b,
-        &SensitivityOptions {
-            model: model.clone(),
+        &StabilityOptions {
+            model,
+            speed_min: 0.0,
             speed_max,
-            ..SensitivityOptions::default()
+            monte_carlo,
+            label: Some(bike.clone()),
         },
-    ) {
-        Ok(u) => u,
-        Err(SensitivityError::NoCrossing { .. }) => None,
-        Err(e) => {
-            eprintln!("note: no standard deviations of the speeds from the file's +/- values: {e}");
-            None
-        }
-    };
-    let sampled = match monte_carlo {
-        None => None,
-        Some((draws, seed)) => {
-            let s = monte_carlo_speeds(
-                &b,
-                &MonteCarloOptions {
-                    draws,
-                    seed,
-                    model: model.clone(),
-                    speed_max,
-                },
-            )?;
-            if s.is_none() {
-                bail!("--monte-carlo draws about the file's +/- standard deviations, and `{bike}` gives none");
-            }
-            s
-        }
-    };
+    )?;
+    // A bicycle without canonical form, or where a derivative does not
+    // exist, says why it has no standard deviations.
+    if let Some(why) = &report.uncertainty_missing {
+        eprintln!("note: no standard deviations of the speeds from the file's +/- values: {why}");
+    }
     if json {
-        let mut v = stability_json(&bike, &crit);
-        v["model"] = serde_json::json!(lin.model);
-        add_spread_json(&mut v, uncertainty.as_ref(), sampled.as_ref())?;
-        outln!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        outln!("model: {}", lin.model);
-        out!("{}", stability_text(&bike, &crit, b.feedback.is_some()));
-        if let Some(u) = &uncertainty {
+        outln!("model: {}", report.model);
+        out!("{}", stability_text(&bike, &report.critical, b.feedback.is_some()));
+        if let Some(u) = &report.uncertainty {
             out!("{}", uncertainty_text(u));
         }
-        if let Some(m) = &sampled {
-            out!("{}", monte_carlo_text(m, uncertainty.as_ref()));
+        if let Some(m) = &report.monte_carlo {
+            out!("{}", monte_carlo_text(m, report.uncertainty.as_ref()));
         }
     }
     Ok(true)

@@ -3,10 +3,10 @@
 
 mod basu_mandal;
 mod benchmark;
-mod canonical_job;
 mod constraints;
 mod fast_path;
 mod free_speed;
 mod frequency_response;
+mod library_jobs;
 mod real_designs;
 mod sensitivity;

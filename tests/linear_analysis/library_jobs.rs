@@ -1,9 +1,10 @@
-//! The `canonical` job as a library call: the typed result the command line
-//! prints and Python converts.
+//! The linear-analysis jobs as library calls (`canonical`, `stability`):
+//! the typed results the command line prints and Python converts.
 
 use bikedyn::bicycle::Bicycle;
 use bikedyn::canonical::{canonical, state_space, CanonicalOptions, CanonicalReport};
 use bikedyn::runtime::eigen::LinearBicycle;
+use bikedyn::stability::{stability, StabilityError, StabilityOptions};
 
 /// The benchmark bicycle has the canonical form; its structural zero
 /// `C1[0][0]` is written as 0, and the file-free built-in has no standard
@@ -89,4 +90,47 @@ fn a_model_with_extra_states_gives_its_own_lateral_states() {
     assert_eq!(ss.at[0].a.len(), n);
     assert!(ss.at[0].b.is_none());
     assert!(state_space(&b, None, &[f64::NAN]).is_err());
+}
+
+/// The benchmark bicycle's weave and capsize speeds from the stability job
+/// are Meijaard et al. (2007)'s (v_w = 4.2923825363 m/s, v_c = 6.0242620154 m/s), its
+/// self-stable interval lies between them, and a built-in bicycle without
+/// `+/-` values has no standard deviations and refuses a Monte Carlo check.
+#[test]
+fn the_stability_job_gives_the_benchmark_speeds_and_refuses_draws_without_spreads() {
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let r = stability(&b, &StabilityOptions::default()).unwrap();
+    assert!(
+        (r.weave_speed.unwrap() - 4.292_382_536_341_11).abs() < 1e-10,
+        "{:?}",
+        r.weave_speed
+    );
+    assert!(
+        (r.capsize_speed.unwrap() - 6.024_262_015_388_37).abs() < 1e-10,
+        "{:?}",
+        r.capsize_speed
+    );
+    assert_eq!(r.stable_intervals.len(), 1);
+    assert!(r
+        .crossings
+        .iter()
+        .any(|c| c.mode == "weave" && c.direction == "stabilizing" && c.kind == "complex_pair"));
+    assert!(r.uncertainty.is_none() && r.weave_speed_sd.is_none());
+    let json = serde_json::to_value(&r).unwrap();
+    assert!(json.get("weave_speed_sd").is_none(), "{json}");
+    assert_eq!(
+        json["weave_real_pair_merge_speed"],
+        serde_json::json!(r.weave_real_pair_merge)
+    );
+    let draws = StabilityOptions {
+        monte_carlo: Some((20, 1)),
+        ..StabilityOptions::default()
+    };
+    assert!(matches!(stability(&b, &draws), Err(StabilityError::NoUncertainties(_))));
+    let backwards = StabilityOptions {
+        speed_min: 5.0,
+        speed_max: 2.0,
+        ..StabilityOptions::default()
+    };
+    assert!(matches!(stability(&b, &backwards), Err(StabilityError::SpeedRange(..))));
 }
