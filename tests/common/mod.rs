@@ -92,6 +92,41 @@ pub fn example_set() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping")
 }
 
+/// A fresh folder `name` under the scratch group `group` holding the
+/// example set's runs `runs` (e.g. `calibration`, `run01`), copied.
+pub fn example_runs(group: &str, name: &str, runs: &[&str]) -> PathBuf {
+    let d = scratch(group).join(name);
+    let _ = std::fs::remove_dir_all(&d);
+    for r in runs {
+        std::fs::create_dir_all(d.join(r)).unwrap();
+        for f in std::fs::read_dir(example_set().join(r)).unwrap() {
+            let f = f.unwrap().path();
+            std::fs::copy(&f, d.join(r).join(f.file_name().unwrap())).unwrap();
+        }
+    }
+    d
+}
+
+/// Rewrite an IMU record's orientations (`time_s,q0,q1,q2,q3`, scalar
+/// first, `v_global = R(q) v_sensor`): `f(t, q, t_end)` gives each
+/// sample's new orientation.
+pub fn rotate_orientations(
+    path: &Path,
+    f: impl Fn(f64, nalgebra::UnitQuaternion<f64>, f64) -> nalgebra::UnitQuaternion<f64>,
+) {
+    let s = std::fs::read_to_string(path).unwrap();
+    let rows: Vec<&str> = s.lines().collect();
+    let t_end: f64 = rows.last().unwrap().split(',').next().unwrap().trim().parse().unwrap();
+    let mut out = String::from(rows[0]) + "\n";
+    for line in &rows[1..] {
+        let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap()).collect();
+        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(v[1], v[2], v[3], v[4]));
+        let r = f(v[0], q, t_end);
+        out += &format!("{:.4},{:.7},{:.7},{:.7},{:.7}\n", v[0], r.w, r.i, r.j, r.k);
+    }
+    std::fs::write(path, out).unwrap();
+}
+
 /// A kick's state (roll 0.02 rad, steer -0.01 rad, rates 0.3 and 0.2 rad/s,
 /// 5 m/s) and tight tolerances, for checks of simulated responses.
 pub fn kick_and_tight_options() -> (

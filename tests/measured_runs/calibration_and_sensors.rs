@@ -8,16 +8,7 @@ use std::path::{Path, PathBuf};
 
 /// The example set's calibration and run03 in a fresh set folder.
 fn mini(name: &str) -> PathBuf {
-    let d = scratch("calibration-and-sensors").join(name);
-    let _ = std::fs::remove_dir_all(&d);
-    for r in ["calibration", "run03"] {
-        std::fs::create_dir_all(d.join(r)).unwrap();
-        for f in std::fs::read_dir(example_set().join(r)).unwrap() {
-            let f = f.unwrap().path();
-            std::fs::copy(&f, d.join(r).join(f.file_name().unwrap())).unwrap();
-        }
-    }
-    d
+    example_runs("calibration-and-sensors", name, &["calibration", "run03"])
 }
 
 /// Rewrite every data row of both IMU files of `run` with `f(row, line)`
@@ -244,21 +235,9 @@ fn a_run_with_its_sensor_files_swapped_is_set_aside() {
 fn a_run_whose_steer_axis_lies_apart_is_fitted_with_a_warning() {
     let d = whole_set("knocked", &[]);
     let run = d.join("run03");
-    let f = run.join("imu_handlebar.csv");
-    let s = std::fs::read_to_string(&f).unwrap();
-    let mut out = String::new();
-    for (i, line) in s.lines().enumerate() {
-        if i == 0 {
-            out += line;
-            out += "\n";
-            continue;
-        }
-        let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap()).collect();
-        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(v[1], v[2], v[3], v[4]));
-        let r = q * nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::x_axis(), 8f64.to_radians());
-        out += &format!("{:.4},{:.7},{:.7},{:.7},{:.7}\n", v[0], r.w, r.i, r.j, r.k);
-    }
-    std::fs::write(&f, out).unwrap();
+    rotate_orientations(&run.join("imu_handlebar.csv"), |_, q, _| {
+        q * nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::x_axis(), 8f64.to_radians())
+    });
     let (_, err, mut knocked) = fits_by_run(&d);
     let warning = err
         .lines()

@@ -184,11 +184,6 @@ fn corrupt_and_missing_inputs_are_reported() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("no calibration run"));
 }
 
-/// The committed example set (six thesis-style runs made by `synth`).
-fn example_set() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/data/hidden_steer_damping")
-}
-
 /// The fitted curve a plot draws is the fit: evaluated at the window's
 /// samples it gives back the fit's own r² for every kick and every form
 /// (the speed-varying forms drew a flat line at zero when the curve was
@@ -327,32 +322,12 @@ fn the_plotted_fit_follows_the_measured_points() {
 /// tilts against gravity by the steer times the sine of the axis's tilt.
 #[test]
 fn a_calibration_run_with_the_handlebar_turning_is_refused() {
-    let d = scratch("fit").join("steering-calibration");
-    let _ = std::fs::remove_dir_all(&d);
-    for r in ["calibration", "run01"] {
-        std::fs::create_dir_all(d.join(r)).unwrap();
-        for f in std::fs::read_dir(example_set().join(r)).unwrap() {
-            let f = f.unwrap().path();
-            std::fs::copy(&f, d.join(r).join(f.file_name().unwrap())).unwrap();
-        }
-    }
-    let f = d.join("calibration").join("imu_handlebar.csv");
-    let s = std::fs::read_to_string(&f).unwrap();
-    let mut out = String::new();
-    for (i, line) in s.lines().enumerate() {
-        if i == 0 {
-            out += line;
-            out += "\n";
-            continue;
-        }
-        let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap()).collect();
-        let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(v[1], v[2], v[3], v[4]));
-        let a = 6f64.to_radians() * (2.0 * std::f64::consts::PI * 0.3 * v[0]).sin();
+    let d = example_runs("fit", "steering-calibration", &["calibration", "run01"]);
+    rotate_orientations(&d.join("calibration").join("imu_handlebar.csv"), |t, q, _| {
+        let a = 6f64.to_radians() * (2.0 * std::f64::consts::PI * 0.3 * t).sin();
         // A rotation about the sensor's own z axis (applied on the right).
-        let r = q * nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), a);
-        out += &format!("{:.4},{:.7},{:.7},{:.7},{:.7}\n", v[0], r.w, r.i, r.j, r.k);
-    }
-    std::fs::write(&f, out).unwrap();
+        q * nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), a)
+    });
     let bad = bikedyn(&["fit", d.to_str().unwrap(), "--json"]);
     assert_eq!(bad.status.code(), Some(1));
     let err = text(&bad.stderr);
@@ -378,15 +353,7 @@ fn a_calibration_run_with_the_handlebar_turning_is_refused() {
 /// offset, moves by 0.07 standard errors.)
 #[test]
 fn a_calibration_run_whose_sensors_drift_in_heading_is_accepted() {
-    let d = scratch("fit").join("drifting-calibration");
-    let _ = std::fs::remove_dir_all(&d);
-    for r in ["calibration", "run01"] {
-        std::fs::create_dir_all(d.join(r)).unwrap();
-        for f in std::fs::read_dir(example_set().join(r)).unwrap() {
-            let f = f.unwrap().path();
-            std::fs::copy(&f, d.join(r).join(f.file_name().unwrap())).unwrap();
-        }
-    }
+    let d = example_runs("fit", "drifting-calibration", &["calibration", "run01"]);
     let fit = |d: &std::path::Path| {
         let out = bikedyn(&["fit", d.to_str().unwrap(), "--json"]);
         assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
@@ -394,20 +361,11 @@ fn a_calibration_run_whose_sensors_drift_in_heading_is_accepted() {
     };
     let before = fit(&d);
     for (sensor, drift_deg) in [("imu_frame.csv", -3.0), ("imu_handlebar.csv", 4.0)] {
-        let f = d.join("calibration").join(sensor);
-        let s = std::fs::read_to_string(&f).unwrap();
-        let rows: Vec<&str> = s.lines().collect();
-        let t_end: f64 = rows.last().unwrap().split(',').next().unwrap().trim().parse().unwrap();
-        let mut out = String::from(rows[0]) + "\n";
-        for line in &rows[1..] {
-            let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap()).collect();
-            let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(v[1], v[2], v[3], v[4]));
+        rotate_orientations(&d.join("calibration").join(sensor), |t, q, t_end| {
             // A heading turn about the global Z axis, growing over the record.
-            let a = f64::to_radians(drift_deg) * v[0] / t_end;
-            let r = nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), a) * q;
-            out += &format!("{:.4},{:.7},{:.7},{:.7},{:.7}\n", v[0], r.w, r.i, r.j, r.k);
-        }
-        std::fs::write(&f, out).unwrap();
+            let a = f64::to_radians(drift_deg) * t / t_end;
+            nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::z_axis(), a) * q
+        });
     }
     let after = fit(&d);
     let (a, b, se) = (&before["weave"], &after["weave"], &before["weave_stderr"]);
@@ -425,35 +383,15 @@ fn a_calibration_run_whose_sensors_drift_in_heading_is_accepted() {
 /// committed set's own calibration (sensor noise and wander only) passes.
 #[test]
 fn a_calibration_run_that_is_not_at_rest_is_refused() {
-    let d = scratch("fit").join("swaying-calibration");
-    let _ = std::fs::remove_dir_all(&d);
-    for r in ["calibration", "run01"] {
-        std::fs::create_dir_all(d.join(r)).unwrap();
-        for f in std::fs::read_dir(example_set().join(r)).unwrap() {
-            let f = f.unwrap().path();
-            std::fs::copy(&f, d.join(r).join(f.file_name().unwrap())).unwrap();
-        }
-    }
+    let d = example_runs("fit", "swaying-calibration", &["calibration", "run01"]);
     let ok = bikedyn(&["fit", d.to_str().unwrap(), "--json"]);
     assert_eq!(ok.status.code(), Some(0), "{}", text(&ok.stderr));
     for sensor in ["imu_frame.csv", "imu_handlebar.csv"] {
-        let f = d.join("calibration").join(sensor);
-        let s = std::fs::read_to_string(&f).unwrap();
-        let mut out = String::new();
-        for (i, line) in s.lines().enumerate() {
-            if i == 0 {
-                out += line;
-                out += "\n";
-                continue;
-            }
-            let v: Vec<f64> = line.split(',').map(|x| x.trim().parse().unwrap()).collect();
-            let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(v[1], v[2], v[3], v[4]));
+        rotate_orientations(&d.join("calibration").join(sensor), |t, q, _| {
             // A rotation about the global X axis (v_global = R(q) v_sensor).
-            let a = 3f64.to_radians() * (2.0 * std::f64::consts::PI * 0.3 * v[0]).sin();
-            let r = nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::x_axis(), a) * q;
-            out += &format!("{:.4},{:.7},{:.7},{:.7},{:.7}\n", v[0], r.w, r.i, r.j, r.k);
-        }
-        std::fs::write(&f, out).unwrap();
+            let a = 3f64.to_radians() * (2.0 * std::f64::consts::PI * 0.3 * t).sin();
+            nalgebra::UnitQuaternion::from_axis_angle(&nalgebra::Vector3::x_axis(), a) * q
+        });
     }
     let bad = bikedyn(&["fit", d.to_str().unwrap(), "--json"]);
     assert_eq!(bad.status.code(), Some(1));
