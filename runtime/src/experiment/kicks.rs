@@ -200,9 +200,9 @@ pub fn find_kicks(
     // In a run of one kick, a change after which the record holds no free
     // response (not one half-cycle of the roll rate) cannot be the kick: a
     // fall (its change can exceed twice the kick's) or a launch's last
-    // wobble (more than half a small kick) that decays at once. The next change standing out of the noise (the
-    // detection threshold) is tried instead, and the first choice is kept
-    // only if none has a response.
+    // wobble (more than half a small kick) that decays at once. The next
+    // change standing out of the noise (the detection threshold) is tried
+    // instead, and the first choice is kept only if none has a response.
     let mut first_choice: Option<Kick> = None;
     while pos < n - w {
         let Some(first) = (pos..n - w).find(|&k| score[k].abs() > thr) else {
@@ -245,13 +245,11 @@ pub fn find_kicks(
             }
             // No response after it: try the changes beyond the detection
             // threshold, from the record's start, other than this one.
+            score[first..=last].iter_mut().for_each(|s| *s = 0.0);
             if first_choice.is_none() {
-                score[first..=last].iter_mut().for_each(|s| *s = 0.0);
                 first_choice = Some(k);
                 thr = detection;
                 pos = 0;
-            } else {
-                score[first..=last].iter_mut().for_each(|s| *s = 0.0);
             }
             continue;
         }
