@@ -767,11 +767,10 @@ pub fn process_set(
     // A run apart whose two files' tilts against gravity match the
     // calibration's sensors the other way round has its files swapped: it
     // is set aside, since its angles would be wrong.
-    type Up = Option<(Vector3<f64>, Vector3<f64>)>;
-    type Rotations = Result<Vec<Vector3<f64>>, RunError>;
     let rest_up = Calibration::typical_up(&cal_run.frame, &cal_run.handlebar, cal.settled_from);
-    type Read = Result<(Vec<Vector3<f64>>, Up), RunError>;
-    let read: Vec<Read> = runs
+    // Each run's relative rotations and its sensors' typical up.
+    type Seen = (Vec<Vector3<f64>>, Option<(Vector3<f64>, Vector3<f64>)>);
+    let seen: Vec<Result<Seen, RunError>> = runs
         .iter()
         .map(|r| {
             read::read_run_orientations(r)
@@ -784,43 +783,40 @@ pub fn process_set(
                 .map_err(RunError::from)
         })
         .collect();
-    let (rotations, ups): (Vec<Rotations>, Vec<Up>) = read
-        .into_iter()
-        .map(|r| match r {
-            Ok((rot, up)) => (Ok(rot), up),
-            Err(e) => (Err(e), None),
-        })
-        .unzip();
-    let readable: Vec<(usize, &[Vector3<f64>])> = rotations
+    let readable: Vec<(usize, &Seen)> = seen
         .iter()
         .enumerate()
-        .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r.as_slice())))
+        .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r)))
         .collect();
-    let consensus = Calibration::steer_axis_consensus(&readable.iter().map(|(_, r)| *r).collect::<Vec<_>>());
-    let mut set_aside: Vec<Option<(f64, f64)>> = vec![None; runs.len()];
-    for ((i, _), v) in readable.iter().zip(&consensus.runs) {
-        if let angles::RunAxisVerdict::Inconsistent { angle, limit } = *v {
-            set_aside[*i] = Some((angle, limit));
-        }
-    }
-    let mut unreadable: Vec<Option<RunError>> = rotations.into_iter().map(|r| r.err()).collect();
-    if let Some((rest_f, rest_h)) = rest_up {
-        for i in 0..runs.len() {
-            if let (Some((angle, limit)), Some((f, h))) = (set_aside[i], ups[i]) {
-                let as_named = f.angle(&rest_f) + h.angle(&rest_h);
-                let as_swapped = f.angle(&rest_h) + h.angle(&rest_f);
-                if as_swapped < as_named {
-                    unreadable[i] = Some(RunError::SensorsSwapped {
-                        run: runs[i].clone(),
-                        angle,
-                        limit,
-                        as_swapped,
-                        as_named,
-                    });
-                }
+    let consensus =
+        Calibration::steer_axis_consensus(&readable.iter().map(|(_, r)| r.0.as_slice()).collect::<Vec<_>>());
+    // Runs apart (angle and limit), and among them the swapped ones.
+    let mut apart: Vec<Option<(f64, f64)>> = vec![None; runs.len()];
+    let mut swapped: Vec<Option<RunError>> = (0..runs.len()).map(|_| None).collect();
+    for ((i, (_, up)), v) in readable.iter().zip(&consensus.runs) {
+        let angles::RunAxisVerdict::Inconsistent { angle, limit } = *v else {
+            continue;
+        };
+        apart[*i] = Some((angle, limit));
+        if let (Some((rest_f, rest_h)), Some((f, h))) = (rest_up, up) {
+            let as_named = f.angle(&rest_f) + h.angle(&rest_h);
+            let as_swapped = f.angle(&rest_h) + h.angle(&rest_f);
+            if as_swapped < as_named {
+                swapped[*i] = Some(RunError::SensorsSwapped {
+                    run: runs[*i].clone(),
+                    angle,
+                    limit,
+                    as_swapped,
+                    as_named,
+                });
             }
         }
     }
+    let unreadable: Vec<Option<RunError>> = seen
+        .into_iter()
+        .zip(swapped)
+        .map(|(r, swapped)| r.err().or(swapped))
+        .collect();
     if let Some(axis) = consensus.axis {
         cal = cal.with_steer_axis(&cal_run, &axis);
     }
@@ -828,7 +824,7 @@ pub fn process_set(
     check_misalignment(&cal, calibration)?;
     let out = runs
         .iter()
-        .zip(set_aside)
+        .zip(apart)
         .zip(unreadable)
         .map(|((path, apart), unreadable)| {
             let rep = match unreadable {
