@@ -96,6 +96,12 @@ impl CalibrationMotion {
     }
 }
 
+/// Global up in a sensor's own axes (the third row of its orientation):
+/// what gravity shows of the sensor's tilt, whatever its heading.
+fn up_in_sensor(q: &UnitQuaternion<f64>) -> Vector3<f64> {
+    q.inverse_transform_vector(&Vector3::z())
+}
+
 fn mat(q: &UnitQuaternion<f64>) -> Matrix3<f64> {
     *q.to_rotation_matrix().matrix()
 }
@@ -230,11 +236,10 @@ impl Calibration {
         if blocks < 4 {
             return None;
         }
-        let up = |q: &UnitQuaternion<f64>| -> Vector3<f64> { q.inverse_transform_vector(&Vector3::z()) };
         let means = |q: &[UnitQuaternion<f64>]| -> Vec<Vector3<f64>> {
             q[k0..k0 + blocks * m]
                 .chunks_exact(m)
-                .map(|c| c.iter().map(up).sum::<Vector3<f64>>().normalize())
+                .map(|c| c.iter().map(up_in_sensor).sum::<Vector3<f64>>().normalize())
                 .collect()
         };
         let range = |g: &[Vector3<f64>]| {
@@ -281,11 +286,12 @@ impl Calibration {
     pub const ONE_AXIS_SHARE: f64 = 0.5;
 
     /// The least angle (rad) between a run's steer axis and the set's that
-    /// sets the run aside: 5 deg. Both sensors are clamped to their bodies,
-    /// so all runs of a set turn about one axis; runs with steer motion give
-    /// it to a fraction of a degree. A sensor moved or turned on its mount,
-    /// or the two sensors' files swapped, tilts it by the mounting's own
-    /// misalignment, several degrees.
+    /// puts the run apart (left out of the set's axis; set aside if its
+    /// files look swapped, else flagged): 5 deg. Both sensors are clamped
+    /// to their bodies, so all runs of a set turn about one axis; runs with
+    /// steer motion give it to a fraction of a degree. A sensor moved or
+    /// turned on its mount, or the two sensors' files swapped, tilts it by
+    /// the mounting's own misalignment, several degrees.
     pub const STEER_AXIS_TOLERANCE: f64 = 5.0 * std::f64::consts::PI / 180.0;
 
     /// How many times the set's median distance of run axes from the
@@ -322,10 +328,7 @@ impl Calibration {
             return None;
         }
         let up = |q: &[UnitQuaternion<f64>]| {
-            let v: Vec<Vector3<f64>> = q[k0..n]
-                .iter()
-                .map(|q| q.inverse_transform_vector(&Vector3::z()))
-                .collect();
+            let v: Vec<Vector3<f64>> = q[k0..n].iter().map(up_in_sensor).collect();
             let c = |i: usize| median(&v.iter().map(|v| v[i]).collect::<Vec<_>>());
             Vector3::new(c(0), c(1), c(2)).normalize()
         };
@@ -408,11 +411,12 @@ impl Calibration {
     /// foreign record) would turn a pooled estimate, and through it every
     /// run's angles: it is left out of the estimate. So is a run turning
     /// about an axis of its own (its sensors swapped or moved, or a good
-    /// run's estimate far out), which the caller flags. The consensus is the axis of the run closest
-    /// to the others (the medoid: it stands while fewer than half the runs
+    /// run's estimate far out), which the caller sets aside or flags. The
+    /// consensus is the axis of the run closest to the others (the medoid: it stands while fewer than half the runs
     /// are bad); a run is inconsistent when its axis is further from it than
     /// [`Self::STEER_AXIS_TOLERANCE`] and than [`Self::STEER_AXIS_SCATTERS`]
-    /// times the runs' median distance from it. The set's axis is pooled over the runs that agree.
+    /// times the runs' median distance from it. The set's axis is pooled
+    /// over the runs that agree.
     /// The test needs three runs with an axis of their own; with fewer, those
     /// runs are pooled untested.
     /// `runs` holds each run's [`Self::relative_rotations`].

@@ -834,9 +834,11 @@ pub fn process_set(
                         let mut report = process_thesis_run(&run, &cal, opt);
                         if let Some((angle, limit)) = apart {
                             report.notes.push(format!(
-                                "{STEER_AXIS_APART}: its handlebar sensor turns about an axis {:.1} deg from the steer axis the set's other runs share (beyond {:.1} deg, five times their median scatter or 5 deg); it is left out of the set's steer axis and fitted with it: check that its frame and handlebar files are not swapped and that both sensors sat on their mounts as in the other runs",
+                                "{STEER_AXIS_APART}: its handlebar sensor turns about an axis {:.1} deg from the steer axis the set's other runs share (beyond {:.1} deg, {} times their median scatter or {:.0} deg); it is left out of the set's steer axis and fitted with it: check that its frame and handlebar files are not swapped and that both sensors sat on their mounts as in the other runs",
                                 angle.to_degrees(),
-                                limit.to_degrees()
+                                limit.to_degrees(),
+                                Calibration::STEER_AXIS_SCATTERS,
+                                Calibration::STEER_AXIS_TOLERANCE.to_degrees()
                             ));
                         }
                         report
