@@ -17,6 +17,7 @@ pub mod compare;
 pub mod fit;
 pub mod kicks;
 pub mod read;
+mod set;
 pub mod speed;
 pub mod sync;
 pub mod synth;
@@ -24,12 +25,13 @@ pub mod synth;
 use angles::{AngleMethod, Angles, Calibration};
 use fit::{FitForm, FitResult};
 use kicks::{Kick, KickOptions};
-use nalgebra::Vector3;
 use read::{ReadError, RunKind, ThesisRun, TudelftLog};
 use serde::Serialize;
 use speed::SpeedProfile;
 use std::path::{Path, PathBuf};
 use sync::ClockOffset;
+
+pub use set::{process_set, MAX_MISALIGNMENT_RAD, MIN_SETTLED_S};
 
 /// Options of the pipeline.
 #[derive(Clone, Debug)]
@@ -693,161 +695,4 @@ fn looks_like_a_run(p: &Path) -> Option<&'static str> {
         name.ends_with(".csv") && (name.starts_with("imu") || name.starts_with("speed_switch"))
     });
     has_records.then_some("it holds a run's records (IMU or speed-switch CSV) but no run.toml")
-}
-
-/// Shortest settled calibration record (s): four of
-/// [`Calibration::MOTION_BLOCK`], what [`Calibration::motion`] needs to
-/// tell rest from motion.
-pub const MIN_SETTLED_S: f64 = 4.0 * Calibration::MOTION_BLOCK;
-
-/// Largest mounting misalignment of a sensor (rad): the sensors are fixed
-/// along the body axes, off by a few degrees (the example set's handlebar
-/// sensor by 11); a calibration rotated half a turn gave 155 deg and was
-/// used without a word.
-pub const MAX_MISALIGNMENT_RAD: f64 = 30.0 * std::f64::consts::PI / 180.0;
-
-/// Refuse a calibration whose estimated misalignment of either sensor is
-/// beyond [`MAX_MISALIGNMENT_RAD`].
-fn check_misalignment(cal: &Calibration, run: &Path) -> Result<(), RunError> {
-    let (frame, handlebar) = cal.misalignment_angles();
-    for (sensor, rotation, euler) in [("frame", &cal.frame, frame), ("handlebar", &cal.handlebar, handlebar)] {
-        let angle = rotation.angle();
-        if angle > MAX_MISALIGNMENT_RAD {
-            return Err(RunError::ImplausibleMisalignment {
-                run: run.to_path_buf(),
-                sensor,
-                angle,
-                euler,
-            });
-        }
-    }
-    Ok(())
-}
-
-/// Process a set of thesis-style runs: calibration (completed with the
-/// steer axis seen in the runs), then every run; a corrupt run gives its
-/// error and the others go on. `progress` is called after each run.
-///
-/// Runs are read one at a time, twice: first their orientations alone, of
-/// which only the relative rotations that show the steer axis are kept,
-/// then each whole run, processed and dropped before the next is read. So
-/// memory holds one run's records at a time, whatever the set's size.
-pub fn process_set(
-    runs: &[PathBuf],
-    calibration: &Path,
-    opt: &PipelineOptions,
-    progress: &(dyn Fn() + Sync),
-) -> Result<(Calibration, Vec<Result<RunReport, RunError>>), RunError> {
-    let cal_run = read::read_run(calibration)?;
-    let mut cal = Calibration::estimate(&cal_run, opt.frame_pitch);
-    match cal.motion(&cal_run) {
-        Some(motion) if !motion.at_rest() => {
-            return Err(RunError::NotAtRest {
-                run: calibration.to_path_buf(),
-                motion,
-            })
-        }
-        Some(_) => {}
-        // Too short to tell rest from motion: a record cut to a few rows
-        // gave a misalignment from noise, silently.
-        None => {
-            let t = &cal_run.frame.t;
-            return Err(RunError::CalibrationTooShort {
-                run: calibration.to_path_buf(),
-                settled: t.last().map_or(0.0, |e| e - cal.settled_from),
-                samples: t.len(),
-            });
-        }
-    }
-    // The steer axis from the runs that agree on it: a bad run must not
-    // turn it, and through it every other run's angles. A run whose own
-    // axis lies apart is left out of it and flagged, not dropped: on
-    // realistic sensors a good run's axis, from few samples above the
-    // noise and with heading drift, can lie several medians out.
-    // A run apart whose two files' tilts against gravity match the
-    // calibration's sensors the other way round has its files swapped: it
-    // is set aside, since its angles would be wrong.
-    let rest_up = Calibration::typical_up(&cal_run.frame, &cal_run.handlebar, cal.settled_from);
-    // Each run's relative rotations and its sensors' typical up.
-    type Seen = (Vec<Vector3<f64>>, Option<(Vector3<f64>, Vector3<f64>)>);
-    let seen: Vec<Result<Seen, RunError>> = runs
-        .iter()
-        .map(|r| {
-            read::read_run_orientations(r)
-                .map(|(_, frame, handlebar)| {
-                    (
-                        cal.relative_rotations(&frame, &handlebar),
-                        Calibration::typical_up(&frame, &handlebar, cal.settled_from),
-                    )
-                })
-                .map_err(RunError::from)
-        })
-        .collect();
-    let readable: Vec<(usize, &Seen)> = seen
-        .iter()
-        .enumerate()
-        .filter_map(|(i, r)| r.as_ref().ok().map(|r| (i, r)))
-        .collect();
-    let consensus =
-        Calibration::steer_axis_consensus(&readable.iter().map(|(_, r)| r.0.as_slice()).collect::<Vec<_>>());
-    // Runs apart (angle and limit), and among them the swapped ones.
-    let mut apart: Vec<Option<(f64, f64)>> = vec![None; runs.len()];
-    let mut swapped: Vec<Option<RunError>> = (0..runs.len()).map(|_| None).collect();
-    for ((i, (_, up)), v) in readable.iter().zip(&consensus.runs) {
-        let angles::RunAxisVerdict::Inconsistent { angle, limit } = *v else {
-            continue;
-        };
-        apart[*i] = Some((angle, limit));
-        if let (Some((rest_f, rest_h)), Some((f, h))) = (rest_up, up) {
-            let as_named = f.angle(&rest_f) + h.angle(&rest_h);
-            let as_swapped = f.angle(&rest_h) + h.angle(&rest_f);
-            if as_swapped < as_named {
-                swapped[*i] = Some(RunError::SensorsSwapped {
-                    run: runs[*i].clone(),
-                    angle,
-                    limit,
-                    as_swapped,
-                    as_named,
-                });
-            }
-        }
-    }
-    let unreadable: Vec<Option<RunError>> = seen
-        .into_iter()
-        .zip(swapped)
-        .map(|(r, swapped)| r.err().or(swapped))
-        .collect();
-    if let Some(axis) = consensus.axis {
-        cal = cal.with_steer_axis(&cal_run, &axis);
-    }
-    drop(cal_run);
-    check_misalignment(&cal, calibration)?;
-    let out = runs
-        .iter()
-        .zip(apart)
-        .zip(unreadable)
-        .map(|((path, apart), unreadable)| {
-            let rep = match unreadable {
-                Some(e) => Err(e),
-                None => read::read_run(path)
-                    .map(|run| {
-                        let mut report = process_thesis_run(&run, &cal, opt);
-                        if let Some((angle, limit)) = apart {
-                            report.notes.push(format!(
-                                "{STEER_AXIS_APART}: its handlebar sensor turns about an axis {:.1} deg from the steer axis the set's other runs share (beyond {:.1} deg, {} times their median scatter or {:.0} deg); it is left out of the set's steer axis and fitted with it: check that its frame and handlebar files are not swapped and that both sensors sat on their mounts as in the other runs",
-                                angle.to_degrees(),
-                                limit.to_degrees(),
-                                Calibration::STEER_AXIS_SCATTERS,
-                                Calibration::STEER_AXIS_TOLERANCE.to_degrees()
-                            ));
-                        }
-                        report
-                    })
-                    .map_err(RunError::from),
-            };
-            progress();
-            rep
-        })
-        .collect();
-    Ok((cal, out))
 }
