@@ -201,7 +201,7 @@ pub fn canonical<R: ModelRegistry>(
             let state_space = state_space_of(&lin, &opts.speeds)?;
             let why = if state_space.model_coordinates {
                 format!(
-                    "model `{}` has extra first-order states ({}): its lateral equations have no second-order roll-steer form",
+                    "model `{}` has extra states or coordinates ({}): its lateral equations have no second-order roll-steer form",
                     lin.model,
                     state_space.extra_states.join(", ")
                 )

@@ -28,7 +28,16 @@ pub fn built_in_thesis_parameters() -> [(&'static str, ThesisParameters); 2] {
 /// True when every parameter the bicycle sets to a non-zero value (thesis
 /// symbols and effect parameters, by `value`) is a parameter of the model.
 pub fn fits(info: &ModelInfo, nonzero: &[(&str, f64)]) -> bool {
+    let given = |name: &str| nonzero.iter().any(|(n, _)| *n == name);
     nonzero.iter().all(|(n, _)| info.parameter(n).is_some())
+        // A model's added body (a leaning rider) is there only when the
+        // bicycle gives it: its parameters have no default.
+        && info.parameters.iter().enumerate().all(|(i, p)| {
+            p.default.is_some()
+                || info.forward_speed_parameter == Some(i)
+                || ThesisParameters::SYMBOLS.contains(&p.name)
+                || given(p.name)
+        })
 }
 
 /// The built-in bicycle a model is exercised with by default: among the
@@ -57,8 +66,30 @@ pub fn default_bicycle(info: &ModelInfo) -> ThesisParameters {
 /// (driven models; free-speed models get their speed from the state).
 pub fn default_parameters<M: MultibodyModel>() -> Vec<f64> {
     let p = default_bicycle(&ModelInfo::of::<M>());
-    parameter_vector::<M>(|s| p.get(s), 4.5).expect("built-in bicycles define every model parameter")
+    let example = |s: &str| EXAMPLE_ADDED_BODIES.iter().find(|(n, _)| *n == s).map(|&(_, v)| v);
+    parameter_vector::<M>(|s| p.get(s).or_else(|| example(s)), 4.5)
+        .expect("built-in bicycles and the example added bodies define every model parameter")
 }
+
+/// Values of the parameters of bodies a model adds to the bicycle, which
+/// no built-in bicycle sets and which have no default (a bicycle file must
+/// give them), for running such a model on its default bicycle (`verify`,
+/// the benchmarks): a rider's upper body of 40 kg, its mass centre 0.2 m
+/// above a lean axis 0.9 m above the ground, with a 2000 N m/rad hip
+/// and trunk (the upper body of the benchmark's rider split in
+/// `tests/linear_analysis/leaning_rider.rs`).
+const EXAMPLE_ADDED_BODIES: &[(&str, f64)] = &[
+    ("xL", 0.3),
+    ("zL", 0.6),
+    ("x6", 0.0),
+    ("z6", 0.2),
+    ("m6", 40.0),
+    ("I6x", 2.5),
+    ("I6y", 2.8),
+    ("I6z", 1.0),
+    ("I6xz", -1.0),
+    ("k_lean", 2000.0),
+];
 
 struct Verify<'a>(&'a VerifyOptions);
 impl ModelVisitor for Verify<'_> {
@@ -89,12 +120,14 @@ pub fn model_names() -> Vec<&'static str> {
     MODELS.iter().map(|m| m.name).collect()
 }
 
-/// Every effect parameter of any built-in model, with its description.
+/// Every effect parameter of any built-in model, and every parameter of a
+/// body a model adds (a leaning rider's), with its description: what a
+/// parameter file may set beyond its form's symbols.
 pub fn effect_parameters() -> &'static [&'static ParameterInfo] {
     effect_parameters_in::<BuiltIn>()
 }
 
-/// Every effect parameter of any model of registry `R`, with its
+/// [`effect_parameters`] of the models of registry `R`, with its
 /// description.
 pub fn effect_parameters_in<R: ModelRegistry>() -> &'static [&'static ParameterInfo] {
     &index::<R>().effect_parameters
@@ -103,7 +136,8 @@ pub fn effect_parameters_in<R: ModelRegistry>() -> &'static [&'static ParameterI
 /// What bicycle resolution and model choice read from a registry, computed
 /// once per registry: sweeps resolve bicycles in their inner loop.
 pub(crate) struct Index {
-    /// Every effect parameter of any model (first declaration of each name).
+    /// Every parameter of any model beyond the thesis form's: effect
+    /// parameters and those of added bodies (first declaration of each name).
     pub effect_parameters: Vec<&'static ParameterInfo>,
     /// The driven-speed models, by increasing number of parameters (stable,
     /// so ties keep registry order).
@@ -118,8 +152,13 @@ impl Index {
     fn of(models: &'static [ModelInfo]) -> Index {
         let mut effect_parameters: Vec<&'static ParameterInfo> = Vec::new();
         for m in models {
-            for p in m.parameters {
-                if p.effect.is_some() && !effect_parameters.iter().any(|q| q.name == p.name) {
+            for (i, p) in m.parameters.iter().enumerate() {
+                // Beside the effects' parameters, those of the bodies a
+                // model adds to the bicycle (a leaning rider's): no form's
+                // table holds them either, and a file sets them alike.
+                let added = p.effect.is_some()
+                    || (!ThesisParameters::SYMBOLS.contains(&p.name) && m.forward_speed_parameter != Some(i));
+                if added && !effect_parameters.iter().any(|q| q.name == p.name) {
                     effect_parameters.push(p);
                 }
             }

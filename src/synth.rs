@@ -265,7 +265,6 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
     // jump of the thesis's kicks (impulse times height over roll inertia).
     // Unscaled, a 33 kg city bicycle's response to a thesis kick sits at the
     // noise level of the thesis's IMU and no kick is found.
-    let kick_scale = canonical_of(&p)?.m0[(0, 0)] / canonical_of(&ThesisParameters::thesis_bicycle())?.m0[(0, 0)];
     let info = match a.model.as_deref() {
         Some(name) => bike.model(Some(name))?,
         None => {
@@ -275,6 +274,16 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
             })?
         }
     };
+    let lookup = bike.lookup()?;
+    // A model's added body (a leaning rider's upper body) rolls with the
+    // bicycle too: its roll inertia is the model's own mass matrix entry
+    // (the lean held), not the bare bicycle's.
+    let roll_inertia = if info.added_coordinates().is_empty() {
+        canonical_of(&p)?.m0[(0, 0)]
+    } else {
+        R::with_model(info.name, RollInertia(&lookup)).expect("registered model")?
+    };
+    let kick_scale = roll_inertia / canonical_of(&ThesisParameters::thesis_bicycle())?.m0[(0, 0)];
     // The truth's frozen-speed eigenvalues: the linear equations of the
     // model simulated, damping, controllers and tyre states included (not
     // the bare Whipple bicycle's).
@@ -282,7 +291,6 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
     check_empty(&a.out, a.force)?;
     let set = StagedDir::new(&a.out, FolderKind::SyntheticSet)?;
     let out = set.path().to_path_buf();
-    let lookup = bike.lookup()?;
     // Sensors like the thesis's instrumentation (FORMAT.md), on this
     // bicycle's rear wheel.
     let sensors = SensorModel {
@@ -361,4 +369,22 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
         });
     }
     Ok(set.commit()?)
+}
+
+/// The roll-roll entry of a model's mass matrix at upright straight running
+/// (kg m^2): the roll inertia about the rear contact line with every other
+/// independent coordinate held.
+struct RollInertia<'a, F: Fn(&str) -> Option<f64>>(&'a F);
+impl<F: Fn(&str) -> Option<f64>> ModelVisitor for RollInertia<'_, F> {
+    type Output = Result<f64, LinearizeError>;
+    fn visit<M: MultibodyModel>(self) -> Self::Output {
+        let param = parameter_vector::<M>(self.0, 0.0)?;
+        let lin = bikedyn_runtime::linearize::linearize_at_speed::<M>(&param, 1.0)?;
+        let roll = M::require_coordinate(CoordinateRole::Roll, "a kick's size")?;
+        let k = M::INDEPENDENT
+            .iter()
+            .position(|&j| j == roll)
+            .expect("roll is independent");
+        Ok(lin.mass[(k, k)])
+    }
 }

@@ -236,3 +236,33 @@ def test_a_files_feedback_closes_the_loop_and_simulate_refuses_to_ignore_it():
     assert abs(weave - complex(-1.5025818770340327, 8.47937107316705)) < 1e-9
     with pytest.raises(bikedyn.Error, match=r"\[feedback\]"):
         bikedyn.simulate(b, duration=0.5, speed=3.0)
+
+
+def test_a_leaning_rider_stiffly_held_is_the_rigid_rider_bicycle():
+    # The benchmark's rear body B split by the parallel-axis theorem into
+    # a lower part and a 40 kg upper body hinged on a stiff lean spring
+    # (the leaning-rider model): the benchmark's eigenvalues come back.
+    par = dict(meijaard2007()["parameters"])
+    m_b, x_b, z_b = par["mB"], par["xB"], par["zB"]
+    m_u, x_u, z_u = 40.0, x_b + 0.02, -1.1
+    u = dict(xx=2.5, yy=2.8, zz=1.0, xz=1.0)
+    m_l = m_b - m_u
+    x_l, z_l = (m_b * x_b - m_u * x_u) / m_l, (m_b * z_b - m_u * z_u) / m_l
+
+    def shift(m, dx, dz):
+        return dict(xx=m * dz * dz, yy=m * (dx * dx + dz * dz), zz=m * dx * dx, xz=-m * dx * dz)
+
+    su, sl = shift(m_u, x_u - x_b, z_u - z_b), shift(m_l, x_l - x_b, z_l - z_b)
+    for k in ("xx", "yy", "zz", "xz"):
+        par["IB" + k] = par["IB" + k] - u[k] - su[k] - sl[k]
+    par.update(mB=m_l, xB=x_l, zB=z_l)
+    h_lean = 0.9
+    par.update(xL=x_b, zL=h_lean - par["rR"], x6=x_u - x_b, z6=-z_u - h_lean, m6=m_u,
+               I6x=u["xx"], I6y=u["yy"], I6z=u["zz"], I6xz=-u["xz"], k_lean=1e9)
+    rider = bikedyn.Bicycle(par, name="split benchmark")
+    assert rider.model == "rider_lean"
+    v = np.array([2.0, 4.0, 5.0, 6.0])
+    a = rider.eig(v).eigenvalues
+    b = bikedyn.Bicycle("benchmark").eig(v).eigenvalues
+    for i in range(len(v)):
+        assert np.max(np.abs(np.sort_complex(a[i]) - np.sort_complex(b[i]))) < 3e-6, (v[i], a[i], b[i])

@@ -57,6 +57,12 @@ pub enum LinearizeError {
     MissingRole(#[from] MissingRole),
     #[error("model `{model}` has no parameter `{name}`")]
     MissingParameter { model: &'static str, name: String },
+    #[error("model `{model}` needs a value of `{name}` ({doc}): the bicycle gives none and the model has no default")]
+    NoValue {
+        model: &'static str,
+        name: &'static str,
+        doc: &'static str,
+    },
     #[error("the canonical form needs exactly 2 independent coordinates (roll, steer), model `{model}` has {n}")]
     NotRollSteer { model: &'static str, n: usize },
     #[error("the reduced mass matrix is singular")]
@@ -88,7 +94,7 @@ pub enum LinearizeError {
     NoForwardSpeed { model: &'static str },
     #[error("model `{model}` has {n} independent coordinates or states, more than the linearization supports")]
     TooManyIndependent { model: &'static str, n: usize },
-    #[error("model `{model}` has extra states (e.g. tyre forces): its linearization is a state-space model, not M, C, K (use state_space_at_speed)")]
+    #[error("model `{model}` has extra states or coordinates (tyre forces, a rider's lean): its linearization is a state-space model, not the roll-steer M, C, K (use state_space_at_speed)")]
     HasStates { model: &'static str },
 }
 

@@ -738,9 +738,10 @@ pub fn parameter_vector<M: MultibodyModel>(
             } else {
                 lookup(info.name).or(info.default)
             }
-            .ok_or_else(|| LinearizeError::MissingParameter {
+            .ok_or(LinearizeError::NoValue {
                 model: M::NAME,
-                name: info.name.to_string(),
+                name: info.name,
+                doc: info.doc,
             })
         })
         .collect::<Result<_, _>>()?;
@@ -899,7 +900,10 @@ impl<M: MultibodyModel> LinearModel<M> {
                 })
         };
         let roll_steer = [position(CoordinateRole::Roll)?, position(CoordinateRole::Steer)?];
-        let lateral = if M::STATES.is_empty() {
+        // A second-order roll-steer form exists only when roll and steer
+        // are all the lateral freedom there is: extra states (tyre forces)
+        // or an extra coordinate (a rider's lean) need the state space.
+        let lateral = if M::STATES.is_empty() && extra_coordinates::<M>().is_empty() {
             None
         } else {
             Some(lateral_states_of::<M>(&param, roll_steer)?)
@@ -911,6 +915,16 @@ impl<M: MultibodyModel> LinearModel<M> {
             _model: std::marker::PhantomData,
         })
     }
+}
+
+/// Positions within the independent coordinates of those the rolling
+/// bicycle lacks: independent coordinates with no declared role (a rider's
+/// lean), unlike the lateral position and yaw that tyre slip frees, which
+/// the bicycle has as ignorable coordinates.
+fn extra_coordinates<M: MultibodyModel>() -> Vec<usize> {
+    (0..M::INDEPENDENT.len())
+        .filter(|&k| !M::COORDINATE_ROLES.iter().any(|&(_, j)| j == M::INDEPENDENT[k]))
+        .collect()
 }
 
 /// The lateral states of a model with extra states: every state of
@@ -987,7 +1001,14 @@ impl<M: MultibodyModel> StateSpaceBicycle for LinearModel<M> {
             roll_steer: [at(r), at(s), at(ni + r), at(ni + s)],
             // The generated models use the thesis's axes (see `at_speed`).
             steer_sign: -1.0,
-            extra: (0..keep.len()).filter(|&i| keep[i] >= 2 * ni).collect(),
+            // Extra: the first-order states and the coordinates (and
+            // their rates) the rolling bicycle lacks.
+            extra: {
+                let coords = extra_coordinates::<M>();
+                (0..keep.len())
+                    .filter(|&i| keep[i] >= 2 * ni || coords.iter().any(|&k| keep[i] == k || keep[i] == ni + k))
+                    .collect()
+            },
             neutral,
         })
     }

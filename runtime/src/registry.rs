@@ -22,6 +22,9 @@ pub struct ModelInfo {
     pub coordinate_roles: &'static [(CoordinateRole, usize)],
     /// The effects applied, with their identification declarations.
     pub effect_declarations: &'static [EffectDeclaration],
+    /// Position in `parameters` of the forward speed a driven-speed model
+    /// imposes (set by each job, not by a bicycle).
+    pub forward_speed_parameter: Option<usize>,
 }
 
 impl ModelInfo {
@@ -39,6 +42,7 @@ impl ModelInfo {
             states: M::STATES,
             coordinate_roles: M::COORDINATE_ROLES,
             effect_declarations: M::EFFECT_DECLARATIONS,
+            forward_speed_parameter: M::FORWARD_SPEED_PARAMETER,
         }
     }
 
@@ -48,6 +52,17 @@ impl ModelInfo {
             .iter()
             .find(|(r, _)| *r == role)
             .map(|&(_, i)| self.coordinates[i])
+    }
+
+    /// The independent coordinates the rolling bicycle lacks, by name:
+    /// those with no declared role (a leaning rider's `lean`). A model with
+    /// one has no second-order roll-steer form.
+    pub fn added_coordinates(&self) -> Vec<&'static str> {
+        self.independent
+            .iter()
+            .filter(|&&i| !self.coordinate_roles.iter().any(|&(_, j)| j == i))
+            .map(|&i| self.coordinates[i])
+            .collect()
     }
 
     /// The declaration of the applied effect `name`.

@@ -78,11 +78,12 @@ impl<R: ModelRegistry> Bicycle<R> {
             return Ok(open);
         };
         let info = self.model(model)?;
-        if !info.states.is_empty() {
+        let added = info.added_coordinates();
+        if !info.states.is_empty() || !added.is_empty() {
             return Err(BicycleError::FeedbackOnStates {
                 bike: self.name.clone(),
                 model: info.name.to_string(),
-                states: info.states.join(", "),
+                states: info.states.iter().chain(&added).copied().collect::<Vec<_>>().join(", "),
             });
         }
         Ok(Linear {
@@ -99,12 +100,14 @@ impl<R: ModelRegistry> Bicycle<R> {
     fn open_loop_with(&self, model: Option<&str>) -> Result<Linear, BicycleError> {
         let nonzero = self.nonzero_parameters()?;
         let info = self.model_for(model, &nonzero)?;
-        // A model with extra states has no canonical form (nor M, C, K).
-        let canonical = if info.states.is_empty() {
+        // A model with extra states or coordinates (tyre forces, a rider's
+        // lean) has no canonical form (nor roll-steer M, C, K).
+        let added = info.added_coordinates();
+        let canonical = if info.states.is_empty() && added.is_empty() {
             self.plant_canonical_with(model)
         } else {
             Err(BicycleError::NotCanonical {
-                effects: info.states.join(", "),
+                effects: info.states.iter().chain(&added).copied().collect::<Vec<_>>().join(", "),
             })
         };
         match canonical {

@@ -60,9 +60,15 @@ pub enum BicycleError {
     EffectParameter { file: String, why: String },
     #[error("no generated model has every parameter `{bike}` sets ({nonzero})")]
     NoModelFits { bike: String, nonzero: String },
+    #[error("`{bike}` gives part of model `{model}`'s added body: it also needs {missing}")]
+    MissingValues {
+        bike: String,
+        model: String,
+        missing: String,
+    },
     #[error("the canonical form M0, C1, K0, K2 holds for the Whipple bicycle; with {effects} the linear equations depend on speed otherwise")]
     NotCanonical { effects: String },
-    #[error("{bike}: its [feedback] closes the loop on the roll-steer equations M, C, K, which model `{model}` does not have (its extra states: {states}); use a model without extra states")]
+    #[error("{bike}: its [feedback] closes the loop on the roll-steer equations M, C, K, which model `{model}` does not have (its extra states or coordinates: {states}); use a model without them")]
     FeedbackOnStates {
         bike: String,
         model: String,
@@ -284,8 +290,45 @@ impl<R: ModelRegistry> Bicycle<R> {
         (var > 0.0).then(|| var.sqrt())
     }
 
+    /// Why no model fits: a model that has every parameter the bicycle sets
+    /// but lacks values of its added body's (a leaning rider's `k_lean`
+    /// left out) is named with them; otherwise the parameters set.
+    fn why_no_model_fits(&self, nonzero: &[(&'static str, f64)]) -> BicycleError {
+        let given = |name: &str| nonzero.iter().any(|(n, _)| *n == name);
+        let near = index::<R>()
+            .driven_by_size
+            .iter()
+            .find(|m| nonzero.iter().all(|(n, _)| m.parameter(n).is_some()));
+        if let Some(m) = near {
+            let missing: Vec<String> = m
+                .parameters
+                .iter()
+                .enumerate()
+                .filter(|&(i, p)| {
+                    p.default.is_none()
+                        && m.forward_speed_parameter != Some(i)
+                        && !ThesisParameters::SYMBOLS.contains(&p.name)
+                        && !given(p.name)
+                })
+                .map(|(_, p)| format!("`{}` ({})", p.name, p.doc))
+                .collect();
+            if !missing.is_empty() {
+                return BicycleError::MissingValues {
+                    bike: self.name.clone(),
+                    model: m.name.to_string(),
+                    missing: missing.join(", "),
+                };
+            }
+        }
+        BicycleError::NoModelFits {
+            bike: self.name.clone(),
+            nonzero: nonzero.iter().map(|(s, _)| *s).collect::<Vec<_>>().join(", "),
+        }
+    }
+
     /// Parameters this bicycle sets to a non-zero value: thesis symbols and
-    /// effect parameters (with their values).
+    /// effect parameters (with their values), and every parameter of an
+    /// added body it gives (a leaning rider's, even at zero).
     pub fn nonzero_parameters(&self) -> Result<Vec<(&'static str, f64)>, BicycleError> {
         let t = self.thesis()?;
         let mut out: Vec<(&'static str, f64)> = ThesisParameters::SYMBOLS
@@ -294,7 +337,10 @@ impl<R: ModelRegistry> Bicycle<R> {
             .collect();
         for p in effect_parameters_in::<R>() {
             if let Some(&v) = self.effects.get(p.name) {
-                if Some(v) != p.default && v != 0.0 {
+                // An effect at its absent value asks for no model; a
+                // parameter of an added body (no default) asks for the
+                // model with that body whatever its value.
+                if p.default.is_none() || (Some(v) != p.default && v != 0.0) {
                     out.push((p.name, v));
                 }
             }
@@ -347,10 +393,7 @@ impl<R: ModelRegistry> Bicycle<R> {
                 .iter()
                 .find(|m| fits(m, nonzero))
                 .copied()
-                .ok_or_else(|| BicycleError::NoModelFits {
-                    bike: self.name.clone(),
-                    nonzero: nonzero.iter().map(|(s, _)| *s).collect::<Vec<_>>().join(", "),
-                }),
+                .ok_or_else(|| self.why_no_model_fits(nonzero)),
         }
     }
 

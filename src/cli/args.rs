@@ -393,8 +393,9 @@ pub struct SimulateArgs {
     /// Built-in bicycle (thesis, benchmark) or parameter file.
     #[arg(long, default_value = "thesis")]
     pub bike: String,
-    /// Generated model (default: thesis_whipple, or whipple_offset when the
-    /// fork mass centre is off the steer axis).
+    /// Generated model (default: the smallest model with every parameter
+    /// the bicycle sets: thesis_whipple, whipple_offset when the fork mass
+    /// centre is off the steer axis, rider_lean with a leaning rider, ...).
     #[arg(long)]
     pub model: Option<String>,
     /// Free forward speed (no driving constraint): needs a free-speed model.

@@ -7,6 +7,7 @@ mod constraints;
 mod fast_path;
 mod free_speed;
 mod frequency_response;
+mod leaning_rider;
 mod library_jobs;
 mod real_designs;
 mod sensitivity;

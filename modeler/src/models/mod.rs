@@ -30,4 +30,6 @@ models!(
     extended,
     extended_free,
     tyre_free,
+    rider_lean,
+    rider_lean_free,
 );

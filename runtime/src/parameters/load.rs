@@ -515,8 +515,12 @@ fn parse_toml_fields(text: &str, path: &Path, extra: &[&str]) -> Result<TomlFiel
                 why: match (form, extra.is_empty()) {
                     (Form::Thesis, true) => "not a thesis-form symbol",
                     (Form::Benchmark, true) => "not a benchmark-form symbol",
-                    (Form::Thesis, false) => "neither a thesis-form symbol nor an effect parameter of any model",
-                    (Form::Benchmark, false) => "neither a benchmark-form symbol nor an effect parameter of any model",
+                    (Form::Thesis, false) => {
+                        "neither a thesis-form symbol nor a parameter of any model's effects or added bodies"
+                    }
+                    (Form::Benchmark, false) => {
+                        "neither a benchmark-form symbol nor a parameter of any model's effects or added bodies"
+                    }
                 },
             });
         }

@@ -773,8 +773,13 @@ pub fn initial_state<M: MultibodyModel>(
     // tyre slip, the lateral ones (yc, phi). They solve `speed = ic.speed`
     // and `z' = ic.state_rates` (by default zero: the extra states at rest;
     // upright, that is rolling without lateral slip), one equation per
-    // extra state.
-    let others: Vec<usize> = (0..l.ni()).filter(|&k| k != c.roll_ind && k != c.steer_ind).collect();
+    // extra state. A coordinate the rolling bicycle lacks (no declared
+    // role: a rider's lean) starts at rest relative to the frame, as roll
+    // and steer start where they are given.
+    let has_role = |k: usize| M::COORDINATE_ROLES.iter().any(|&(_, j)| j == l.independent[k]);
+    let others: Vec<usize> = (0..l.ni())
+        .filter(|&k| k != c.roll_ind && k != c.steer_ind && has_role(k))
+        .collect();
     if !others.is_empty() {
         if others.len() != 1 + l.extra {
             return Err(SimulateError::InvalidInput(format!(
