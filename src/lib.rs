@@ -27,6 +27,7 @@ pub mod registry {
 
 pub mod bicycle;
 pub mod canonical;
+pub mod eigen;
 pub mod fit;
 pub mod frequency;
 pub mod identify;

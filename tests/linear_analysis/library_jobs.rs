@@ -1,8 +1,10 @@
-//! The linear-analysis jobs as library calls (`canonical`, `stability`):
-//! the typed results the command line prints and Python converts.
+//! The linear-analysis jobs as library calls (`canonical`, `stability`,
+//! `eig`): the typed results the command line prints and Python converts.
 
+use crate::common::{fixture, fixture_arg, ok_json};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::canonical::{canonical, state_space, CanonicalOptions, CanonicalReport};
+use bikedyn::eigen::{eigen_sweep, eigenvalues, EigenJob, EigenOptions, EigenSweepError, Speeds};
 use bikedyn::runtime::eigen::LinearBicycle;
 use bikedyn::stability::{stability, StabilityError, StabilityOptions};
 
@@ -133,4 +135,160 @@ fn the_stability_job_gives_the_benchmark_speeds_and_refuses_draws_without_spread
         ..StabilityOptions::default()
     };
     assert!(matches!(stability(&b, &backwards), Err(StabilityError::SpeedRange(..))));
+}
+
+/// `value` as JSON text read back: the command line's output is read by
+/// the same parser, whose last digit can differ from the number's
+/// (serde_json reads floats fast, not exactly), so text equal to the
+/// command line's compares equal.
+fn as_printed(value: &impl serde::Serialize) -> serde_json::Value {
+    serde_json::from_str(&serde_json::to_string(value).unwrap()).unwrap()
+}
+
+/// What `bikedyn eig --format json` prints is the serialization of the
+/// `eig` job's typed result, field for field and number for number: for a
+/// file with `+/-` values (standard deviations in every entry) over a
+/// range, and for a model with extra states (extra eigenvalues).
+#[test]
+fn the_eig_job_result_is_what_bikedyn_eig_prints_in_json() {
+    let file = fixture_arg("Balanceassistv1Benchmark.txt");
+    let b = Bicycle::resolve(&file).unwrap();
+    let printed = ok_json(&["eig", "--bike", &file, "--speeds", "0:9:0.75", "--format", "json"]);
+    let report = eigen_sweep(
+        &b,
+        &EigenOptions {
+            speeds: Speeds::Range {
+                start: 0.0,
+                step: 0.75,
+                count: 13,
+            },
+            ..EigenOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(report.points.iter().all(|p| p.standard_deviations.is_some()));
+    assert_eq!(as_printed(&report), printed);
+
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let printed = ok_json(&[
+        "eig",
+        "--bike",
+        "benchmark",
+        "--model",
+        "tyre_free",
+        "--speeds",
+        "2:6:2",
+        "--format",
+        "json",
+    ]);
+    let report = eigen_sweep(
+        &b,
+        &EigenOptions {
+            model: Some("tyre_free".into()),
+            speeds: Speeds::List(vec![2.0, 4.0, 6.0]),
+            ..EigenOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(report.model, "tyre_free");
+    assert!(!report.points[0].extra_eigenvalues.is_empty());
+    assert_eq!(as_printed(&report), printed);
+}
+
+/// The defaults are those documented (and `bikedyn eig`'s): 0 to 10 m/s in
+/// steps of 0.5 m/s through the bicycle's own model, standard deviations
+/// when the file has `+/-` values, no critical speeds; the benchmark's
+/// weave pair at 0 m/s is the first entry.
+#[test]
+fn the_eig_job_defaults_are_21_speeds_from_rest_to_10_m_per_s() {
+    let o = EigenOptions::default();
+    assert!(o.model.is_none() && o.standard_deviations && !o.critical_speeds);
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let r = eigen_sweep(&b, &o).unwrap();
+    let v: Vec<f64> = r.points.iter().map(|p| p.v).collect();
+    assert_eq!(v, (0..=20).map(|k| 0.5 * k as f64).collect::<Vec<_>>());
+    assert_eq!(r.model, b.model(None).unwrap().name);
+    assert!(r.critical.is_none());
+    // A built-in bicycle has no `+/-` values: nothing to give.
+    assert!(r.points.iter().all(|p| p.standard_deviations.is_none()));
+    assert_eq!(
+        as_printed(&r),
+        ok_json(&["eig", "--bike", "benchmark", "--format", "json"])
+    );
+    // With critical speeds asked, the benchmark's v_w and v_c.
+    let crit = eigen_sweep(
+        &b,
+        &EigenOptions {
+            critical_speeds: true,
+            ..EigenOptions::default()
+        },
+    )
+    .unwrap()
+    .critical
+    .unwrap();
+    assert!((crit.weave_speed.unwrap() - 4.292_382_536_341_11).abs() < 1e-8);
+    assert!((crit.capsize_speed.unwrap() - 6.024_262_015_388_37).abs() < 1e-8);
+}
+
+/// Speeds given a block at a time (the command line's streaming) give the
+/// same points as one call, and the fast eigenvalue path gives the same
+/// spectrum by descending real part.
+#[test]
+fn the_eig_job_streamed_equals_the_job_at_once_and_the_fast_path() {
+    let b = Bicycle::resolve(&fixture("TmsBenchmark.txt").to_string_lossy()).unwrap();
+    let speeds = Speeds::Range {
+        start: 0.0,
+        step: 0.001,
+        count: 5001,
+    };
+    let opts = EigenOptions {
+        speeds: speeds.clone(),
+        ..EigenOptions::default()
+    };
+    let job = EigenJob::new(&b, &opts).unwrap();
+    let streamed: Vec<_> = job.points().map(Result::unwrap).collect();
+    let at_once = eigen_sweep(&b, &opts).unwrap();
+    assert_eq!(streamed, at_once.points);
+    let list: Vec<f64> = (0..speeds.len()).map(|k| speeds.at(k)).collect();
+    let fast = eigenvalues(&b, None, &list).unwrap();
+    assert_eq!(fast.per_speed, 4);
+    for (p, z) in streamed.iter().zip(fast.values.chunks(4)) {
+        let mut e = p.eigenvalues;
+        e.sort_by(|a, b| b[0].total_cmp(&a[0]).then(b[1].total_cmp(&a[1])));
+        assert_eq!(e.as_slice(), z, "at {} m/s", p.v);
+    }
+}
+
+/// Bad speeds are typed errors naming what is wrong, never a panic.
+#[test]
+fn the_eig_job_refuses_bad_speeds_with_a_typed_error() {
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let with = |speeds| EigenOptions {
+        speeds,
+        ..EigenOptions::default()
+    };
+    let e = eigen_sweep(&b, &with(Speeds::List(vec![1.0, f64::NAN]))).unwrap_err();
+    assert!(matches!(e, EigenSweepError::Speed { index: 1, .. }), "{e}");
+    assert!(e.to_string().starts_with("speeds[1]"), "{e}");
+    assert!(matches!(
+        eigen_sweep(&b, &with(Speeds::List(Vec::new()))),
+        Err(EigenSweepError::NoSpeeds)
+    ));
+    let backwards = Speeds::Range {
+        start: 0.0,
+        step: -1.0,
+        count: 3,
+    };
+    let e = eigen_sweep(&b, &with(backwards)).unwrap_err();
+    assert!(
+        matches!(e, EigenSweepError::Step(_)) && e.to_string().contains("step"),
+        "{e}"
+    );
+    let e = eigenvalues(&b, None, &[f64::INFINITY]).unwrap_err();
+    assert!(matches!(e, EigenSweepError::Speed { index: 0, .. }), "{e}");
+    let bad_model = EigenOptions {
+        model: Some("nosuch".into()),
+        ..EigenOptions::default()
+    };
+    assert!(matches!(eigen_sweep(&b, &bad_model), Err(EigenSweepError::Bicycle(_))));
 }
