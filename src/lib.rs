@@ -37,4 +37,5 @@ pub mod progress;
 pub mod sensitivity;
 pub mod simulate;
 pub mod stability;
+pub mod sweep;
 pub mod synth;

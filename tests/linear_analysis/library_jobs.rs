@@ -1,12 +1,15 @@
 //! The linear-analysis jobs as library calls (`canonical`, `stability`,
-//! `eig`): the typed results the command line prints and Python converts.
+//! `eig`, `sweep`): the typed results the command line prints and Python
+//! converts.
 
 use crate::common::{fixture, fixture_arg, ok_json};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::canonical::{canonical, state_space, CanonicalOptions, CanonicalReport};
 use bikedyn::eigen::{eigen_sweep, eigenvalues, EigenJob, EigenOptions, EigenSweepError, Speeds};
 use bikedyn::runtime::eigen::LinearBicycle;
+use bikedyn::runtime::sweep::no_progress;
 use bikedyn::stability::{stability, StabilityError, StabilityOptions};
+use bikedyn::sweep::{sweep, sweep_at_speeds, sweep_model, SweepError, SweepOptions, SweepReport, SweptParameter};
 
 /// The benchmark bicycle has the canonical form; its structural zero
 /// `C1[0][0]` is written as 0, and the file-free built-in has no standard
@@ -291,4 +294,160 @@ fn the_eig_job_refuses_bad_speeds_with_a_typed_error() {
         ..EigenOptions::default()
     };
     assert!(matches!(eigen_sweep(&b, &bad_model), Err(EigenSweepError::Bicycle(_))));
+}
+
+/// What `bikedyn sweep --format json` prints is the serialization of the
+/// `sweep` job's typed result: over one parameter of a file with `+/-`
+/// values (the critical speeds' standard deviations in every point), and
+/// over two with the least stable real part at a speed.
+#[test]
+fn the_sweep_job_result_is_what_bikedyn_sweep_prints_in_json() {
+    let file = fixture_arg("Balanceassistv1Benchmark.txt");
+    let b = Bicycle::resolve(&file).unwrap();
+    let printed = ok_json(&[
+        "sweep",
+        "--bike",
+        &file,
+        "--param",
+        "c",
+        "--values",
+        "0.05:0.1:0.025",
+        "--format",
+        "json",
+    ]);
+    // The values as the command line counts them (0.05 + 0.025 is not 0.075).
+    let values: Vec<f64> = (0..3).map(|k| 0.05 + k as f64 * 0.025).collect();
+    let report = sweep(&b, &SweepOptions::new("c", values), &no_progress).unwrap();
+    let SweepReport::Parameter(p) = &report else {
+        panic!("one parameter: no map");
+    };
+    assert!(p.points.iter().all(|p| p.weave_speed_sd.is_some()));
+    assert_eq!(as_printed(&report), printed);
+
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let printed = ok_json(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0:0.1:0.05",
+        "--param2",
+        "lam",
+        "--values2",
+        "0.2:0.4:0.2",
+        "--at-speed",
+        "5",
+        "--format",
+        "json",
+    ]);
+    let report = sweep(
+        &b,
+        &SweepOptions {
+            second: Some(SweptParameter::new("lam", vec![0.2, 0.4])),
+            at_speed: Some(5.0),
+            ..SweepOptions::new("c", vec![0.0, 0.05, 0.1])
+        },
+        &no_progress,
+    )
+    .unwrap();
+    let SweepReport::Map(m) = &report else {
+        panic!("two parameters: a map");
+    };
+    assert_eq!(m.cells.len(), 6);
+    assert!(m.cells.iter().all(|c| c.least_stable_real_part.is_some()));
+    assert_eq!(as_printed(&report), printed);
+}
+
+/// The defaults are those documented: the model chosen at the first
+/// non-zero values (a steer-damping sweep from 0 goes through the model
+/// with steer damping), speeds searched from 0 to 10 m/s, standard
+/// deviations asked; and the sweep at given speeds finds the benchmark's
+/// weave speed at its own trail.
+#[test]
+fn the_sweep_job_defaults_and_its_model_choice() {
+    let o = SweepOptions::new("c_steer", vec![0.0, 1.0]);
+    assert!(o.model.is_none() && o.second.is_none() && o.at_speed.is_none() && o.standard_deviations);
+    assert_eq!(o.speed_max, 10.0);
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let damped = b.with_parameter("c_steer", 1.0).unwrap().model(None).unwrap().name;
+    assert_ne!(damped, b.model(None).unwrap().name);
+    assert_eq!(sweep_model(&b, &o).unwrap(), damped);
+    let SweepReport::Parameter(p) = sweep(&b, &o, &no_progress).unwrap() else {
+        panic!("one parameter: no map");
+    };
+    assert_eq!(p.model, damped);
+    assert_eq!(p.speed_range, [0.0, 10.0]);
+    // A built-in bicycle has no `+/-` values.
+    assert!(p.standard_deviations.is_none() && !p.standard_deviations_missing);
+    let named = SweepOptions {
+        model: Some("extended".into()),
+        ..SweepOptions::new("c", vec![0.08])
+    };
+    assert_eq!(sweep_model(&b, &named).unwrap(), "extended");
+
+    let speeds: Vec<f64> = (0..=20).map(|k| 0.5 * k as f64).collect();
+    let s = sweep_at_speeds(&b, &SweepOptions::new("c", vec![0.08, 0.1]), &speeds).unwrap();
+    assert_eq!((s.designs, s.least_stable_real_part.len()), (2, 42));
+    assert!(
+        (s.weave_speed[0] - 4.292_382_536_341_11).abs() < 1e-8,
+        "{:?}",
+        s.weave_speed
+    );
+    assert!(
+        (s.capsize_speed[0] - 6.024_262_015_388_37).abs() < 1e-8,
+        "{:?}",
+        s.capsize_speed
+    );
+    // Unstable at rest, stable at 5 m/s.
+    assert!(s.least_stable_real_part[0] > 0.0 && s.least_stable_real_part[10] < 0.0);
+}
+
+/// Bad options are typed errors naming the field, and failed designs an
+/// error listing them, never a panic or a table with messages in it.
+#[test]
+fn the_sweep_job_refuses_bad_options_with_a_typed_error() {
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let run = |o: &SweepOptions| sweep(&b, o, &no_progress);
+    let same = SweepOptions {
+        second: Some(SweptParameter::new("c", vec![0.1])),
+        ..SweepOptions::new("c", vec![0.1])
+    };
+    assert!(matches!(run(&same), Err(SweepError::SameParameter(p)) if p == "c"));
+    assert!(matches!(
+        run(&SweepOptions::new("c", Vec::new())),
+        Err(SweepError::NoValues("parameter"))
+    ));
+    let speed_max = SweepOptions {
+        speed_max: -1.0,
+        ..SweepOptions::new("c", vec![0.1])
+    };
+    let e = run(&speed_max).unwrap_err();
+    assert!(
+        matches!(e, SweepError::SpeedMax(_)) && e.to_string().starts_with("speed_max"),
+        "{e}"
+    );
+    let at_speed = SweepOptions {
+        at_speed: Some(f64::NAN),
+        ..SweepOptions::new("c", vec![0.1])
+    };
+    let e = run(&at_speed).unwrap_err();
+    assert!(
+        matches!(e, SweepError::AtSpeed(_)) && e.to_string().starts_with("at_speed"),
+        "{e}"
+    );
+    assert!(matches!(
+        run(&SweepOptions::new("nosuch", vec![1.0])),
+        Err(SweepError::Bicycle(_))
+    ));
+    // Steer-axis tilts of 1.6 and 2 rad are no bicycle: both listed.
+    let e = run(&SweepOptions::new("lam", vec![0.3, 1.6, 2.0])).unwrap_err();
+    let SweepError::FailedDesigns(failed) = &e else {
+        panic!("{e}");
+    };
+    assert_eq!(failed.len(), 2);
+    assert_eq!(failed[0].at, [("lam".to_string(), 1.6)]);
+    assert!(e.to_string().starts_with("2 of the sweep's designs failed"), "{e}");
+    assert!(sweep_at_speeds(&b, &SweepOptions::new("c", vec![0.1]), &[f64::NAN]).is_err());
 }
