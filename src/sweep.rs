@@ -600,8 +600,8 @@ pub enum SweepAtSpeedsError {
     Design {
         /// `(symbol, value)` of each swept parameter.
         at: Vec<(String, f64)>,
-        /// Why.
-        source: BicycleError,
+        /// Why (boxed: the error stays small on the way up).
+        source: Box<BicycleError>,
     },
     /// A design's eigenvalues.
     #[error("at {}: {source}", at_text(.at))]
@@ -660,7 +660,9 @@ where
         .iter()
         .flat_map(|&x| ys.iter().map(move |&y| (x, y)))
         .collect();
-    let results: Vec<Result<(Vec<f64>, f64, f64), SweepAtSpeedsError>> = cells
+    // Each design's least stable real parts, v_w and v_c.
+    type Design = (Vec<f64>, f64, f64);
+    let results: Vec<Result<Design, SweepAtSpeedsError>> = cells
         .par_iter()
         .map(|&(x, y)| {
             let at = || {
@@ -672,7 +674,10 @@ where
             };
             let lin = design(bike, opts, x, y)
                 .and_then(|b| b.linear_with(Some(&model)))
-                .map_err(|source| SweepAtSpeedsError::Design { at: at(), source })?;
+                .map_err(|e| SweepAtSpeedsError::Design {
+                    at: at(),
+                    source: Box::new(e),
+                })?;
             let eig = |source| SweepAtSpeedsError::Eigen { at: at(), source };
             let mut least = Vec::with_capacity(speeds.len());
             if lin.first_order().is_some() {
