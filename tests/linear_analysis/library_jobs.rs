@@ -2,7 +2,7 @@
 //! `eig`, `sweep`): the typed results the command line prints and Python
 //! converts.
 
-use crate::common::{fixture, fixture_arg, ok_json};
+use crate::common::{bikedyn, fixture, fixture_arg, ok_json, text};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::canonical::{canonical, state_space, CanonicalOptions, CanonicalReport};
 use bikedyn::eigen::{eigen_sweep, eigenvalues, EigenJob, EigenOptions, EigenSweepError, Speeds};
@@ -148,6 +148,19 @@ fn as_printed(value: &impl serde::Serialize) -> serde_json::Value {
     serde_json::from_str(&serde_json::to_string(value).unwrap()).unwrap()
 }
 
+/// The keys `keys` appear in `json` (an object's text) in this order
+/// (each key's last occurrence: an object's own after its nested ones).
+fn assert_in_order(json: &str, keys: &[&str]) {
+    let at: Vec<usize> = keys
+        .iter()
+        .map(|k| {
+            json.rfind(&format!("\"{k}\":"))
+                .unwrap_or_else(|| panic!("{k} in {json}"))
+        })
+        .collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "{keys:?} out of order in {json}");
+}
+
 /// What `bikedyn eig --format json` prints is the serialization of the
 /// `eig` job's typed result, field for field and number for number: for a
 /// file with `+/-` values (standard deviations in every entry) over a
@@ -218,6 +231,12 @@ fn the_eig_job_defaults_are_21_speeds_from_rest_to_10_m_per_s() {
         as_printed(&r),
         ok_json(&["eig", "--bike", "benchmark", "--format", "json"])
     );
+    // Byte for byte: one speed's object per line, fields in their order.
+    let out = bikedyn(&["eig", "--bike", "benchmark", "--format", "json"]);
+    let lines: Vec<String> = r.points.iter().map(|p| serde_json::to_string(p).unwrap()).collect();
+    assert_eq!(text(&out.stdout), format!("[\n  {}\n]\n", lines.join(",\n  ")));
+    // The fields in the order the command has always written them.
+    assert_in_order(&lines[0], &["eigenvalues", "mode_shapes", "modes", "v"]);
     // With critical speeds asked, the benchmark's v_w and v_c.
     let crit = eigen_sweep(
         &b,
@@ -358,6 +377,49 @@ fn the_sweep_job_result_is_what_bikedyn_sweep_prints_in_json() {
     assert_eq!(m.cells.len(), 6);
     assert!(m.cells.iter().all(|c| c.least_stable_real_part.is_some()));
     assert_eq!(as_printed(&report), printed);
+    // Byte for byte: the pretty-printed serialization, fields in their
+    // order.
+    let out = bikedyn(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0:0.1:0.05",
+        "--param2",
+        "lam",
+        "--values2",
+        "0.2:0.4:0.2",
+        "--at-speed",
+        "5",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(text(&out.stdout), serde_json::to_string_pretty(&report).unwrap() + "\n");
+    // The fields in the order the command has always written them.
+    let first_cell = serde_json::to_string(&m.cells[0]).unwrap();
+    assert_in_order(
+        &first_cell,
+        &[
+            "capsize_speed",
+            "error",
+            "i",
+            "j",
+            "least_stable_real_part",
+            "open_ended",
+            "stable_intervals",
+            "stable_width",
+            "weave_real_pair_merge",
+            "weave_speed",
+            "x",
+            "y",
+        ],
+    );
+    assert_in_order(
+        &serde_json::to_string(&report).unwrap(),
+        &["cells", "layout", "speed_range", "x", "y"],
+    );
 }
 
 /// The defaults are those documented: the model chosen at the first
