@@ -27,6 +27,7 @@ pub mod registry {
 
 pub mod bicycle;
 pub mod canonical;
+pub mod eigen;
 pub mod fit;
 pub mod frequency;
 pub mod identify;
@@ -36,4 +37,5 @@ pub mod progress;
 pub mod sensitivity;
 pub mod simulate;
 pub mod stability;
+pub mod sweep;
 pub mod synth;

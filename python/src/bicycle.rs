@@ -1,6 +1,19 @@
 //! `_Bicycle`: a bicycle's linear analysis, stability and uncertainties.
 
 use super::*;
+use bikedyn::eigen::{eigenvalues, EigenJob, EigenOptions, EigenSweepError, Speeds};
+use bikedyn::runtime::eigen::EigenPoint;
+
+/// The exception kind of an eigen-analysis error.
+fn eigen_failure(e: EigenSweepError) -> Failure {
+    match e {
+        EigenSweepError::Bicycle(e) => Failure::from(e),
+        EigenSweepError::Eigen(e) => Failure::new("ComputationError", e),
+        e @ (EigenSweepError::NoSpeeds | EigenSweepError::Speed { .. } | EigenSweepError::Step(_)) => {
+            Failure::new("InvalidArgumentError", e)
+        }
+    }
+}
 
 /// A bicycle: its parameters (thesis or benchmark form), effect
 /// parameters and uncertainties, resolved against the built-in models.
@@ -228,19 +241,29 @@ impl PyBicycle {
         let speeds = doubles(speeds, "speeds").map_err(|e| e.into_py(py))?;
         let (name, k, values, codes, names, vectors) = detached(py, || {
             finite_speeds(&speeds, "speeds")?;
-            let lin = self.linear(model.as_deref())?;
-            let sweep = eigen_sweep_of(&lin, &speeds).map_err(|e| Failure::new("ComputationError", e))?;
-            let k = 4 + sweep
-                .points
-                .iter()
-                .map(|p| p.extra_eigenvalues.len())
-                .max()
-                .unwrap_or(0);
+            let job = EigenJob::new(
+                &self.inner,
+                &EigenOptions {
+                    model,
+                    speeds: Speeds::List(speeds.clone()),
+                    standard_deviations: false,
+                    critical_speeds: false,
+                },
+            )
+            .map_err(eigen_failure)?;
+            // The solver's order, with the eigenvectors: as the arrays have
+            // always been.
+            let points: Vec<EigenPoint> = job
+                .points()
+                .map(|p| p.map(|p| p.point))
+                .collect::<Result<_, _>>()
+                .map_err(eigen_failure)?;
+            let k = 4 + points.iter().map(|p| p.extra_eigenvalues.len()).max().unwrap_or(0);
             let mut values = Vec::with_capacity(2 * k * speeds.len());
             let mut vectors = Vec::with_capacity(32 * speeds.len());
             let mut codes = Vec::with_capacity(4 * speeds.len());
             let mut names: Vec<&'static str> = Vec::new();
-            for p in &sweep.points {
+            for p in &points {
                 for z in p.eigenvalues.iter().chain(&p.extra_eigenvalues) {
                     values.extend([z.re, z.im]);
                 }
@@ -266,7 +289,7 @@ impl PyBicycle {
                     }
                 }
             }
-            Ok((lin.model, k, values, codes, names, vectors))
+            Ok((job.model, k, values, codes, names, vectors))
         })?;
         Ok((
             name.to_string(),
@@ -289,51 +312,12 @@ impl PyBicycle {
         model: Option<String>,
     ) -> PyResult<(String, usize, Bound<'py, PyBytes>)> {
         let speeds = doubles(speeds, "speeds").map_err(|e| e.into_py(py))?;
-        let (name, k, values) = detached(py, || {
+        let e = detached(py, || {
             finite_speeds(&speeds, "speeds")?;
-            let lin = self.linear(model.as_deref())?;
-            let fail = |e: bikedyn::runtime::eigen::EigenError| Failure::new("ComputationError", e);
-            let sort = |z: &mut Vec<nalgebra::Complex<f64>>| {
-                z.sort_by(|a, b| b.re.total_cmp(&a.re).then(b.im.total_cmp(&a.im)));
-            };
-            if lin.first_order().is_some() {
-                // Extra states: the sweep's spectrum, which includes them.
-                let sweep = eigen_sweep_of(&lin, &speeds).map_err(fail)?;
-                let k = 4 + sweep
-                    .points
-                    .iter()
-                    .map(|p| p.extra_eigenvalues.len())
-                    .max()
-                    .unwrap_or(0);
-                let mut values = Vec::with_capacity(2 * k * speeds.len());
-                for p in &sweep.points {
-                    let mut z: Vec<_> = p.eigenvalues.iter().chain(&p.extra_eigenvalues).copied().collect();
-                    sort(&mut z);
-                    z.resize(k, nalgebra::Complex::new(f64::NAN, f64::NAN));
-                    values.extend(z.iter().flat_map(|z| [z.re, z.im]));
-                }
-                return Ok((lin.model, k, values));
-            }
-            const CHUNK: usize = 1024;
-            let rows: Vec<Result<Vec<f64>, Failure>> = speeds
-                .par_chunks(CHUNK)
-                .map(|chunk| {
-                    let mut out = Vec::with_capacity(8 * chunk.len());
-                    for &v in chunk {
-                        let mut z = eigenvalues_of(&lin, v).map_err(fail)?.to_vec();
-                        sort(&mut z);
-                        out.extend(z.iter().flat_map(|z| [z.re, z.im]));
-                    }
-                    Ok(out)
-                })
-                .collect();
-            let mut values = Vec::with_capacity(8 * speeds.len());
-            for r in rows {
-                values.extend(r?);
-            }
-            Ok((lin.model, 4, values))
+            eigenvalues(&self.inner, model.as_deref(), &speeds).map_err(eigen_failure)
         })?;
-        Ok((name.to_string(), k, PyBytes::new(py, &bytes_of(&values))))
+        let values: Vec<f64> = e.values.iter().flatten().copied().collect();
+        Ok((e.model, e.per_speed, PyBytes::new(py, &bytes_of(&values))))
     }
 
     /// The standard deviations `[re, im]` (1/s) of `eigenvalues` (`[re,

@@ -19,7 +19,7 @@ use bikedyn::identify::{report as identify_report, run as identify_run, Identify
 use bikedyn::report::output::write_atomic;
 use bikedyn::report::plot::PlotOptions;
 use bikedyn::report::staged::{FolderKind, StagedDir};
-use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, eigenvalues_of, LinearBicycle};
+use bikedyn::runtime::eigen::LinearBicycle;
 use bikedyn::runtime::experiment::angles::AngleMethod;
 use bikedyn::runtime::parameters::ParameterSet;
 use bikedyn::runtime::simulate::{
@@ -27,7 +27,6 @@ use bikedyn::runtime::simulate::{
 };
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
-use rayon::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
@@ -71,7 +70,12 @@ impl Failure {
 /// does not exist is `BicycleNotFoundError` (a `FileNotFoundError`); the
 /// rest are the parameters' (`ParameterError`, a `ValueError`).
 fn bicycle_failure(e: BicycleError) -> Failure {
-    let kind = match &e {
+    Failure::new(bicycle_kind(&e), e)
+}
+
+/// The exception kind of a bicycle error ([`bicycle_failure`]).
+fn bicycle_kind(e: &BicycleError) -> &'static str {
+    match e {
         BicycleError::NotFound { .. } => "NotFoundError",
         BicycleError::UnknownModel { .. }
         | BicycleError::ModelDoesNotFit { .. }
@@ -79,8 +83,7 @@ fn bicycle_failure(e: BicycleError) -> Failure {
         | BicycleError::NotCanonical { .. } => "ModelError",
         BicycleError::Linearize { .. } => "ComputationError",
         _ => "ParameterError",
-    };
-    Failure::new(kind, e)
+    }
 }
 
 impl From<BicycleError> for Failure {

@@ -1,14 +1,15 @@
 //! `bikedyn eig`: eigenvalues and modes over forward speed (table, CSV or
-//! JSON, streamed when long) and the continuation diagram.
+//! JSON, streamed when long) and the continuation diagram. The job is
+//! [`bikedyn::eigen`]; this checks the paths, calls it and prints, writes
+//! or plots its result.
 
 use super::args::{BikeArg, Format, OutputArgs, PlotArgs};
 use super::{check_outputs, emit, load, plot_options, range_spec, MAX_STREAMED_POINTS, MAX_TABLE_ROWS};
 use anyhow::{bail, Result};
+use bikedyn::eigen::{eigen_sweep, EigenJob, EigenOptions, Speeds};
 use bikedyn::report::output;
 use bikedyn::report::plot::locus::{plot_mode_shapes, plot_root_locus};
 use bikedyn::report::plot::{plot_continuation, subject};
-use bikedyn::runtime::eigen::{critical_speeds_of, eigen_sweep_of, LinearBicycle};
-use bikedyn::sensitivity::EigenvalueSpread;
 use std::path::PathBuf;
 
 /// The figures `eig` draws and their options.
@@ -60,7 +61,7 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
         Format::Table => MAX_TABLE_ROWS,
         Format::Csv | Format::Json => MAX_STREAMED_POINTS,
     };
-    let (start, step, n) = range_spec(&speeds, "--speeds", limit).map_err(|e| match format {
+    let (start, step, count) = range_spec(&speeds, "--speeds", limit).map_err(|e| match format {
         Format::Table => {
             anyhow::anyhow!(
                 "{e}; a table holds every row, --format csv or json streams up to {MAX_STREAMED_POINTS} points"
@@ -68,39 +69,49 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
         }
         _ => e,
     })?;
-    let lin = b.linear_with(model.as_deref())?;
-    eprintln!("model: {}", lin.model);
-    opts.subject = Some(subject(&b.name, Some(lin.model)));
-    let c: &dyn LinearBicycle = &lin;
-    // The eigenvalues' standard deviations from the file's +/- values
-    // (first order, exact derivatives), in CSV and JSON.
-    let spread = if b.uncertainties.is_empty() || matches!(format, Format::Table) || !write_table {
-        None
-    } else {
-        match EigenvalueSpread::of(&b, model.as_deref()) {
-            Ok(s) => s,
-            Err(e) => {
-                eprintln!("note: no standard deviations of the eigenvalues from the file's +/- values: {e}");
-                None
-            }
-        }
+    let speeds = Speeds::Range { start, step, count };
+    let options = EigenOptions {
+        model: model.clone(),
+        speeds: speeds.clone(),
+        // The eigenvalues' standard deviations from the file's +/- values
+        // (first order, exact derivatives), in CSV and JSON.
+        standard_deviations: write_table && !matches!(format, Format::Table),
+        critical_speeds: false,
     };
-    let spread_fn = spread
-        .as_ref()
-        .map(|s| move |v: f64, z: &[[f64; 2]]| s.of_eigenvalues(v, z));
-    let spread_arg: Option<output::EigenSpread<'_>> = spread_fn.as_ref().map(|f| f as output::EigenSpread<'_>);
+    let job = EigenJob::new(&b, &options)?;
+    eprintln!("model: {}", job.model);
+    opts.subject = Some(subject(&b.name, Some(job.model)));
+    if let Some(why) = &job.standard_deviations_missing {
+        eprintln!("note: no standard deviations of the eigenvalues from the file's +/- values: {why}");
+    }
     if !b.uncertainties.is_empty() && matches!(format, Format::Table) && write_table {
         eprintln!("note: the eigenvalues' standard deviations from the file's +/- values are in --format csv (re_sd_k, im_sd_k) and json (standard_deviations)");
     }
-    let speed = |k: usize| start + k as f64 * step;
-    let stream = |fmt: output::StreamFormat| -> Result<()> {
-        match &out {
-            Some(p) => output::write_atomic(p, |w| output::stream_eigen_sweep_with(c, n, speed, fmt, w, spread_arg))?,
-            None => {
-                let mut w = std::io::BufWriter::new(std::io::stdout().lock());
-                output::stream_eigen_sweep_with(c, n, speed, fmt, &mut w, spread_arg)
-                    .map_err(super::stdout_error_of)?;
-                std::io::Write::flush(&mut w).map_err(super::stdout_error)?;
+    let write = |w: &mut dyn std::io::Write| -> Result<(), output::BoxError> {
+        match format {
+            Format::Csv => {
+                let mut wr = csv::Writer::from_writer(w);
+                wr.write_record(output::eigen_csv_header(
+                    job.extra_eigenvalues,
+                    job.standard_deviations(),
+                ))?;
+                for p in job.points() {
+                    let p = p?;
+                    wr.write_record(output::eigen_point_csv_row_with(
+                        &p.point,
+                        p.standard_deviations.as_deref(),
+                    ))?;
+                }
+                wr.flush()?;
+            }
+            _ => {
+                // One speed's object per line, as each is computed.
+                w.write_all(b"[")?;
+                for (i, p) in job.points().enumerate() {
+                    w.write_all(if i == 0 { b"\n  " } else { b",\n  " })?;
+                    serde_json::to_writer(&mut *w, &p?)?;
+                }
+                w.write_all(b"\n]\n")?;
             }
         }
         Ok(())
@@ -110,29 +121,44 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
             eprintln!("table not printed (a figure was asked for): add --format table|csv|json or --output FILE for it")
         }
         Format::Table => {
-            let speeds: Vec<f64> = (0..n).map(speed).collect();
-            emit(&output::format_eigen_table(&eigen_sweep_of(c, &speeds)?), &out)?;
+            let report = job.report()?;
+            emit(&output::format_eigen_table(&report.sweep()), &out)?;
         }
-        Format::Csv => stream(output::StreamFormat::Csv)?,
-        Format::Json => stream(output::StreamFormat::Json)?,
+        Format::Csv | Format::Json => match &out {
+            Some(p) => output::write_atomic(p, |w| write(w))?,
+            None => {
+                let mut w = std::io::BufWriter::new(std::io::stdout().lock());
+                write(&mut w).map_err(super::stdout_error_of)?;
+                std::io::Write::flush(&mut w).map_err(super::stdout_error)?;
+            }
+        },
     }
     if plots.continuation.is_some() || plots.root_locus.is_some() {
         // A diagram needs no more than 20,001 points: longer ranges are
         // plotted at evenly spaced speeds over the same interval.
         const PLOT_POINTS: usize = 20_001;
-        let last = speed(n - 1);
-        let speeds: Vec<f64> = if n <= PLOT_POINTS {
-            (0..n).map(speed).collect()
+        let last = speeds.at(count - 1);
+        let plotted = if count <= PLOT_POINTS {
+            speeds
         } else {
-            (0..PLOT_POINTS)
-                .map(|k| start + (last - start) * k as f64 / (PLOT_POINTS - 1) as f64)
-                .collect()
+            Speeds::List(
+                (0..PLOT_POINTS)
+                    .map(|k| start + (last - start) * k as f64 / (PLOT_POINTS - 1) as f64)
+                    .collect(),
+            )
         };
-        let sweep = eigen_sweep_of(c, &speeds)?;
+        let report = eigen_sweep(
+            &b,
+            &EigenOptions {
+                model: model.clone(),
+                speeds: plotted,
+                standard_deviations: false,
+                critical_speeds: plots.continuation.is_some(),
+            },
+        )?;
+        let sweep = report.sweep();
         if let Some(p) = &plots.continuation {
-            let vmax = last.max(start + 1e-9);
-            let crit = critical_speeds_of(c, start, vmax).ok();
-            plot_continuation(p, &sweep, crit.as_ref(), &opts)?;
+            plot_continuation(p, &sweep, report.critical.as_ref(), &opts)?;
             eprintln!("wrote {}", p.display());
         }
         if let Some(p) = &plots.root_locus {
@@ -141,8 +167,16 @@ pub fn run(bike: BikeArg, speeds: String, out: OutputArgs, plots: Plots) -> Resu
         }
     }
     if let (Some(p), Some(v)) = (&plots.mode_shapes, plots.speed) {
-        let at = eigen_sweep_of(c, &[v])?;
-        plot_mode_shapes(p, &at.points[0], &opts)?;
+        let at = eigen_sweep(
+            &b,
+            &EigenOptions {
+                model,
+                speeds: Speeds::List(vec![v]),
+                standard_deviations: false,
+                critical_speeds: false,
+            },
+        )?;
+        plot_mode_shapes(p, &at.points[0].point, &opts)?;
         eprintln!("wrote {}", p.display());
     }
     Ok(true)

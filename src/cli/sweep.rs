@@ -1,14 +1,15 @@
-//! `bikedyn sweep`: stability over one parameter, or a stability map over two.
+//! `bikedyn sweep`: stability over one parameter, or a stability map over
+//! two. The job is [`bikedyn::sweep::sweep`]; this checks the options,
+//! calls it and prints, writes or plots its result.
 
 use super::args::{BikeArg, Format, MapArg, SweepArgs};
 use super::{emit, parse_range, plot_options, CellProgressBar, MAX_MAP_CELLS};
 use anyhow::{bail, Result};
-use bikedyn::bicycle::Bicycle;
 use bikedyn::report::output;
 use bikedyn::report::plot::sweep::plot_parameter_sweep;
 use bikedyn::report::plot::{plot_stability_map, subject, PlotOptions};
-use bikedyn::runtime::sweep::{parameter_sweep, stability_map, MapQuantity, ParamAxis, SweepOptions};
-use bikedyn::sensitivity::{speed_spread_over, SensitivityOptions};
+use bikedyn::runtime::sweep::MapQuantity;
+use bikedyn::sweep::{stability_map_row, sweep, sweep_model, SweepOptions, SweepReport, SweptParameter};
 
 /// Run `bikedyn sweep`.
 pub fn run(a: SweepArgs) -> Result<bool> {
@@ -48,39 +49,34 @@ pub fn run(a: SweepArgs) -> Result<bool> {
         }
     }
     let xs = parse_range(&values, "--values")?;
-    // One model for every cell: the one that represents the design
-    // with the swept parameters at their first non-zero values (a
-    // sweep of c_steer from 0 runs wholly through the model with
-    // steer damping), unless the user names it.
-    let model: Option<String> = match model {
-        Some(m) => Some(m),
-        None => {
-            let pick = |b: &Bicycle, name: &str, vals: &[f64]| -> Result<Bicycle> {
-                let v = vals.iter().copied().find(|&v| v != 0.0).unwrap_or(vals[0]);
-                Ok(b.with_parameter(name, v)?)
-            };
-            let mut probe = pick(&b, &param, &xs)?;
-            if let (Some(p2), Some(v2)) = (&param2, &values2) {
-                probe = pick(&probe, p2, &parse_range(v2, "--values2")?)?;
-            }
-            Some(probe.model(None)?.name.to_string())
-        }
+    let ys = match (&param2, &values2) {
+        (Some(_), Some(v2)) => Some(parse_range(v2, "--values2")?),
+        _ => None,
     };
-    eprintln!("model: {}", model.as_deref().unwrap_or_default());
-    let info = model.as_deref().and_then(bikedyn::models::model_info);
+    let mut options = SweepOptions {
+        model,
+        parameter: SweptParameter::new(param.clone(), xs.clone()),
+        second: match (&param2, &ys) {
+            (Some(p2), Some(ys)) => Some(SweptParameter::new(p2.clone(), ys.clone())),
+            _ => None,
+        },
+        speed_max,
+        at_speed,
+        // The standard deviations are in CSV and JSON.
+        standard_deviations: !matches!(format, Format::Table),
+    };
+    let model = sweep_model(&b, &options)?;
+    eprintln!("model: {model}");
+    options.model = Some(model.clone());
+    let info = bikedyn::models::model_info(&model);
     let describe = |symbol: &str| output::describe_parameter(symbol, info);
     // "trail (m) [c]" from a parameter symbol, for plot axes.
     let axis_label = |symbol: &str| match describe(symbol) {
         Some(d) => format!("{d} [{symbol}]"),
         None => symbol.to_string(),
     };
-    let opts = SweepOptions {
-        probe_speed: at_speed,
-        ..SweepOptions::with_speed_range(0.0, speed_max)
-    };
-    let text = match (param2, values2) {
-        (Some(p2), Some(v2)) => {
-            let ys = parse_range(&v2, "--values2")?;
+    let text = match (param2, ys) {
+        (Some(p2), Some(ys)) => {
             let cells = xs.len() as f64 * ys.len() as f64;
             if cells > MAX_MAP_CELLS as f64 {
                 bail!(
@@ -99,29 +95,12 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                 let bar = CellProgressBar::new(xs.len() * ys.len(), "stability map");
                 let stream = |w: &mut dyn std::io::Write| -> Result<(), output::BoxError> {
                     let mut wr = csv::Writer::from_writer(w);
-                    for (i, &x) in xs.iter().enumerate() {
-                        let row = stability_map(
-                            ParamAxis::new(param.clone(), vec![x]),
-                            ParamAxis::new(p2.clone(), ys.clone()),
-                            |x, y| {
-                                b.with_parameter(&param, x)
-                                    .and_then(|b| b.with_parameter(&p2, y))
-                                    .and_then(|b| b.linear_with(model.as_deref()))
-                            },
-                            &opts,
-                            &|done, total| bar.cell_done(done, total),
-                        )?;
-                        refuse_failed_cells(
-                            row.cells
-                                .iter()
-                                .zip(&ys)
-                                .map(|(c, y)| (format!("{param} = {x}, {p2} = {y}"), c)),
-                        )
-                        .map_err(|e| -> output::BoxError { e.to_string().into() })?;
+                    for i in 0..xs.len() {
+                        let row = stability_map_row(&b, &options, i, &|done, total| bar.cell_done(done, total))?;
                         if i == 0 {
-                            wr.write_record(output::stability_map_csv_header(&row))?;
+                            wr.write_record(output::stability_map_csv_header(&row.map))?;
                         }
-                        output::write_stability_map_csv_rows(&mut wr, &row, i)?;
+                        output::write_stability_map_csv_rows(&mut wr, &row.map, i)?;
                         wr.flush()?;
                     }
                     Ok(())
@@ -138,95 +117,64 @@ pub fn run(a: SweepArgs) -> Result<bool> {
                 return Ok(true);
             }
             let bar = CellProgressBar::new(xs.len() * ys.len(), "stability map");
-            let map = stability_map(
-                ParamAxis::new(param.clone(), xs),
-                ParamAxis::new(p2.clone(), ys),
-                |x, y| {
-                    b.with_parameter(&param, x)
-                        .and_then(|b| b.with_parameter(&p2, y))
-                        .and_then(|b| b.linear_with(model.as_deref()))
-                },
-                &opts,
-                &|done, total| bar.cell_done(done, total),
-            )?;
+            let report = sweep(&b, &options, &|done, total| bar.cell_done(done, total));
             drop(bar);
-            refuse_failed_cells(map.cells.iter().enumerate().map(|(k, c)| {
-                let (ny, x, y) = (map.y.values.len(), &map.x.values, &map.y.values);
-                (format!("{param} = {}, {p2} = {}", x[k / ny], y[k % ny]), c)
-            }))?;
+            let SweepReport::Map(report) = report? else {
+                unreachable!("a sweep over two parameters is a map")
+            };
             if let Some(p) = &plot {
                 let opts = PlotOptions {
                     x_label: Some(axis_label(&param)),
                     y_label: Some(axis_label(&p2)),
-                    subject: Some(subject(&b.name, model.as_deref())),
+                    subject: Some(subject(&b.name, Some(&model))),
                     ..base_opts.clone()
                 };
-                plot_stability_map(p, &map, quantity, at_speed, &opts)?;
+                plot_stability_map(p, &report.map, quantity, at_speed, &opts)?;
                 eprintln!("wrote {}", p.display());
             }
             match format {
-                Format::Table => output::format_stability_map_table(&map, &describe),
-                Format::Json => serde_json::to_string_pretty(&output::stability_map_json(&map))? + "\n",
+                Format::Table => output::format_stability_map_table(&report.map, &describe),
+                Format::Json => serde_json::to_string_pretty(&SweepReport::Map(report))? + "\n",
                 Format::Csv => {
                     let mut buf = Vec::new();
-                    output::write_stability_map_csv(&mut buf, &map)?;
+                    output::write_stability_map_csv(&mut buf, &report.map)?;
                     String::from_utf8(buf)?
                 }
             }
         }
-        (None, None) => {
+        (None, None) if values2.is_none() => {
             b.with_parameter(&param, xs[0])?;
             let bar = CellProgressBar::new(xs.len(), "parameter sweep");
-            let s = parameter_sweep(
-                ParamAxis::new(param.clone(), xs),
-                |x| {
-                    b.with_parameter(&param, x)
-                        .and_then(|b| b.linear_with(model.as_deref()))
-                },
-                &opts,
-                &|done, total| bar.cell_done(done, total),
-            )?;
+            let report = sweep(&b, &options, &|done, total| bar.cell_done(done, total));
             drop(bar);
-            refuse_failed_cells(
-                s.points
-                    .iter()
-                    .zip(&s.param.values)
-                    .map(|(c, x)| (format!("{param} = {x}"), c)),
-            )?;
+            let SweepReport::Parameter(report) = report? else {
+                unreachable!("a sweep over one parameter is no map")
+            };
             if let Some(p) = &plot {
                 let opts = PlotOptions {
                     x_label: Some(axis_label(&param)),
-                    subject: Some(subject(&b.name, model.as_deref())),
+                    subject: Some(subject(&b.name, Some(&model))),
                     ..base_opts.clone()
                 };
-                plot_parameter_sweep(p, &s, quantity, at_speed, &opts)?;
+                plot_parameter_sweep(p, &report.sweep, quantity, at_speed, &opts)?;
                 eprintln!("wrote {}", p.display());
             }
-            // The critical speeds' standard deviations at each value from
-            // the file's other +/- values (the swept parameter is set, so
-            // its own is left out), in CSV and JSON.
-            let spread = if b.uncertainties.is_empty() || matches!(format, Format::Table) {
-                Vec::new()
-            } else {
-                let options = SensitivityOptions {
-                    model: model.clone(),
-                    speed_max,
-                    ..SensitivityOptions::default()
-                };
-                match speed_spread_over(&b, &param, &s.param.values, &options) {
-                    Some(u) => vec![("weave_speed_sd", u.weave_speed), ("capsize_speed_sd", u.capsize_speed)],
-                    None => {
-                        eprintln!("note: no standard deviations in the sweep: `{param}` is not in the file's form, and setting it converts the file");
-                        Vec::new()
-                    }
-                }
-            };
+            if report.standard_deviations_missing {
+                eprintln!("note: no standard deviations in the sweep: `{param}` is not in the file's form, and setting it converts the file");
+            }
             match format {
-                Format::Table => output::format_parameter_table(&s, &describe),
-                Format::Json => serde_json::to_string_pretty(&output::parameter_sweep_json_with(&s, &spread))? + "\n",
+                Format::Table => output::format_parameter_table(&report.sweep, &describe),
+                Format::Json => serde_json::to_string_pretty(&SweepReport::Parameter(report))? + "\n",
                 Format::Csv => {
+                    let spread = match &report.standard_deviations {
+                        Some(u) => vec![
+                            ("weave_speed_sd", u.weave_speed.clone()),
+                            ("capsize_speed_sd", u.capsize_speed.clone()),
+                        ],
+                        None => Vec::new(),
+                    };
                     let mut buf = Vec::new();
-                    output::write_parameter_sweep_csv_with(&mut buf, &s, &spread)?;
+                    output::write_parameter_sweep_csv_with(&mut buf, &report.sweep, &spread)?;
                     String::from_utf8(buf)?
                 }
             }
@@ -235,27 +183,4 @@ pub fn run(a: SweepArgs) -> Result<bool> {
     };
     emit(&text, &out)?;
     Ok(true)
-}
-
-/// A sweep with failed cells is an error listing them (at most ten), never
-/// a table with messages in it.
-fn refuse_failed_cells<'a>(
-    cells: impl Iterator<Item = (String, &'a bikedyn::runtime::sweep::CellResult)>,
-) -> Result<()> {
-    let failed: Vec<String> = cells
-        .filter_map(|(at, c)| c.as_ref().err().map(|e| format!("  {at}: {}", e.message)))
-        .collect();
-    if failed.is_empty() {
-        return Ok(());
-    }
-    let shown = failed.iter().take(10).cloned().collect::<Vec<_>>().join("\n");
-    let more = if failed.len() > 10 {
-        format!("\n  ... and {} more", failed.len() - 10)
-    } else {
-        String::new()
-    };
-    bail!(
-        "{} of the sweep's designs failed, no table written:\n{shown}{more}",
-        failed.len()
-    )
 }

@@ -1,10 +1,15 @@
-//! The linear-analysis jobs as library calls (`canonical`, `stability`):
-//! the typed results the command line prints and Python converts.
+//! The linear-analysis jobs as library calls (`canonical`, `stability`,
+//! `eig`, `sweep`): the typed results the command line prints and Python
+//! converts.
 
+use crate::common::{bikedyn, fixture, fixture_arg, ok_json, text};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::canonical::{canonical, state_space, CanonicalOptions, CanonicalReport};
+use bikedyn::eigen::{eigen_sweep, eigenvalues, EigenJob, EigenOptions, EigenSweepError, Speeds};
 use bikedyn::runtime::eigen::LinearBicycle;
+use bikedyn::runtime::sweep::no_progress;
 use bikedyn::stability::{stability, StabilityError, StabilityOptions};
+use bikedyn::sweep::{sweep, sweep_at_speeds, sweep_model, SweepError, SweepOptions, SweepReport, SweptParameter};
 
 /// The benchmark bicycle has the canonical form; its structural zero
 /// `C1[0][0]` is written as 0, and the file-free built-in has no standard
@@ -133,4 +138,378 @@ fn the_stability_job_gives_the_benchmark_speeds_and_refuses_draws_without_spread
         ..StabilityOptions::default()
     };
     assert!(matches!(stability(&b, &backwards), Err(StabilityError::SpeedRange(..))));
+}
+
+/// `value` as JSON text read back: the command line's output is read by
+/// the same parser, whose last digit can differ from the number's
+/// (serde_json reads floats fast, not exactly), so text equal to the
+/// command line's compares equal.
+fn as_printed(value: &impl serde::Serialize) -> serde_json::Value {
+    serde_json::from_str(&serde_json::to_string(value).unwrap()).unwrap()
+}
+
+/// The keys `keys` appear in `json` (an object's text) in this order
+/// (each key's last occurrence: an object's own after its nested ones).
+fn assert_in_order(json: &str, keys: &[&str]) {
+    let at: Vec<usize> = keys
+        .iter()
+        .map(|k| {
+            json.rfind(&format!("\"{k}\":"))
+                .unwrap_or_else(|| panic!("{k} in {json}"))
+        })
+        .collect();
+    assert!(at.windows(2).all(|w| w[0] < w[1]), "{keys:?} out of order in {json}");
+}
+
+/// What `bikedyn eig --format json` prints is the serialization of the
+/// `eig` job's typed result, field for field and number for number: for a
+/// file with `+/-` values (standard deviations in every entry) over a
+/// range, and for a model with extra states (extra eigenvalues).
+#[test]
+fn the_eig_job_result_is_what_bikedyn_eig_prints_in_json() {
+    let file = fixture_arg("Balanceassistv1Benchmark.txt");
+    let b = Bicycle::resolve(&file).unwrap();
+    let printed = ok_json(&["eig", "--bike", &file, "--speeds", "0:9:0.75", "--format", "json"]);
+    let report = eigen_sweep(
+        &b,
+        &EigenOptions {
+            speeds: Speeds::Range {
+                start: 0.0,
+                step: 0.75,
+                count: 13,
+            },
+            ..EigenOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(report.points.iter().all(|p| p.standard_deviations.is_some()));
+    assert_eq!(as_printed(&report), printed);
+
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let printed = ok_json(&[
+        "eig",
+        "--bike",
+        "benchmark",
+        "--model",
+        "tyre_free",
+        "--speeds",
+        "2:6:2",
+        "--format",
+        "json",
+    ]);
+    let report = eigen_sweep(
+        &b,
+        &EigenOptions {
+            model: Some("tyre_free".into()),
+            speeds: Speeds::List(vec![2.0, 4.0, 6.0]),
+            ..EigenOptions::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(report.model, "tyre_free");
+    assert!(!report.points[0].extra_eigenvalues.is_empty());
+    assert_eq!(as_printed(&report), printed);
+}
+
+/// The defaults are those documented (and `bikedyn eig`'s): 0 to 10 m/s in
+/// steps of 0.5 m/s through the bicycle's own model, standard deviations
+/// when the file has `+/-` values, no critical speeds; the benchmark's
+/// weave pair at 0 m/s is the first entry.
+#[test]
+fn the_eig_job_defaults_are_21_speeds_from_rest_to_10_m_per_s() {
+    let o = EigenOptions::default();
+    assert!(o.model.is_none() && o.standard_deviations && !o.critical_speeds);
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let r = eigen_sweep(&b, &o).unwrap();
+    let v: Vec<f64> = r.points.iter().map(|p| p.v).collect();
+    assert_eq!(v, (0..=20).map(|k| 0.5 * k as f64).collect::<Vec<_>>());
+    assert_eq!(r.model, b.model(None).unwrap().name);
+    assert!(r.critical.is_none());
+    // A built-in bicycle has no `+/-` values: nothing to give.
+    assert!(r.points.iter().all(|p| p.standard_deviations.is_none()));
+    assert_eq!(
+        as_printed(&r),
+        ok_json(&["eig", "--bike", "benchmark", "--format", "json"])
+    );
+    // Byte for byte: one speed's object per line, fields in their order.
+    let out = bikedyn(&["eig", "--bike", "benchmark", "--format", "json"]);
+    let lines: Vec<String> = r.points.iter().map(|p| serde_json::to_string(p).unwrap()).collect();
+    assert_eq!(text(&out.stdout), format!("[\n  {}\n]\n", lines.join(",\n  ")));
+    // The fields in the order the command has always written them.
+    assert_in_order(&lines[0], &["eigenvalues", "mode_shapes", "modes", "v"]);
+    // With critical speeds asked, the benchmark's v_w and v_c.
+    let crit = eigen_sweep(
+        &b,
+        &EigenOptions {
+            critical_speeds: true,
+            ..EigenOptions::default()
+        },
+    )
+    .unwrap()
+    .critical
+    .unwrap();
+    assert!((crit.weave_speed.unwrap() - 4.292_382_536_341_11).abs() < 1e-8);
+    assert!((crit.capsize_speed.unwrap() - 6.024_262_015_388_37).abs() < 1e-8);
+}
+
+/// Speeds given a block at a time (the command line's streaming) give the
+/// same points as one call, and the fast eigenvalue path gives the same
+/// spectrum by descending real part.
+#[test]
+fn the_eig_job_streamed_equals_the_job_at_once_and_the_fast_path() {
+    let b = Bicycle::resolve(&fixture("TmsBenchmark.txt").to_string_lossy()).unwrap();
+    let speeds = Speeds::Range {
+        start: 0.0,
+        step: 0.001,
+        count: 5001,
+    };
+    let opts = EigenOptions {
+        speeds: speeds.clone(),
+        ..EigenOptions::default()
+    };
+    let job = EigenJob::new(&b, &opts).unwrap();
+    let streamed: Vec<_> = job.points().map(Result::unwrap).collect();
+    let at_once = eigen_sweep(&b, &opts).unwrap();
+    assert_eq!(streamed, at_once.points);
+    let list: Vec<f64> = (0..speeds.len()).map(|k| speeds.at(k)).collect();
+    let fast = eigenvalues(&b, None, &list).unwrap();
+    assert_eq!(fast.per_speed, 4);
+    for (p, z) in streamed.iter().zip(fast.values.chunks(4)) {
+        let mut e = p.eigenvalues;
+        e.sort_by(|a, b| b[0].total_cmp(&a[0]).then(b[1].total_cmp(&a[1])));
+        assert_eq!(e.as_slice(), z, "at {} m/s", p.v);
+    }
+}
+
+/// Bad speeds are typed errors naming what is wrong, never a panic.
+#[test]
+fn the_eig_job_refuses_bad_speeds_with_a_typed_error() {
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let with = |speeds| EigenOptions {
+        speeds,
+        ..EigenOptions::default()
+    };
+    let e = eigen_sweep(&b, &with(Speeds::List(vec![1.0, f64::NAN]))).unwrap_err();
+    assert!(matches!(e, EigenSweepError::Speed { index: 1, .. }), "{e}");
+    assert!(e.to_string().starts_with("speeds[1]"), "{e}");
+    assert!(matches!(
+        eigen_sweep(&b, &with(Speeds::List(Vec::new()))),
+        Err(EigenSweepError::NoSpeeds)
+    ));
+    let backwards = Speeds::Range {
+        start: 0.0,
+        step: -1.0,
+        count: 3,
+    };
+    let e = eigen_sweep(&b, &with(backwards)).unwrap_err();
+    assert!(
+        matches!(e, EigenSweepError::Step(_)) && e.to_string().contains("step"),
+        "{e}"
+    );
+    let e = eigenvalues(&b, None, &[f64::INFINITY]).unwrap_err();
+    assert!(matches!(e, EigenSweepError::Speed { index: 0, .. }), "{e}");
+    let bad_model = EigenOptions {
+        model: Some("nosuch".into()),
+        ..EigenOptions::default()
+    };
+    assert!(matches!(eigen_sweep(&b, &bad_model), Err(EigenSweepError::Bicycle(_))));
+}
+
+/// What `bikedyn sweep --format json` prints is the serialization of the
+/// `sweep` job's typed result: over one parameter of a file with `+/-`
+/// values (the critical speeds' standard deviations in every point), and
+/// over two with the least stable real part at a speed.
+#[test]
+fn the_sweep_job_result_is_what_bikedyn_sweep_prints_in_json() {
+    let file = fixture_arg("Balanceassistv1Benchmark.txt");
+    let b = Bicycle::resolve(&file).unwrap();
+    let printed = ok_json(&[
+        "sweep",
+        "--bike",
+        &file,
+        "--param",
+        "c",
+        "--values",
+        "0.05:0.1:0.025",
+        "--format",
+        "json",
+    ]);
+    // The values as the command line counts them (0.05 + 0.025 is not 0.075).
+    let values: Vec<f64> = (0..3).map(|k| 0.05 + k as f64 * 0.025).collect();
+    let report = sweep(&b, &SweepOptions::new("c", values), &no_progress).unwrap();
+    let SweepReport::Parameter(p) = &report else {
+        panic!("one parameter: no map");
+    };
+    assert!(p.points.iter().all(|p| p.weave_speed_sd.is_some()));
+    assert_eq!(as_printed(&report), printed);
+
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let printed = ok_json(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0:0.1:0.05",
+        "--param2",
+        "lam",
+        "--values2",
+        "0.2:0.4:0.2",
+        "--at-speed",
+        "5",
+        "--format",
+        "json",
+    ]);
+    let report = sweep(
+        &b,
+        &SweepOptions {
+            second: Some(SweptParameter::new("lam", vec![0.2, 0.4])),
+            at_speed: Some(5.0),
+            ..SweepOptions::new("c", vec![0.0, 0.05, 0.1])
+        },
+        &no_progress,
+    )
+    .unwrap();
+    let SweepReport::Map(m) = &report else {
+        panic!("two parameters: a map");
+    };
+    assert_eq!(m.cells.len(), 6);
+    assert!(m.cells.iter().all(|c| c.least_stable_real_part.is_some()));
+    assert_eq!(as_printed(&report), printed);
+    // Byte for byte: the pretty-printed serialization, fields in their
+    // order.
+    let out = bikedyn(&[
+        "sweep",
+        "--bike",
+        "benchmark",
+        "--param",
+        "c",
+        "--values",
+        "0:0.1:0.05",
+        "--param2",
+        "lam",
+        "--values2",
+        "0.2:0.4:0.2",
+        "--at-speed",
+        "5",
+        "--format",
+        "json",
+    ]);
+    assert_eq!(text(&out.stdout), serde_json::to_string_pretty(&report).unwrap() + "\n");
+    // The fields in the order the command has always written them.
+    let first_cell = serde_json::to_string(&m.cells[0]).unwrap();
+    assert_in_order(
+        &first_cell,
+        &[
+            "capsize_speed",
+            "error",
+            "i",
+            "j",
+            "least_stable_real_part",
+            "open_ended",
+            "stable_intervals",
+            "stable_width",
+            "weave_real_pair_merge",
+            "weave_speed",
+            "x",
+            "y",
+        ],
+    );
+    assert_in_order(
+        &serde_json::to_string(&report).unwrap(),
+        &["cells", "layout", "speed_range", "x", "y"],
+    );
+}
+
+/// The defaults are those documented: the model chosen at the first
+/// non-zero values (a steer-damping sweep from 0 goes through the model
+/// with steer damping), speeds searched from 0 to 10 m/s, standard
+/// deviations asked; and the sweep at given speeds finds the benchmark's
+/// weave speed at its own trail.
+#[test]
+fn the_sweep_job_defaults_and_its_model_choice() {
+    let o = SweepOptions::new("c_steer", vec![0.0, 1.0]);
+    assert!(o.model.is_none() && o.second.is_none() && o.at_speed.is_none() && o.standard_deviations);
+    assert_eq!(o.speed_max, 10.0);
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let damped = b.with_parameter("c_steer", 1.0).unwrap().model(None).unwrap().name;
+    assert_ne!(damped, b.model(None).unwrap().name);
+    assert_eq!(sweep_model(&b, &o).unwrap(), damped);
+    let SweepReport::Parameter(p) = sweep(&b, &o, &no_progress).unwrap() else {
+        panic!("one parameter: no map");
+    };
+    assert_eq!(p.model, damped);
+    assert_eq!(p.speed_range, [0.0, 10.0]);
+    // A built-in bicycle has no `+/-` values.
+    assert!(p.standard_deviations.is_none() && !p.standard_deviations_missing);
+    let named = SweepOptions {
+        model: Some("extended".into()),
+        ..SweepOptions::new("c", vec![0.08])
+    };
+    assert_eq!(sweep_model(&b, &named).unwrap(), "extended");
+
+    let speeds: Vec<f64> = (0..=20).map(|k| 0.5 * k as f64).collect();
+    let s = sweep_at_speeds(&b, &SweepOptions::new("c", vec![0.08, 0.1]), &speeds).unwrap();
+    assert_eq!((s.designs, s.least_stable_real_part.len()), (2, 42));
+    assert!(
+        (s.weave_speed[0] - 4.292_382_536_341_11).abs() < 1e-8,
+        "{:?}",
+        s.weave_speed
+    );
+    assert!(
+        (s.capsize_speed[0] - 6.024_262_015_388_37).abs() < 1e-8,
+        "{:?}",
+        s.capsize_speed
+    );
+    // Unstable at rest, stable at 5 m/s.
+    assert!(s.least_stable_real_part[0] > 0.0 && s.least_stable_real_part[10] < 0.0);
+}
+
+/// Bad options are typed errors naming the field, and failed designs an
+/// error listing them, never a panic or a table with messages in it.
+#[test]
+fn the_sweep_job_refuses_bad_options_with_a_typed_error() {
+    let b = Bicycle::resolve("benchmark").unwrap();
+    let run = |o: &SweepOptions| sweep(&b, o, &no_progress);
+    let same = SweepOptions {
+        second: Some(SweptParameter::new("c", vec![0.1])),
+        ..SweepOptions::new("c", vec![0.1])
+    };
+    assert!(matches!(run(&same), Err(SweepError::SameParameter(p)) if p == "c"));
+    assert!(matches!(
+        run(&SweepOptions::new("c", Vec::new())),
+        Err(SweepError::NoValues("parameter"))
+    ));
+    let speed_max = SweepOptions {
+        speed_max: -1.0,
+        ..SweepOptions::new("c", vec![0.1])
+    };
+    let e = run(&speed_max).unwrap_err();
+    assert!(
+        matches!(e, SweepError::SpeedMax(_)) && e.to_string().starts_with("speed_max"),
+        "{e}"
+    );
+    let at_speed = SweepOptions {
+        at_speed: Some(f64::NAN),
+        ..SweepOptions::new("c", vec![0.1])
+    };
+    let e = run(&at_speed).unwrap_err();
+    assert!(
+        matches!(e, SweepError::AtSpeed(_)) && e.to_string().starts_with("at_speed"),
+        "{e}"
+    );
+    assert!(matches!(
+        run(&SweepOptions::new("nosuch", vec![1.0])),
+        Err(SweepError::Bicycle(_))
+    ));
+    // Steer-axis tilts of 1.6 and 2 rad are no bicycle: both listed.
+    let e = run(&SweepOptions::new("lam", vec![0.3, 1.6, 2.0])).unwrap_err();
+    let SweepError::FailedDesigns(failed) = &e else {
+        panic!("{e}");
+    };
+    assert_eq!(failed.len(), 2);
+    assert_eq!(failed[0].at, [("lam".to_string(), 1.6)]);
+    assert!(e.to_string().starts_with("2 of the sweep's designs failed"), "{e}");
+    assert!(sweep_at_speeds(&b, &SweepOptions::new("c", vec![0.1]), &[f64::NAN]).is_err());
 }

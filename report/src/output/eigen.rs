@@ -148,6 +148,31 @@ pub fn eigen_point_csv_row(p: &EigenPoint) -> Vec<String> {
     row
 }
 
+/// [`eigen_sweep_csv_header_with`] with, when `standard_deviations`, the
+/// columns `re_sd_k, im_sd_k` of the four eigenvalues after the others.
+pub fn eigen_csv_header(extra: usize, standard_deviations: bool) -> Vec<String> {
+    let mut header = eigen_sweep_csv_header_with(extra);
+    if standard_deviations {
+        for k in 1..=4 {
+            header.push(format!("re_sd_{k}"));
+            header.push(format!("im_sd_{k}"));
+        }
+    }
+    header
+}
+
+/// [`eigen_point_csv_row`] with the standard deviations `[re, im]` (1/s)
+/// of the point's eigenvalues in the output order ([`ordered_indices`]),
+/// when given (columns of [`eigen_csv_header`]).
+pub fn eigen_point_csv_row_with(p: &EigenPoint, standard_deviations: Option<&[[f64; 2]]>) -> Vec<String> {
+    let mut row = eigen_point_csv_row(p);
+    for sd in standard_deviations.unwrap_or_default() {
+        row.push(num(sd[0]));
+        row.push(num(sd[1]));
+    }
+    row
+}
+
 /// Write an eigen sweep as CSV (see the module docs for the columns).
 pub fn write_eigen_sweep_csv<W: Write>(w: W, sweep: &EigenSweep) -> Result<(), csv::Error> {
     let mut wr = csv::Writer::from_writer(w);
@@ -238,22 +263,8 @@ pub fn stream_eigen_sweep_with(
     match format {
         StreamFormat::Csv => {
             let mut wr = csv::Writer::from_writer(w);
-            let mut header = eigen_sweep_csv_header_with(extra);
-            if spread.is_some() {
-                for k in 1..=4 {
-                    header.push(format!("re_sd_{k}"));
-                    header.push(format!("im_sd_{k}"));
-                }
-            }
-            wr.write_record(header)?;
-            for_each_point(&mut |_, p| {
-                let mut row = eigen_point_csv_row(p);
-                for sd in sd_of(p).unwrap_or_default() {
-                    row.push(num(sd[0]));
-                    row.push(num(sd[1]));
-                }
-                Ok(wr.write_record(row)?)
-            })?;
+            wr.write_record(eigen_csv_header(extra, spread.is_some()))?;
+            for_each_point(&mut |_, p| Ok(wr.write_record(eigen_point_csv_row_with(p, sd_of(p).as_deref()))?))?;
             wr.flush()?;
         }
         StreamFormat::Json => {
