@@ -16,25 +16,23 @@
 //! rotation about that axis relative to the frame, positive to the right as
 //! the roll.
 
-use super::thesis_whipple::Speed;
+use super::thesis_whipple::{self, Speed};
 use super::whipple_offset;
 use crate::effects::{self, BicycleParts};
-use crate::expr::{coord, exact, inertia_xz, num, param, rate, vec3, Expr};
+use crate::expr::{coord, inertia_xz, num, param, rate, vec3, Expr};
 use crate::model::{Axis, Force, Model, ModelBuilder, ModelError, Role, SourceFile, Uncertainty};
-use std::f64::consts::PI;
 
 const SOURCE: SourceFile = SourceFile::new("modeler/src/models/rider_lean.rs", include_str!("rider_lean.rs"));
 
-/// The rear frame's pitch when both wheels stand on the ground: the
-/// thesis model's closed form (see `thesis_whipple::declare`), from the
-/// wheel radii and the front wheel centre `(x4 + x5, z4 + z5)` in frame
-/// axes. The lean axis is turned back by it to lie horizontal at upright.
+/// The rear frame's pitch when both wheels stand on the ground, by which
+/// the lean axis is turned back to lie horizontal at upright.
 fn upright_pitch() -> Expr {
-    let (p, q) = (param("x4") + param("x5"), param("z4") + param("z5"));
-    let d = param("Rd") - param("Rt");
-    let r2 = p.clone().powi(2) + q.clone().powi(2);
-    let r = r2.clone().sqrt();
-    exact(PI / 2.0) - (d.clone() / (r2 - d.powi(2)).sqrt()).atan() - num(2) * (p / (r + q)).atan()
+    thesis_whipple::upright_pitch(
+        param("x4") + param("x5"),
+        param("z4") + param("z5"),
+        param("Rt"),
+        param("Rd"),
+    )
 }
 
 /// Declare the leaning-rider bicycle under `name` (model file `source`).

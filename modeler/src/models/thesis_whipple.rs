@@ -5,7 +5,7 @@
 //! Axes: X forward, Y left, Z up.
 
 use crate::effects::BicycleParts;
-use crate::expr::{exact, inertia_wheel, inertia_xz, num, rate, time, vec3};
+use crate::expr::{exact, inertia_wheel, inertia_xz, num, rate, time, vec3, Expr};
 use crate::model::{
     Axis, BodyId, CoordinateRole, Holonomic, Model, ModelBuilder, ModelError, Nonholonomic, ParameterRole, Role,
     SourceFile, Uncertainty, GROUND,
@@ -163,13 +163,12 @@ pub fn declare(name: &str, source: impl Into<SourceFile>, speed: Speed) -> (Mode
     // atan2(P, Q) = 2 atan(P / (R + Q)); and the rim angle of the lowest
     // point of the front rim, xi = pi/2 - beta - eps.
     {
-        let (p, q) = (x4.clone() + x5.clone(), z4.clone() + z5.clone());
-        let d = rd.clone() - rt.clone();
-        let r2 = p.clone().powi(2) + q.clone().powi(2);
-        let r = r2.clone().sqrt();
-        let beta_up = exact(PI / 2.0)
-            - (d.clone() / (r2 - d.powi(2)).sqrt()).atan()
-            - crate::expr::num(2) * (p / (r + q)).atan();
+        let beta_up = upright_pitch(
+            x4.clone() + x5.clone(),
+            z4.clone() + z5.clone(),
+            rt.clone(),
+            rd.clone(),
+        );
         m.upright_value("beta", beta_up.clone());
         m.upright_value("xi", exact(PI / 2.0) - beta_up - crate::expr::coord("eps"));
     }
@@ -284,6 +283,17 @@ pub fn declare(name: &str, source: impl Into<SourceFile>, speed: Speed) -> (Mode
             gravity: crate::expr::param("g"),
         },
     )
+}
+
+/// The frame pitch that puts both wheels on the ground with the front
+/// wheel ahead, from the front wheel centre `(p, q)` relative to the rear
+/// one in frame axes and the wheel radii (see the upright configuration in
+/// [`declare`]).
+pub fn upright_pitch(p: Expr, q: Expr, rt: Expr, rd: Expr) -> Expr {
+    let d = rd - rt;
+    let r2 = p.clone().powi(2) + q.clone().powi(2);
+    let r = r2.clone().sqrt();
+    exact(PI / 2.0) - (d.clone() / (r2 - d.powi(2)).sqrt()).atan() - crate::expr::num(2) * (p / (r + q)).atan()
 }
 
 /// The thesis model.
