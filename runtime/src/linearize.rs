@@ -918,13 +918,9 @@ impl<M: MultibodyModel> LinearModel<M> {
 }
 
 /// Positions within the independent coordinates of those the rolling
-/// bicycle lacks: independent coordinates with no declared role (a rider's
-/// lean), unlike the lateral position and yaw that tyre slip frees, which
-/// the bicycle has as ignorable coordinates.
+/// bicycle lacks ([`crate::model::added_coordinates`]).
 fn extra_coordinates<M: MultibodyModel>() -> Vec<usize> {
-    (0..M::INDEPENDENT.len())
-        .filter(|&k| !M::COORDINATE_ROLES.iter().any(|&(_, j)| j == M::INDEPENDENT[k]))
-        .collect()
+    crate::model::added_coordinates(M::INDEPENDENT, M::COORDINATE_ROLES)
 }
 
 /// The lateral states of a model with extra states: every state of

@@ -33,6 +33,16 @@ pub struct ParameterInfo {
     pub uncertainty: Option<Uncertainty>,
 }
 
+/// Positions within `independent` (coordinate indices) of the independent
+/// coordinates with no declared role in `roles`: those the rolling bicycle
+/// lacks, which a model adds with a body of its own (a leaning rider's
+/// `lean`). The lateral position and yaw that tyre slip frees have roles.
+pub fn added_coordinates(independent: &[usize], roles: &[(CoordinateRole, usize)]) -> Vec<usize> {
+    (0..independent.len())
+        .filter(|&k| !roles.iter().any(|&(_, j)| j == independent[k]))
+        .collect()
+}
+
 /// The unit at the end of a parameter's description, as in `"trail (m)"`
 /// or `"steer-axis viscous damping coefficient (N m s/rad)"`; `None` when
 /// the description does not end in one.

@@ -58,10 +58,9 @@ impl ModelInfo {
     /// those with no declared role (a leaning rider's `lean`). A model with
     /// one has no second-order roll-steer form.
     pub fn added_coordinates(&self) -> Vec<&'static str> {
-        self.independent
-            .iter()
-            .filter(|&&i| !self.coordinate_roles.iter().any(|&(_, j)| j == i))
-            .map(|&i| self.coordinates[i])
+        crate::model::added_coordinates(self.independent, self.coordinate_roles)
+            .into_iter()
+            .map(|k| self.coordinates[self.independent[k]])
             .collect()
     }
 

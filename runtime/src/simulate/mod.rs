@@ -776,9 +776,9 @@ pub fn initial_state<M: MultibodyModel>(
     // extra state. A coordinate the rolling bicycle lacks (no declared
     // role: a rider's lean) starts at rest relative to the frame, as roll
     // and steer start where they are given.
-    let has_role = |k: usize| M::COORDINATE_ROLES.iter().any(|&(_, j)| j == l.independent[k]);
+    let added = crate::model::added_coordinates(&l.independent, M::COORDINATE_ROLES);
     let others: Vec<usize> = (0..l.ni())
-        .filter(|&k| k != c.roll_ind && k != c.steer_ind && has_role(k))
+        .filter(|&k| k != c.roll_ind && k != c.steer_ind && !added.contains(&k))
         .collect();
     if !others.is_empty() {
         if others.len() != 1 + l.extra {
