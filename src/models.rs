@@ -28,16 +28,20 @@ pub fn built_in_thesis_parameters() -> [(&'static str, ThesisParameters); 2] {
 /// True when every parameter the bicycle sets to a non-zero value (thesis
 /// symbols and effect parameters, by `value`) is a parameter of the model.
 pub fn fits(info: &ModelInfo, nonzero: &[(&str, f64)]) -> bool {
-    let given = |name: &str| nonzero.iter().any(|(n, _)| *n == name);
     nonzero.iter().all(|(n, _)| info.parameter(n).is_some())
         // A model's added body (a leaning rider) is there only when the
-        // bicycle gives it: its parameters have no default.
-        && info.parameters.iter().enumerate().all(|(i, p)| {
-            p.default.is_some()
-                || info.forward_speed_parameter == Some(i)
-                || ThesisParameters::SYMBOLS.contains(&p.name)
-                || given(p.name)
-        })
+        // bicycle gives it.
+        && required_added_parameters(info).all(|p| nonzero.iter().any(|(n, _)| *n == p.name))
+}
+
+/// The parameters of a model's added bodies, which have no default and no
+/// form's table holds (a leaning rider's `m6`, `k_lean`, ...): a bicycle
+/// must give each for the model to represent it.
+pub(crate) fn required_added_parameters(info: &ModelInfo) -> impl Iterator<Item = &'static ParameterInfo> + '_ {
+    info.parameters.iter().enumerate().filter_map(move |(i, p)| {
+        (p.default.is_none() && info.forward_speed_parameter != Some(i) && !ThesisParameters::SYMBOLS.contains(&p.name))
+            .then_some(p)
+    })
 }
 
 /// The built-in bicycle a model is exercised with by default: among the

@@ -300,17 +300,9 @@ impl<R: ModelRegistry> Bicycle<R> {
             .iter()
             .find(|m| nonzero.iter().all(|(n, _)| m.parameter(n).is_some()));
         if let Some(m) = near {
-            let missing: Vec<String> = m
-                .parameters
-                .iter()
-                .enumerate()
-                .filter(|&(i, p)| {
-                    p.default.is_none()
-                        && m.forward_speed_parameter != Some(i)
-                        && !ThesisParameters::SYMBOLS.contains(&p.name)
-                        && !given(p.name)
-                })
-                .map(|(_, p)| format!("`{}` ({})", p.name, p.doc))
+            let missing: Vec<String> = crate::models::required_added_parameters(m)
+                .filter(|p| !given(p.name))
+                .map(|p| format!("`{}` ({})", p.name, p.doc))
                 .collect();
             if !missing.is_empty() {
                 return BicycleError::MissingValues {
