@@ -2,7 +2,7 @@
 //! `eig`, `sweep`): the typed results the command line prints and Python
 //! converts.
 
-use crate::common::{bikedyn, fixture, fixture_arg, ok_json, text};
+use crate::common::{bikedyn, fixture, fixture_arg, ok_json, stdout_json, text};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::canonical::{canonical, state_space, CanonicalOptions, CanonicalReport};
 use bikedyn::eigen::{eigen_sweep, eigenvalues, EigenJob, EigenOptions, EigenSweepError, Speeds};
@@ -344,7 +344,7 @@ fn the_sweep_job_result_is_what_bikedyn_sweep_prints_in_json() {
     assert_eq!(as_printed(&report), printed);
 
     let b = Bicycle::resolve("benchmark").unwrap();
-    let printed = ok_json(&[
+    let out = bikedyn(&[
         "sweep",
         "--bike",
         "benchmark",
@@ -361,6 +361,8 @@ fn the_sweep_job_result_is_what_bikedyn_sweep_prints_in_json() {
         "--format",
         "json",
     ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let printed = stdout_json(&out);
     let report = sweep(
         &b,
         &SweepOptions {
@@ -379,23 +381,6 @@ fn the_sweep_job_result_is_what_bikedyn_sweep_prints_in_json() {
     assert_eq!(as_printed(&report), printed);
     // Byte for byte: the pretty-printed serialization, fields in their
     // order.
-    let out = bikedyn(&[
-        "sweep",
-        "--bike",
-        "benchmark",
-        "--param",
-        "c",
-        "--values",
-        "0:0.1:0.05",
-        "--param2",
-        "lam",
-        "--values2",
-        "0.2:0.4:0.2",
-        "--at-speed",
-        "5",
-        "--format",
-        "json",
-    ]);
     assert_eq!(text(&out.stdout), serde_json::to_string_pretty(&report).unwrap() + "\n");
     // The fields in the order the command has always written them.
     let first_cell = serde_json::to_string(&m.cells[0]).unwrap();
