@@ -246,6 +246,10 @@ macro_rules! effects {
                     "modeler/src/effects/tyre_relaxation.rs",
                     include_str!("tyre_relaxation.rs"),
                 )),
+                "generalized_forces" => Some(SourceFile::new(
+                    "modeler/src/effects/generalized_forces.rs",
+                    include_str!("generalized_forces.rs"),
+                )),
                 _ => None,
             }
         }
@@ -255,6 +259,7 @@ macro_rules! effects {
 /// Tyre lateral slip with relaxation: it changes the degrees of freedom (the
 /// wheels may slide sideways), so it is never "absent" and is applied by its
 /// own models, not by the extended ones.
+pub mod generalized_forces;
 pub mod tyre_relaxation;
 
 effects!(

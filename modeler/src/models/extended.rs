@@ -17,5 +17,8 @@ pub fn model() -> Result<Model, ModelError> {
     for e in effects::all() {
         effects::apply(&mut m, &parts, &e);
     }
+    // The dictionary discovery searches beyond the library (the models
+    // identification fits through carry it; every term zero by default).
+    effects::apply(&mut m, &parts, &effects::generalized_forces::effect());
     m.build()
 }

@@ -191,6 +191,7 @@ pub fn identify<M: MultibodyModel>(
         reference: &before,
         stated: candidates,
         progress,
+        gain_sigmas: 2.0,
     };
 
     let mut current = before.clone();
@@ -270,6 +271,22 @@ pub(super) struct Search<'s> {
     /// rival; the fits use them on the data's scale).
     pub(super) stated: &'s [Candidate],
     pub(super) progress: &'s (dyn Fn(&str, Option<(usize, usize)>) + Sync),
+    /// Standard errors by which a candidate's held-out gain, paired run by
+    /// run, must exceed zero to enter (2 for the library's search).
+    pub(super) gain_sigmas: f64,
+}
+
+/// The bar of a consistent held-out gain, in standard errors, when one of
+/// `candidates` alike candidates may enter: the library's two standard
+/// errors are a one-sided test at about 2.3 %; for a dictionary of many
+/// terms the same family-wise rate (Bonferroni) keeps a term from entering
+/// because one of many fitted the scatter best by chance (1: 2.0; 28 terms:
+/// about 3.1).
+pub fn family_wise_sigmas(candidates: usize) -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal};
+    let alpha = 1.0 - Normal::standard().cdf(2.0);
+    let k = candidates.max(1) as f64;
+    Normal::standard().inverse_cdf(1.0 - alpha / k).max(2.0)
 }
 
 /// A trial being considered: its members (indices into the step's
@@ -295,7 +312,7 @@ impl<'s> Search<'s> {
     /// One step on top of `current` (with the candidates `selected`): the
     /// step's record, the fit of the extended model when something was
     /// added, and the simulations run.
-    fn step(
+    pub(super) fn step(
         &self,
         current: &CandidateFit,
         selected: &[&'s Candidate],
@@ -691,9 +708,14 @@ impl<'s> Search<'s> {
                 cv: fit.cv,
                 base_cv: current.cv,
             }
-        } else if let Some((gain, stderr)) = paired_gain(current, fit, self.weights).filter(|(d, se)| !(*d > 2.0 * se))
+        } else if let Some((gain, stderr)) =
+            paired_gain(current, fit, self.weights).filter(|(d, se)| !(*d > self.gain_sigmas * se))
         {
-            Verdict::HeldOutGainNotConsistent { gain, stderr }
+            Verdict::HeldOutGainNotConsistent {
+                gain,
+                stderr,
+                sigmas: self.gain_sigmas,
+            }
         } else {
             Verdict::Added {
                 bic_change: fit.bic - bic(current, self.reference),

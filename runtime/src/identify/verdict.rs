@@ -55,7 +55,14 @@ pub enum Verdict {
     HeldOutNotLower { cv: f64, base_cv: f64 },
     /// The held-out gain per run is within two standard errors of zero:
     /// not a consistent improvement.
-    HeldOutGainNotConsistent { gain: f64, stderr: f64 },
+    HeldOutGainNotConsistent {
+        gain: f64,
+        stderr: f64,
+        /// The bar: standard errors the gain must exceed (2 for the
+        /// library; more for a dictionary of many terms, see
+        /// [`super::selection::family_wise_sigmas`]).
+        sigmas: f64,
+    },
     /// It passed, but fitted together with a correction beyond its prior
     /// that fits better, its parameters fall within two standard errors of
     /// their absence (largest |shift / standard error| `t`) or keep less

@@ -35,7 +35,21 @@ pub enum Signal {
     /// The declared controller's torque (N m), passed through a lag in
     /// place of acting at once.
     ControllerTorque,
+    /// A constant torque (N m): a bias, such as a cable pulling the
+    /// handlebar or a load off the plane of symmetry. It leaves the linear
+    /// equations unchanged, so only the time series see it.
+    Constant,
+    /// A Coulomb-like torque opposing a rate, `-T tanh(w / w0)` with
+    /// `w0` = [`COULOMB_SMOOTHING`] (T in N m): friction in a
+    /// joint. Its linearization about upright is not useful (its describing
+    /// function depends on the amplitude), so only the time series see it.
+    Coulomb(Coordinate),
 }
+
+/// The rate (rad/s) below which a Coulomb-like term of the time-series
+/// dictionary turns smoothly to zero (keeps exact derivatives at rest; a
+/// measured weave's steer rate is of order 0.1-1 rad/s).
+pub const COULOMB_SMOOTHING: f64 = 0.02;
 
 /// One term of the dictionary: `Q_equation += theta v^speed_power signal`,
 /// through a first-order lag when `lagged`.
@@ -87,6 +101,61 @@ impl Term {
         terms
     }
 
+    /// Every term the time-series search can fit through the nonlinear
+    /// model: on each equation, each angle and rate times 1, v or v^2, a
+    /// constant bias, and a Coulomb-like torque opposing its own rate. The
+    /// lags and added inertias stay with the linear stage (a lag adds a
+    /// state and an inertia a mass-matrix entry, which a generalized
+    /// force of the derived model cannot carry).
+    pub fn time_series_dictionary() -> Vec<Term> {
+        use Coordinate::*;
+        use Signal::*;
+        let mut terms = Vec::new();
+        for equation in [Roll, Steer] {
+            for signal in [Angle(Roll), Angle(Steer), Rate(Roll), Rate(Steer)] {
+                for speed_power in 0..=2 {
+                    terms.push(Term {
+                        equation,
+                        signal,
+                        speed_power,
+                        lagged: false,
+                    });
+                }
+            }
+            for signal in [Constant, Coulomb(equation)] {
+                terms.push(Term {
+                    equation,
+                    signal,
+                    speed_power: 0,
+                    lagged: false,
+                });
+            }
+        }
+        terms
+    }
+
+    /// The symbol of this term's coefficient in the derived models that
+    /// carry the time-series dictionary (`modeler/src/effects/
+    /// generalized_forces.rs`, the models' signs): `Q_` and [`Term::name`].
+    pub fn model_symbol(&self) -> String {
+        format!("Q_{}", self.name())
+    }
+
+    /// The factor from the benchmark's signs (roll and steer positive to
+    /// the right) to the models' (the thesis's: steer positive to the
+    /// left) of this term's coefficient: -1 when exactly one of the
+    /// equation and the signal is the steer (a constant counts as its
+    /// equation's coordinate; a Coulomb term opposes its own rate).
+    pub fn model_sign(&self) -> f64 {
+        let sign = |c: Coordinate| if c == Coordinate::Steer { -1.0 } else { 1.0 };
+        let of = match self.signal {
+            Signal::Angle(c) | Signal::Rate(c) | Signal::Acceleration(c) => sign(c),
+            Signal::Constant => 1.0,
+            Signal::Coulomb(_) | Signal::ControllerTorque => sign(self.equation),
+        };
+        sign(self.equation) * of
+    }
+
     /// A name for reports and JSON: the equation's torque, the signal, the
     /// speed power and the lag, as `steer_torque_roll_rate_v2` or
     /// `steer_torque_controller_lagged`.
@@ -100,6 +169,8 @@ impl Term {
             Signal::Rate(c) => format!("{}_rate", coordinate(c)),
             Signal::Acceleration(c) => format!("{}_acceleration", coordinate(c)),
             Signal::ControllerTorque => "controller".to_string(),
+            Signal::Constant => "bias".to_string(),
+            Signal::Coulomb(c) => format!("coulomb_{}_rate", coordinate(c)),
         };
         let power = match self.speed_power {
             0 => String::new(),
@@ -126,6 +197,7 @@ impl Term {
             Signal::Rate(_) => "N m s/rad",
             Signal::Acceleration(_) => "kg m^2",
             Signal::ControllerTorque => "",
+            Signal::Constant | Signal::Coulomb(_) => "N m",
         };
         match self.speed_power {
             0 => base.to_string(),
@@ -183,7 +255,9 @@ pub fn state_matrix(plant: &PlantAt, terms: &[Term], theta: &[f64], v: f64) -> O
                 m[(t.equation.index(), s.index())] -= coefficient;
                 continue;
             }
-            Signal::ControllerTorque => unreachable!(),
+            // No part in the linear equations about upright (only the
+            // time-series search offers them).
+            Signal::ControllerTorque | Signal::Constant | Signal::Coulomb(_) => continue,
         };
         if t.lagged {
             lags.push((e, col, coefficient, time_constant(*it.next()?)));

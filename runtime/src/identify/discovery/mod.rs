@@ -46,8 +46,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 mod dictionary;
+pub mod time_series;
 use dictionary::{eigenvalues, time_constant};
-pub use dictionary::{state_matrix, weave_near, Coordinate, PlantAt, Signal, Term};
+pub use dictionary::{state_matrix, weave_near, Coordinate, PlantAt, Signal, Term, COULOMB_SMOOTHING};
 
 /// A measured weave eigenvalue.
 #[derive(Clone, Copy, Debug)]
@@ -470,7 +471,11 @@ pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
                         base_cv: current_cv,
                     }
                 } else if !(gain > 2.0 * stderr) {
-                    Verdict::HeldOutGainNotConsistent { gain, stderr }
+                    Verdict::HeldOutGainNotConsistent {
+                        gain,
+                        stderr,
+                        sigmas: 2.0,
+                    }
                 } else {
                     Verdict::Added {
                         bic_change: db,
