@@ -10,7 +10,9 @@ outcome is scored against the truth the oracle wrote apart:
 * right cause: every cause in the set is selected, or reported as not
   separable from a selected candidate (the report's `confounded` list);
 * false causes: selected candidates that are neither a cause nor speed decay
-  (rolling resistance and drag are in every set);
+  (rolling resistance and drag are in every set), and every term the
+  search in the time series discovers beyond the library (the oracle's
+  causes are all named by the library);
 * parameter error: for an effect, |fitted - true| / |true|; for a
   correction, the error of the fitted shift from the nominal value relative
   to the true shift;
@@ -187,6 +189,11 @@ def base_name(selected: str) -> str:
 def score(row, truth, report, seconds):
     causes = causes_of(row, truth)
     selected = [base_name(s) for s in report["selected_effects"]]
+    # Terms the search in the time series adds beyond the library: the
+    # oracle's causes are all effects and corrections the library names,
+    # so every such term is a false cause.
+    ts = report.get("time_series_discovery") or {}
+    discovered = [f"discovered {t}" for t in ts.get("selected", [])] if ts.get("status") == "ran" else []
     confounded = [(c["chosen"], c["rival"]) for c in report.get("confounded", []) if c.get("confounded")]
     cause_names = {c[0] for c in causes}
     found = []
@@ -209,7 +216,7 @@ def score(row, truth, report, seconds):
                 err = abs(p["value"] - true) / abs(true)
             param_errors.append((symbol, p["value"], true, err))
     false = [s for s in selected if s not in cause_names and s not in SPEED_DECAY
-             and not any(rv in cause_names for ch, rv in confounded if ch == s)]
+             and not any(rv in cause_names for ch, rv in confounded if ch == s)] + discovered
     before, after = report["error_before"], report["error_after"]
     ho_b, ho_a = before["held_out"], after["held_out"]
 
@@ -233,7 +240,7 @@ def score(row, truth, report, seconds):
     return {
         "set": row["name"],
         "causes": [f"{c[0]}" for c in causes],
-        "selected": report["selected_effects"],
+        "selected": report["selected_effects"] + discovered,
         "right": all(found) if causes else None,
         "right_via": [{"cause": c, "not_separable_from": v} for c, v in found_via],
         "control_clean": (not false) if not causes else None,

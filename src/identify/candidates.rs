@@ -30,7 +30,11 @@ pub fn identification_models<R: ModelRegistry>(
             m.free_speed == !speed_imposed
                 && !m.states.is_empty()
                 && crate::models::fits(m, &nonzero)
-                && free.effects.iter().all(|e| m.effects.contains(e))
+                && free
+                    .effects
+                    .iter()
+                    .filter(|e| **e != super::time_series::DICTIONARY_EFFECT)
+                    .all(|e| m.effects.contains(e))
         })
         .max_by_key(|m| m.effects.len());
     Ok((fitted, driven, alt))

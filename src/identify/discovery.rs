@@ -346,6 +346,18 @@ pub fn reading(f: &FoundTerm) -> String {
         (Coordinate::Roll, Signal::Angle(Coordinate::Steer)) => {
             format!("a roll torque from the steer angle: {value}")
         }
+        (e, Signal::Constant) => format!(
+            "a constant {} torque to the {} (a bias: a cable or a load pulling to one side, a motor's offset): {value}",
+            coordinate(e),
+            if theta > 0.0 { "right" } else { "left" }
+        ),
+        (e, Signal::Coulomb(s)) => {
+            if theta > 0.0 {
+                format!("{} friction (a Coulomb-like torque opposing the {} rate): {value}", coordinate(e), coordinate(s))
+            } else {
+                format!("a torque of constant size that drives the {} rate (negative friction): {value}", coordinate(s))
+            }
+        }
         _ => format!("{}: {value}", t.name()),
     };
     let alike = match f.alike.len() {
@@ -367,12 +379,12 @@ pub fn reading(f: &FoundTerm) -> String {
 /// `e` changes sign when exactly one of them is the steer. `None` for the
 /// controller's lag and for an added inertia (no generalized force).
 pub fn model_coefficient(f: &FoundTerm) -> Option<f64> {
-    let sign = |c: Coordinate| if c == Coordinate::Steer { -1.0 } else { 1.0 };
-    let of = match f.term.signal {
-        Signal::Angle(c) | Signal::Rate(c) => c,
-        Signal::Acceleration(_) | Signal::ControllerTorque => return None,
-    };
-    Some(f.coefficient?.0 * sign(f.term.equation) * sign(of))
+    match f.term.signal {
+        Signal::Angle(_) | Signal::Rate(_) | Signal::Constant | Signal::Coulomb(_) => {
+            Some(f.coefficient?.0 * f.term.model_sign())
+        }
+        Signal::Acceleration(_) | Signal::ControllerTorque => None,
+    }
 }
 
 /// The discovered terms as an effect file in the modeler's form (one file,
@@ -408,6 +420,13 @@ fn effect_source(name: &str, found: &[FoundTerm]) -> String {
         let source = match t.signal {
             Signal::Angle(c) => format!("coord(&parts.{})", coordinate(c)),
             Signal::Rate(c) => format!("rate(&parts.{})", coordinate(c)),
+            Signal::Constant => "bikedyn_modeler::expr::num(1)".to_string(),
+            // -tanh(w / w0): opposing the rate, smoothed below w0.
+            Signal::Coulomb(c) => format!(
+                "-(rate(&parts.{}) / bikedyn_modeler::expr::ratio(1, {})).tanh()",
+                coordinate(c),
+                (1.0 / bikedyn_runtime::identify::discovery::COULOMB_SMOOTHING).round()
+            ),
             Signal::Acceleration(c) => {
                 let _ = writeln!(
                     doc,

@@ -22,6 +22,7 @@ pub mod predict;
 mod remaining;
 pub mod report;
 pub mod segments;
+pub mod time_series;
 pub mod weave_errors;
 
 pub use error::IdentifyError;
@@ -171,6 +172,9 @@ pub struct Outcome<R: ModelRegistry = BuiltIn> {
     /// What the dictionary of generalized forces found beyond the library
     /// on the kicks' weave eigenvalues (`None`: not requested).
     pub discovery: Option<discovery::DiscoveryOutcome>,
+    /// What the dictionary's terms that the model carries found beyond the
+    /// library in the time series (`None`: not requested).
+    pub time_series: Option<time_series::TimeSeriesOutcome>,
     /// The model's speed was imposed (logs of a motor-held speed).
     pub speed_imposed: bool,
     run_plot: Option<RunPlot>,
@@ -443,6 +447,35 @@ pub fn run_plan<R: ModelRegistry>(
     } else {
         None
     };
+    // Beyond the library in the time series: the dictionary's terms that
+    // the model carries, through the nonlinear simulation of every kick,
+    // where the library leaves a structured residual in the weave or in
+    // the time series (never fitted to what is within the scatter).
+    let time_series = if !request.discover {
+        None
+    } else if !(remaining.as_ref().is_some_and(|r| r.structured) || state_correlation.iter().any(|c| c.significant)) {
+        Some(time_series::TimeSeriesOutcome::NotRun {
+            reason: "the library leaves no structured residual, in the weave eigenvalues or in the time series".into(),
+        })
+    } else {
+        let terms = time_series::terms(free);
+        R::with_model(
+            free.name,
+            time_series::Search {
+                bike,
+                segments: &segs,
+                library: &id,
+                candidates: cands,
+                terms: &terms,
+                opts: &opts,
+                progress: &on_fit,
+            },
+        )
+        .expect("registered model")
+        .map(Some)
+        // The library's result stands whatever the search meets.
+        .unwrap_or_else(|e| Some(time_series::TimeSeriesOutcome::NotRun { reason: e.to_string() }))
+    };
     // Steady bias: the base model's roll residual over the second half of
     // each window.
     let bias: Vec<f64> = run_plot
@@ -494,6 +527,7 @@ pub fn run_plan<R: ModelRegistry>(
         remaining,
         state_correlation,
         discovery,
+        time_series,
         speed_imposed: plan.speed_imposed,
         run_plot,
         registry: PhantomData,

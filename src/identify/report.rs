@@ -171,6 +171,7 @@ pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
         "remaining": o.remaining,
         "state_correlation": o.state_correlation,
         "discovery": o.discovery,
+        "time_series_discovery": o.time_series,
         "weights": id.weights,
         "folds": id.folds,
         "simulations": id.simulations,
@@ -318,6 +319,9 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     }
     if let Some(d) = &o.discovery {
         let _ = write!(s, "\n{}", super::discovery::kicks_sentence(d));
+    }
+    if let Some(t) = &o.time_series {
+        let _ = write!(s, "\n{}", super::time_series::sentence(t, unit, 1f64.to_degrees()));
     }
     s
 }
@@ -498,9 +502,23 @@ pub fn write_report<R: ModelRegistry>(
         }
     }
     let mut md = report_markdown(o, a, dir);
+    // The effect file: the terms found in the time series (fitted through
+    // the nonlinear model), else those found on the kicks' eigenvalues.
+    let time_series_file = o.time_series.as_ref().and_then(super::time_series::effect_file_of);
+    if let Some(super::time_series::TimeSeriesOutcome::Ran(f)) = &o.time_series {
+        md += &super::time_series::markdown(f);
+        match &time_series_file {
+            Some(Ok(file)) => {
+                md += "\nThe terms found in the time series are written as an effect file in the modeler's form: `discovered.rs` (for `modeler/src/effects/` or a crate of your own).\n";
+                write_string_atomic(out.join("discovered.rs"), file)?;
+            }
+            Some(Err(e)) => md += &format!("\nNo effect file was written: {e}.\n"),
+            None => {}
+        }
+    }
     if let Some(super::discovery::DiscoveryOutcome::Ran(d)) = &o.discovery {
         md += &super::discovery::trials_markdown(d);
-        if !d.discovery.terms.is_empty() {
+        if !d.discovery.terms.is_empty() && time_series_file.is_none() {
             match super::discovery::effect_file("discovered", &d.discovery.terms) {
                 Ok(file) => {
                     md += "\nThe discovered terms are written as an effect file in the modeler's form: `discovered.rs` (for `modeler/src/effects/` or a crate of your own).\n";
@@ -557,8 +575,9 @@ pub fn verdict_text(v: &Verdict) -> String {
         Verdict::HeldOutNotLower { cv, base_cv } => {
             format!("rejected: held-out error {cv:.4} not below {base_cv:.4} (does not generalise)")
         }
-        Verdict::HeldOutGainNotConsistent { gain, stderr } => format!(
-            "rejected: mean held-out gain per run (per row or kick in the dictionary's search) {gain:.4}, within two standard errors of zero (standard error {stderr:.4}; not a consistent improvement)"
+        Verdict::HeldOutGainNotConsistent { gain, stderr, sigmas } => format!(
+            "rejected: mean held-out gain per run (per row or kick in the dictionary's search) {gain:.4}, within {} standard errors of zero (standard error {stderr:.4}; not a consistent improvement)",
+            if (*sigmas - 2.0).abs() < 1e-9 { "two".to_string() } else { format!("{sigmas:.2}") }
         ),
         Verdict::Encompassed { by, t, remains } => format!(
             "replaced by {by}: fitted together with it, its parameters keep {:.0} % of their shift alone ({t:.1} standard errors from their absence) while {by} stays significant; it stood in for {by}",
