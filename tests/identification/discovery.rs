@@ -384,3 +384,47 @@ fn in_the_time_series_a_steer_torque_from_the_roll_angle_is_found_beyond_the_lib
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Every term of the runtime's time-series dictionary is a parameter of
+/// both identification models (the modeler's `generalized_forces` effect
+/// and the runtime's term names are written apart), absent at its default,
+/// and its model sign converts the benchmark's signs as the steer's sign
+/// demands.
+#[test]
+fn every_term_of_the_time_series_dictionary_is_a_parameter_of_the_identification_models() {
+    use bikedyn::registry::ModelRegistry;
+    use bikedyn_runtime::identify::discovery::{Coordinate, Signal, Term};
+    let models = bikedyn::registry::BuiltIn::models();
+    let terms = Term::time_series_dictionary();
+    assert_eq!(terms.len(), 28);
+    for name in ["extended", "extended_free"] {
+        let info = models.iter().find(|m| m.name == name).unwrap();
+        assert!(
+            info.effects.contains(&"generalized_forces"),
+            "{name}: {:?}",
+            info.effects
+        );
+        for t in &terms {
+            let p = info
+                .parameter(&t.model_symbol())
+                .unwrap_or_else(|| panic!("{name} lacks {}", t.model_symbol()));
+            assert_eq!(p.default, Some(0.0), "{}", t.model_symbol());
+        }
+        // The candidates the application builds are exactly these.
+        assert_eq!(bikedyn::identify::time_series::terms(info).len(), terms.len());
+    }
+    let t = |equation, signal| Term {
+        equation,
+        signal,
+        speed_power: 0,
+        lagged: false,
+    };
+    assert_eq!(t(Coordinate::Steer, Signal::Angle(Coordinate::Roll)).model_sign(), -1.0);
+    assert_eq!(t(Coordinate::Steer, Signal::Rate(Coordinate::Steer)).model_sign(), 1.0);
+    assert_eq!(t(Coordinate::Steer, Signal::Constant).model_sign(), -1.0);
+    assert_eq!(t(Coordinate::Roll, Signal::Constant).model_sign(), 1.0);
+    assert_eq!(
+        t(Coordinate::Steer, Signal::Coulomb(Coordinate::Steer)).model_sign(),
+        1.0
+    );
+}

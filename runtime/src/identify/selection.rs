@@ -284,6 +284,9 @@ pub(super) struct Search<'s> {
 /// about 3.1).
 pub fn family_wise_sigmas(candidates: usize) -> f64 {
     use statrs::distribution::{ContinuousCDF, Normal};
+    if candidates <= 1 {
+        return 2.0;
+    }
     let alpha = 1.0 - Normal::standard().cdf(2.0);
     let k = candidates.max(1) as f64;
     Normal::standard().inverse_cdf(1.0 - alpha / k).max(2.0)

@@ -180,3 +180,16 @@ fn of_contenders_that_both_pass_one_predicting_held_out_runs_consistently_better
     );
     assert_eq!(w, Some(0));
 }
+
+#[test]
+fn the_consistent_gain_bar_of_many_alike_candidates_keeps_the_family_wise_rate() {
+    // One candidate: the library's two standard errors.
+    assert_eq!(family_wise_sigmas(1), 2.0);
+    assert_eq!(family_wise_sigmas(0), 2.0);
+    // 28 terms: the one-sided rate of 2 SE (about 2.3 %) shared among
+    // them, 2.275e-2 / 28 = 8.1e-4, is the normal quantile 3.151.
+    let z = family_wise_sigmas(28);
+    assert!((z - 3.151).abs() < 0.01, "{z}");
+    // More candidates ask more.
+    assert!(family_wise_sigmas(56) > z && family_wise_sigmas(2) < z);
+}
