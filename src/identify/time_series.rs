@@ -218,10 +218,18 @@ pub fn sentence(o: &TimeSeriesOutcome, unit: &str, scale: f64) -> String {
     match o {
         TimeSeriesOutcome::NotRun { reason } => format!("discovery in the time series not run: {reason}"),
         TimeSeriesOutcome::Ran(f) => {
+            // The first step's trials: every term, and the pairs tried
+            // when no term passed alone.
+            let tried = |pairs: bool| {
+                f.search.steps.first().map_or(0, |s| {
+                    s.trials.iter().filter(|t| (t.members.len() > 1) == pairs).count()
+                })
+            };
             let found = if f.readings.is_empty() {
                 format!(
-                    "discovered in the time series: no term of the dictionary passes ({} tried)",
-                    f.search.steps.first().map_or(0, |s| s.trials.len())
+                    "discovered in the time series: no term of the dictionary passes ({} terms, {} pairs tried)",
+                    tried(false),
+                    tried(true)
                 )
             } else {
                 format!("discovered in the time series: {}", f.readings.join("; "))
