@@ -13,6 +13,8 @@ use std::path::PathBuf;
 mod discovered;
 #[path = "effects/discovered_lag.rs"]
 mod discovered_lag;
+#[path = "effects/discovered_runs.rs"]
+mod discovered_runs;
 
 const SOURCE: &str = "examples/discovered_force/build.rs";
 
@@ -30,14 +32,18 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=effects/discovered.rs");
     println!("cargo:rerun-if-changed=effects/discovered_lag.rs");
+    println!("cargo:rerun-if-changed=effects/discovered_runs.rs");
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     // The steer torque from the roll angle (refitted in the tests), and a
-    // lagged steer torque from the roll rate (a first-order state).
+    // lagged steer torque from the roll rate (a first-order state), and
+    // what the search in the time series found in measured-style runs.
     let models = [
         bicycle("discovered_bicycle", Speed::Driven, discovered::effect()),
         bicycle("discovered_bicycle_free", Speed::Free, discovered::effect()),
         bicycle("discovered_lag_bicycle", Speed::Driven, discovered_lag::effect()),
         bicycle("discovered_lag_bicycle_free", Speed::Free, discovered_lag::effect()),
+        bicycle("discovered_runs_bicycle", Speed::Driven, discovered_runs::effect()),
+        bicycle("discovered_runs_bicycle_free", Speed::Free, discovered_runs::effect()),
     ]
     .into_iter()
     .collect::<Result<Vec<Model>, ModelError>>()

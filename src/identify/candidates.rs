@@ -41,16 +41,21 @@ pub fn identification_models<R: ModelRegistry>(
 }
 
 /// The free-speed model without extra states that can represent the
-/// bicycle and carries the most effects (every candidate of the library on
-/// every geometry), and its driven-speed twin (same effects).
+/// bicycle, carries the effect parameters its file names and then the most
+/// effects (every candidate of the library on every geometry), and its
+/// driven-speed twin (same effects).
 fn identification_model_pair<R: ModelRegistry>(
     bike: &Bicycle<R>,
 ) -> Result<(&'static ModelInfo, &'static ModelInfo), IdentifyError> {
     let nonzero = bike.nonzero_parameters()?;
+    // An effect the bicycle file names, even at zero (to be fitted from
+    // there), asks for the models that carry it: a registry may hold
+    // several effects no built-in model has.
+    let named = |m: &ModelInfo| bike.effects.keys().filter(|k| m.parameter(k).is_some()).count();
     let free = R::models()
         .iter()
         .filter(|m| m.free_speed && m.states.is_empty() && crate::models::fits(m, &nonzero))
-        .max_by_key(|m| m.effects.len())
+        .max_by_key(|m| (named(m), m.effects.len()))
         .ok_or_else(|| IdentifyError::NoFreeSpeedModel {
             bicycle: bike.name.clone(),
         })?;

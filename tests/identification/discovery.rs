@@ -330,60 +330,9 @@ fn in_the_time_series_a_steer_damper_the_library_lacks_is_found_and_halves_the_r
     );
 }
 
-/// A steer torque from the roll angle (3 N m/rad, steering into the lean,
-/// benchmark signs: no library effect expresses it) hidden in measured
-/// runs: the library takes what it can (inertia and geometry corrections),
-/// the search in the time series then names a steer torque from the roll
-/// angle, within 25 % of the hidden value over the set's speeds (the runs'
-/// narrow speed range cannot tell a constant coefficient from one growing
-/// with speed), and the held-out roll error with it is at most half the
-/// library's. The set is made through the dictionary's own parameter
-/// (`synth --effects`), which no library candidate sets. (A constant steer
-/// torque is no test: a lateral mass offset of the library explains it
-/// within the runs' scatter, and nothing is then searched.)
-#[test]
-fn in_the_time_series_a_steer_torque_from_the_roll_angle_is_found_beyond_the_library() {
-    let dir = scratch("time-series-roll-angle");
-    let set = dir.join("set");
-    let _ = std::fs::remove_dir_all(&set);
-    // The models' signs are the thesis's (steer positive to the left).
-    let synth = bikedyn(&[
-        "synth",
-        "--effects",
-        "Q_steer_torque_roll=-3,Crr_rear=0.01,Crr_front=0.01",
-        "--speeds",
-        "5.5:7",
-        "--runs",
-        "8",
-        "--seed",
-        "11",
-        "--out",
-        set.to_str().unwrap(),
-    ]);
-    assert!(synth.status.success(), "{}", text(&synth.stderr));
-    let v = ok_json(&["identify", set.to_str().unwrap(), "--json"]);
-    let terms = time_series_terms(&v);
-    let found = terms
-        .iter()
-        .find(|t| {
-            t["term"]["equation"] == "steer"
-                && t["term"]["signal"]["kind"] == "angle"
-                && t["term"]["signal"]["of"] == "roll"
-        })
-        .unwrap_or_else(|| panic!("no steer torque from the roll angle: {:#}", v["time_series_discovery"]));
-    let power = found["term"]["speed_power"].as_i64().unwrap() as i32;
-    let k = found["coefficient"][0].as_f64().unwrap();
-    for speed in [5.5f64, 7.0] {
-        let at = k * speed.powi(power);
-        assert!((at - 3.0).abs() <= 0.25 * 3.0, "{at} N m/rad at {speed} m/s: {found:#}");
-    }
-    assert!(
-        held_out_roll(&v, "after") <= 0.5 * held_out_roll(&v, "library"),
-        "{:#}",
-        v["time_series_discovery"]
-    );
-    let _ = std::fs::remove_dir_all(&dir);
-}
+// A steer torque from the roll angle hidden in runs (no library effect
+// expresses it), found in the time series, written as an effect file,
+// derived and refitted: `examples/discovered_force/tests/runs.rs`.
 
 /// Every term of the runtime's time-series dictionary is a parameter of
 /// both identification models (the modeler's `generalized_forces` effect

@@ -192,6 +192,7 @@ pub fn identify<M: MultibodyModel>(
         stated: candidates,
         progress,
         gain_sigmas: 2.0,
+        pair_gain_sigmas: Some(2.0),
     };
 
     let mut current = before.clone();
@@ -274,6 +275,10 @@ pub(super) struct Search<'s> {
     /// Standard errors by which a candidate's held-out gain, paired run by
     /// run, must exceed zero to enter (2 for the library's search).
     pub(super) gain_sigmas: f64,
+    /// The same for a pair, or `None` when no pair may enter (one place
+    /// left). A pair is one of many more hypotheses than a single
+    /// candidate; the library keeps its two standard errors for both.
+    pub(super) pair_gain_sigmas: Option<f64>,
 }
 
 /// The bar of a consistent held-out gain, in standard errors, when one of
@@ -409,7 +414,7 @@ impl<'s> Search<'s> {
         )?;
         // No single candidate passed: pairs whose joint linearised fit
         // beats each member's alone, best predicted first.
-        if winner.is_none() {
+        if winner.is_none() && self.pair_gain_sigmas.is_some() {
             let mut pairs = screened.pairs.clone();
             pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
             pairs.retain(|(_, p)| *p < reference_bic);
@@ -704,6 +709,11 @@ impl<'s> Search<'s> {
     /// Cross-validate one fitted trial against `current`: its verdict
     /// (`None`: not fitted).
     pub(super) fn validate_one(&self, p: &mut Pending<'s>, current: &CandidateFit) -> Option<Verdict> {
+        let sigmas = if p.members.len() > 1 {
+            self.pair_gain_sigmas.unwrap_or(f64::INFINITY)
+        } else {
+            self.gain_sigmas
+        };
         let (fit, setup) = p.fit.as_mut()?;
         cross_validate(setup, fit, self.fold_of, self.opts);
         Some(if !(fit.cv < current.cv) {
@@ -712,13 +722,9 @@ impl<'s> Search<'s> {
                 base_cv: current.cv,
             }
         } else if let Some((gain, stderr)) =
-            paired_gain(current, fit, self.weights).filter(|(d, se)| !(*d > self.gain_sigmas * se))
+            paired_gain(current, fit, self.weights).filter(|(d, se)| !(*d > sigmas * se))
         {
-            Verdict::HeldOutGainNotConsistent {
-                gain,
-                stderr,
-                sigmas: self.gain_sigmas,
-            }
+            Verdict::HeldOutGainNotConsistent { gain, stderr, sigmas }
         } else {
             Verdict::Added {
                 bic_change: fit.bic - bic(current, self.reference),

@@ -97,8 +97,10 @@ pub fn discover_in_time_series<M: MultibodyModel>(
         reference: &library.before,
         stated: &all,
         progress,
-        // One of many terms entering by chance is guarded against.
+        // One of many terms entering by chance is guarded against; a pair
+        // is one of n (n - 1) / 2.
         gain_sigmas: family_wise_sigmas(terms.len()),
+        pair_gain_sigmas: Some(family_wise_sigmas(terms.len() * terms.len().saturating_sub(1) / 2)),
     };
     let is_term = |c: &&Candidate| terms.iter().any(|t| t.name == c.name);
     let mut current = library.after.clone();
@@ -122,7 +124,12 @@ pub fn discover_in_time_series<M: MultibodyModel>(
             if remaining.is_empty() {
                 break;
             }
-            let (step, fit, sims) = search.step(&current, &selected, &remaining)?;
+            // A pair only where two places are left.
+            let step_search = Search {
+                pair_gain_sigmas: search.pair_gain_sigmas.filter(|_| added.len() + 2 <= max_terms),
+                ..search
+            };
+            let (step, fit, sims) = step_search.step(&current, &selected, &remaining)?;
             simulations += sims;
             let names = step.added.clone();
             steps.push(step);
