@@ -175,8 +175,11 @@ class Simulation(dict):
     Attributes:
         model: the generated model simulated.
         stop: why the integration stopped (end time, an event).
-        stats: right-hand-side evaluations, steps, constraint residuals and
-            the relative energy change.
+        stats: the job's summary (``bikedyn::simulate::SimulationSummary``):
+            ``model``, ``free_speed``, ``stop``, ``simulated_seconds``,
+            ``wall_seconds``, ``rhs_evaluations``, ``accepted_steps``,
+            ``rejected_steps``, ``max_constraint_residual`` (m),
+            ``max_velocity_residual`` (m/s), ``relative_energy_change``.
         roles: the model's coordinate of each role (``roll``, ``steer``,
             ``yaw``, ``pitch``, ``rear_contact_x`` ...): models name their
             coordinates in their own words (the thesis model's roll is

@@ -122,21 +122,27 @@ pub(crate) fn simulate<'py>(
                 steer_limit,
             },
         };
-        let info = bikedyn::simulate::choose_model(b, model.as_deref(), free_speed).map_err(sim_failure)?;
-        let ic = InitialConditions {
-            roll,
-            steer,
-            roll_rate,
-            steer_rate,
-            speed,
-            yaw,
-            ..InitialConditions::default()
+        let request = bikedyn::simulate::SimulateRequest {
+            model,
+            free_speed,
+            initial: InitialConditions {
+                roll,
+                steer,
+                roll_rate,
+                steer_rate,
+                speed,
+                yaw,
+                ..InitialConditions::default()
+            },
+            inputs: Inputs {
+                kicks: kick_list,
+                pulses: pulse_list,
+            },
+            duration,
+            options: opts,
         };
-        let inputs = Inputs {
-            kicks: kick_list,
-            pulses: pulse_list,
-        };
-        let sim = bikedyn::simulate::run(b, info, &ic, &inputs, duration, &opts).map_err(sim_failure)?;
+        let outcome = bikedyn::simulate::simulate(b, &request).map_err(sim_failure)?;
+        let sim = &outcome.simulation;
         let header = bikedyn::report::simulate::simulation_csv_header(&sim);
         let n = sim.t.len();
         let mut columns: Vec<f64> = Vec::with_capacity(header.len() * n);
@@ -164,15 +170,8 @@ pub(crate) fn simulate<'py>(
                 "simulation columns do not match the CSV header",
             ));
         }
-        let stats = serde_json::json!({
-            "rhs_evaluations": sim.stats.rhs_evaluations,
-            "accepted_steps": sim.stats.accepted_steps,
-            "rejected_steps": sim.stats.rejected_steps,
-            "max_constraint_residual": sim.max_constraint_residual(),
-            "max_velocity_residual": sim.max_velocity_residual(),
-            "relative_energy_change": sim.relative_energy_drift(),
-            "free_speed": info.free_speed,
-        });
+        let stats =
+            serde_json::to_string(&outcome.summary()).map_err(|e| Failure::new("InternalError", e.to_string()))?;
         let roles = sim
             .roles
             .iter()
@@ -184,7 +183,7 @@ pub(crate) fn simulate<'py>(
             columns,
             n,
             sim.stop.to_string(),
-            stats.to_string(),
+            stats,
             roles,
         ))
     })?;

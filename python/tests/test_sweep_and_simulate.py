@@ -40,6 +40,9 @@ def test_simulation_columns_and_physics():
     assert sim["t"][0] == 0 and sim["t"][-1] == pytest.approx(3.0)
     assert sim.stats["relative_energy_change"] < 1e-6
     assert sim.stats["free_speed"]
+    # The stats are the job's summary, as the command line prints it.
+    assert sim.stats["model"] == sim.model and sim.stats["simulated_seconds"] == pytest.approx(3.0)
+    assert sim.stats["rhs_evaluations"] > 0 and sim.stats["stop"] == sim.stop
     assert set(sim.roles) >= {"roll", "steer", "yaw"}
     r = sim.coordinate("roll")
     # Self-stable at 5 m/s (between v_w 4.29 and v_c 6.02): the roll

@@ -10,8 +10,7 @@ use bikedyn::report::simulate::save_simulation_csv;
 use bikedyn::runtime::simulate::{
     Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, TorquePulse, MIN_RTOL,
 };
-use bikedyn::simulate;
-use std::time::Instant;
+use bikedyn::simulate::{self, SimulateRequest};
 
 /// The numbers of a colon-separated spec; `format` is the expected form,
 /// shown when a part is not a number (`--kick 1,3` names TIME:IMPULSE).
@@ -91,7 +90,12 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
     super::check_outputs(a.out.as_deref(), a.plot.as_deref())?;
     let bike = Bicycle::resolve(&a.bike)?;
     super::show_warnings(&bike);
-    let info = simulate::choose_model(&bike, a.model.as_deref(), a.free_speed)?;
+    let request = SimulateRequest {
+        model: a.model.clone(),
+        free_speed: a.free_speed,
+        ..SimulateRequest::default()
+    };
+    let info = simulate::choose_model(&bike, request.model.as_deref(), request.free_speed)?;
     if let Some(m) = a.model.as_deref().filter(|m| *m != info.name) {
         // The named model is not the one run: say which is.
         eprintln!(
@@ -143,39 +147,51 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
             steer_limit: limit(a.steer_limit),
         },
     };
-    let start = Instant::now();
-    let sim = simulate::run(&bike, info, &ic, &inputs, a.duration, &opts)?;
-    let wall = start.elapsed().as_secs_f64();
-    let simulated = sim.t.last().copied().unwrap_or(0.0);
+    let request = SimulateRequest {
+        initial: ic,
+        inputs,
+        duration: a.duration,
+        options: opts,
+        ..request
+    };
+    let outcome = simulate::simulate(&bike, &request)?;
+    let summary = outcome.summary();
+    let sim = &outcome.simulation;
+    let inputs = &request.inputs;
     outln!(
         "model {} ({}), bicycle {}",
-        sim.model,
-        if info.free_speed { "free speed" } else { "driven speed" },
+        summary.model,
+        if summary.free_speed {
+            "free speed"
+        } else {
+            "driven speed"
+        },
         a.bike
     );
-    outln!("  stop: {}", sim.stop);
+    outln!("  stop: {}", summary.stop);
     outln!(
-        "  {}: simulated {simulated:.3} s in {:.3} ms ({:.0}x real time), {} right-hand-side evaluations, {} steps ({} rejected)",
-        opts.method.name(),
-        wall * 1e3,
-        simulated / wall.max(1e-12),
-        sim.stats.rhs_evaluations,
-        sim.stats.accepted_steps,
-        sim.stats.rejected_steps
+        "  {}: simulated {:.3} s in {:.3} ms ({:.0}x real time), {} right-hand-side evaluations, {} steps ({} rejected)",
+        request.options.method.name(),
+        summary.simulated_seconds,
+        summary.wall_seconds * 1e3,
+        summary.simulated_seconds / summary.wall_seconds.max(1e-12),
+        summary.rhs_evaluations,
+        summary.accepted_steps,
+        summary.rejected_steps
     );
     outln!(
         "  max holonomic constraint residual {:.2e}, max velocity-constraint residual {:.2e}, relative energy change {:.2e}",
-        sim.max_constraint_residual(),
-        sim.max_velocity_residual(),
-        sim.relative_energy_drift()
+        summary.max_constraint_residual,
+        summary.max_velocity_residual,
+        summary.relative_energy_change
     );
     if let Some(out) = &a.out {
-        save_simulation_csv(out, &sim)?;
+        save_simulation_csv(out, sim)?;
         eprintln!("wrote {}", out.display());
     }
     if let Some(plot) = &a.plot {
         plot_opts.subject = Some(bikedyn::report::plot::subject(&a.bike, Some(&sim.model)));
-        plot_simulation(plot, &sim, &inputs, &plot_opts)?;
+        plot_simulation(plot, sim, inputs, &plot_opts)?;
         eprintln!("wrote {}", plot.display());
     }
     Ok(true)

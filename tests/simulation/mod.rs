@@ -1047,3 +1047,71 @@ fn initial_rates_of_states_the_model_lacks_are_refused() {
     };
     simulate::<TyreFree>(&default_parameters::<TyreFree>(), &ic, &Inputs::default(), 0.5, &opts).unwrap();
 }
+
+/// The simulation job is the one call behind `bikedyn simulate` (and
+/// Python's `simulate`): the library's outcome and the command line's CSV
+/// are the same run, sample for sample, and the job's summary carries the
+/// run's own statistics.
+#[test]
+fn the_simulation_job_and_the_command_line_give_the_same_run() {
+    use bikedyn::bicycle::Bicycle;
+    use bikedyn::simulate::{simulate as simulate_job, SimulateRequest};
+    let bike = Bicycle::resolve("thesis").unwrap();
+    let request = SimulateRequest {
+        initial: InitialConditions {
+            roll: 3f64.to_radians(),
+            speed: 5.0,
+            ..InitialConditions::default()
+        },
+        inputs: Inputs {
+            kicks: vec![Kick::at_saddle(0.5, 2.0)],
+            ..Inputs::default()
+        },
+        duration: 2.0,
+        ..SimulateRequest::default()
+    };
+    let outcome = simulate_job(&bike, &request).unwrap();
+    let summary = outcome.summary();
+    let sim = &outcome.simulation;
+    assert_eq!(outcome.model.name, sim.model);
+    assert_eq!(summary.rhs_evaluations, sim.stats.rhs_evaluations);
+    assert_eq!(summary.simulated_seconds, 2.0);
+    assert!(!summary.free_speed);
+
+    let csv = scratch("simulate-job").join("run.csv");
+    let out = bikedyn(&[
+        "simulate",
+        "--speed",
+        "5",
+        "--roll",
+        "3",
+        "--kick",
+        "0.5:2",
+        "--duration",
+        "2",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains(&format!("model {}", sim.model)),
+        "{}",
+        text(&out.stdout)
+    );
+    let rows: Vec<Vec<f64>> = std::fs::read_to_string(&csv)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), sim.t.len());
+    let n = sim.coordinates.len();
+    for (row, (p, dp)) in rows.iter().zip(sim.p.iter().zip(&sim.dp)) {
+        for (a, b) in row[1..=n].iter().zip(p) {
+            assert!((a - b).abs() <= 1e-11 * b.abs().max(1e-3), "{a} against {b}");
+        }
+        for (a, b) in row[n + 1..=2 * n].iter().zip(dp) {
+            assert!((a - b).abs() <= 1e-11 * b.abs().max(1e-3), "{a} against {b}");
+        }
+    }
+}
