@@ -31,6 +31,7 @@ pub mod eigen;
 pub mod fit;
 pub mod frequency;
 pub mod identify;
+pub mod main_report;
 pub mod models;
 pub mod monte_carlo;
 pub mod progress;

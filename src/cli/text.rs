@@ -8,8 +8,6 @@ use bikedyn::report::output;
 use bikedyn::runtime::eigen::{CriticalSpeeds, CrossingDirection, CrossingKind};
 use bikedyn::runtime::CanonicalMatrices;
 
-pub use bikedyn::report::output::stability_json;
-
 /// The stability of bicycle `name` in words; `controlled`: its file's
 /// `[feedback]` closes the loop, so it is stable with it, not self-stable.
 pub fn stability_text(name: &str, c: &CriticalSpeeds, controlled: bool) -> String {

@@ -498,3 +498,51 @@ fn the_sweep_job_refuses_bad_options_with_a_typed_error() {
     assert!(e.to_string().starts_with("2 of the sweep's designs failed"), "{e}");
     assert!(sweep_at_speeds(&b, &SweepOptions::new("c", vec![0.1]), &[f64::NAN]).is_err());
 }
+
+/// The main job (`bikedyn report`) is one library call: every built-in
+/// model passes its verification, each built-in bicycle has its figures
+/// and files (the benchmark's weave speed to 1e-10), the files are in the
+/// target folder once the job returns, and a folder bikedyn did not write
+/// is refused before anything is computed, left as it was.
+#[test]
+fn the_main_job_verifies_the_models_and_writes_each_bicycles_figures() {
+    use bikedyn::main_report::{main_report, MainReportError, MainReportOptions};
+    let dir = crate::common::scratch("main-job");
+    let out = dir.join("report");
+    let _ = std::fs::remove_dir_all(&out);
+    let options = MainReportOptions {
+        identify: false,
+        ..MainReportOptions::new(&out)
+    };
+    let r = main_report(&options, &bikedyn::progress::ignore).unwrap();
+    assert!(r.verified(), "{:?}", r.verified);
+    assert_eq!(r.verified.len(), bikedyn::models::model_names().len());
+    assert_eq!(r.bicycles.len(), bikedyn::bicycle::BUILT_IN.len());
+    let benchmark = r.bicycles.iter().find(|b| b.name == "benchmark").unwrap();
+    assert!((benchmark.critical.weave_speed.unwrap() - 4.292_382_536_341_11).abs() < 1e-10);
+    for b in &r.bicycles {
+        assert_eq!(b.files.len(), 5, "{:?}", b.files);
+        for f in &b.files {
+            assert!(f.starts_with(&out) && f.is_file(), "{}", f.display());
+        }
+    }
+    assert!(r.identification.is_none());
+
+    let foreign = dir.join("foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("notes.txt"), "mine").unwrap();
+    let refused = main_report(
+        &MainReportOptions {
+            identify: false,
+            ..MainReportOptions::new(&foreign)
+        },
+        &bikedyn::progress::ignore,
+    );
+    assert!(
+        matches!(refused, Err(MainReportError::Output(_))),
+        "{:?}",
+        refused.err()
+    );
+    assert_eq!(std::fs::read_to_string(foreign.join("notes.txt")).unwrap(), "mine");
+    let _ = std::fs::remove_dir_all(&dir);
+}
