@@ -109,6 +109,91 @@ pub fn verify_model(name: &str, opts: &VerifyOptions) -> Option<VerifyReport> {
     with_model(name, Verify(opts))
 }
 
+/// The verification job (`bikedyn verify`): every generated derivative of
+/// `model` (`None`: every built-in model) against central finite
+/// differences at `options.states` random states.
+pub fn verify_models(model: Option<&str>, options: &VerifyOptions) -> Result<Verification, UnknownModel> {
+    let names: Vec<&str> = match model {
+        Some(m) => vec![m],
+        None => model_names(),
+    };
+    let reports = names
+        .into_iter()
+        .map(|n| {
+            verify_model(n, options).ok_or_else(|| UnknownModel {
+                model: n.to_string(),
+                known: model_names().join(", "),
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    Ok(Verification {
+        passed: reports.iter().all(|r| r.passed),
+        reports,
+    })
+}
+
+/// A model name the registry does not have.
+#[derive(Debug, thiserror::Error)]
+#[error("unknown model `{model}` (models: {known})")]
+pub struct UnknownModel {
+    pub model: String,
+    pub known: String,
+}
+
+/// What the verification job found.
+#[derive(Clone, Debug)]
+pub struct Verification {
+    /// Every quantity of every model within its tolerance.
+    pub passed: bool,
+    /// Each model's checks.
+    pub reports: Vec<VerifyReport>,
+}
+
+/// One quantity of one model, as `verify --json` lists them.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct VerifiedQuantity {
+    /// The model.
+    pub model: String,
+    /// The quantity (`Cq`, `dBdp`, `M symmetric`, ...).
+    pub name: String,
+    /// Largest error over the states, relative to the reference's largest
+    /// magnitude at that state.
+    pub max_rel_error: f64,
+    /// The tolerance it is held to.
+    pub tolerance: f64,
+    /// Whether it is within it.
+    pub passed: bool,
+}
+
+/// `verify --json`: the verdict and every quantity of every model.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct VerificationJson {
+    pub passed: bool,
+    pub quantities: Vec<VerifiedQuantity>,
+}
+
+impl Verification {
+    /// The verdict and every quantity, flat (the JSON of `verify --json`).
+    pub fn to_json(&self) -> VerificationJson {
+        VerificationJson {
+            passed: self.passed,
+            quantities: self
+                .reports
+                .iter()
+                .flat_map(|r| {
+                    r.quantities.iter().map(move |q| VerifiedQuantity {
+                        model: r.model.clone(),
+                        name: q.name.clone(),
+                        max_rel_error: q.max_rel_error,
+                        tolerance: q.tolerance,
+                        passed: q.passed,
+                    })
+                })
+                .collect(),
+        }
+    }
+}
+
 /// Every generated model.
 pub fn models() -> &'static [ModelInfo] {
     MODELS

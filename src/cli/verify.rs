@@ -1,43 +1,21 @@
-//! `bikedyn verify`: every generated derivative against finite differences.
+//! `bikedyn verify`: every generated derivative against finite differences
+//! ([`bikedyn::models::verify_models`]), printed.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use bikedyn::runtime::verify::VerifyOptions;
 
 /// Run `bikedyn verify`.
 pub fn run(model: Option<String>, states: usize, seed: u64, json: bool) -> Result<bool> {
-    let names: Vec<&str> = match &model {
-        Some(m) => vec![m.as_str()],
-        None => bikedyn::models::model_names(),
-    };
     let opts = VerifyOptions {
         states,
         seed,
         ..VerifyOptions::default()
     };
-    let mut reports = Vec::new();
-    for n in names {
-        let r = bikedyn::models::verify_model(n, &opts).with_context(|| {
-            format!(
-                "unknown model `{n}` (models: {})",
-                bikedyn::models::model_names().join(", ")
-            )
-        })?;
-        reports.push(r);
-    }
-    let passed = reports.iter().all(|r| r.passed);
+    let v = bikedyn::models::verify_models(model.as_deref(), &opts)?;
     if json {
-        let quantities: Vec<_> = reports
-            .iter()
-            .flat_map(|r| r.quantities.iter().map(move |q| serde_json::json!({
-                "model": r.model, "name": q.name, "max_rel_error": q.max_rel_error, "tolerance": q.tolerance, "passed": q.passed
-            })))
-            .collect();
-        outln!(
-            "{}",
-            serde_json::to_string_pretty(&serde_json::json!({"passed": passed, "quantities": quantities}))?
-        );
+        outln!("{}", serde_json::to_string_pretty(&v.to_json())?);
     } else {
-        for r in &reports {
+        for r in &v.reports {
             outln!("model {} ({} random states, seed {}):", r.model, r.states, r.seed);
             for q in &r.quantities {
                 outln!(
@@ -51,12 +29,12 @@ pub fn run(model: Option<String>, states: usize, seed: u64, json: bool) -> Resul
         }
         outln!(
             "{}",
-            if passed {
+            if v.passed {
                 "verification passed"
             } else {
                 "verification FAILED"
             }
         );
     }
-    Ok(passed)
+    Ok(v.passed)
 }

@@ -550,3 +550,37 @@ fn wheel_sensor_times(duration: f64) -> Vec<f64> {
         .take_while(|&t| t < duration + 0.1)
         .collect()
 }
+
+/// The verification job is one library call: its typed result is what
+/// `verify --json` prints (the JSON comes from the type), and an unknown
+/// model is a typed error that lists the known ones.
+#[test]
+fn the_verification_job_gives_the_command_lines_json() {
+    use bikedyn::runtime::verify::VerifyOptions;
+    let opts = VerifyOptions {
+        states: 5,
+        seed: 3,
+        ..VerifyOptions::default()
+    };
+    let v = bikedyn::models::verify_models(Some("thesis_whipple"), &opts).unwrap();
+    assert!(v.passed);
+    assert_eq!(v.reports.len(), 1);
+    let out = bikedyn(&[
+        "verify",
+        "--model",
+        "thesis_whipple",
+        "--states",
+        "5",
+        "--seed",
+        "3",
+        "--json",
+    ]);
+    // The same text (parsing would round the last digit of some numbers).
+    assert_eq!(
+        String::from_utf8_lossy(&out.stdout).trim_end(),
+        serde_json::to_string_pretty(&v.to_json()).unwrap()
+    );
+    let e = bikedyn::models::verify_models(Some("tricycle"), &opts).unwrap_err();
+    assert_eq!(e.model, "tricycle");
+    assert!(e.known.contains("thesis_whipple"), "{}", e.known);
+}
