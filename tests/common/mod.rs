@@ -54,11 +54,47 @@ pub fn ok_json(args: &[&str]) -> serde_json::Value {
 }
 
 /// A scratch folder for one group of tests, unique to this test process so
-/// that concurrent runs never share files.
+/// that concurrent runs never share files. The test harness has no hook at
+/// exit, so the folders of earlier test processes that have ended are
+/// removed the first time a process asks for one: only folders with the
+/// marker file this function writes, and only of a process no longer
+/// running (`/proc/PID`; elsewhere nothing is removed).
 pub fn scratch(group: &str) -> PathBuf {
+    static SWEPT: std::sync::Once = std::sync::Once::new();
+    SWEPT.call_once(remove_scratch_of_ended_runs);
     let d = std::env::temp_dir().join(format!("bikedyn-{group}-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
+    let _ = std::fs::write(d.join(SCRATCH_MARKER), "");
     d
+}
+
+/// The file that marks a folder as a test scratch folder of `scratch`.
+const SCRATCH_MARKER: &str = ".bikedyn-test-scratch";
+
+fn remove_scratch_of_ended_runs() {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(dir) = std::fs::read_dir(std::env::temp_dir()) else {
+        return;
+    };
+    for e in dir.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(pid) = name
+            .strip_prefix("bikedyn-")
+            .and_then(|rest| rest.rsplit_once('-'))
+            .and_then(|(_, pid)| pid.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        let path = e.path();
+        if pid != std::process::id()
+            && !Path::new(&format!("/proc/{pid}")).exists()
+            && path.join(SCRATCH_MARKER).is_file()
+        {
+            let _ = std::fs::remove_dir_all(&path);
+        }
+    }
 }
 
 /// A fixture of `tests/data`.

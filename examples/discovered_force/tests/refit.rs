@@ -106,6 +106,7 @@ fn discovered() -> (TableOutcome, TableDiscovery) {
 
 fn discovered_in(request: TableRequest) -> (TableOutcome, TableDiscovery) {
     let o = identify_table(&request).unwrap();
+    let _ = std::fs::remove_file(&request.path);
     let Some(DiscoveryOutcome::Ran(d)) = o.discovery.clone() else {
         panic!("no discovery: {:?}", o.discovery)
     };
@@ -187,6 +188,8 @@ fn the_refit_with_the_derived_model_gives_the_discovered_value_and_the_error_of_
     let mut req = request(&["discovered"], false);
     req.bike = bike.to_str().unwrap().into();
     let refit = identify_table_in::<Registry>(&req).unwrap();
+    let _ = std::fs::remove_file(&req.path);
+    let _ = std::fs::remove_file(&bike);
     assert_eq!(refit.selected, ["discovered"]);
     let (value, stderr) = refit.parameters["discovered_k0"];
     let expected = model_coefficient(found).unwrap();
