@@ -71,7 +71,7 @@ pub struct ExampleIdentification {
 pub struct MainReport {
     /// Each built-in model's verification against finite differences:
     /// `(model, passed)`.
-    pub verified: Vec<(&'static str, bool)>,
+    pub verified: Vec<(String, bool)>,
     /// The built-in bicycles' figures.
     pub bicycles: Vec<BicycleFigures>,
     /// The example set's identification (`None` when not asked).
@@ -107,8 +107,8 @@ pub enum MainReportError {
         source: EigenError,
     },
     /// A model of the registry could not be verified.
-    #[error("model `{model}` is not in the registry")]
-    UnknownModel { model: &'static str },
+    #[error(transparent)]
+    UnknownModel(#[from] crate::models::UnknownModel),
     /// The example set's identification failed.
     #[error(transparent)]
     Identify(#[from] IdentifyError),
@@ -119,12 +119,11 @@ pub enum MainReportError {
 pub fn main_report(options: &MainReportOptions, progress: OnProgress<'_>) -> Result<MainReport, MainReportError> {
     let staged = StagedDir::new(&options.out, FolderKind::Report)?;
     let out = staged.path().to_path_buf();
-    let mut verified = Vec::new();
-    for m in crate::models::model_names() {
-        let r = crate::models::verify_model(m, &VerifyOptions::default())
-            .ok_or(MainReportError::UnknownModel { model: m })?;
-        verified.push((m, r.passed));
-    }
+    let verified = crate::models::verify_models(None, &VerifyOptions::default())?
+        .reports
+        .into_iter()
+        .map(|r| (r.model, r.passed))
+        .collect();
     let mut bicycles = Vec::new();
     for &(name, _) in BUILT_IN {
         bicycles.push(bicycle_figures(name, options, &out)?);
