@@ -7,7 +7,9 @@ use bikedyn_runtime::linearize::parameter_vector;
 use bikedyn_runtime::model::ParameterInfo;
 use bikedyn_runtime::parameters::{BenchmarkParameters, ThesisParameters};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
-use bikedyn_runtime::verify::{verify, with_effects_switched_on, VerifyOptions, VerifyReport};
+use bikedyn_runtime::verify::{verify, with_effects_switched_on};
+/// The verification job's options and per-model report.
+pub use bikedyn_runtime::verify::{VerifyOptions, VerifyReport};
 use bikedyn_runtime::MultibodyModel;
 use std::any::TypeId;
 use std::sync::{Mutex, OnceLock, PoisonError};

@@ -7,8 +7,12 @@
 use crate::bicycle::{Bicycle, BicycleError};
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
-use bikedyn_runtime::simulate::{
-    simulate as integrate, InitialConditions, Inputs, SimOptions, SimulateError, Simulation,
+use bikedyn_runtime::simulate::simulate as integrate;
+/// The job's vocabulary: initial state, inputs, integration options and
+/// the simulated run (the runtime's plain structs).
+pub use bikedyn_runtime::simulate::{
+    Events, InitialConditions, Inputs, Kick, Method, PulseShape, PulseTarget, SimOptions, SimulateError, Simulation,
+    TorquePulse, MIN_RTOL,
 };
 use bikedyn_runtime::MultibodyModel;
 use serde::Serialize;

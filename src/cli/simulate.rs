@@ -7,10 +7,10 @@ use anyhow::{bail, Context, Result};
 use bikedyn::bicycle::Bicycle;
 use bikedyn::report::simulate::plot::plot_simulation;
 use bikedyn::report::simulate::save_simulation_csv;
-use bikedyn::runtime::simulate::{
-    Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, TorquePulse, MIN_RTOL,
+use bikedyn::simulate::{
+    self, Events, InitialConditions, Inputs, Kick, PulseShape, PulseTarget, SimOptions, SimulateRequest, TorquePulse,
+    MIN_RTOL,
 };
-use bikedyn::simulate::{self, SimulateRequest};
 
 /// The numbers of a colon-separated spec; `format` is the expected form,
 /// shown when a part is not a number (`--kick 1,3` names TIME:IMPULSE).

@@ -2,7 +2,7 @@
 //! ([`bikedyn::models::verify_models`]), printed.
 
 use anyhow::Result;
-use bikedyn::runtime::verify::VerifyOptions;
+use bikedyn::models::VerifyOptions;
 
 /// Run `bikedyn verify`.
 pub fn run(model: Option<String>, states: usize, seed: u64, json: bool) -> Result<bool> {
