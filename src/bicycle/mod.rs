@@ -401,6 +401,15 @@ impl<R: ModelRegistry> Bicycle<R> {
         Ok(self.parameters.to_thesis()?)
     }
 
+    /// The geometry derived from the parameters, whatever their form
+    /// (Meijaard et al. 2007, appendix A; benchmark axes): each row is
+    /// `(symbol, value, unit, what)`.
+    pub fn derived_geometry(&self) -> Result<bikedyn_runtime::geometry::DerivedGeometry, BicycleError> {
+        Ok(bikedyn_runtime::geometry::DerivedGeometry::of(
+            &self.parameters.to_benchmark()?,
+        ))
+    }
+
     /// The same bicycle with one parameter changed. `symbol` is a thesis
     /// symbol (`Rt`, `x4`, `d4`, ...) or a benchmark symbol (`c`, `lam`, ...).
     pub fn with_parameter(&self, symbol: &str, value: f64) -> Result<Bicycle<R>, BicycleError> {

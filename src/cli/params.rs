@@ -31,7 +31,7 @@ pub fn run(command: ParamsCommand) -> Result<bool> {
             out!("{}", params_show_text(&b, model.as_deref())?);
             // Derived geometry, whatever the form of the file (issue 10,
             // point 9), as TOML comments so the output still loads.
-            let g = bikedyn::runtime::geometry::DerivedGeometry::of(&b.parameters.to_benchmark()?);
+            let g = b.derived_geometry()?;
             outln!("\n# Derived geometry (Meijaard et al. 2007, appendix A; benchmark axes):");
             for (sym, value, unit, what) in g.rows() {
                 outln!(
