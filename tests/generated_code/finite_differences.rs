@@ -30,18 +30,21 @@ fn every_generated_derivative_of_every_model_matches_finite_differences() {
     }
 }
 
+/// `verify --json` of the thesis model at five states, seed 3.
+const VERIFY_JSON_ARGS: &[&str] = &[
+    "verify",
+    "--model",
+    "thesis_whipple",
+    "--states",
+    "5",
+    "--seed",
+    "3",
+    "--json",
+];
+
 #[test]
 fn cli_verify_json_reports_every_quantity() {
-    let out = bikedyn(&[
-        "verify",
-        "--model",
-        "thesis_whipple",
-        "--states",
-        "5",
-        "--seed",
-        "3",
-        "--json",
-    ]);
+    let out = bikedyn(VERIFY_JSON_ARGS);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["passed"], true);
@@ -565,16 +568,7 @@ fn the_verification_job_gives_the_command_lines_json() {
     let v = bikedyn::models::verify_models(Some("thesis_whipple"), &opts).unwrap();
     assert!(v.passed);
     assert_eq!(v.reports.len(), 1);
-    let out = bikedyn(&[
-        "verify",
-        "--model",
-        "thesis_whipple",
-        "--states",
-        "5",
-        "--seed",
-        "3",
-        "--json",
-    ]);
+    let out = bikedyn(VERIFY_JSON_ARGS);
     // The same text (parsing would round the last digit of some numbers).
     assert_eq!(
         String::from_utf8_lossy(&out.stdout).trim_end(),
