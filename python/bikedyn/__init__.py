@@ -42,6 +42,37 @@ from ._errors import (
     OutputError,
     ParameterError,
 )
+from .results import (
+    Bode,
+    BodeResponse,
+    Canonical,
+    CanonicalStandardDeviations,
+    ClockOffset,
+    CriticalSpeedSensitivity,
+    Crossing,
+    DiscoveredTerm,
+    Discovery,
+    EigenvalueDerivative,
+    EigenvalueSensitivities,
+    Errors,
+    Estimate,
+    FailedFit,
+    FitResult,
+    FormFit,
+    IdentifyResult,
+    Kick,
+    ModeSensitivity,
+    MonteCarlo,
+    Refusal,
+    SampledSpeed,
+    Sensitivity,
+    SpeedDerivative,
+    SpeedUncertainty,
+    Stability,
+    StabilityUncertainty,
+    StageErrors,
+    VarianceShare,
+)
 
 __version__: str = _bikedyn.__version__
 
@@ -50,8 +81,35 @@ __all__ = [
     "Eigen",
     "SweepResult",
     "Simulation",
+    "Stability",
+    "Crossing",
+    "StabilityUncertainty",
+    "SpeedUncertainty",
+    "VarianceShare",
+    "MonteCarlo",
+    "SampledSpeed",
+    "Canonical",
+    "CanonicalStandardDeviations",
+    "Sensitivity",
+    "CriticalSpeedSensitivity",
+    "SpeedDerivative",
+    "EigenvalueSensitivities",
+    "ModeSensitivity",
+    "EigenvalueDerivative",
+    "Bode",
+    "BodeResponse",
     "FitResult",
+    "Kick",
+    "FormFit",
+    "FailedFit",
+    "Refusal",
+    "ClockOffset",
     "IdentifyResult",
+    "Estimate",
+    "Errors",
+    "Discovery",
+    "DiscoveredTerm",
+    "StageErrors",
     "ProgressCallback",
     "sweep",
     "simulate",
@@ -166,11 +224,34 @@ class SweepResult(NamedTuple):
     model: str
 
 
+# The generated models' axes are the thesis's (Martin Recuero 2009): roll
+# positive leaning right, as the benchmark's, and steer positive turning
+# left, minus the benchmark's (runtime/src/linearize.rs: `steer_sign: -1.0`
+# for every generated model; runtime/src/simulate/inputs.rs). The benchmark
+# convention (Meijaard et al. 2007) has both positive to the right: the
+# signs of `eig`'s eigenvectors, `state_space`, `canonical` and `bode`.
+_BENCHMARK_SIGN = {"roll": 1.0, "steer": -1.0}
+
+
 class Simulation(dict):
     """A nonlinear simulation: a dict of arrays with the column names of
     ``bikedyn simulate --out``'s CSV (``t`` in s, coordinates in rad or m,
     their rates with a ``d`` prefix, ``speed`` m/s, energies J, the
-    constraint residual m, extra states).
+    constraint residual m, extra states), in the model's own names and
+    signs.
+
+    Two conventions, stated once:
+
+    * The columns (``sim["theta"]``, ``sim["gamma"]``, ``sim["dgamma"]``
+      ...) and :meth:`coordinate` are the model's: the generated models use
+      the thesis's axes, roll (``theta``) positive leaning right and steer
+      (``gamma``) positive turning *left*.
+    * :attr:`roll`, :attr:`steer`, :attr:`roll_rate` and :attr:`steer_rate`
+      are in the benchmark's signs (Meijaard et al. 2007; bicycleparameters):
+      roll positive leaning right, steer positive turning *right*, the signs
+      of ``Bicycle.eig``'s eigenvectors, ``state_space``, ``canonical`` and
+      ``bode``. So ``sim.roll == sim["theta"]`` and ``sim.steer ==
+      -sim["gamma"]``.
 
     Attributes:
         model: the generated model simulated.
@@ -193,69 +274,50 @@ class Simulation(dict):
 
     def coordinate(self, role: str) -> np.ndarray:
         """The time history of the coordinate with ``role`` (``"roll"``,
-        ``"steer"`` ...), in the model's units and signs."""
+        ``"steer"`` ...), in the model's units and signs (steer positive
+        to the left; :attr:`steer` is the benchmark's)."""
         try:
             return self[self.roles[role]]
         except KeyError:
             raise InvalidArgumentError(f"no coordinate with role {role!r} (roles: {sorted(self.roles)})") from None
 
+    def _benchmark(self, role: str, rate: bool) -> np.ndarray:
+        name = self.roles.get(role)
+        if name is None:
+            raise InvalidArgumentError(f"model {self.model}: no coordinate with role {role!r}")
+        return _BENCHMARK_SIGN[role] * self["d" + name if rate else name]
+
+    @property
+    def t(self) -> np.ndarray:
+        """Time of each sample (s): ``sim["t"]``."""
+        return self["t"]
+
+    @property
+    def roll(self) -> np.ndarray:
+        """Roll angle (rad), benchmark signs: positive leaning right (the
+        model's roll column, e.g. ``theta``, which has the same sign)."""
+        return self._benchmark("roll", False)
+
+    @property
+    def steer(self) -> np.ndarray:
+        """Steer angle (rad), benchmark signs: positive turning right (minus
+        the model's steer column, e.g. ``-sim["gamma"]``)."""
+        return self._benchmark("steer", False)
+
+    @property
+    def roll_rate(self) -> np.ndarray:
+        """Roll rate (rad/s), benchmark signs (positive rolling right)."""
+        return self._benchmark("roll", True)
+
+    @property
+    def steer_rate(self) -> np.ndarray:
+        """Steer rate (rad/s), benchmark signs (positive turning right;
+        ``-sim["dgamma"]``)."""
+        return self._benchmark("steer", True)
+
     def __repr__(self) -> str:
         n = len(self.get("t", ()))
         return f"<Simulation model={self.model!r} samples={n} stop={self.stop!r} columns={list(self)}>"
-
-
-class _JsonResult:
-    """Fields of the command line's JSON as attributes."""
-
-    def __init__(self, raw: Any):
-        self._raw = raw
-        self._dict = json.loads(raw.json())
-
-    def to_dict(self) -> Dict[str, Any]:
-        """The result as the command line's ``--json`` prints it."""
-        return json.loads(self._raw.json())
-
-    def __getattr__(self, name: str) -> Any:
-        if name.startswith("_"):
-            raise AttributeError(name)
-        try:
-            return self._dict[name]
-        except KeyError:
-            raise AttributeError(f"{type(self).__name__} has no field {name!r} (fields: {sorted(self._dict)})") from None
-
-    def __dir__(self) -> List[str]:
-        return sorted(set(super().__dir__()) | set(self._dict))
-
-    def write_report(self, directory: PathLike) -> None:
-        """Write the report files into ``directory`` (created if needed)."""
-        self._raw.write_report(os.fspath(directory))
-
-
-class FitResult(_JsonResult):
-    """Measured weave eigenvalues of measured runs (``bikedyn fit``).
-
-    Fields: ``kicks`` (one dict per kick: run, speed, fitted eigenvalue
-    with standard errors, r², the model's prediction), ``skipped`` (runs
-    left out, with the reason), ``notes``, ``calibration``,
-    ``prediction_model``. ``write_report(dir)`` writes ``kicks.json`` and
-    the fit plots (SVG and PNG).
-    """
-
-    def __repr__(self) -> str:
-        return f"<FitResult kicks={len(self._dict['kicks'])} skipped={len(self._dict['skipped'])}>"
-
-
-class IdentifyResult(_JsonResult):
-    """What identification found (``bikedyn identify``): the fields of
-    ``bikedyn identify --json`` as attributes, ``summary()`` the console
-    summary, ``write_report(dir)`` the report (report.md, JSON, plots)."""
-
-    def summary(self) -> str:
-        """The console summary of ``bikedyn identify``."""
-        return self._raw.summary()
-
-    def __repr__(self) -> str:
-        return f"<IdentifyResult fields={sorted(self._dict)}>"
 
 
 class Bicycle:
@@ -378,22 +440,22 @@ class Bicycle:
         """The parameter file text (TOML), effect parameters included."""
         return self._b.to_toml()
 
-    def canonical(self) -> Dict[str, Any]:
+    def canonical(self) -> Canonical:
         """The canonical matrices of ``M q'' + v C1 q' + (g K0 + v² K2) q =
-        f`` (Meijaard et al. 2007), ``q = [roll, steer]``: a dict with
-        ``M0`` (kg m²), ``C1`` (kg m), ``K0`` (kg m), ``K2`` (kg) as 2x2
-        arrays and ``model``, and ``standard_deviations``: the same four
-        matrices' standard deviations that the file's ``+/-`` values imply
-        (first order, exact derivatives, parameters independent; what
-        bicycleparameters' ``canonical(nominal=False)`` propagates), or
-        ``None`` for a file without them. ``ModelError`` when the model's
-        linear equations have no such form (damping, a controller, tyre
-        lag)."""
+        f`` (Meijaard et al. 2007), ``q = [roll, steer]`` in benchmark
+        signs: a :class:`Canonical` with ``M`` (kg m², also ``M0``), ``C1``
+        (kg m), ``K0`` (kg m), ``K2`` (kg) as 2x2 arrays, ``model``, and
+        ``standard_deviations``: the same four matrices' standard
+        deviations that the file's ``+/-`` values imply (first order, exact
+        derivatives, parameters independent; what bicycleparameters'
+        ``canonical(nominal=False)`` propagates), or ``None`` for a file
+        without them. ``ModelError`` when the model's linear equations
+        have no such form (damping, a controller, tyre lag)."""
         model, (m0, c1, k0, k2) = self._b.canonical(self._model)
         r = lambda x: np.array(x, dtype=float).reshape(2, 2)  # noqa: E731
         sd = self._b.canonical_standard_deviations(self._model)
-        spread = None if sd is None else dict(zip(("M0", "C1", "K0", "K2"), (r(x) for x in sd)))
-        return {"M0": r(m0), "C1": r(c1), "K0": r(k0), "K2": r(k2), "model": model, "standard_deviations": spread}
+        spread = None if sd is None else CanonicalStandardDeviations(*(r(x) for x in sd))
+        return Canonical(r(m0), r(c1), r(k0), r(k2), model, spread)
 
     def state_space(self, speeds: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """``A`` and ``B`` of ``x' = A(v) x + B(v) u`` at each speed (m/s),
@@ -458,21 +520,23 @@ class Bicycle:
         speed_min: float = 0.0,
         monte_carlo: Optional[int] = None,
         seed: int = 1,
-    ) -> Dict[str, Any]:
+    ) -> Stability:
         """Weave and capsize speeds (m/s) between ``speed_min`` and
-        ``speed_max``: the dict of ``bikedyn stability --json`` (
-        ``weave_speed``, ``capsize_speed``, ``weave_real_pair_merge_speed``,
-        ``stable_intervals``, every ``crossings`` with speed, mode,
-        direction and frequency in rad/s, ``model``); a speed is ``None``
-        when it is not in the range. A file with standard deviations
-        (``value+/-sd``) also gives ``weave_speed_sd``, ``capsize_speed_sd``
-        and ``uncertainty`` (first order, from ``speed_min = 0``; see
-        ``docs/design-questions.md``). ``monte_carlo = N`` also draws N
-        bicycles about the file's values with its standard deviations
-        (``seed``): ``monte_carlo`` holds each speed's drawn ``mean``,
-        ``standard_deviation`` and ``standard_error_of_sd`` (m/s), the check
-        of the first order."""
-        return json.loads(
+        ``speed_max``: a :class:`Stability` with every field of ``bikedyn
+        stability --json``: ``weave_speed``, ``capsize_speed``,
+        ``weave_real_pair_merge_speed`` (each ``None`` when not in the
+        range), ``stable_intervals`` as ``(low, high)`` tuples, every
+        :class:`Crossing` with speed, mode, direction and frequency in
+        rad/s, ``model``. A file with standard deviations (``value+/-sd``)
+        also gives ``weave_speed_sd``, ``capsize_speed_sd`` and
+        ``uncertainty`` (first order, from ``speed_min = 0``; see
+        ``docs/design-questions.md``), else they are ``None``.
+        ``monte_carlo = N`` also draws N bicycles about the file's values
+        with its standard deviations (``seed``): ``monte_carlo`` holds each
+        speed's drawn ``mean``, ``standard_deviation`` and
+        ``standard_error_of_sd`` (m/s), the check of the first order.
+        ``to_dict()`` gives the command line's JSON."""
+        return Stability._from_json(
             self._b.stability(
                 float(speed_min),
                 float(speed_max),
@@ -484,41 +548,34 @@ class Bicycle:
 
     def sensitivity(
         self, speed: Optional[float] = None, speed_max: float = 10.0, form: Optional[str] = None
-    ) -> Dict[str, Any]:
+    ) -> Sensitivity:
         """Exact derivatives of the weave and capsize speeds (searched on 0
         to ``speed_max`` m/s) with respect to every parameter, and, with
-        ``speed``, of the eigenvalues there: the dict of ``bikedyn
-        sensitivity --format json`` (``weave_speed`` and ``capsize_speed``
-        each ``{speed, eigenvalue, real_part_slope, derivatives: [{parameter,
-        value, derivative, elasticity}]}`` ranked by elasticity, or ``None``;
-        ``eigenvalues``; ``parameter_form``). ``form``: ``"benchmark"``,
-        ``"thesis"`` or ``None`` (the bicycle's own). A bicycle with an
-        effect raises :class:`ModelError` (exact for the canonical form
-        only); see ``docs/design-questions.md``."""
-        return json.loads(
-            self._b.sensitivity(
-                None if speed is None else float(speed), float(speed_max), form, self._model
-            )
+        ``speed``, of the eigenvalues there: a :class:`Sensitivity` (the
+        fields of ``bikedyn sensitivity --format json``): ``weave_speed``
+        and ``capsize_speed`` each a :class:`CriticalSpeedSensitivity`
+        (``speed``, complex ``eigenvalue``, ``real_part_slope``,
+        ``derivatives`` ranked by elasticity) or ``None``; ``eigenvalues``
+        (complex derivatives per mode) or ``None``; ``parameter_form``.
+        ``form``: ``"benchmark"``, ``"thesis"`` or ``None`` (the bicycle's
+        own). A bicycle with an effect raises :class:`ModelError` (exact for
+        the canonical form only); see ``docs/design-questions.md``."""
+        return Sensitivity._from_json(
+            self._b.sensitivity(None if speed is None else float(speed), float(speed_max), form, self._model)
         )
 
-    def bode(
-        self, speed: float, omega_min: float = 0.1, omega_max: float = 100.0, points: int = 200
-    ) -> Dict[str, Any]:
+    def bode(self, speed: float, omega_min: float = 0.1, omega_max: float = 100.0, points: int = 200) -> Bode:
         """Frequency response at ``speed`` (m/s): ``G(i omega)`` from the roll
-        and steer torques to the roll and steer angles on ``points``
-        log-spaced angular frequencies (rad/s). The dict of ``bikedyn bode
-        --format json`` with NumPy arrays: ``omega``, and per entry of
-        ``responses`` (``input``, ``output``) the complex ``G``,
-        ``magnitude_db``, ``phase_deg`` and ``static_gain``."""
-        r = json.loads(
+        and steer torques to the roll and steer angles (benchmark signs) on
+        ``points`` log-spaced angular frequencies (rad/s). A :class:`Bode`
+        (the fields of ``bikedyn bode --format json``): ``omega``, and per
+        :class:`BodeResponse` (``input``, ``output``) the complex ``G``,
+        ``magnitude_db``, ``phase_deg`` as arrays and ``static_gain``;
+        ``.response(input, output)`` picks one, ``.G`` stacks all four as
+        ``(n, 2, 2)``."""
+        return Bode._from_json(
             self._b.bode(float(speed), float(omega_min), float(omega_max), int(points), self._model)
         )
-        r["omega"] = np.asarray(r["omega"], dtype=float)
-        for g in r["responses"]:
-            g["G"] = np.asarray(g.pop("re"), dtype=float) + 1j * np.asarray(g.pop("im"), dtype=float)
-            g["magnitude_db"] = np.asarray(g["magnitude_db"], dtype=float)
-            g["phase_deg"] = np.asarray(g["phase_deg"], dtype=float)
-        return r
 
     def _as_spec(self, stack: List[Any]) -> str:
         """A spec the pipelines resolve: the original name or file, or a
@@ -603,15 +660,21 @@ def simulate(
     """Nonlinear simulation from upright straight running, perturbed.
 
     Initial ``roll``, ``steer`` (rad), ``roll_rate``, ``steer_rate``
-    (rad/s), ``speed`` (m/s), ``yaw`` (rad); ``kicks``: ``(time s,
+    (rad/s), ``speed`` (m/s), ``yaw`` (rad), in the model's signs as the
+    command line's ``--roll`` and ``--steer``: roll positive leaning right,
+    steer positive turning *left* (the thesis's axes; the benchmark's steer
+    is minus this). ``kicks``: ``(time s,
     impulse N s)`` or ``(time, impulse, ahead m, height m)`` lateral
     impulses on the rear frame; ``pulses``: ``(target, start s, duration
-    s, amplitude N m[, shape])`` with target ``"roll"`` or ``"steer"``,
+    s, amplitude N m[, shape])`` with target ``"roll"`` or ``"steer"``
+    (the torque in the model's signs, as the angles),
     shape ``"rect"`` (default) or ``"halfsine"``. ``free_speed``: the speed
     is a state (the model's free-speed variant), else it is held.
     ``roll_limit``, ``steer_limit`` (rad) stop the run when exceeded.
-    Returns a :class:`Simulation` (a dict of arrays with the CSV's column
-    names)."""
+    Returns a :class:`Simulation`: a dict of arrays with the CSV's column
+    names (the model's signs), and ``sim.roll``, ``sim.steer``,
+    ``sim.roll_rate``, ``sim.steer_rate`` in the benchmark's signs (both
+    positive to the right, as ``Bicycle.eig``'s eigenvectors)."""
     b = _bicycle(bike)
     ks = []
     for k in kicks:
@@ -681,11 +744,13 @@ def fit(
     (default: the built-in thesis bicycle for thesis-format runs; TU Delft
     logs need theirs). ``progress``: called as
     ``progress(step, done, total)`` after each run or log (see
-    :data:`ProgressCallback`). Returns a :class:`FitResult`."""
+    :data:`ProgressCallback`). Returns a :class:`FitResult`: ``kicks``,
+    each a :class:`Kick` with the fitted weave eigenvalue as a complex
+    (1/s), its standard errors, r² and the model's prediction."""
     stack: List[Any] = []
     spec = None if bike is None else _bicycle(bike)._as_spec(stack)
     cal = None if calibration is None else _paths(calibration, "calibration")[0]
-    return FitResult(_bikedyn.fit(_paths(paths, "fit"), cal, spec, angles, nominal_clock, progress))
+    return FitResult._from_raw(_bikedyn.fit(_paths(paths, "fit"), cal, spec, angles, nominal_clock, progress))
 
 
 def _count(name: str, value: Any, low: int, high: int) -> int:
@@ -722,7 +787,10 @@ def identify(
     of generalized forces on the roll and steer equations, on the table or
     on the kicks' weave eigenvalues (``result.discovery``; the command
     line's ``--no-discover`` is ``discover=False``). Returns an
-    :class:`IdentifyResult`."""
+    :class:`IdentifyResult`: ``selected``, ``parameters`` (each an
+    :class:`Estimate` with its 95 % interval), ``error_before`` and
+    ``error_after`` (fitted and held out), ``discovery``; ``summary()``,
+    ``write_report(dir)`` and ``to_dict()`` (the full JSON)."""
     # As the command line's --folds and --corrections: named, with their range
     # (an int beyond the machine's would be an OverflowError naming nothing).
     folds = _count("folds", folds, 2, 1000)
@@ -732,9 +800,11 @@ def identify(
     single = isinstance(paths_or_eigen_table, (str, os.PathLike))
     if single and os.fspath(paths_or_eigen_table).lower().endswith(".csv"):
         table = _paths(paths_or_eigen_table, "identify")[0]
-        return IdentifyResult(_bikedyn.identify_eigenvalues(table, spec, list(effects), corrections, bool(discover)))
+        return IdentifyResult._from_table(
+            _bikedyn.identify_eigenvalues(table, spec, list(effects), corrections, bool(discover))
+        )
     cal = None if calibration is None else _paths(calibration, "calibration")[0]
-    return IdentifyResult(
+    return IdentifyResult._from_runs(
         _bikedyn.identify(
             _paths(paths_or_eigen_table, "identify"),
             cal,

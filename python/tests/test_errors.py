@@ -120,7 +120,7 @@ def test_a_rust_panic_is_an_exception_with_its_message():
         _bikedyn._panic_for_tests()
     assert isinstance(e.value, bikedyn.Error) and isinstance(e.value, RuntimeError)
     # The interpreter goes on.
-    assert bikedyn.Bicycle("benchmark").stability()["weave_speed"] > 4
+    assert bikedyn.Bicycle("benchmark").stability().weave_speed > 4
 
 
 def test_a_result_too_large_for_memory_is_refused_before_computing():

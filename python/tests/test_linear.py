@@ -12,23 +12,24 @@ from conftest import meijaard2007
 def test_canonical_matrices_match_the_paper():
     ref = meijaard2007()["canonical"]
     c = bikedyn.Bicycle("benchmark").canonical()
-    for name, key in [("M0", "M"), ("C1", "C1"), ("K0", "K0"), ("K2", "K2")]:
+    for key in ["M", "C1", "K0", "K2"]:
         want = np.array(ref[key])
         scale = np.abs(want).max()
-        assert np.allclose(c[name], want, rtol=1e-12, atol=1e-12 * scale), (name, c[name], want)
-    assert isinstance(c["model"], str)
+        got = getattr(c, key)
+        assert np.allclose(got, want, rtol=1e-12, atol=1e-12 * scale), (key, got, want)
+    assert isinstance(c.model, str)
 
 
 def test_stability_gives_the_published_speeds():
     ref = meijaard2007()["critical_speeds"]
     s = bikedyn.Bicycle("benchmark").stability(speed_max=10)
-    assert abs(s["weave_speed"] - ref["weave_speed"]) < 1e-10
-    assert abs(s["capsize_speed"] - ref["capsize_speed"]) < 1e-10
-    assert abs(s["weave_real_pair_merge_speed"] - ref["weave_real_pair_merge"]) < 1e-8
-    assert s["stable_intervals"][0][0] == pytest.approx(ref["weave_speed"], abs=1e-10)
-    assert {c["mode"] for c in s["crossings"]} >= {"weave", "capsize"}
+    assert abs(s.weave_speed - ref["weave_speed"]) < 1e-10
+    assert abs(s.capsize_speed - ref["capsize_speed"]) < 1e-10
+    assert abs(s.weave_real_pair_merge_speed - ref["weave_real_pair_merge"]) < 1e-8
+    assert s.stable_intervals[0][0] == pytest.approx(ref["weave_speed"], abs=1e-10)
+    assert {c.mode for c in s.crossings} >= {"weave", "capsize"}
     # Out of range: None, as the command line's JSON has null.
-    assert bikedyn.Bicycle("benchmark").stability(speed_max=3)["weave_speed"] is None
+    assert bikedyn.Bicycle("benchmark").stability(speed_max=3).weave_speed is None
 
 
 def test_eig_gives_table2_and_labels_the_modes():
@@ -61,7 +62,7 @@ def test_eigenvectors_are_right_eigenvectors_of_the_state_matrix():
         # The eigenvalues of A are those of eig.
         assert np.allclose(np.sort_complex(np.linalg.eigvals(A[i])), np.sort_complex(e.eigenvalues[i]), atol=1e-9)
     # B is [0; M0^-1] (inputs roll and steer torque).
-    m0 = bike.canonical()["M0"]
+    m0 = bike.canonical().M
     assert np.allclose(B[0, 2:], np.linalg.inv(m0), rtol=1e-12)
     assert np.all(B[:, :2] == 0)
 
@@ -102,7 +103,7 @@ def test_effects_and_models():
     assert bike.model != bikedyn.Bicycle("thesis").model
     # Steer damping stabilises the weave at a lower speed (Sharp 2008;
     # it is the premise of the damping tests of the Rust suite).
-    assert bike.stability()["weave_speed"] != bikedyn.Bicycle("thesis").stability()["weave_speed"]
+    assert bike.stability().weave_speed != bikedyn.Bicycle("thesis").stability().weave_speed
     with pytest.raises(bikedyn.ModelError, match="canonical"):
         bike.canonical()
     # Without a canonical form, eig and state_space still work.
@@ -132,17 +133,16 @@ def test_the_fast_eigenvalues_are_eigs_sorted():
 
 def test_sensitivity_is_exact_and_ranked():
     s = bikedyn.Bicycle("benchmark").sensitivity(speed=5.0)
-    assert s["parameter_form"] == "benchmark"
-    w = s["weave_speed"]
-    assert abs(w["speed"] - meijaard2007()["critical_speeds"]["weave_speed"]) < 1e-10
-    e = [d["elasticity"] for d in w["derivatives"]]
+    assert s.parameter_form == "benchmark"
+    w = s.weave_speed
+    assert abs(w.speed - meijaard2007()["critical_speeds"]["weave_speed"]) < 1e-10
+    e = [d.elasticity for d in w.derivatives]
     assert len(e) == 26 and all(abs(a) >= abs(b) for a, b in zip(e, e[1:]))
     # A speed scales as sqrt(g L): its elasticity to g is 1/2 exactly.
-    g = next(d for d in s["capsize_speed"]["derivatives"] if d["parameter"] == "g")
-    assert g["elasticity"] == pytest.approx(0.5, abs=1e-12)
-    assert [m["mode"] for m in s["eigenvalues"]["modes"]] == ["weave", "capsize", "castering"]
-    assert bikedyn.Bicycle("thesis").sensitivity()["parameter_form"] == "thesis"
-    assert bikedyn.Bicycle("thesis").sensitivity(form="benchmark")["parameter_form"] == "benchmark"
+    assert s.capsize_speed.derivative("g").elasticity == pytest.approx(0.5, abs=1e-12)
+    assert [m.mode for m in s.eigenvalues.modes] == ["weave", "capsize", "castering"]
+    assert bikedyn.Bicycle("thesis").sensitivity().parameter_form == "thesis"
+    assert bikedyn.Bicycle("thesis").sensitivity(form="benchmark").parameter_form == "benchmark"
 
 
 def test_sensitivity_refuses_what_it_cannot_differentiate():
@@ -161,14 +161,14 @@ def test_bode_equals_the_state_space_transfer_function():
     A, B = A[0], B[0]
     C = np.hstack([np.eye(2), np.zeros((2, 2))])
     inputs, outputs = ["roll_torque", "steer_torque"], ["roll", "steer"]
-    for k, w in enumerate(r["omega"]):
+    for k, w in enumerate(r.omega):
         G = C @ np.linalg.solve(1j * w * np.eye(4) - A, B)
-        for g in r["responses"]:
-            i, j = outputs.index(g["output"]), inputs.index(g["input"])
-            assert abs(g["G"][k] - G[i, j]) < 1e-10 * abs(G).max()
-    for g in r["responses"]:
-        i, j = outputs.index(g["output"]), inputs.index(g["input"])
-        assert g["static_gain"] == pytest.approx((-C @ np.linalg.solve(A, B))[i, j], rel=1e-10)
+        for g in r.responses:
+            i, j = outputs.index(g.output), inputs.index(g.input)
+            assert abs(g.G[k] - G[i, j]) < 1e-10 * abs(G).max()
+    for g in r.responses:
+        i, j = outputs.index(g.output), inputs.index(g.input)
+        assert g.static_gain == pytest.approx((-C @ np.linalg.solve(A, B))[i, j], rel=1e-10)
     with pytest.raises(bikedyn.InvalidArgumentError):
         b.bode(float("nan"))
 
@@ -177,10 +177,13 @@ def test_stability_gives_standard_deviations_from_a_files_uncertainties(tmp_path
     import pathlib
     src = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "Balanceassistv1Benchmark.txt"
     s = bikedyn.Bicycle(str(src)).stability()
-    assert s["weave_speed_sd"] > 0 and s["capsize_speed_sd"] > 0
-    shares = s["uncertainty"]["weave_speed"]["shares"]
-    assert abs(sum(x["share"] for x in shares) - 1) < 1e-12
-    assert "weave_speed_sd" not in bikedyn.Bicycle("benchmark").stability()
+    assert s.weave_speed_sd > 0 and s.capsize_speed_sd > 0
+    shares = s.uncertainty.weave_speed.shares
+    assert abs(sum(x.share for x in shares) - 1) < 1e-12
+    plain = bikedyn.Bicycle("benchmark").stability()
+    assert plain.weave_speed_sd is None and plain.uncertainty is None
+    # As the command line's JSON: no key at all without +/- values.
+    assert "weave_speed_sd" not in plain.to_dict()
 
 
 def test_stability_monte_carlo_draws_about_a_files_uncertainties():
@@ -188,13 +191,13 @@ def test_stability_monte_carlo_draws_about_a_files_uncertainties():
     src = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "Balanceassistv1Benchmark.txt"
     b = bikedyn.Bicycle(str(src))
     s = b.stability(monte_carlo=500, seed=7)
-    m = s["monte_carlo"]
-    assert m["draws"] == 500 and m["seed"] == 7
+    m = s.monte_carlo
+    assert m.draws == 500 and m.seed == 7
     # The capsize speed is near linear over this file's spread: the drawn
     # deviation is the first order's within four of its standard errors.
-    c = m["capsize_speed"]
-    assert abs(c["standard_deviation"] - s["capsize_speed_sd"]) < 4 * c["standard_error_of_sd"]
-    assert b.stability(monte_carlo=500, seed=7)["monte_carlo"] == m
+    c = m.capsize_speed
+    assert abs(c.standard_deviation - s.capsize_speed_sd) < 4 * c.standard_error_of_sd
+    assert b.stability(monte_carlo=500, seed=7).monte_carlo == m
     with pytest.raises(bikedyn.InvalidArgumentError, match=r"\+/-"):
         bikedyn.Bicycle("benchmark").stability(monte_carlo=10)
 
@@ -230,7 +233,7 @@ def test_a_files_feedback_closes_the_loop_and_simulate_refuses_to_ignore_it():
     # With its steer motor the balance-assist bicycle is stable from about
     # 1.04 m/s (bicycleparameters' A - B K: -1.50 +- 8.48i, -0.83, -1.73
     # at 1.66 m/s); the open loop is not below its weave speed.
-    lo, hi = s["stable_intervals"][0]
+    lo, hi = s.stable_intervals[0]
     assert 1.0 < lo < 1.1 and 4.3 < hi < 4.4
     weave = max(b.eig([1.66]).eigenvalues[0], key=lambda z: z.imag)
     assert abs(weave - complex(-1.5025818770340327, 8.47937107316705)) < 1e-9

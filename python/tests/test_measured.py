@@ -17,12 +17,12 @@ SET = REPO / "examples/data/hidden_steer_damping"
 def test_fit_returns_the_kicks_and_writes_plots(tmp_path):
     r = bikedyn.fit(SET, bike="thesis")
     assert len(r.kicks) >= 6
-    assert r.skipped == []
+    assert r.skipped == ()
     assert r.prediction_model
     truth = json.loads((SET / "truth/run01_truth.json").read_text())
     assert truth  # the runs were made at 4 to 6.5 m/s
     for k in r.kicks:
-        assert 3.5 < k["mean_speed"] < 7.0, k
+        assert 3.5 < k.mean_speed < 7.0, k
     d = r.to_dict()
     assert set(d) >= {"kicks", "skipped", "calibration", "prediction_model"}
     r.write_report(tmp_path / "fit")
@@ -65,7 +65,7 @@ def test_identify_finds_the_hidden_steer_damping(tmp_path):
         corrections=0,
         progress=lambda step, done, total: seen.append((step, done, total)),
     )
-    assert r.selected_effects == ["steer_damping"], r.summary()
+    assert r.selected_effects == ("steer_damping",), r.summary()
     # Each stage counts from 1; the fitted candidate is among the steps.
     assert seen and all(isinstance(s, str) and d >= 1 for s, d, _ in seen), seen
     assert any("steer_damping" in s for s, _, _ in seen), seen
@@ -87,13 +87,13 @@ def test_identify_from_a_measured_eigenvalue_table(tmp_path):
     table = tmp_path / "weave.csv"
     table.write_text("\n".join(lines) + "\n")
     r = bikedyn.identify(table, bike="thesis")
-    assert r.selected == ["steer_damping"], r.summary()
-    assert r.parameters["c_steer"][0] == pytest.approx(0.3, abs=0.015)
+    assert r.selected == ("steer_damping",), r.summary()
+    assert r.parameters["c_steer"].value == pytest.approx(0.3, abs=0.015)
     r.write_report(tmp_path / "table-report")
     assert any((tmp_path / "table-report").iterdir())
     # After the library, the dictionary of generalized forces: steer
     # damping explains the table, so no structured residual is left and
     # the search does not run; discover=False skips it outright.
-    assert r.discovery["status"] == "not_run", r.summary()
+    assert r.discovery.status == "not_run", r.summary()
     assert "discovery beyond the library not run: the library leaves no structured residual" in r.summary()
     assert bikedyn.identify(table, bike="thesis", discover=False).discovery is None

@@ -18,10 +18,10 @@ def test_one_parameter_sweep_agrees_with_each_design():
         e = b.eig(speeds)
         assert np.allclose(s.least_stable_real_part[i], e.eigenvalues.real.max(axis=1), rtol=0, atol=1e-12)
         st = b.stability(speed_min=1.0, speed_max=9.0)
-        if st["weave_speed"] is None:
+        if st.weave_speed is None:
             assert np.isnan(s.weave_speed[i])
         else:
-            assert s.weave_speed[i] == pytest.approx(st["weave_speed"], abs=1e-9)
+            assert s.weave_speed[i] == pytest.approx(st.weave_speed, abs=1e-9)
 
 
 def test_two_parameter_map_shape_and_values():
