@@ -233,7 +233,7 @@ class SweepResult(NamedTuple):
 _BENCHMARK_SIGN = {"roll": 1.0, "steer": -1.0}
 
 
-class Simulation(dict):
+class Simulation(Dict[str, np.ndarray]):
     """A nonlinear simulation: a dict of arrays with the column names of
     ``bikedyn simulate --out``'s CSV (``t`` in s, coordinates in rad or m,
     their rates with a ``d`` prefix, ``speed`` m/s, energies J, the
@@ -342,8 +342,9 @@ class Bicycle:
     ``ValueError``) naming the file or dict, line and field.
     """
 
-    def __init__(self, spec: Union[PathLike, Mapping, "Bicycle"], name: Optional[str] = None, model: Optional[str] = None):
+    def __init__(self, spec: Union[PathLike, Mapping[str, Any], "Bicycle"], name: Optional[str] = None, model: Optional[str] = None):
         self._spec: Optional[str] = None
+        self._b: _bikedyn._Bicycle
         if isinstance(spec, Bicycle):
             self._b = spec._b
             self._spec = spec._spec
@@ -444,7 +445,8 @@ class Bicycle:
         """The canonical matrices of ``M q'' + v C1 q' + (g K0 + v² K2) q =
         f`` (Meijaard et al. 2007), ``q = [roll, steer]`` in benchmark
         signs: a :class:`Canonical` with ``M`` (kg m², also ``M0``), ``C1``
-        (kg m), ``K0`` (kg m), ``K2`` (kg) as 2x2 arrays, ``model``, and
+        (kg m), ``K0`` (kg m), ``K2`` (kg) as 2x2 arrays, ``model``, ``g``
+        (m/s²), and
         ``standard_deviations``: the same four matrices' standard
         deviations that the file's ``+/-`` values imply (first order, exact
         derivatives, parameters independent; what bicycleparameters'
@@ -452,10 +454,12 @@ class Bicycle:
         without them. ``ModelError`` when the model's linear equations
         have no such form (damping, a controller, tyre lag)."""
         model, (m0, c1, k0, k2) = self._b.canonical(self._model)
-        r = lambda x: np.array(x, dtype=float).reshape(2, 2)  # noqa: E731
+        def r(x: Sequence[float]) -> np.ndarray:
+            return np.array(x, dtype=float).reshape(2, 2)
+
         sd = self._b.canonical_standard_deviations(self._model)
         spread = None if sd is None else CanonicalStandardDeviations(*(r(x) for x in sd))
-        return Canonical(r(m0), r(c1), r(k0), r(k2), model, spread)
+        return Canonical(r(m0), r(c1), r(k0), r(k2), model, self.value("g"), spread)
 
     def state_space(self, speeds: Any) -> Tuple[np.ndarray, Optional[np.ndarray]]:
         """``A`` and ``B`` of ``x' = A(v) x + B(v) u`` at each speed (m/s),
@@ -593,7 +597,7 @@ class Bicycle:
         return f"Bicycle({self.name!r}, form={self.form!r}, model={self.model!r})"
 
 
-BikeLike = Union[Bicycle, PathLike, Mapping]
+BikeLike = Union[Bicycle, PathLike, Mapping[str, Any]]
 
 
 def _bicycle(bike: BikeLike) -> Bicycle:
@@ -676,13 +680,13 @@ def simulate(
     ``sim.roll_rate``, ``sim.steer_rate`` in the benchmark's signs (both
     positive to the right, as ``Bicycle.eig``'s eigenvectors)."""
     b = _bicycle(bike)
-    ks = []
-    for k in kicks:
-        k = tuple(float(x) for x in k)
+    ks: List[Tuple[float, float, Optional[float], Optional[float]]] = []
+    for kick in kicks:
+        k = tuple(float(x) for x in kick)
         if len(k) == 2:
             ks.append((k[0], k[1], None, None))
         elif len(k) == 4:
-            ks.append(k)
+            ks.append((k[0], k[1], k[2], k[3]))
         else:
             raise InvalidArgumentError(f"kick {k}: expected (time, impulse) or (time, impulse, ahead, height)")
     ps = []
@@ -691,7 +695,7 @@ def simulate(
         if len(p) not in (4, 5):
             raise InvalidArgumentError(f"pulse {p}: expected (target, start, duration, amplitude[, shape])")
         ps.append((str(p[0]), float(p[1]), float(p[2]), float(p[3]), str(p[4]) if len(p) == 5 else "rect"))
-    initial = tuple(float(x) for x in (roll, steer, roll_rate, steer_rate, speed, yaw))
+    initial = (float(roll), float(steer), float(roll_rate), float(steer_rate), float(speed), float(yaw))
     model_used, header, columns, samples, stop, stats, roles = _bikedyn.simulate(
         b._b, float(duration), initial, ks, ps, model or b._model, bool(free_speed),
         float(rtol), float(atol), str(method), float(dt),
@@ -797,8 +801,7 @@ def identify(
     corrections = None if corrections is None else _count("corrections", corrections, 0, 1_000_000)
     stack: List[Any] = []
     spec = None if bike is None else _bicycle(bike)._as_spec(stack)
-    single = isinstance(paths_or_eigen_table, (str, os.PathLike))
-    if single and os.fspath(paths_or_eigen_table).lower().endswith(".csv"):
+    if isinstance(paths_or_eigen_table, (str, os.PathLike)) and os.fspath(paths_or_eigen_table).lower().endswith(".csv"):
         table = _paths(paths_or_eigen_table, "identify")[0]
         return IdentifyResult._from_table(
             _bikedyn.identify_eigenvalues(table, spec, list(effects), corrections, bool(discover))
@@ -821,7 +824,8 @@ def identify(
 def models() -> List[Dict[str, Any]]:
     """The generated models (``bikedyn models --json``): name, base model,
     effects, coordinates and parameters with units."""
-    return json.loads(_bikedyn.models())
+    out: List[Dict[str, Any]] = json.loads(_bikedyn.models())
+    return out
 
 
 def allow_implausible_units(allow: bool = True) -> None:

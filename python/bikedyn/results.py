@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass
-from typing import Any, Dict, Mapping, Optional, Tuple, Union
+from typing import Any, Dict, Mapping, Optional, Tuple, TypeVar, Union
 
 import numpy as np
 
@@ -87,7 +87,10 @@ def _pair(x: Any) -> Optional[Tuple[float, float]]:
     return (_float(a), _float(b))
 
 
-def _attach(obj: Any, **hidden: Any) -> Any:
+_T = TypeVar("_T")
+
+
+def _attach(obj: _T, **hidden: Any) -> _T:
     """Keep what is not a field (the JSON, the extension's object) on a
     frozen dataclass, out of its fields, ``repr`` and comparison."""
     for k, v in hidden.items():
@@ -102,7 +105,8 @@ class _FromJson:
 
     def to_dict(self) -> Dict[str, Any]:
         """The result as the command line's JSON prints it (a new dict)."""
-        return json.loads(self._json)
+        d: Dict[str, Any] = json.loads(self._json)
+        return d
 
 
 # --------------------------------------------------------------------------
@@ -353,6 +357,8 @@ class Canonical:
         K0: gravity stiffness matrix per g, 2x2 (kg m).
         K2: stiffness matrix per speed squared, 2x2 (kg).
         model: the generated model whose linearization they are.
+        g: the bicycle's gravitational acceleration (m/s²), the ``g`` of
+            ``g K0``.
         standard_deviations: the entries' standard deviations from the
             file's ``+/-`` values (first order), or ``None`` for a bicycle
             without them.
@@ -363,6 +369,7 @@ class Canonical:
     K0: np.ndarray
     K2: np.ndarray
     model: str
+    g: float
     standard_deviations: Optional[CanonicalStandardDeviations]
 
     @property
@@ -370,9 +377,9 @@ class Canonical:
         """``M`` under its older name (kg m²)."""
         return self.M
 
-    def stiffness(self, speed: float, g: float = 9.81) -> np.ndarray:
+    def stiffness(self, speed: float) -> np.ndarray:
         """``g K0 + v² K2`` at forward speed ``speed`` (m/s), 2x2 (N m/rad)."""
-        return g * self.K0 + speed**2 * self.K2
+        return self.g * self.K0 + speed**2 * self.K2
 
     def damping(self, speed: float) -> np.ndarray:
         """``v C1`` at forward speed ``speed`` (m/s), 2x2 (N m s/rad)."""
@@ -607,7 +614,10 @@ class Bode(_FromJson):
     @classmethod
     def _from_json(cls, text: str) -> "Bode":
         d = json.loads(text)
-        arr = lambda x: np.array([_float(v) for v in x], dtype=float)  # noqa: E731
+
+        def arr(x: Any) -> np.ndarray:
+            return np.array([_float(v) for v in x], dtype=float)
+
         responses = tuple(
             BodeResponse(
                 g["input"],
