@@ -4,8 +4,12 @@ A bicycle (built-in, a parameter file, or a dict such as bicycleparameters'
 ``Meijaard2007ParameterSet(...).parameters``) is analysed through generated
 Rust code of its multibody model: linear stability over forward speed,
 parameter sweeps, nonlinear simulation, and the measured-run pipeline
-(fit and identify). Arrays come back as NumPy arrays; names and units are
-those of the command line's JSON, in SI units (m, kg, s, rad).
+(fit and identify). Results are frozen dataclasses (``Stability``,
+``FitResult``, ``Kick`` ..., see :mod:`bikedyn.results`) with NumPy arrays
+and complex eigenvalues; names and units are those of the command line's
+JSON, in SI units (m, kg, s, rad), and signs the benchmark's (roll and
+steer positive to the right) except a simulation's model columns (see
+:class:`Simulation`).
 
 Start with::
 

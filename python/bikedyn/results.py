@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from dataclasses import dataclass
 from typing import Any, Dict, Mapping, Optional, Tuple, TypeVar, Union
 
@@ -98,6 +99,26 @@ def _attach(obj: _T, **hidden: Any) -> _T:
     return obj
 
 
+class _Subscript:
+    """``result["field"]``: the dict access of the results that were dicts
+    before they were dataclasses (bikedyn 0.1), deprecated; use
+    ``result.field``. Values are the dataclass's (tuples, complex numbers,
+    dataclasses), not the JSON's."""
+
+    def __getitem__(self, key: str) -> Any:
+        if not isinstance(key, str):
+            raise TypeError(f"{type(self).__name__} indices are field names")
+        warnings.warn(
+            f"{type(self).__name__}[{key!r}] is deprecated: the result is a dataclass, use .{key}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        try:
+            return getattr(self, key)
+        except AttributeError:
+            raise KeyError(key) from None
+
+
 class _FromJson:
     """``to_dict()``: the command line's JSON that a result was built from."""
 
@@ -114,7 +135,7 @@ class _FromJson:
 
 
 @dataclass(frozen=True)
-class Crossing:
+class Crossing(_Subscript):
     """One speed where a real part of an eigenvalue crosses zero.
 
     Attributes:
@@ -140,7 +161,7 @@ class Crossing:
 
 
 @dataclass(frozen=True)
-class VarianceShare:
+class VarianceShare(_Subscript):
     """One parameter's part in a critical speed's variance.
 
     Attributes:
@@ -156,7 +177,7 @@ class VarianceShare:
 
 
 @dataclass(frozen=True)
-class SpeedUncertainty:
+class SpeedUncertainty(_Subscript):
     """A critical speed's standard deviation from the file's ``+/-`` values
     (first order, exact derivatives, parameters independent).
 
@@ -182,7 +203,7 @@ class SpeedUncertainty:
 
 
 @dataclass(frozen=True)
-class StabilityUncertainty:
+class StabilityUncertainty(_Subscript):
     """The first-order propagation of the file's standard deviations to the
     weave and capsize speeds.
 
@@ -196,7 +217,7 @@ class StabilityUncertainty:
 
 
 @dataclass(frozen=True)
-class SampledSpeed:
+class SampledSpeed(_Subscript):
     """One critical speed over the Monte Carlo draws that have it.
 
     Attributes:
@@ -220,7 +241,7 @@ class SampledSpeed:
 
 
 @dataclass(frozen=True)
-class MonteCarlo:
+class MonteCarlo(_Subscript):
     """The critical speeds of bicycles drawn about the file's values with
     its standard deviations (``stability(monte_carlo=N)``).
 
@@ -241,7 +262,7 @@ class MonteCarlo:
 
 
 @dataclass(frozen=True)
-class Stability(_FromJson):
+class Stability(_FromJson, _Subscript):
     """Weave and capsize speeds of a bicycle (``Bicycle.stability``, the
     JSON of ``bikedyn stability --json``).
 
@@ -322,7 +343,7 @@ class Stability(_FromJson):
 
 
 @dataclass(frozen=True, eq=False)
-class CanonicalStandardDeviations:
+class CanonicalStandardDeviations(_Subscript):
     """Standard deviations of the canonical matrices' entries that the
     file's ``+/-`` values imply (first order, exact derivatives, parameters
     independent; bicycleparameters' ``canonical(nominal=False)``).
@@ -346,7 +367,7 @@ class CanonicalStandardDeviations:
 
 
 @dataclass(frozen=True, eq=False)
-class Canonical:
+class Canonical(_Subscript):
     """The canonical matrices of ``M q'' + v C1 q' + (g K0 + v² K2) q = f``
     (Meijaard et al. 2007), ``q = [roll, steer]`` (rad), ``f = [roll
     torque, steer torque]`` (N m), benchmark signs (``Bicycle.canonical``).
@@ -391,7 +412,7 @@ class Canonical:
 
 
 @dataclass(frozen=True)
-class SpeedDerivative:
+class SpeedDerivative(_Subscript):
     """One parameter's derivative of a critical speed.
 
     Attributes:
@@ -409,7 +430,7 @@ class SpeedDerivative:
 
 
 @dataclass(frozen=True)
-class CriticalSpeedSensitivity:
+class CriticalSpeedSensitivity(_Subscript):
     """The sensitivity of one critical speed to every parameter.
 
     Attributes:
@@ -445,7 +466,7 @@ class CriticalSpeedSensitivity:
 
 
 @dataclass(frozen=True)
-class EigenvalueDerivative:
+class EigenvalueDerivative(_Subscript):
     """One parameter's derivative of an eigenvalue.
 
     Attributes:
@@ -463,7 +484,7 @@ class EigenvalueDerivative:
 
 
 @dataclass(frozen=True)
-class ModeSensitivity:
+class ModeSensitivity(_Subscript):
     """The derivatives of one eigenvalue at a speed.
 
     Attributes:
@@ -482,7 +503,7 @@ class ModeSensitivity:
 
 
 @dataclass(frozen=True)
-class EigenvalueSensitivities:
+class EigenvalueSensitivities(_Subscript):
     """The eigenvalues' derivatives at one speed.
 
     Attributes:
@@ -495,7 +516,7 @@ class EigenvalueSensitivities:
 
 
 @dataclass(frozen=True)
-class Sensitivity(_FromJson):
+class Sensitivity(_FromJson, _Subscript):
     """Exact derivatives of the critical speeds (and the eigenvalues at a
     speed) with respect to every parameter (``Bicycle.sensitivity``, the
     JSON of ``bikedyn sensitivity --format json``).
@@ -563,7 +584,7 @@ class Sensitivity(_FromJson):
 
 
 @dataclass(frozen=True, eq=False)
-class BodeResponse:
+class BodeResponse(_Subscript):
     """The frequency response of one input-output pair.
 
     Attributes:
@@ -587,7 +608,7 @@ class BodeResponse:
 
 
 @dataclass(frozen=True, eq=False)
-class Bode(_FromJson):
+class Bode(_FromJson, _Subscript):
     """Frequency response at one speed (``Bicycle.bode``, the JSON of
     ``bikedyn bode --format json``), from the roll and steer torques to the
     roll and steer angles.
@@ -763,7 +784,7 @@ class ClockOffset:
 
 
 @dataclass(frozen=True)
-class Kick:
+class Kick(_Subscript):
     """One kick of a measured run and its fitted weave eigenvalue
     (``FitResult.kicks``; ``bikedyn fit --json``'s record).
 
@@ -1131,7 +1152,7 @@ class DiscoveredTerm:
 
 
 @dataclass(frozen=True)
-class Discovery:
+class Discovery(_Subscript):
     """What the search of the dictionary of generalized forces found beyond
     the library (``IdentifyResult.discovery``: on the weave eigenvalues of
     the kicks or table; ``IdentifyResult.time_series_discovery``: in the

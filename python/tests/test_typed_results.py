@@ -336,3 +336,20 @@ def test_results_compare_by_value():
 
 def test_source_tree_ships_the_typed_marker():
     assert (pathlib.Path(bikedyn.__file__).parent / "py.typed").is_file()
+
+
+def test_dict_access_of_the_former_dicts_still_works_with_a_deprecation_warning():
+    # As docs/design-questions.md's example was written for the dicts.
+    b = bikedyn.Bicycle("benchmark")
+    with pytest.warns(DeprecationWarning) as seen:
+        top = [(d["parameter"], d["elasticity"]) for d in b.sensitivity(speed=5.0)["capsize_speed"]["derivatives"][:3]]
+        r = b.bode(5.0, points=5)
+        assert np.array_equal(r["responses"][3]["G"], r.responses[3].G)
+        assert b.stability()["weave_speed"] == b.stability().weave_speed
+        assert np.array_equal(b.canonical()["M0"], b.canonical().M)
+        with pytest.raises(KeyError):
+            b.stability()["no_such_field"]
+    first = b.sensitivity().capsize_speed.derivatives[0]
+    assert top[0] == (first.parameter, first.elasticity)
+    assert "use .capsize_speed" in str(seen[0].message)
+    assert all(w.category is DeprecationWarning for w in seen)
