@@ -16,7 +16,6 @@ pub use bikedyn_runtime::simulate::{
 };
 use bikedyn_runtime::MultibodyModel;
 use serde::Serialize;
-use std::time::Instant;
 use thiserror::Error;
 
 /// A simulation job: which model, from what state, with what inputs, for
@@ -62,7 +61,8 @@ pub struct SimulationOutcome {
     pub model: &'static ModelInfo,
     /// The motion, sample by sample, and the integrator's statistics.
     pub simulation: Simulation,
-    /// Wall-clock time of the integration (s).
+    /// Wall-clock time of the integration (s; NaN in WebAssembly, which has
+    /// no clock).
     pub wall_seconds: f64,
 }
 
@@ -78,7 +78,7 @@ pub struct SimulationSummary {
     pub stop: String,
     /// Simulated time (s).
     pub simulated_seconds: f64,
-    /// Wall-clock time of the integration (s).
+    /// Wall-clock time of the integration (s; `null` in WebAssembly).
     pub wall_seconds: f64,
     /// Right-hand-side evaluations of the integrator.
     pub rhs_evaluations: u64,
@@ -125,20 +125,37 @@ pub fn simulate<R: ModelRegistry>(
     request: &SimulateRequest,
 ) -> Result<SimulationOutcome, SimulationError> {
     let model = choose_model(bike, request.model.as_deref(), request.free_speed)?;
-    let start = Instant::now();
-    let simulation = run(
-        bike,
-        model,
-        &request.initial,
-        &request.inputs,
-        request.duration,
-        &request.options,
-    )?;
+    let (simulation, wall_seconds) = timed(|| {
+        run(
+            bike,
+            model,
+            &request.initial,
+            &request.inputs,
+            request.duration,
+            &request.options,
+        )
+    });
     Ok(SimulationOutcome {
         model,
-        simulation,
-        wall_seconds: start.elapsed().as_secs_f64(),
+        simulation: simulation?,
+        wall_seconds,
     })
+}
+
+/// `f`'s result and the wall-clock seconds it took.
+#[cfg(not(target_arch = "wasm32"))]
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let start = std::time::Instant::now();
+    let out = f();
+    (out, start.elapsed().as_secs_f64())
+}
+
+/// In WebAssembly there is no clock in `std` (`Instant::now` would abort
+/// the module): the time is NaN (`null` in JSON), and the browser page
+/// times the call itself.
+#[cfg(target_arch = "wasm32")]
+fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    (f(), f64::NAN)
 }
 
 /// Why a simulation could not run.

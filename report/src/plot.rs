@@ -468,6 +468,17 @@ pub fn use_font(path: impl AsRef<Path>) -> Result<(), PlotError> {
     Ok(())
 }
 
+/// In WebAssembly plotters draws text through the browser's fonts, and there
+/// are no font files to read: the browser build draws its own figures.
+#[cfg(target_arch = "wasm32")]
+fn register_file(path: &Path) -> Result<(), PlotError> {
+    Err(PlotError::Font {
+        path: path.to_path_buf(),
+        message: "font files are not read in the WebAssembly build".into(),
+    })
+}
+
+#[cfg(not(target_arch = "wasm32"))]
 fn register_file(path: &Path) -> Result<(), PlotError> {
     let bytes = std::fs::read(path).map_err(|e| PlotError::Font {
         path: path.to_path_buf(),

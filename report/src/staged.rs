@@ -317,6 +317,9 @@ pub(crate) fn sync_dir(path: &Path) {
             let _ = d.sync_all();
         }
     }
+    // Elsewhere (Windows, WebAssembly) a folder cannot be opened to sync.
+    #[cfg(not(unix))]
+    let _ = path;
 }
 
 /// A temporary of bikedyn's naming: which kind and the process that made it.

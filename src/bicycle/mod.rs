@@ -6,7 +6,7 @@ use crate::registry::BuiltIn;
 use bikedyn_runtime::feedback::GainSchedule;
 use bikedyn_runtime::linearize::LinearizeError;
 use bikedyn_runtime::parameters::{
-    BenchmarkParameters, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
+    BenchmarkParameters, LoadedSet, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
 };
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 use std::collections::BTreeMap;
@@ -165,21 +165,7 @@ impl<R: ModelRegistry> Bicycle<R> {
             }
             path if Path::new(path).exists() => {
                 let extra: Vec<&str> = effect_parameters_in::<R>().iter().map(|p| p.name).collect();
-                let loaded = ParameterSet::load_with_extra(path, &extra)?;
-                for (name, &value) in &loaded.effects {
-                    check_effect_value_in::<R>(name, value, path)?;
-                }
-                check_effect_windows_in::<R>(&loaded.effects, path)?;
-                refuse_millimetres(&loaded.warnings, path)?;
-                return Ok(Bicycle {
-                    name: spec.to_string(),
-                    parameters: loaded.set,
-                    warnings: loaded.warnings,
-                    effects: loaded.effects,
-                    uncertainties: loaded.uncertainties,
-                    feedback: loaded.feedback,
-                    registry: PhantomData,
-                });
+                return Self::loaded(spec, ParameterSet::load_with_extra(path, &extra)?);
             }
             _ => return Err(BicycleError::NotFound { spec: spec.to_string() }),
         };
@@ -190,6 +176,38 @@ impl<R: ModelRegistry> Bicycle<R> {
             effects: BTreeMap::new(),
             uncertainties: BTreeMap::new(),
             feedback: None,
+            registry: PhantomData,
+        })
+    }
+
+    /// A bicycle from the text of a parameter file (TOML in either form, or
+    /// the text form of bicycleparameters and HumanControl) that is not on
+    /// disk, such as a file dropped on the browser explorer: read and
+    /// checked as [`Bicycle::resolve_in`] reads a file, with the same
+    /// messages; `file_name` names it (and its extension `.toml` says
+    /// TOML, as for a file).
+    pub fn from_file_text_in(file_name: &str, text: &str) -> Result<Bicycle<R>, BicycleError> {
+        let extra: Vec<&str> = effect_parameters_in::<R>().iter().map(|p| p.name).collect();
+        Self::loaded(
+            file_name,
+            ParameterSet::from_file_text_with_extra(text, file_name, &extra)?,
+        )
+    }
+
+    /// A bicycle of a read parameter file, its effect values checked.
+    fn loaded(file: &str, loaded: LoadedSet) -> Result<Bicycle<R>, BicycleError> {
+        for (name, &value) in &loaded.effects {
+            check_effect_value_in::<R>(name, value, file)?;
+        }
+        check_effect_windows_in::<R>(&loaded.effects, file)?;
+        refuse_millimetres(&loaded.warnings, file)?;
+        Ok(Bicycle {
+            name: file.to_string(),
+            parameters: loaded.set,
+            warnings: loaded.warnings,
+            effects: loaded.effects,
+            uncertainties: loaded.uncertainties,
+            feedback: loaded.feedback,
             registry: PhantomData,
         })
     }

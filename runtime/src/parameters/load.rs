@@ -176,6 +176,19 @@ impl ParameterSet {
     pub fn load_with_extra(path: impl AsRef<Path>, extra: &[&str]) -> Result<LoadedSet, ParameterError> {
         let path = path.as_ref();
         let text = read(path)?;
+        Self::from_file_text_with_extra(&text, path, extra)
+    }
+
+    /// [`load_with_extra`](Self::load_with_extra) of a file's text already
+    /// read (a file dropped on the browser explorer): TOML or the text
+    /// form, told apart as for a file; `path` names it in messages.
+    pub fn from_file_text_with_extra(
+        text: &str,
+        path: impl AsRef<Path>,
+        extra: &[&str],
+    ) -> Result<LoadedSet, ParameterError> {
+        let path = path.as_ref();
+        let text = text.to_string();
         if is_toml(path, &text) {
             let feedback = feedback_from_toml_str(&text, path)?;
             Self::from_toml_str_with_extra(&text, path, extra).map(|(set, effects, warnings)| LoadedSet {

@@ -38,7 +38,7 @@ mod validate;
 
 pub use benchmark::{BenchmarkParameters, BENCHMARK_BICYCLE_TOML};
 pub use error::{Origin, ParameterError, ParameterWarning};
-pub use load::{Form, ParameterSet};
+pub use load::{Form, LoadedSet, ParameterSet};
 pub use text::{MeasuredBenchmark, EXTRA_TEXT_FIELDS};
 pub use thesis::{ThesisParameters, THESIS_BICYCLE_TOML};
 pub use validate::body;

@@ -1,0 +1,83 @@
+// bikedyn's WebAssembly module, for a page or for Node.js: one function,
+// `call(request)`, that sends a JSON request to the module and returns the
+// job's result (or throws a BikedynError with the library's message).
+// The requests are documented in wasm/README.md.
+
+/** An error the library returned: `kind` is `request`, `bicycle` or `job`. */
+export class BikedynError extends Error {
+  constructor(kind, message) {
+    super(message);
+    this.name = "BikedynError";
+    this.kind = kind;
+  }
+}
+
+// The report crate's figures (plotters) are compiled into the module but
+// never drawn there: plotters imports these functions of wasm-bindgen for
+// the browser's fonts. Any call would be a defect, and says so.
+function unused(name) {
+  return () => {
+    throw new Error(`bikedyn module: ${name} was called; the WebAssembly build draws no figures`);
+  };
+}
+
+function importsOf(module) {
+  const imports = {};
+  for (const { module: m, name, kind } of WebAssembly.Module.imports(module)) {
+    if (kind !== "function") {
+      throw new Error(`bikedyn module: unexpected import ${m}.${name} (${kind})`);
+    }
+    (imports[m] ??= {})[name] = unused(`${m}.${name}`);
+  }
+  return imports;
+}
+
+/** A loaded module: `await Bikedyn.load(bytesOrResponse)`. */
+export class Bikedyn {
+  static async load(source) {
+    const module =
+      source instanceof WebAssembly.Module
+        ? source
+        : source && typeof source.arrayBuffer === "function"
+          ? await WebAssembly.compile(await source.arrayBuffer())
+          : await WebAssembly.compile(source);
+    const instance = await WebAssembly.instantiate(module, importsOf(module));
+    return new Bikedyn(module, instance);
+  }
+
+  constructor(module, instance) {
+    this.module = module;
+    this.exports = instance.exports;
+    this.encoder = new TextEncoder();
+    this.decoder = new TextDecoder();
+  }
+
+  /** The result of `request` (an object with a `job` field). */
+  call(request) {
+    const x = this.exports;
+    const bytes = this.encoder.encode(JSON.stringify(request));
+    const ptr = x.bikedyn_alloc(bytes.length);
+    new Uint8Array(x.memory.buffer, ptr, bytes.length).set(bytes);
+    let status;
+    try {
+      status = x.bikedyn_call(ptr, bytes.length);
+    } catch (trap) {
+      // A panic traps the call; the module's state is then unknown, so a
+      // fresh instance replaces it.
+      const message = this.decoder.decode(
+        new Uint8Array(x.memory.buffer, x.bikedyn_panic_ptr(), x.bikedyn_panic_len()).slice(),
+      );
+      this.exports = new WebAssembly.Instance(this.module, importsOf(this.module)).exports;
+      throw new Error(`bikedyn module: internal error (${message || trap})`);
+    }
+    x.bikedyn_free(ptr, bytes.length);
+    const text = this.decoder.decode(
+      new Uint8Array(x.memory.buffer, x.bikedyn_answer_ptr(), x.bikedyn_answer_len()).slice(),
+    );
+    const answer = JSON.parse(text);
+    if (status !== 0) {
+      throw new BikedynError(answer.kind, answer.message);
+    }
+    return answer;
+  }
+}

@@ -1,0 +1,493 @@
+//! The requests the module answers, and their answers: each job's options
+//! as JSON fields (SI units, the command line's defaults), each result the
+//! library's typed result serialized.
+
+use bikedyn::bicycle::{Bicycle, BicycleError};
+use bikedyn::canonical::{canonical, CanonicalOptions};
+use bikedyn::eigen::{eigen_sweep, EigenOptions, Speeds};
+use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
+use bikedyn::runtime::simulate::{InitialConditions, Inputs, SimOptions};
+use bikedyn::simulate::{simulate, SimulateRequest};
+use bikedyn::stability::{stability, StabilityOptions};
+use bikedyn::sweep::{stability_map_row, sweep, SweepOptions, SweptParameter};
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::collections::BTreeMap;
+
+/// The answer to a request: the result's JSON, or an error's.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Answer {
+    /// The job's result.
+    Result(String),
+    /// `{"kind": ..., "message": ...}`: `request` (the request is not
+    /// valid JSON or lacks a field), `bicycle` (the bicycle or a
+    /// parameter, with the command line's message) or `job` (the job
+    /// failed).
+    Error(String),
+}
+
+/// Which bicycle, as the command line's `--bike` and Python's `Bicycle`
+/// take it, then parameters changed in order.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BicycleSpec {
+    /// `benchmark` or `thesis`.
+    #[serde(default)]
+    builtin: Option<String>,
+    /// A parameter file's text (TOML in either form, or the text form of
+    /// bicycleparameters and HumanControl) and its file name.
+    #[serde(default)]
+    file: Option<FileText>,
+    /// Named values, every benchmark or every thesis symbol (SI units).
+    #[serde(default)]
+    values: Option<BTreeMap<String, f64>>,
+    /// `[symbol, value]` pairs set in order (thesis, benchmark or effect
+    /// symbols).
+    #[serde(default)]
+    set: Vec<(String, f64)>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileText {
+    name: String,
+    text: String,
+}
+
+/// The speeds of `eig`: a list, or `count` speeds from `start` by `step`.
+#[derive(Debug, Deserialize)]
+#[serde(untagged)]
+enum SpeedsSpec {
+    List(Vec<f64>),
+    Range { start: f64, step: f64, count: usize },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Swept {
+    symbol: String,
+    values: Vec<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "job", rename_all = "snake_case", deny_unknown_fields)]
+enum Request {
+    /// The generated models (`bikedyn models --json`).
+    Models,
+    /// The bicycle's parameters in both forms, its derived geometry, its
+    /// model and its TOML.
+    Bicycle {
+        bicycle: BicycleSpec,
+        #[serde(default)]
+        model: Option<String>,
+    },
+    /// `bikedyn eig --format json`, with the model and the critical speeds.
+    Eig {
+        bicycle: BicycleSpec,
+        #[serde(default)]
+        model: Option<String>,
+        speeds: SpeedsSpec,
+        #[serde(default)]
+        critical_speeds: bool,
+        #[serde(default = "yes")]
+        standard_deviations: bool,
+        /// Also give the table as `bikedyn eig --format csv` writes it.
+        #[serde(default)]
+        csv: bool,
+    },
+    /// `bikedyn stability --json`.
+    Stability {
+        bicycle: BicycleSpec,
+        #[serde(default)]
+        model: Option<String>,
+        #[serde(default)]
+        speed_min: Option<f64>,
+        #[serde(default)]
+        speed_max: Option<f64>,
+    },
+    /// `bikedyn canonical --json`.
+    Canonical {
+        bicycle: BicycleSpec,
+        #[serde(default)]
+        model: Option<String>,
+        #[serde(default)]
+        speeds: Vec<f64>,
+    },
+    /// `bikedyn sweep --format json`: one parameter, or a map over two.
+    Sweep {
+        bicycle: BicycleSpec,
+        #[serde(default)]
+        model: Option<String>,
+        parameter: Swept,
+        #[serde(default)]
+        second: Option<Swept>,
+        #[serde(default)]
+        speed_max: Option<f64>,
+        #[serde(default)]
+        at_speed: Option<f64>,
+    },
+    /// Row `row` of a stability map (a map drawn row by row, with progress).
+    MapRow {
+        bicycle: BicycleSpec,
+        #[serde(default)]
+        model: Option<String>,
+        parameter: Swept,
+        second: Swept,
+        row: usize,
+        #[serde(default)]
+        speed_max: Option<f64>,
+        #[serde(default)]
+        at_speed: Option<f64>,
+    },
+    /// A nonlinear simulation (thesis signs, SI units, as the library's
+    /// `SimulateRequest`); the answer has the summary and the samples.
+    Simulate {
+        bicycle: BicycleSpec,
+        #[serde(default)]
+        model: Option<String>,
+        #[serde(default)]
+        free_speed: bool,
+        initial: InitialConditions,
+        #[serde(default)]
+        inputs: Inputs,
+        duration: f64,
+        #[serde(default)]
+        output_interval: Option<f64>,
+    },
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// The bicycle of `bikedyn bicycle`-like requests: parameters in both
+/// forms, derived geometry, uncertainties, effects, warnings, the model the
+/// bicycle gets, and its TOML (benchmark form, effects after).
+#[derive(Serialize)]
+struct BicycleAnswer {
+    name: String,
+    form: &'static str,
+    model: String,
+    /// `[symbol, value]` in Meijaard et al. (2007) Table 1's order (SI).
+    benchmark: Vec<(&'static str, f64)>,
+    /// `[symbol, value]` in the thesis's order (SI).
+    thesis: Vec<(&'static str, f64)>,
+    effects: BTreeMap<String, f64>,
+    uncertainties: BTreeMap<String, f64>,
+    warnings: Vec<String>,
+    derived_geometry: Vec<GeometryRow>,
+    toml: String,
+}
+
+#[derive(Serialize)]
+struct GeometryRow {
+    symbol: &'static str,
+    value: f64,
+    unit: &'static str,
+    what: &'static str,
+}
+
+#[derive(Serialize)]
+struct ErrorAnswer<'a> {
+    kind: &'a str,
+    message: String,
+}
+
+fn error(kind: &str, message: impl ToString) -> Answer {
+    Answer::Error(
+        serde_json::to_string(&ErrorAnswer {
+            kind,
+            message: message.to_string(),
+        })
+        .unwrap_or_default(),
+    )
+}
+
+fn result(v: &impl Serialize) -> Answer {
+    match serde_json::to_string(v) {
+        Ok(t) => Answer::Result(t),
+        Err(e) => error("job", format!("the result could not be written as JSON: {e}")),
+    }
+}
+
+fn bicycle(spec: &BicycleSpec) -> Result<Bicycle, BicycleError> {
+    let given = [spec.builtin.is_some(), spec.file.is_some(), spec.values.is_some()];
+    if given.iter().filter(|g| **g).count() != 1 {
+        return Err(BicycleError::NotFound {
+            spec: "a bicycle request needs exactly one of `builtin`, `file` and `values`".into(),
+        });
+    }
+    let mut b = if let Some(name) = &spec.builtin {
+        // Only the built-in names: a module in a page has no files.
+        if !matches!(name.as_str(), "benchmark" | "thesis") {
+            return Err(BicycleError::NotFound { spec: name.clone() });
+        }
+        Bicycle::resolve(name)?
+    } else if let Some(f) = &spec.file {
+        Bicycle::from_file_text_in(&f.name, &f.text)?
+    } else {
+        let values: Vec<(String, f64, Option<f64>)> = spec
+            .values
+            .iter()
+            .flatten()
+            .map(|(k, v)| (k.clone(), *v, None))
+            .collect();
+        Bicycle::from_values("bicycle", &values)?
+    };
+    for (symbol, value) in &spec.set {
+        b = b.with_parameter(symbol, *value)?;
+    }
+    Ok(b)
+}
+
+fn bicycle_answer(b: &Bicycle, model: Option<&str>) -> Result<BicycleAnswer, BicycleError> {
+    let benchmark = b.parameters.to_benchmark()?;
+    let thesis = b.thesis()?;
+    let mut toml = benchmark.to_toml_string();
+    let effects = b.effects_toml();
+    if !effects.is_empty() {
+        toml.push_str(&format!("\n# Effect parameters of {}:\n{effects}", b.name));
+    }
+    Ok(BicycleAnswer {
+        name: b.name.clone(),
+        form: match b.parameters.form() {
+            bikedyn::runtime::parameters::Form::Thesis => "thesis",
+            bikedyn::runtime::parameters::Form::Benchmark => "benchmark",
+        },
+        model: b.model(model)?.name.to_string(),
+        benchmark: BenchmarkParameters::SYMBOLS
+            .iter()
+            .map(|s| (*s, benchmark.get(s).unwrap_or(f64::NAN)))
+            .collect(),
+        thesis: ThesisParameters::SYMBOLS
+            .iter()
+            .map(|s| (*s, thesis.get(s).unwrap_or(f64::NAN)))
+            .collect(),
+        effects: b.effects.clone(),
+        uncertainties: b.uncertainties.clone(),
+        warnings: b.warnings.iter().map(|w| w.to_string()).collect(),
+        derived_geometry: b
+            .derived_geometry()?
+            .rows()
+            .into_iter()
+            .map(|(symbol, value, unit, what)| GeometryRow {
+                symbol,
+                value,
+                unit,
+                what,
+            })
+            .collect(),
+        toml,
+    })
+}
+
+/// The answer to the UTF-8 JSON request `bytes`.
+pub fn answer(bytes: &[u8]) -> Answer {
+    let request: Request = match serde_json::from_slice(bytes) {
+        Ok(r) => r,
+        Err(e) => return error("request", format!("the request is not one this module answers: {e}")),
+    };
+    // The bicycle first, so that its errors say `bicycle`.
+    let spec = match &request {
+        Request::Models => None,
+        Request::Bicycle { bicycle, .. }
+        | Request::Eig { bicycle, .. }
+        | Request::Stability { bicycle, .. }
+        | Request::Canonical { bicycle, .. }
+        | Request::Sweep { bicycle, .. }
+        | Request::MapRow { bicycle, .. }
+        | Request::Simulate { bicycle, .. } => Some(bicycle),
+    };
+    let bike = match spec.map(bicycle).transpose() {
+        Ok(b) => b,
+        Err(e) => return error("bicycle", e),
+    };
+    let bike = bike.as_ref();
+    match request {
+        Request::Models => {
+            let v: Vec<Value> = bikedyn::models::models()
+                .iter()
+                .map(bikedyn::models::model_json)
+                .collect();
+            result(&v)
+        }
+        Request::Bicycle { model, .. } => match bicycle_answer(bike.unwrap(), model.as_deref()) {
+            Ok(a) => result(&a),
+            Err(e) => error("bicycle", e),
+        },
+        Request::Eig {
+            model,
+            speeds,
+            critical_speeds,
+            standard_deviations,
+            csv,
+            ..
+        } => {
+            let speeds = match speeds {
+                SpeedsSpec::List(v) => Speeds::List(v),
+                SpeedsSpec::Range { start, step, count } => Speeds::Range { start, step, count },
+            };
+            let opts = EigenOptions {
+                model,
+                speeds,
+                standard_deviations,
+                critical_speeds,
+            };
+            match eigen_sweep(bike.unwrap(), &opts) {
+                Ok(r) => result(&EigAnswer {
+                    model: &r.model,
+                    weave_speed: r.critical.as_ref().and_then(|c| c.weave_speed),
+                    capsize_speed: r.critical.as_ref().and_then(|c| c.capsize_speed),
+                    weave_real_pair_merge_speed: r.critical.as_ref().and_then(|c| c.weave_real_pair_merge),
+                    csv: csv.then(|| eigen_csv(&r)),
+                    points: &r,
+                }),
+                Err(e) => error("job", e),
+            }
+        }
+        Request::Stability {
+            model,
+            speed_min,
+            speed_max,
+            ..
+        } => {
+            let d = StabilityOptions::default();
+            let opts = StabilityOptions {
+                model,
+                speed_min: speed_min.unwrap_or(d.speed_min),
+                speed_max: speed_max.unwrap_or(d.speed_max),
+                ..d
+            };
+            match stability(bike.unwrap(), &opts) {
+                Ok(r) => result(&r),
+                Err(e) => error("job", e),
+            }
+        }
+        Request::Canonical { model, speeds, .. } => match canonical(bike.unwrap(), &CanonicalOptions { model, speeds })
+        {
+            Ok(r) => result(&r),
+            Err(e) => error("job", e),
+        },
+        Request::Sweep {
+            model,
+            parameter,
+            second,
+            speed_max,
+            at_speed,
+            ..
+        } => {
+            let opts = sweep_options(model, parameter, Some(second).flatten(), speed_max, at_speed);
+            match sweep(bike.unwrap(), &opts, &bikedyn::runtime::sweep::no_progress) {
+                Ok(r) => result(&r),
+                Err(e) => error("job", e),
+            }
+        }
+        Request::MapRow {
+            model,
+            parameter,
+            second,
+            row,
+            speed_max,
+            at_speed,
+            ..
+        } => {
+            let opts = sweep_options(model, parameter, Some(second), speed_max, at_speed);
+            match stability_map_row(bike.unwrap(), &opts, row, &bikedyn::runtime::sweep::no_progress) {
+                Ok(r) => result(&r),
+                Err(e) => error("job", e),
+            }
+        }
+        Request::Simulate {
+            model,
+            free_speed,
+            initial,
+            inputs,
+            duration,
+            output_interval,
+            ..
+        } => {
+            let mut options = SimOptions::default();
+            if let Some(dt) = output_interval {
+                options.output_interval = dt;
+            }
+            let request = SimulateRequest {
+                model,
+                free_speed,
+                initial,
+                inputs,
+                duration,
+                options,
+            };
+            match simulate(bike.unwrap(), &request) {
+                Ok(o) => result(&SimulateAnswer {
+                    summary: o.summary(),
+                    roles: o
+                        .simulation
+                        .roles
+                        .iter()
+                        .map(|(role, i)| (role.describe().replace(' ', "_"), o.simulation.coordinates[*i]))
+                        .collect(),
+                    simulation: &o.simulation,
+                }),
+                Err(e) => error("job", e),
+            }
+        }
+    }
+}
+
+fn sweep_options(
+    model: Option<String>,
+    parameter: Swept,
+    second: Option<Swept>,
+    speed_max: Option<f64>,
+    at_speed: Option<f64>,
+) -> SweepOptions {
+    let mut o = SweepOptions::new(parameter.symbol, parameter.values);
+    o.model = model;
+    o.second = second.map(|s| SweptParameter::new(s.symbol, s.values));
+    if let Some(v) = speed_max {
+        o.speed_max = v;
+    }
+    o.at_speed = at_speed;
+    o
+}
+
+#[derive(Serialize)]
+struct EigAnswer<'a> {
+    model: &'a str,
+    /// `bikedyn eig --format json`: one entry per speed.
+    points: &'a bikedyn::eigen::EigenSweepReport,
+    /// With `critical_speeds`: `v_w`, `v_c` and `v_d` in the speeds' range
+    /// (m/s).
+    weave_speed: Option<f64>,
+    capsize_speed: Option<f64>,
+    weave_real_pair_merge_speed: Option<f64>,
+    /// With `csv`: the table of `bikedyn eig --format csv`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    csv: Option<String>,
+}
+
+/// The rows `bikedyn eig --format csv` writes, from the report's own
+/// header and row functions.
+fn eigen_csv(r: &bikedyn::eigen::EigenSweepReport) -> String {
+    use bikedyn::report::output::{eigen_csv_header, eigen_point_csv_row_with};
+    let first = r.points.first();
+    let header = eigen_csv_header(
+        first.map_or(0, |p| p.extra_eigenvalues.len()),
+        first.is_some_and(|p| p.standard_deviations.is_some()),
+    );
+    let mut text = header.join(",") + "\n";
+    for p in &r.points {
+        text += &eigen_point_csv_row_with(&p.point, p.standard_deviations.as_deref()).join(",");
+        text.push('\n');
+    }
+    text
+}
+
+#[derive(Serialize)]
+struct SimulateAnswer<'a> {
+    summary: bikedyn::simulate::SimulationSummary,
+    /// The coordinate of each role (`roll`, `steer`, ...).
+    roles: BTreeMap<String, &'static str>,
+    simulation: &'a bikedyn::runtime::simulate::Simulation,
+}
