@@ -1207,7 +1207,7 @@ class Discovery(_Subscript):
             rms_held_out=_opt_float(d.get("rms_held_out")),
             base=StageErrors._of(d.get("base")),
             library=StageErrors._of(d.get("library")),
-            after=StageErrors._of(d.get("after")),
+            after=StageErrors._of(d.get("with_terms")),
         )
 
 

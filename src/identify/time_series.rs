@@ -112,7 +112,9 @@ pub struct TimeSeriesFound {
     pub readings: Vec<String>,
     pub base: StageErrors,
     pub library: StageErrors,
-    pub after: StageErrors,
+    /// With the terms added. (Named apart from the search's own `after`,
+    /// the fit, which the flattened search also writes.)
+    pub with_terms: StageErrors,
 }
 
 /// Why the search in the time series did not run, or what it found.
@@ -206,7 +208,7 @@ fn found_terms(
         readings: terms.iter().map(reading).collect(),
         base: StageErrors::of(&library.before),
         library: StageErrors::of(&library.after),
-        after: StageErrors::of(&search.after),
+        with_terms: StageErrors::of(&search.after),
         terms,
         search,
     }
@@ -246,10 +248,10 @@ pub fn sentence(o: &TimeSeriesOutcome, unit: &str, scale: f64) -> String {
                 "{found}\nroll RMS: base model {:.3}, with the library {:.3}, with the discovered terms {:.3} {unit}; held out: {:.3} -> {:.3} -> {:.3} {unit}",
                 f.base.roll_rms * scale,
                 f.library.roll_rms * scale,
-                f.after.roll_rms * scale,
+                f.with_terms.roll_rms * scale,
                 f.base.roll_rms_held_out * scale,
                 f.library.roll_rms_held_out * scale,
-                f.after.roll_rms_held_out * scale,
+                f.with_terms.roll_rms_held_out * scale,
             )
         }
     }
@@ -280,8 +282,8 @@ pub fn markdown(f: &TimeSeriesFound) -> String {
         f.base.roll_rms_held_out,
         f.library.roll_rms,
         f.library.roll_rms_held_out,
-        f.after.roll_rms,
-        f.after.roll_rms_held_out
+        f.with_terms.roll_rms,
+        f.with_terms.roll_rms_held_out
     );
     s
 }

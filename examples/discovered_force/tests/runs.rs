@@ -138,10 +138,24 @@ fn in_runs_the_force_found_in_the_time_series_is_written_derived_and_refitted() 
         );
     }
     assert!(
-        found.after.roll_rms_held_out <= 0.5 * found.library.roll_rms_held_out,
+        found.with_terms.roll_rms_held_out <= 0.5 * found.library.roll_rms_held_out,
         "held-out roll RMS {} with the term against {} with the library",
-        found.after.roll_rms_held_out,
+        found.with_terms.roll_rms_held_out,
         found.library.roll_rms_held_out
+    );
+
+    // The JSON of `identify --json` keeps both: the search's fit (`after`)
+    // and the errors with the terms (`with_terms`); once they shared a
+    // name, and the fit was lost.
+    let json = serde_json::to_value(&**found).unwrap();
+    assert_eq!(
+        json["with_terms"]["roll_rms_held_out"],
+        found.with_terms.roll_rms_held_out
+    );
+    assert!(
+        json["after"]["values"].is_array(),
+        "the search's fit is in the JSON: {}",
+        json["after"]
     );
 
     // Written: the committed file is identify's writing for these runs.
@@ -228,9 +242,9 @@ fn in_runs_the_force_found_in_the_time_series_is_written_derived_and_refitted() 
         "{refitted} against {value}"
     );
     assert!(
-        (roll - found.after.roll_rms).abs() < 1e-3 * found.after.roll_rms,
+        (roll - found.with_terms.roll_rms).abs() < 1e-3 * found.with_terms.roll_rms,
         "{roll} against {}",
-        found.after.roll_rms
+        found.with_terms.roll_rms
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
