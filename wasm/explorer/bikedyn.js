@@ -2,82 +2,114 @@
 // `call(request)`, that sends a JSON request to the module and returns the
 // job's result (or throws a BikedynError with the library's message).
 // The requests are documented in wasm/README.md.
-
-/** An error the library returned: `kind` is `request`, `bicycle` or `job`. */
-export class BikedynError extends Error {
-  constructor(kind, message) {
-    super(message);
-    this.name = "BikedynError";
-    this.kind = kind;
+//
+// A classic script, not an ES module, so that a page opened as a file
+// (file://, where Chromium refuses module imports and fetch) can load it:
+// in a page it defines the globals `Bikedyn`, `BikedynError` and
+// `bikedynBytesFromBase64`; in Node.js they are the exports of a CommonJS
+// module, which `import { Bikedyn, BikedynError } from ".../bikedyn.js"`
+// also reads.
+(function (root, factory) {
+  const api = factory();
+  if (typeof module === "object" && module && module.exports) {
+    module.exports.Bikedyn = api.Bikedyn;
+    module.exports.BikedynError = api.BikedynError;
+    module.exports.bikedynBytesFromBase64 = api.bikedynBytesFromBase64;
+  } else {
+    root.Bikedyn = api.Bikedyn;
+    root.BikedynError = api.BikedynError;
+    root.bikedynBytesFromBase64 = api.bikedynBytesFromBase64;
   }
-}
+})(typeof globalThis !== "undefined" ? globalThis : this, function () {
+  "use strict";
 
-// The report crate's figures (plotters) are compiled into the module but
-// never drawn there: plotters imports these functions of wasm-bindgen for
-// the browser's fonts. Any call would be a defect, and says so.
-function unused(name) {
-  return () => {
-    throw new Error(`bikedyn module: ${name} was called; the WebAssembly build draws no figures`);
-  };
-}
-
-function importsOf(module) {
-  const imports = {};
-  for (const { module: m, name, kind } of WebAssembly.Module.imports(module)) {
-    if (kind !== "function") {
-      throw new Error(`bikedyn module: unexpected import ${m}.${name} (${kind})`);
+  /** An error the library returned: `kind` is `request`, `bicycle` or `job`. */
+  class BikedynError extends Error {
+    constructor(kind, message) {
+      super(message);
+      this.name = "BikedynError";
+      this.kind = kind;
     }
-    (imports[m] ??= {})[name] = unused(`${m}.${name}`);
-  }
-  return imports;
-}
-
-/** A loaded module: `await Bikedyn.load(bytesOrResponse)`. */
-export class Bikedyn {
-  static async load(source) {
-    const module =
-      source instanceof WebAssembly.Module
-        ? source
-        : source && typeof source.arrayBuffer === "function"
-          ? await WebAssembly.compile(await source.arrayBuffer())
-          : await WebAssembly.compile(source);
-    const instance = await WebAssembly.instantiate(module, importsOf(module));
-    return new Bikedyn(module, instance);
   }
 
-  constructor(module, instance) {
-    this.module = module;
-    this.exports = instance.exports;
-    this.encoder = new TextEncoder();
-    this.decoder = new TextDecoder();
+  // The report crate's figures (plotters) are compiled into the module but
+  // never drawn there: plotters imports these functions of wasm-bindgen for
+  // the browser's fonts. Any call would be a defect, and says so.
+  function unused(name) {
+    return () => {
+      throw new Error(`bikedyn module: ${name} was called; the WebAssembly build draws no figures`);
+    };
   }
 
-  /** The result of `request` (an object with a `job` field). */
-  call(request) {
-    const x = this.exports;
-    const bytes = this.encoder.encode(JSON.stringify(request));
-    const ptr = x.bikedyn_alloc(bytes.length);
-    new Uint8Array(x.memory.buffer, ptr, bytes.length).set(bytes);
-    let status;
-    try {
-      status = x.bikedyn_call(ptr, bytes.length);
-    } catch (trap) {
-      // A panic traps the call; the module's state is then unknown, so a
-      // fresh instance replaces it.
-      const message = this.decoder.decode(
-        new Uint8Array(x.memory.buffer, x.bikedyn_panic_ptr(), x.bikedyn_panic_len()).slice(),
+  function importsOf(module) {
+    const imports = {};
+    for (const { module: m, name, kind } of WebAssembly.Module.imports(module)) {
+      if (kind !== "function") {
+        throw new Error(`bikedyn module: unexpected import ${m}.${name} (${kind})`);
+      }
+      (imports[m] ??= {})[name] = unused(`${m}.${name}`);
+    }
+    return imports;
+  }
+
+  /** A loaded module: `await Bikedyn.load(bytesOrResponse)`. */
+  class Bikedyn {
+    static async load(source) {
+      const module =
+        source instanceof WebAssembly.Module
+          ? source
+          : source && typeof source.arrayBuffer === "function"
+            ? await WebAssembly.compile(await source.arrayBuffer())
+            : await WebAssembly.compile(source);
+      const instance = await WebAssembly.instantiate(module, importsOf(module));
+      return new Bikedyn(module, instance);
+    }
+
+    constructor(module, instance) {
+      this.module = module;
+      this.exports = instance.exports;
+      this.encoder = new TextEncoder();
+      this.decoder = new TextDecoder();
+    }
+
+    /** The result of `request` (an object with a `job` field). */
+    call(request) {
+      const x = this.exports;
+      const bytes = this.encoder.encode(JSON.stringify(request));
+      const ptr = x.bikedyn_alloc(bytes.length);
+      new Uint8Array(x.memory.buffer, ptr, bytes.length).set(bytes);
+      let status;
+      try {
+        status = x.bikedyn_call(ptr, bytes.length);
+      } catch (trap) {
+        // A panic traps the call; the module's state is then unknown, so a
+        // fresh instance replaces it.
+        const message = this.decoder.decode(
+          new Uint8Array(x.memory.buffer, x.bikedyn_panic_ptr(), x.bikedyn_panic_len()).slice(),
+        );
+        this.exports = new WebAssembly.Instance(this.module, importsOf(this.module)).exports;
+        throw new Error(`bikedyn module: internal error (${message || trap})`);
+      }
+      x.bikedyn_free(ptr, bytes.length);
+      const text = this.decoder.decode(
+        new Uint8Array(x.memory.buffer, x.bikedyn_answer_ptr(), x.bikedyn_answer_len()).slice(),
       );
-      this.exports = new WebAssembly.Instance(this.module, importsOf(this.module)).exports;
-      throw new Error(`bikedyn module: internal error (${message || trap})`);
+      const answer = JSON.parse(text);
+      if (status !== 0) {
+        throw new BikedynError(answer.kind, answer.message);
+      }
+      return answer;
     }
-    x.bikedyn_free(ptr, bytes.length);
-    const text = this.decoder.decode(
-      new Uint8Array(x.memory.buffer, x.bikedyn_answer_ptr(), x.bikedyn_answer_len()).slice(),
-    );
-    const answer = JSON.parse(text);
-    if (status !== 0) {
-      throw new BikedynError(answer.kind, answer.message);
-    }
-    return answer;
   }
-}
+
+  /** The module's bytes from base64 (build.sh's `bikedyn-wasm.js`). */
+  function bikedynBytesFromBase64(text) {
+    if (typeof Buffer !== "undefined") return new Uint8Array(Buffer.from(text, "base64"));
+    const binary = atob(text);
+    const bytes = new Uint8Array(binary.length);
+    for (let i = 0; i < binary.length; i += 1) bytes[i] = binary.charCodeAt(i);
+    return bytes;
+  }
+
+  return { Bikedyn, BikedynError, bikedynBytesFromBase64 };
+});

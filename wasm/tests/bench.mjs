@@ -1,0 +1,63 @@
+// The explorer's speed and weight, against issue 34's targets: a
+// 1,000-speed eigenvalue diagram after a parameter change (< 5 ms), a
+// 100 x 100 stability map (< 2 s), page and module (< 2 MB). Node.js runs
+// the module with the V8 engine of Chromium; the page adds its drawing.
+// Prints figures; asserts nothing (targets are checked by reading them).
+//
+//   node wasm/tests/bench.mjs   (after bash wasm/build.sh)
+
+import fs from "node:fs";
+import path from "node:path";
+import zlib from "node:zlib";
+import { fileURLToPath } from "node:url";
+import { Bikedyn } from "../explorer/bikedyn.js";
+
+const explorer = path.join(path.dirname(fileURLToPath(import.meta.url)), "..", "explorer");
+const module = fs.readFileSync(path.join(explorer, "bikedyn.wasm"));
+const bikedyn = await Bikedyn.load(module);
+
+function median(f, n) {
+  const t = [];
+  for (let k = 0; k < n; k++) {
+    const s = performance.now();
+    f(k);
+    t.push(performance.now() - s);
+  }
+  t.sort((a, b) => a - b);
+  return t[n >> 1];
+}
+const mb = (n) => (n / 1e6).toFixed(2);
+
+// Weight: what a browser loads served (the module fetched) and as a file
+// (the module in base64).
+const page = ["index.html", "style.css", "bikedyn.js", "explorer.js", "plot.js", "state.js"]
+  .map((f) => fs.readFileSync(path.join(explorer, f)));
+const pageBytes = page.reduce((s, b) => s + b.length, 0);
+const gz = (b) => zlib.gzipSync(b, { level: 9 }).length;
+const pageGz = page.reduce((s, b) => s + gz(b), 0);
+console.log(`weight: module ${mb(module.length)} MB (${mb(gz(module))} MB gzip), page ${mb(pageBytes)} MB; served ${mb(module.length + pageBytes)} MB (${mb(gz(module) + pageGz)} MB gzip) [target < 2 MB]`);
+
+// A parameter change: the diagram's request with a new trail each time.
+const speeds = { start: 0, step: 0.01, count: 1000 };
+const diagram = median((k) => bikedyn.call({
+  job: "eig", bicycle: { builtin: "benchmark", set: [["c", 0.08 + 1e-4 * k]] }, speeds, critical_speeds: true,
+}), 21);
+console.log(`1,000-speed diagram after a parameter change (eig with modes and critical speeds, JSON both ways): ${diagram.toFixed(2)} ms median of 21 [target < 5 ms]`);
+const stability = median((k) => bikedyn.call({ job: "stability", bicycle: { builtin: "benchmark", set: [["c", 0.08 + 1e-4 * k]] } }), 21);
+console.log(`weave and capsize speeds after a parameter change: ${stability.toFixed(2)} ms median of 21`);
+
+// A 100 x 100 map, row by row as the page computes it.
+const values = (a, b, n) => Array.from({ length: n }, (_, k) => a + ((b - a) * k) / (n - 1));
+const request = {
+  job: "map_row", bicycle: { builtin: "benchmark" }, at_speed: 5,
+  parameter: { symbol: "c", values: values(0.02, 0.14, 100) },
+  second: { symbol: "lam", values: values(0.1, 0.5, 100) },
+};
+const start = performance.now();
+let slowest = 0;
+for (let row = 0; row < 100; row++) {
+  const s = performance.now();
+  bikedyn.call({ ...request, row });
+  slowest = Math.max(slowest, performance.now() - s);
+}
+console.log(`100 x 100 stability map (critical speeds on 0-10 m/s and the least-stable real part at 5 m/s per design): ${((performance.now() - start) / 1000).toFixed(2)} s, slowest row ${slowest.toFixed(0)} ms (the page's longest pause) [target < 2 s]`);

@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# The stability explorer in a real browser: headless Chromium opens the
+# page with `#selftest`, served (python3 -m http.server on a free localhost
+# port) and as a file (file://); the page loads the benchmark bicycle,
+# checks the weave and capsize speeds shown (4.2924 and 6.0243 m/s), edits
+# the trail, switches steer damping on, imports an invalid and a valid
+# file, computes a small stability map and simulates a kick, and writes
+# `SELFTEST PASS` or `SELFTEST FAIL: reasons` into the page. Two more runs
+# open shared links (one with a file in it) and check that the page
+# restores their state.
+#
+#   bash wasm/tests/explorer.sh
+#
+# Needs the built module (bash wasm/build.sh), python3 and Chromium
+# (Debian: apt-get install -y chromium; or set CHROMIUM=/path/to/chrome).
+set -uo pipefail
+here="$(cd "$(dirname "$0")/.." && pwd)"
+explorer="$here/explorer"
+chromium="${CHROMIUM:-}"
+if [ -z "$chromium" ]; then
+  for c in chromium chromium-browser google-chrome google-chrome-stable chrome; do
+    if command -v "$c" >/dev/null 2>&1; then chromium="$(command -v "$c")"; break; fi
+  done
+fi
+if [ -z "$chromium" ]; then
+  echo "explorer test: no Chromium found (install it: apt-get install -y chromium, or set CHROMIUM=/path/to/chrome)" >&2
+  exit 2
+fi
+for f in bikedyn.wasm bikedyn-wasm.js; do
+  if [ ! -f "$explorer/$f" ]; then
+    echo "explorer test: $explorer/$f is missing: build the module first (bash wasm/build.sh)" >&2
+    exit 2
+  fi
+done
+
+profile="$(mktemp -d)"
+server_pid=""
+cleanup() {
+  if [ -n "$server_pid" ]; then kill "$server_pid" 2>/dev/null; wait "$server_pid" 2>/dev/null; fi
+  rm -rf "$profile"
+}
+trap cleanup EXIT
+
+# A free port, then the server on it.
+port="$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1]); s.close()')"
+(cd "$explorer" && exec python3 -m http.server "$port" --bind 127.0.0.1 >"$profile/server.log" 2>&1) &
+server_pid=$!
+for _ in $(seq 1 50); do
+  if python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$port/index.html')" 2>/dev/null; then break; fi
+  sleep 0.1
+done
+
+# The page's DOM after the self-test (virtual time runs the page's timers
+# without waiting; the module's computations take real time).
+run() {
+  local url="$1" out="$2"
+  timeout 180 "$chromium" --headless --no-sandbox --disable-gpu --disable-dev-shm-usage \
+    --user-data-dir="$profile/chrome-$out" --allow-file-access-from-files \
+    --virtual-time-budget=1000000 --run-all-compositor-stages-before-draw \
+    --dump-dom "$url" >"$profile/$out.html" 2>"$profile/$out.log"
+}
+
+# A shared link: the page must restore it (checked first by the self-test).
+link='bike=thesis&set=c:0.1,mB:80&fx=c_steer:0.4&v=0:8:0.04&at=3.5&selftest=1'
+# A shared link with a file in it (a bicycle with a gain-scheduled feedback table).
+bikefile="$here/../tests/data/balance_assist_gain_8.toml"
+filelink=""
+if [ -f "$bikefile" ]; then
+  filelink="bike=file&name=balance_assist_gain_8.toml&file=$(python3 -c 'import base64, sys; print(base64.urlsafe_b64encode(open(sys.argv[1], "rb").read()).decode().rstrip("="))' "$bikefile")&selftest=1"
+fi
+status=0
+for mode in served file link filelink; do
+  if [ "$mode" = filelink ] && [ -z "$filelink" ]; then continue; fi
+  case "$mode" in
+    served) url="http://127.0.0.1:$port/index.html#selftest" ;;
+    file) url="file://$explorer/index.html#selftest" ;;
+    link) url="http://127.0.0.1:$port/index.html#$link" ;;
+    filelink) url="http://127.0.0.1:$port/index.html#$filelink" ;;
+  esac
+  run "$url" "$mode"
+  result="$(grep -o 'SELFTEST [A-Z]*[^<]*' "$profile/$mode.html" | head -1)"
+  if [ -z "$result" ]; then
+    echo "explorer test ($mode, ${url:0:160}): no self-test result in the page" >&2
+    grep -o '<div id="error"[^<]*<[^<]*' "$profile/$mode.html" >&2 || true
+    tail -20 "$profile/$mode.log" >&2
+    status=1
+  elif [ "${result#SELFTEST PASS}" != "$result" ]; then
+    echo "explorer test ($mode): $result"
+  else
+    echo "explorer test ($mode, ${url:0:160}): $result" >&2
+    status=1
+  fi
+done
+exit $status
