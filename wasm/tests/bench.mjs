@@ -30,8 +30,10 @@ const mb = (n) => (n / 1e6).toFixed(2);
 
 // Weight: what a browser loads served (the module fetched) and as a file
 // (the module in base64).
-const page = ["index.html", "style.css", "bikedyn.js", "explorer.js", "plot.js", "state.js"]
-  .map((f) => fs.readFileSync(path.join(explorer, f)));
+const page = [
+  "index.html", "style.css", "bikedyn.js", "plot.js", "state.js",
+  "explorer.js", "panel-bicycle.js", "panel-eigen.js", "panel-map.js", "panel-simulation.js", "downloads.js", "selftest.js",
+].map((f) => fs.readFileSync(path.join(explorer, f)));
 const pageBytes = page.reduce((s, b) => s + b.length, 0);
 const gz = (b) => zlib.gzipSync(b, { level: 9 }).length;
 const pageGz = page.reduce((s, b) => s + gz(b), 0);

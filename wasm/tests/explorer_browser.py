@@ -129,7 +129,7 @@ def js_fixed(x, d=4):
 
 
 def table_row(mode, re_, im):
-    """A row of the eigenvalues-at-speed table as explorer.js's renderEigTable writes it."""
+    """A row of the eigenvalues-at-speed table as panel-eigen.js's renderEigTable writes it."""
     f = abs(im) / (2 * math.pi)
     return [
         mode,

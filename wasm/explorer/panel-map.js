@@ -1,0 +1,148 @@
+// The stability map panel: a metric (least-stable real part at a speed,
+// width of the self-stable range, weave or capsize speed) over any two
+// parameters, benchmark or effect, computed row by row (`map_row`) with
+// progress, cancellable.
+// Shares the page's state through `Explorer` (explorer.js).
+(function (app) {
+  "use strict";
+  const P = BikedynPlot;
+  const S = ExplorerState;
+  const { $, call, showError, sig, bicycleSpec, withModel, writeHash } = app;
+
+  // ---- stability map --------------------------------------------------------
+
+  let mapRun = null; // {cancelled}
+
+  function paramOptions(select, selected) {
+    select.innerHTML = "";
+    const g1 = document.createElement("optgroup");
+    g1.label = "benchmark parameters";
+    for (const [k] of app.base.benchmark) g1.appendChild(new Option(`${k}${app.units[k] ? ` \u2014 ${app.units[k].what}` : ""}`, k));
+    const g2 = document.createElement("optgroup");
+    g2.label = "effect parameters";
+    for (const p of app.effectParams) g2.appendChild(new Option(`${p.name} \u2014 ${p.doc}`, p.name));
+    select.append(g1, g2);
+    select.value = selected;
+  }
+
+  function readMapInputs() {
+    const m = app.state.map;
+    m.x = $("map-x").value;
+    m.y = $("map-y").value;
+    for (const k of ["x0", "x1", "y0", "y1", "at"]) {
+      const v = Number($(`map-${k}`).value);
+      if (Number.isFinite(v)) m[k] = v;
+    }
+    for (const k of ["nx", "ny"]) {
+      const v = Math.round(Number($(`map-${k}`).value));
+      if (Number.isFinite(v) && v >= 2) m[k] = Math.min(200, v);
+    }
+    m.metric = $("map-metric").value;
+    writeHash();
+  }
+
+  function writeMapInputs() {
+    const m = app.state.map;
+    for (const k of ["x0", "x1", "nx", "y0", "y1", "ny", "at"]) $(`map-${k}`).value = String(m[k]);
+    $("map-metric").value = m.metric;
+    if (app.base) {
+      paramOptions($("map-x"), m.x);
+      paramOptions($("map-y"), m.y);
+    }
+  }
+
+  /** Computes the map row by row, yielding to the page between rows; resolves with the cells (or null, cancelled). */
+  async function runMap() {
+    if (mapRun) mapRun.cancelled = true;
+    readMapInputs();
+    const m = app.state.map;
+    const xs = S.linspace(m.x0, m.x1, m.nx);
+    const ys = S.linspace(m.y0, m.y1, m.ny);
+    const run = (mapRun = { cancelled: false });
+    const req = withModel({
+      job: "map_row", bicycle: bicycleSpec(), parameter: { symbol: m.x, values: xs }, second: { symbol: m.y, values: ys },
+      row: 0, speed_max: app.state.vmax,
+    });
+    if (m.metric === "least_stable_real_part") req.at_speed = m.at;
+    const cells = [];
+    $("map-cancel").disabled = false;
+    $("map-run").disabled = true;
+    $("map-progress").value = 0;
+    const t0 = performance.now();
+    try {
+      for (let i = 0; i < xs.length; i += 1) {
+        if (run.cancelled) {
+          $("map-status").textContent = `cancelled after ${i} of ${xs.length} rows`;
+          return null;
+        }
+        req.row = i;
+        const r = call(req);
+        if (r.error) {
+          showError(r.error);
+          $("map-status").textContent = "error";
+          return null;
+        }
+        cells.push(...r.ok.cells.map((c) => Object.assign(c, { i })));
+        $("map-progress").value = (i + 1) / xs.length;
+        $("map-status").textContent = `row ${i + 1} of ${xs.length}`;
+        app.mapResult = { xs, ys, cells, map: Object.assign({}, m), done: false };
+        $("map-plot").innerHTML = mapSvg();
+        await new Promise((resolve) => setTimeout(resolve, 0));
+      }
+      app.mapResult.done = true;
+      $("map-status").textContent = `${xs.length} \u00d7 ${ys.length} points in ${((performance.now() - t0) / 1000).toFixed(1)} s`;
+      return cells;
+    } finally {
+      if (mapRun === run) mapRun = null;
+      $("map-cancel").disabled = true;
+      $("map-run").disabled = false;
+    }
+  }
+
+  /** Stops the map being computed, after its current row. */
+  function cancelMap() {
+    if (mapRun) mapRun.cancelled = true;
+  }
+
+  const METRIC_LABELS = {
+    least_stable_real_part: (m) => `least-stable real part at ${m.at} m/s (1/s)`,
+    stable_width: () => "self-stable speed range width (m/s)",
+    weave_speed: () => "weave speed (m/s)",
+    capsize_speed: () => "capsize speed (m/s)",
+  };
+
+  function mapSvg(width = 760, height = 460) {
+    const { xs, ys, cells, map } = app.mapResult;
+    const half = (v, k) => (v.length > 1 ? Math.abs(v[1] - v[0]) / 2 : 0.5) * (k || 1);
+    const xlim = [Math.min(...xs) - half(xs), Math.max(...xs) + half(xs)];
+    const ylim = [Math.min(...ys) - half(ys), Math.max(...ys) + half(ys)];
+    const unitOf = (k) => (app.units[k] ? ` (${app.units[k].unit})` : "");
+    const fig = P.figure({ width, height, xlim, ylim, xlabel: `${map.x}${unitOf(map.x)}`, ylabel: `${map.y}${unitOf(map.y)}`, grid: false, zeroY: false, margin: { right: 110 } });
+    const vals = cells.map((c) => c[map.metric]).filter((v) => v !== null && v !== undefined && Number.isFinite(v));
+    let lo = Math.min(...vals);
+    let hi = Math.max(...vals);
+    let cmap = P.viridis;
+    if (map.metric === "least_stable_real_part") {
+      const a = Math.max(Math.abs(lo), Math.abs(hi)) || 1;
+      [lo, hi] = [-a, a];
+      cmap = P.diverging;
+    }
+    if (!vals.length) [lo, hi] = [0, 1];
+    if (hi === lo) hi = lo + 1;
+    for (const c of cells) {
+      const v = c[map.metric];
+      const x0 = fig.x(c.x - half(xs));
+      const x1 = fig.x(c.x + half(xs));
+      const y0 = fig.y(c.y + half(ys));
+      const y1 = fig.y(c.y - half(ys));
+      const fill = v === null || v === undefined || !Number.isFinite(v) ? "#cccccc" : cmap((v - lo) / (hi - lo));
+      const title = `${map.x} = ${sig(c.x)}, ${map.y} = ${sig(c.y)}: ${v === null || v === undefined ? (c.error || "none") : sig(v)}`;
+      fig.add(`<rect data-cell="1" x="${P.n(x0)}" y="${P.n(y0)}" width="${P.n(x1 - x0 + 0.5)}" height="${P.n(y1 - y0 + 0.5)}" fill="${fill}"><title>${P.esc(title)}</title></rect>`);
+    }
+    fig.over(P.colorbar(fig, lo, hi, cmap, METRIC_LABELS[map.metric] ? METRIC_LABELS[map.metric](map) : map.metric));
+    return fig.svg();
+  }
+
+  // Used by the other files.
+  Object.assign(app, { readMapInputs, writeMapInputs, runMap, cancelMap, mapSvg });
+})(window.Explorer);
