@@ -430,6 +430,8 @@ impl<R: ModelRegistry> Bicycle<R> {
 
     /// The same bicycle with one parameter changed. `symbol` is a thesis
     /// symbol (`Rt`, `x4`, `d4`, ...) or a benchmark symbol (`c`, `lam`, ...).
+    /// The file's standard deviation of `symbol`, if any, is dropped: a
+    /// value set is not measured.
     pub fn with_parameter(&self, symbol: &str, value: f64) -> Result<Bicycle<R>, BicycleError> {
         // (A NaN would otherwise fail the parameter table's conversion and
         // be reported as an unknown parameter.)
@@ -444,6 +446,7 @@ impl<R: ModelRegistry> Bicycle<R> {
             check_effect_value_in::<R>(symbol, value, &self.name)?;
             let mut b = self.clone();
             b.effects.insert(symbol.to_string(), value);
+            b.uncertainties.remove(symbol);
             check_effect_windows_in::<R>(&b.effects, &self.name)?;
             b.name = format!("{} ({symbol} = {value})", self.name);
             return Ok(b);
@@ -459,12 +462,16 @@ impl<R: ModelRegistry> Bicycle<R> {
         // A value set here is checked as a file's would be (a wheelbase of
         // 1020 is millimetres, not metres).
         refuse_millimetres(&warnings, &format!("{} ({symbol} = {value})", self.name))?;
+        // A value set is set, not measured: the file's `+/-` of that symbol
+        // no longer applies (the others do).
+        let mut uncertainties = self.uncertainties.clone();
+        uncertainties.remove(symbol);
         Ok(Bicycle {
             name: format!("{} ({symbol} = {value})", self.name),
             parameters,
             warnings,
             effects: self.effects.clone(),
-            uncertainties: self.uncertainties.clone(),
+            uncertainties,
             feedback: self.feedback.clone(),
             registry: PhantomData,
         })

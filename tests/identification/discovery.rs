@@ -290,7 +290,7 @@ fn time_series_terms(v: &Value) -> Vec<Value> {
     d["terms"].as_array().unwrap().clone()
 }
 
-/// The roll RMS of a stage (`base`, `library`, `after`) held out.
+/// The roll RMS of a stage (`base`, `library`, `with_terms`) held out.
 fn held_out_roll(v: &Value, stage: &str) -> f64 {
     v["time_series_discovery"][stage]["roll_rms_held_out"].as_f64().unwrap()
 }
@@ -324,7 +324,7 @@ fn in_the_time_series_a_steer_damper_the_library_lacks_is_found_and_halves_the_r
     let c = -damper["coefficient"][0].as_f64().unwrap();
     assert!((c - 0.25).abs() <= 0.25 * 0.25, "c = {c}");
     assert!(
-        held_out_roll(&v, "after") <= 0.5 * held_out_roll(&v, "library"),
+        held_out_roll(&v, "with_terms") <= 0.5 * held_out_roll(&v, "library"),
         "{:#}",
         v["time_series_discovery"]
     );

@@ -238,3 +238,53 @@ fn speed_standard_deviations_propagate_the_files_uncertainties() {
         .unwrap()
         .is_none());
 }
+
+/// A parameter set (a sweep's value, an explorer's edit, Python's
+/// `with_parameter`) is set, not measured: the file's `+/-` of that
+/// parameter no longer counts, the others do. The speeds' standard
+/// deviations equal those of the same file with that line written without
+/// its `+/-`.
+#[test]
+fn a_parameter_set_drops_its_standard_deviation_and_keeps_the_others() {
+    use bikedyn::sensitivity::speed_uncertainties;
+    let file = crate::common::fixture_arg("BrowserBenchmark.txt");
+    let b = Bicycle::resolve(&file).unwrap();
+    let set = b.with_parameter("c", 0.1).unwrap();
+    assert!(b.uncertainties.contains_key("c"));
+    assert!(!set.uncertainties.contains_key("c"));
+    assert_eq!(set.uncertainties.len(), b.uncertainties.len() - 1);
+
+    let text = std::fs::read_to_string(&file).unwrap();
+    let edited: String = text
+        .lines()
+        .map(|l| {
+            if l.trim_start().starts_with("c =") {
+                "c = 0.1".to_string()
+            } else {
+                l.to_string()
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let dir = crate::common::scratch("set-drops-sd");
+    let path = dir.join("BrowserTrail.txt");
+    std::fs::write(&path, edited).unwrap();
+    let from_file = Bicycle::resolve(path.to_str().unwrap()).unwrap();
+
+    let opts = SensitivityOptions::default();
+    let (a, f) = (
+        speed_uncertainties(&set, &opts).unwrap().unwrap(),
+        speed_uncertainties(&from_file, &opts).unwrap().unwrap(),
+    );
+    for (x, y) in [
+        (a.weave_speed.unwrap(), f.weave_speed.unwrap()),
+        (a.capsize_speed.unwrap(), f.capsize_speed.unwrap()),
+    ] {
+        assert!(
+            (x.standard_deviation - y.standard_deviation).abs() <= 1e-12 * y.standard_deviation,
+            "{} against {} from the file",
+            x.standard_deviation,
+            y.standard_deviation
+        );
+    }
+}

@@ -7,7 +7,7 @@ nothing) over the page served by `python3 -m http.server` on a free
 localhost port, and checks what the page shows against the command line:
 
   1. load the page (the benchmark bicycle) until the eigenvalue plot is drawn;
-  2. import tests/data/BluenosePar.txt (bicycleparameters text) through the
+  2. import tests/data/BrowserBenchmark.txt (bicycleparameters text, with +/- values) through the
      page's file input;
   3. the weave and capsize speeds shown = `bikedyn stability --json`, to the
      digits shown;
@@ -61,13 +61,26 @@ except ImportError as e:  # pragma: no cover
 TESTS = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(TESTS, "..", ".."))
 EXPLORER = os.path.join(ROOT, "wasm", "explorer")
-BIKE_FILE = os.path.join(ROOT, "tests", "data", "BluenosePar.txt")
+BIKE_FILE = os.path.join(ROOT, "tests", "data", "BrowserBenchmark.txt")
+
+
+def file_value(path, symbol):
+    """A symbol's value as the file writes it (`name = value[+/-sd]`)."""
+    with open(path) as f:
+        for line in f:
+            name, _, value = line.partition("=")
+            if name.strip() == symbol:
+                return value.split("+/-")[0].strip()
+    raise SystemExit(f"{path}: no `{symbol}`")
+
+
+FILE_TRAIL = file_value(BIKE_FILE, "c")
 CHROMIUM = os.environ.get("CHROMIUM", "/usr/bin/chromium")
 CHROMEDRIVER = os.environ.get("CHROMEDRIVER", "/usr/bin/chromedriver")
 BIKEDYN = os.environ.get("BIKEDYN", os.path.join(ROOT, "target", "release", "bikedyn"))
 ARTIFACTS = os.path.abspath(os.environ.get("ARTIFACTS", os.path.join(TESTS, "artifacts")))
 
-NEW_TRAIL = "0.1"  # the edit typed into the trail's field (the file's is 0.089)
+NEW_TRAIL = "0.1"  # the edit typed into the trail's field (the file's is 0.0686)
 SLIDER_SPEED = "8.95"  # End, Page Down, then 5 x Left from the slider's 0..10 m/s, step 0.01
 SIM_SPEED = "9"  # the kick simulation's speed (m/s): Bluenose with c = 0.1 is self-stable there
 SIM_KICK = "1"  # N s (the page's default 8 N s makes this bicycle fall, as on the command line)
@@ -266,7 +279,7 @@ def step_import(p):
     check(p.text("file-name") == f"imported {name}", f"the page says {p.text('file-name')!r} after importing {name}")
     check("bike=file" in p.hash() and f"name={name}" in p.hash(), f"the link does not carry the file: {p.hash()[:80]}")
     c = p.el('input[data-symbol="c"]').get_attribute("value")
-    check(c == "0.089", f"the trail in the parameter table is {c}, the file's is 0.089")
+    check(c == FILE_TRAIL, f"the trail in the parameter table is {c}, the file's is {FILE_TRAIL}")
     ok(f"imported {name}: bicycle {p.text('bike-name')!r}, model {p.text('bike-model')}, trail c = {c} in the table")
     p.screenshot("02-imported-file")
 
@@ -475,7 +488,7 @@ def step_bad_file(p, tmp, file_ref):
     check(p.text("file-name") == f"imported {os.path.basename(BIKE_FILE)}", f"the bad file replaced the import: {p.text('file-name')!r}")
     check(p.text("v-weave") == weave_before and p.text("v-capsize") == capsize_before,
           f"the speeds changed with the bad file: {weave_before} -> {p.text('v-weave')}")
-    check(f"set=c:{NEW_TRAIL}" in p.hash() and "name=BluenosePar.txt" in p.hash(), f"the link lost the bicycle: {p.hash()[:120]}")
+    check(f"set=c:{NEW_TRAIL}" in p.hash() and "name=BrowserBenchmark.txt" in p.hash(), f"the link lost the bicycle: {p.hash()[:120]}")
     ok(f"after the bad file: still {p.text('file-name')!r}, weave {p.text('v-weave')} and capsize {p.text('v-capsize')} m/s unchanged")
     p.screenshot("06-bad-file")
     # The previous bicycle still works: the trail's reset button gives the file's own speeds back.
@@ -484,7 +497,7 @@ def step_bad_file(p, tmp, file_ref):
     p.wait_redraw(old, "resetting the trail")
     check(p.error() is None, f"the error stays shown after a good update: {p.error()!r}")
     c = p.el('input[data-symbol="c"]').get_attribute("value")
-    check(c == "0.089", f"the trail after its reset is {c}")
+    check(c == FILE_TRAIL, f"the trail after its reset is {c}, the file's is {FILE_TRAIL}")
     for elem_id, key in (("v-weave", "weave_speed"), ("v-capsize", "capsize_speed")):
         shown, want = p.text(elem_id), js_fixed(file_ref[key])
         check(shown == want, f"{key} after the reset: page {shown}, CLI {file_ref[key]} ({want})")
