@@ -287,22 +287,6 @@ pub fn answer(bytes: &[u8]) -> Answer {
         Ok(r) => r,
         Err(e) => return error("request", format!("the request is not one this module answers: {e}")),
     };
-    // The bicycle first, so that its errors say `bicycle`.
-    let spec = match &request {
-        Request::Models => None,
-        Request::Bicycle { bicycle, .. }
-        | Request::Eig { bicycle, .. }
-        | Request::Stability { bicycle, .. }
-        | Request::Canonical { bicycle, .. }
-        | Request::Sweep { bicycle, .. }
-        | Request::MapRow { bicycle, .. }
-        | Request::Simulate { bicycle, .. } => Some(bicycle),
-    };
-    let bike = match spec.map(bicycle).transpose() {
-        Ok(b) => b,
-        Err(e) => return error("bicycle", e),
-    };
-    let bike = bike.as_ref();
     match request {
         Request::Models => {
             let v: Vec<Value> = bikedyn::models::models()
@@ -311,17 +295,14 @@ pub fn answer(bytes: &[u8]) -> Answer {
                 .collect();
             result(&v)
         }
-        Request::Bicycle { model, .. } => match bicycle_answer(bike.unwrap(), model.as_deref()) {
-            Ok(a) => result(&a),
-            Err(e) => error("bicycle", e),
-        },
+        Request::Bicycle { bicycle, model } => on(&bicycle, "bicycle", |b| bicycle_answer(b, model.as_deref())),
         Request::Eig {
+            bicycle,
             model,
             speeds,
             critical_speeds,
             standard_deviations,
             csv,
-            ..
         } => {
             let speeds = match speeds {
                 SpeedsSpec::List(v) => Speeds::List(v),
@@ -333,23 +314,22 @@ pub fn answer(bytes: &[u8]) -> Answer {
                 standard_deviations,
                 critical_speeds,
             };
-            match eigen_sweep(bike.unwrap(), &opts) {
-                Ok(r) => result(&EigAnswer {
-                    model: &r.model,
+            on(&bicycle, "job", |b| {
+                eigen_sweep(b, &opts).map(|r| EigAnswer {
+                    model: r.model.clone(),
                     weave_speed: r.critical.as_ref().and_then(|c| c.weave_speed),
                     capsize_speed: r.critical.as_ref().and_then(|c| c.capsize_speed),
                     weave_real_pair_merge_speed: r.critical.as_ref().and_then(|c| c.weave_real_pair_merge),
                     csv: csv.then(|| eigen_csv(&r)),
-                    points: &r,
-                }),
-                Err(e) => error("job", e),
-            }
+                    points: r,
+                })
+            })
         }
         Request::Stability {
+            bicycle,
             model,
             speed_min,
             speed_max,
-            ..
         } => {
             let d = StabilityOptions::default();
             let opts = StabilityOptions {
@@ -358,53 +338,46 @@ pub fn answer(bytes: &[u8]) -> Answer {
                 speed_max: speed_max.unwrap_or(d.speed_max),
                 ..d
             };
-            match stability(bike.unwrap(), &opts) {
-                Ok(r) => result(&r),
-                Err(e) => error("job", e),
-            }
+            on(&bicycle, "job", |b| stability(b, &opts))
         }
-        Request::Canonical { model, speeds, .. } => match canonical(bike.unwrap(), &CanonicalOptions { model, speeds })
-        {
-            Ok(r) => result(&r),
-            Err(e) => error("job", e),
-        },
+        Request::Canonical { bicycle, model, speeds } => {
+            on(&bicycle, "job", |b| canonical(b, &CanonicalOptions { model, speeds }))
+        }
         Request::Sweep {
+            bicycle,
             model,
             parameter,
             second,
             speed_max,
             at_speed,
-            ..
         } => {
-            let opts = sweep_options(model, parameter, Some(second).flatten(), speed_max, at_speed);
-            match sweep(bike.unwrap(), &opts, &bikedyn::runtime::sweep::no_progress) {
-                Ok(r) => result(&r),
-                Err(e) => error("job", e),
-            }
+            let opts = sweep_options(model, parameter, second, speed_max, at_speed);
+            on(&bicycle, "job", |b| {
+                sweep(b, &opts, &bikedyn::runtime::sweep::no_progress)
+            })
         }
         Request::MapRow {
+            bicycle,
             model,
             parameter,
             second,
             row,
             speed_max,
             at_speed,
-            ..
         } => {
             let opts = sweep_options(model, parameter, Some(second), speed_max, at_speed);
-            match stability_map_row(bike.unwrap(), &opts, row, &bikedyn::runtime::sweep::no_progress) {
-                Ok(r) => result(&r),
-                Err(e) => error("job", e),
-            }
+            on(&bicycle, "job", |b| {
+                stability_map_row(b, &opts, row, &bikedyn::runtime::sweep::no_progress)
+            })
         }
         Request::Simulate {
+            bicycle,
             model,
             free_speed,
             initial,
             inputs,
             duration,
             output_interval,
-            ..
         } => {
             let mut options = SimOptions::default();
             if let Some(dt) = output_interval {
@@ -418,8 +391,8 @@ pub fn answer(bytes: &[u8]) -> Answer {
                 duration,
                 options,
             };
-            match simulate(bike.unwrap(), &request) {
-                Ok(o) => result(&SimulateAnswer {
+            on(&bicycle, "job", |b| {
+                simulate(b, &request).map(|o| SimulateAnswer {
                     summary: o.summary(),
                     roles: o
                         .simulation
@@ -427,11 +400,26 @@ pub fn answer(bytes: &[u8]) -> Answer {
                         .iter()
                         .map(|(role, i)| (role.describe().replace(' ', "_"), o.simulation.coordinates[*i]))
                         .collect(),
-                    simulation: &o.simulation,
-                }),
-                Err(e) => error("job", e),
-            }
+                    simulation: o.simulation,
+                })
+            })
         }
+    }
+}
+
+/// `job` on the bicycle of `spec`: its result, or the error of the bicycle
+/// (kind `bicycle`) or of the job (kind `kind`).
+fn on<T: Serialize, E: std::fmt::Display>(
+    spec: &BicycleSpec,
+    kind: &str,
+    job: impl FnOnce(&Bicycle) -> Result<T, E>,
+) -> Answer {
+    match bicycle(spec) {
+        Err(e) => error("bicycle", e),
+        Ok(b) => match job(&b) {
+            Ok(r) => result(&r),
+            Err(e) => error(kind, e),
+        },
     }
 }
 
@@ -453,10 +441,10 @@ fn sweep_options(
 }
 
 #[derive(Serialize)]
-struct EigAnswer<'a> {
-    model: &'a str,
+struct EigAnswer {
+    model: String,
     /// `bikedyn eig --format json`: one entry per speed.
-    points: &'a bikedyn::eigen::EigenSweepReport,
+    points: bikedyn::eigen::EigenSweepReport,
     /// With `critical_speeds`: `v_w`, `v_c` and `v_d` in the speeds' range
     /// (m/s).
     weave_speed: Option<f64>,
@@ -485,9 +473,9 @@ fn eigen_csv(r: &bikedyn::eigen::EigenSweepReport) -> String {
 }
 
 #[derive(Serialize)]
-struct SimulateAnswer<'a> {
+struct SimulateAnswer {
     summary: bikedyn::simulate::SimulationSummary,
     /// The coordinate of each role (`roll`, `steer`, ...).
     roles: BTreeMap<String, &'static str>,
-    simulation: &'a bikedyn::runtime::simulate::Simulation,
+    simulation: bikedyn::runtime::simulate::Simulation,
 }
