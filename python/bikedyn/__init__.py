@@ -337,7 +337,10 @@ class Bicycle:
       with any effect parameters (``c_steer`` ...). The parameter dict of
       bicycleparameters' ``Meijaard2007ParameterSet`` is accepted as it is
       (its speed ``v`` is ignored); ``uncertainties`` ufloats keep their
-      standard deviation.
+      standard deviation. So is the dict of its
+      ``MooreRiderLean2012ParameterSet`` (J. K. Moore's 2012 parameters
+      with a leaning rider; without the rider's keys, ``Moore2012ParameterSet``),
+      converted to the benchmark form and the ``rider_lean`` model's rider.
     * ``name`` names a dict bicycle in messages.
     * ``model`` a generated model to use for every analysis (default: the
       one that represents the bicycle, see ``bikedyn.models()``).

@@ -6,7 +6,7 @@ use crate::registry::BuiltIn;
 use bikedyn_runtime::feedback::GainSchedule;
 use bikedyn_runtime::linearize::LinearizeError;
 use bikedyn_runtime::parameters::{
-    BenchmarkParameters, LoadedSet, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
+    moore, BenchmarkParameters, LoadedSet, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
 };
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 use std::collections::BTreeMap;
@@ -217,7 +217,11 @@ impl<R: ModelRegistry> Bicycle<R> {
     /// parameter dict of bicycleparameters' `Meijaard2007ParameterSet`) or
     /// every thesis symbol, in SI units, plus any effect parameters of
     /// `R`'s models. A value may carry its standard deviation (kept as a
-    /// file's `+/-` is). `v` (the nominal speed some sets carry) is not a
+    /// file's `+/-` is). J. K. Moore's (2012) parameters with a leaning
+    /// rider, the dict of bicycleparameters' `MooreRiderLean2012ParameterSet`
+    /// (or without the rider, `Moore2012ParameterSet`), are read too:
+    /// converted to the benchmark form and the `rider_lean` model's rider
+    /// (see [`moore`]). `v` (the nominal speed some sets carry) is not a
     /// bicycle parameter and is ignored: speeds are given to each analysis.
     /// `name` names the bicycle in messages; errors name the key.
     pub fn from_values_in(name: &str, values: &[(String, f64, Option<f64>)]) -> Result<Bicycle<R>, BicycleError> {
@@ -248,7 +252,10 @@ impl<R: ModelRegistry> Bicycle<R> {
             if effect_names.contains(&key) {
                 check_effect_value_in::<R>(key, *value, name)?;
                 effects.insert(key.to_string(), *value);
-            } else if ThesisParameters::SYMBOLS.contains(&key) || BenchmarkParameters::SYMBOLS.contains(&key) {
+            } else if ThesisParameters::SYMBOLS.contains(&key)
+                || BenchmarkParameters::SYMBOLS.contains(&key)
+                || moore::is_moore_symbol(key)
+            {
                 geometry.push((key, *value));
             } else {
                 return Err(unknown_parameter::<R>(key));
@@ -256,6 +263,50 @@ impl<R: ModelRegistry> Bicycle<R> {
             if let Some(sd) = sd {
                 uncertainties.insert(key.to_string(), *sd);
             }
+        }
+        // J. K. Moore's parameters (bicycleparameters'
+        // `MooreRiderLean2012ParameterSet`): converted to the benchmark form
+        // and the leaning rider's parameters, which join the effects.
+        if moore::is_moore_set(geometry.iter().map(|(k, _)| *k)) {
+            if let Some((k, _)) = geometry.iter().find(|(k, _)| uncertainties.contains_key(*k)) {
+                return Err(bad(
+                    k,
+                    "a standard deviation of Moore's parameters would not reach the converted ones; give nominal values"
+                        .to_string(),
+                ));
+            }
+            let mut text = format!("form = \"{}\"\n", moore::MOORE_FORM);
+            for (k, v) in &geometry {
+                text.push_str(&format!("{k} = {v:?}\n"));
+            }
+            let rider: Vec<&str> = effect_names
+                .iter()
+                .copied()
+                .filter(|n| moore::RIDER_LEAN_PARAMETERS.contains(n))
+                .collect();
+            let (parameters, converted, warnings) = ParameterSet::from_toml_str_with_extra(&text, name, &rider)?;
+            for (k, v) in converted {
+                if effects.contains_key(&k) {
+                    return Err(bad(
+                        &k,
+                        "the leaning rider is given twice: in Moore's keys and in the rider_lean model's; give one of them"
+                            .to_string(),
+                    ));
+                }
+                check_effect_value_in::<R>(&k, v, name)?;
+                effects.insert(k, v);
+            }
+            check_effect_windows_in::<R>(&effects, name)?;
+            refuse_millimetres(&warnings, name)?;
+            return Ok(Bicycle {
+                name: name.to_string(),
+                parameters,
+                warnings,
+                effects,
+                uncertainties,
+                feedback: None,
+                registry: PhantomData,
+            });
         }
         check_effect_windows_in::<R>(&effects, name)?;
         // The form is the one whose symbols are given: a thesis-only symbol

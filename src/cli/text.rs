@@ -86,7 +86,26 @@ pub fn params_show_text(b: &Bicycle, model: Option<&str>) -> Result<String> {
     let info = b.model(model)?;
     let mut s = b.parameters.to_toml_string();
     let effects: Vec<_> = info.parameters.iter().filter(|p| p.effect.is_some()).collect();
+    // The parameters of the bodies the model adds (a leaning rider's),
+    // which neither form's table holds: without them the file would not
+    // read back as the same bicycle.
+    let added: Vec<_> = info
+        .parameters
+        .iter()
+        .enumerate()
+        .filter(|&(i, p)| {
+            p.effect.is_none()
+                && info.forward_speed_parameter != Some(i)
+                && !bikedyn_runtime::parameters::ThesisParameters::SYMBOLS.contains(&p.name)
+        })
+        .map(|(_, p)| p)
+        .collect();
     s += &format!("# model: {} ({})\n", info.name, info.doc);
+    for p in &added {
+        let v = b.effects.get(p.name).copied().or(p.default).unwrap_or(f64::NAN);
+        let line = format!("{} = {v:?}", p.name);
+        s += &format!("{line:<32} # {} [added body]\n", p.doc);
+    }
     if effects.is_empty() {
         s += "# this model has no effect parameters (see `bikedyn models`)\n";
     }

@@ -9,5 +9,6 @@ mod free_speed;
 mod frequency_response;
 mod leaning_rider;
 mod library_jobs;
+mod moore_rider_lean;
 mod real_designs;
 mod sensitivity;

@@ -257,7 +257,7 @@ pub enum ParameterError {
     },
 
     /// `form = "..."` names neither form.
-    #[error("{}:{line}: `form` must be \"thesis\" or \"benchmark\", found \"{value}\"", path.display())]
+    #[error("{}:{line}: `form` must be \"thesis\", \"benchmark\" or \"MooreRiderLean2012\", found \"{value}\"", path.display())]
     InvalidForm {
         /// The file.
         path: PathBuf,
@@ -325,6 +325,19 @@ pub enum ParameterError {
         value: f64,
         /// File and line, when read from a file.
         origin: Origin,
+    },
+
+    /// A set in J. K. Moore's (2012) parameters (bicycleparameters'
+    /// `MooreRiderLean2012ParameterSet`, or `Moore2012ParameterSet` without
+    /// the rider) that cannot be read or converted.
+    #[error("{}{}: {why} (read as J. K. Moore's 2012 parameters, bicycleparameters' MooreRiderLean2012ParameterSet)", path.display(), fmt_line(*line))]
+    MooreSet {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line of the key at fault, when there is one.
+        line: Option<usize>,
+        /// What is wrong.
+        why: String,
     },
 
     /// A parameter set was of the other form than the one required.
@@ -459,7 +472,7 @@ impl ParameterError {
     /// The 1-based line the error is about, if it has one.
     pub fn line(&self) -> Option<usize> {
         match self {
-            ParameterError::Toml { line, .. } => *line,
+            ParameterError::Toml { line, .. } | ParameterError::MooreSet { line, .. } => *line,
             ParameterError::Syntax { line, .. }
             | ParameterError::UnknownField { line, .. }
             | ParameterError::RawMeasurementFile { line, .. }

@@ -12,6 +12,7 @@ use toml::Spanned;
 use crate::feedback::{GainSchedule, GAIN_NAMES};
 use nalgebra::Matrix2x4;
 
+use super::moore::{self, MOORE_FORM};
 use super::{BenchmarkParameters, MeasuredBenchmark, ParameterError, ParameterWarning, ThesisParameters};
 
 /// Which parameterization a set uses.
@@ -65,6 +66,12 @@ impl Form {
 /// known; the thesis `d4` may be omitted (it defaults to 0). Loading validates
 /// the set and returns the warnings beside it.
 ///
+/// A file of J. K. Moore's (2012) parameters (bicycleparameters'
+/// `MooreRiderLean2012ParameterSet`; TOML or text, told by its keys or
+/// `form = "MooreRiderLean2012"`) is converted on reading to the benchmark
+/// form, its leaning rider to the `rider_lean` model's parameters, returned
+/// with the extra symbols ([`super::moore`]).
+///
 /// ```
 /// use bikedyn_runtime::parameters::{ParameterSet, ThesisParameters};
 /// let text = ThesisParameters::thesis_bicycle().to_toml_string();
@@ -108,6 +115,8 @@ impl ParameterSet {
         let text = read(path)?;
         if is_toml(path, &text) {
             Self::from_toml_str(&text, path)
+        } else if super::text::text_is_moore(&text) {
+            Self::from_file_text_with_extra(&text, path, &[]).map(|l| (l.set, l.warnings))
         } else {
             Self::from_text_str(&text, path)
         }
@@ -137,6 +146,18 @@ impl ParameterSet {
             .iter()
             .filter_map(|&e| fields.values.remove(e).map(|(v, _)| (e.to_string(), v)))
             .collect();
+        if fields.moore {
+            // J. K. Moore's parameters: the benchmark set they convert to,
+            // the leaning rider's parameters joined to the extras.
+            let conversion = moore::convert(&fields.values, path)?;
+            let mut extras = extras;
+            moore::join_rider(&conversion, &mut extras, extra, path)?;
+            return Ok((
+                ParameterSet::Benchmark(conversion.benchmark),
+                extras,
+                conversion.warnings,
+            ));
+        }
         let line_of = |f: &str| fields.values.get(f).map(|&(_, line)| line);
         let symbols: &[&str] = match fields.form {
             Form::Thesis => &ThesisParameters::SYMBOLS,
@@ -197,6 +218,14 @@ impl ParameterSet {
                 uncertainties: BTreeMap::new(),
                 warnings,
                 feedback,
+            })
+        } else if super::text::text_is_moore(&text) {
+            super::text::moore_from_text_str_with_extra(&text, path, extra).map(|(set, effects, warnings)| LoadedSet {
+                set: ParameterSet::Benchmark(set),
+                effects,
+                uncertainties: BTreeMap::new(),
+                warnings,
+                feedback: None,
             })
         } else {
             MeasuredBenchmark::from_text_str_with_extra(&text, path, extra).map(|(m, effects, warnings)| LoadedSet {
@@ -436,6 +465,9 @@ fn write_toml(
 /// The numeric fields of a TOML parameter table, with their lines.
 struct TomlFields {
     form: Form,
+    /// J. K. Moore's (2012) parameters (by their keys or `form`), read
+    /// under his names; `form` is then the benchmark form they convert to.
+    moore: bool,
     values: BTreeMap<String, (f64, usize)>,
 }
 
@@ -504,7 +536,12 @@ fn parse_toml_fields(text: &str, path: &Path, extra: &[&str]) -> Result<TomlFiel
         forced = Some(form_value(k, v, path, text)?);
     }
 
+    let moore = match &forced {
+        Some((name, _)) => name == MOORE_FORM,
+        None => moore::is_moore_set(entries.iter().map(|(k, _)| -> &str { k.get_ref() })),
+    };
     let form = match forced {
+        _ if moore => Form::Benchmark,
         Some((name, l)) => Form::from_name(&name).ok_or(ParameterError::InvalidForm {
             path: pb(),
             line: l,
@@ -520,12 +557,24 @@ fn parse_toml_fields(text: &str, path: &Path, extra: &[&str]) -> Result<TomlFiel
         if name == "form" || (name == "feedback" && matches!(v.get_ref(), DeValue::Table(_))) {
             continue;
         }
-        if !form.symbols().contains(&name) && !extra.contains(&name) {
+        let known = if moore {
+            moore::is_moore_symbol(name)
+        } else {
+            form.symbols().contains(&name)
+        };
+        if !known && !extra.contains(&name) {
             return Err(ParameterError::UnknownField {
                 path: pb(),
                 line: l,
                 field: name.to_string(),
                 why: match (form, extra.is_empty()) {
+                    _ if moore => "not one of Moore's (2012) keys nor an effect parameter (see `bikedyn params show`)",
+                    // A key of Moore's among another form's: say why it is
+                    // not read as his (basu_mandal2007.toml mixes them).
+                    _ if moore::is_moore_symbol(name) => {
+                        "a key of J. K. Moore's 2012 parameters (bicycleparameters' MooreRiderLean2012ParameterSet), \
+                         which a file gives alone, without benchmark or thesis symbols; this file has those"
+                    }
                     (Form::Thesis, true) => "not a thesis-form symbol",
                     (Form::Benchmark, true) => "not a benchmark-form symbol",
                     (Form::Thesis, false) => {
@@ -560,7 +609,7 @@ fn parse_toml_fields(text: &str, path: &Path, extra: &[&str]) -> Result<TomlFiel
         })?;
         values.insert(name.to_string(), (value, l));
     }
-    Ok(TomlFields { form, values })
+    Ok(TomlFields { form, moore, values })
 }
 
 fn form_value(
@@ -576,7 +625,7 @@ fn form_value(
             path: path.to_path_buf(),
             line: l,
             field: "form".to_string(),
-            expected: "\"thesis\" or \"benchmark\"",
+            expected: "\"thesis\", \"benchmark\" or \"MooreRiderLean2012\"",
             found: toml_type(other),
         }),
     }

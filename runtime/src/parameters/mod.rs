@@ -10,6 +10,10 @@
 //!   or forced with `form = "..."`) and the benchmark text files of
 //!   BicycleParameters / HumanControl ([`MeasuredBenchmark`] keeps their
 //!   `+/-` uncertainties).
+//! - J. K. Moore's (2012) parameters with a leaning rider, as
+//!   bicycleparameters names them (`MooreRiderLean2012ParameterSet`), in
+//!   either file format: told by their keys and converted on reading to the
+//!   benchmark form and the `rider_lean` model's rider ([`moore`]).
 //! - `validate()`: errors ([`ParameterError`]) for non-finite values,
 //!   non-positive masses/radii/inertias and non-positive-definite tensors;
 //!   warnings ([`ParameterWarning`]) for principal moments that violate the
@@ -32,6 +36,7 @@ mod convert;
 pub use convert::thesis_to_benchmark_in;
 mod error;
 mod load;
+pub mod moore;
 mod text;
 mod thesis;
 mod validate;

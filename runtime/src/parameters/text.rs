@@ -122,31 +122,16 @@ impl MeasuredBenchmark {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         for (index, raw) in text.lines().enumerate() {
             let line = index + 1;
-            let content = raw.split('#').next().unwrap_or("").trim();
-            if content.is_empty() {
+            let Some((name, value, std)) = parse_line(raw, line, path)? else {
                 continue;
-            }
+            };
+            let name = name.as_str();
             let syntax = |reason: String| ParameterError::Syntax {
                 path: pb(),
                 line,
                 text: super::error::cut(raw.trim(), 80),
                 reason: super::error::cut(&reason, 160),
             };
-            let Some((name, rhs)) = content.split_once('=') else {
-                return Err(syntax("expected `name = value`".to_string()));
-            };
-            let name = name.trim();
-            if !is_identifier(name) {
-                return Err(syntax(format!("`{name}` is not a parameter name")));
-            }
-            let (nominal, std) = match rhs.split_once("+/-") {
-                Some((n, s)) => (n, Some(s)),
-                None => (rhs, None),
-            };
-            let value = evaluate(nominal).map_err(|r| syntax(format!("value: {r}")))?;
-            let std = std
-                .map(|s| evaluate(s).map_err(|r| syntax(format!("uncertainty: {r}"))))
-                .transpose()?;
             if let Some(&(_, first_line)) = values.get(name) {
                 return Err(ParameterError::DuplicateField {
                     path: pb(),
@@ -233,6 +218,112 @@ impl MeasuredBenchmark {
     pub fn uncertainty(&self, symbol: &str) -> Option<f64> {
         self.uncertainties.get(symbol).copied()
     }
+}
+
+/// One line of a text file: `None` for a blank or comment line, else its
+/// name, value and `+/-` uncertainty (not yet checked).
+#[allow(clippy::type_complexity)]
+fn parse_line(raw: &str, line: usize, path: &Path) -> Result<Option<(String, f64, Option<f64>)>, ParameterError> {
+    let content = raw.split('#').next().unwrap_or("").trim();
+    if content.is_empty() {
+        return Ok(None);
+    }
+    let syntax = |reason: String| ParameterError::Syntax {
+        path: path.to_path_buf(),
+        line,
+        text: super::error::cut(raw.trim(), 80),
+        reason: super::error::cut(&reason, 160),
+    };
+    let Some((name, rhs)) = content.split_once('=') else {
+        return Err(syntax("expected `name = value`".to_string()));
+    };
+    let name = name.trim();
+    if !is_identifier(name) {
+        return Err(syntax(format!("`{name}` is not a parameter name")));
+    }
+    let (nominal, std) = match rhs.split_once("+/-") {
+        Some((n, s)) => (n, Some(s)),
+        None => (rhs, None),
+    };
+    let value = evaluate(nominal).map_err(|r| syntax(format!("value: {r}")))?;
+    let std = std
+        .map(|s| evaluate(s).map_err(|r| syntax(format!("uncertainty: {r}"))))
+        .transpose()?;
+    Ok(Some((name.to_string(), value, std)))
+}
+
+/// Whether a text file holds J. K. Moore's (2012) parameters
+/// ([`super::moore::is_moore_set`] of its names).
+pub(crate) fn text_is_moore(text: &str) -> bool {
+    let names = text.lines().filter_map(|raw| {
+        let content = raw.split('#').next().unwrap_or("").trim();
+        content.split_once('=').map(|(n, _)| n.trim())
+    });
+    super::moore::is_moore_set(names)
+}
+
+/// A text file of J. K. Moore's (2012) parameters (`name = value` per
+/// line, as for the benchmark text form), with the `accepted` names (effect
+/// and leaning-rider parameters) beside them: the converted benchmark set,
+/// the accepted values given with the rider's converted parameters added,
+/// and the warnings. Uncertainties (`+/-`) are refused: they would not
+/// reach the converted parameters.
+#[allow(clippy::type_complexity)]
+pub(crate) fn moore_from_text_str_with_extra(
+    text: &str,
+    path: &Path,
+    accepted: &[&str],
+) -> Result<(BenchmarkParameters, BTreeMap<String, f64>, Vec<ParameterWarning>), ParameterError> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut values: BTreeMap<String, (f64, usize)> = BTreeMap::new();
+    let mut accepted_values = BTreeMap::new();
+    for (index, raw) in text.lines().enumerate() {
+        let line = index + 1;
+        let Some((name, value, std)) = parse_line(raw, line, path)? else {
+            continue;
+        };
+        if let Some(&(_, first_line)) = values.get(&name) {
+            return Err(ParameterError::DuplicateField {
+                path: path.to_path_buf(),
+                line,
+                first_line,
+                field: name,
+            });
+        }
+        if std.is_some() {
+            return Err(ParameterError::MooreSet {
+                path: path.to_path_buf(),
+                line: Some(line),
+                why: format!(
+                    "`{name}` has an uncertainty (`+/-`), which the conversion to the benchmark form would not carry; give nominal values"
+                ),
+            });
+        }
+        if accepted.contains(&name.as_str()) {
+            if !value.is_finite() {
+                return Err(ParameterError::NotFinite {
+                    field: name,
+                    value,
+                    origin: super::Origin::new(path, Some(line)),
+                });
+            }
+            accepted_values.insert(name.clone(), value);
+        } else if !super::moore::is_moore_symbol(&name) {
+            return Err(ParameterError::UnknownField {
+                path: path.to_path_buf(),
+                line,
+                field: name,
+                why: "not one of Moore's (2012) keys nor an effect parameter (see `bikedyn params show`)",
+            });
+        }
+        values.insert(name, (value, line));
+    }
+    for k in accepted_values.keys() {
+        values.remove(k);
+    }
+    let conversion = super::moore::convert(&values, path)?;
+    super::moore::join_rider(&conversion, &mut accepted_values, accepted, path)?;
+    Ok((conversion.benchmark, accepted_values, conversion.warnings))
 }
 
 fn is_identifier(name: &str) -> bool {
