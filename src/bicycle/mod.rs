@@ -267,7 +267,7 @@ impl<R: ModelRegistry> Bicycle<R> {
         // J. K. Moore's parameters (bicycleparameters'
         // `MooreRiderLean2012ParameterSet`): converted to the benchmark form
         // and the leaning rider's parameters, which join the effects.
-        if moore::is_moore_set(geometry.iter().map(|(k, _)| *k)) {
+        let (parameters, warnings) = if moore::is_moore_set(geometry.iter().map(|(k, _)| *k)) {
             if let Some((k, _)) = geometry.iter().find(|(k, _)| uncertainties.contains_key(*k)) {
                 return Err(bad(
                     k,
@@ -296,29 +296,22 @@ impl<R: ModelRegistry> Bicycle<R> {
                 check_effect_value_in::<R>(&k, v, name)?;
                 effects.insert(k, v);
             }
-            check_effect_windows_in::<R>(&effects, name)?;
-            refuse_millimetres(&warnings, name)?;
-            return Ok(Bicycle {
-                name: name.to_string(),
-                parameters,
-                warnings,
-                effects,
-                uncertainties,
-                feedback: None,
-                registry: PhantomData,
-            });
-        }
+            (parameters, warnings)
+        } else {
+            // The form is the one whose symbols are given: a thesis-only
+            // symbol makes it the thesis form (the two share `g` and a few
+            // names).
+            let thesis = geometry
+                .iter()
+                .any(|(k, _)| ThesisParameters::SYMBOLS.contains(k) && !BenchmarkParameters::SYMBOLS.contains(k));
+            let mut text = format!("form = \"{}\"\n", if thesis { "thesis" } else { "benchmark" });
+            for (k, v) in &geometry {
+                text.push_str(&format!("{k} = {v:?}\n"));
+            }
+            let (parameters, _, warnings) = ParameterSet::from_toml_str_with_extra(&text, name, &[])?;
+            (parameters, warnings)
+        };
         check_effect_windows_in::<R>(&effects, name)?;
-        // The form is the one whose symbols are given: a thesis-only symbol
-        // makes it the thesis form (the two share `g` and a few names).
-        let thesis = geometry
-            .iter()
-            .any(|(k, _)| ThesisParameters::SYMBOLS.contains(k) && !BenchmarkParameters::SYMBOLS.contains(k));
-        let mut text = format!("form = \"{}\"\n", if thesis { "thesis" } else { "benchmark" });
-        for (k, v) in &geometry {
-            text.push_str(&format!("{k} = {v:?}\n"));
-        }
-        let (parameters, _, warnings) = ParameterSet::from_toml_str_with_extra(&text, name, &[])?;
         refuse_millimetres(&warnings, name)?;
         Ok(Bicycle {
             name: name.to_string(),
