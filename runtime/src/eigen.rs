@@ -669,6 +669,35 @@ fn pair_rule(z: &[C64; 4], mut l: [Mode; 4]) -> [Mode; 4] {
     l
 }
 
+/// Whether the roots moved by a finite amount over a vanishing speed step:
+/// a model with extra states (see [`StateSpaceBicycle`]) chooses its four
+/// bicycle modes from a larger spectrum at each speed, and where a bicycle
+/// mode merges with an extra one (a leaning rider's lean with capsize, or
+/// with castering) the chosen four change at once. (Roots that only collide
+/// move by the square root of the step, 1e-6 of their size at most; the
+/// threshold 1e-3 lies between.) The quartic's roots of a second-order model
+/// are continuous in speed and never jump.
+fn jumped(prev: &[C64; 4], new: &[C64; 4]) -> bool {
+    let size = prev.iter().chain(new).map(|z| z.norm()).fold(1.0, f64::max);
+    let moved = (0..4).map(|k| (prev[k] - new[k]).norm()).fold(0.0, f64::max);
+    moved > 1e-3 * size
+}
+
+/// The anchor's pattern (one complex pair, two real roots) in any order of
+/// the roots: the pair is the weave, the larger real root capsize and the
+/// smaller castering.
+fn classify_pattern(z: &[C64; 4]) -> Option<[Mode; 4]> {
+    let mut idx = [0usize, 1, 2, 3];
+    idx.sort_by(|&i, &j| z[j].re.total_cmp(&z[i].re).then(z[j].im.total_cmp(&z[i].im)));
+    let sorted: [C64; 4] = std::array::from_fn(|k| z[idx[k]]);
+    let l = classify_anchor(&sorted)?;
+    let mut out = [Mode::Weave; 4];
+    for k in 0..4 {
+        out[idx[k]] = l[k];
+    }
+    Some(out)
+}
+
 /// Continue labelled roots from `v0` (>= 0) to `v1` (>= 0) adaptively.
 fn continue_to<S: Spectrum + ?Sized>(cp: &S, start: Labelled, v0: f64, v1: f64) -> Result<Labelled, EigenError> {
     let mut cur = start;
@@ -694,10 +723,14 @@ fn continue_to<S: Spectrum + ?Sized>(cp: &S, start: Labelled, v0: f64, v1: f64) 
         let z = cp.roots_at(vt)?;
         let (m, ok) = match_roots(&cur, &z);
         if ok || h.abs() <= hmin {
-            cur = Labelled {
-                roots: m,
-                labels: pair_rule(&m, cur.labels),
+            // A jump is no continuation: the labels start again from the
+            // pattern of the roots where it applies.
+            let labels = if !ok && jumped(&cur.roots, &m) {
+                classify_pattern(&m).unwrap_or_else(|| pair_rule(&m, cur.labels))
+            } else {
+                pair_rule(&m, cur.labels)
             };
+            cur = Labelled { roots: m, labels };
             v = vt;
             h *= 2.0;
             if h.abs() > (v1 - v).abs() && v != v1 {

@@ -324,6 +324,12 @@ fn the_command_line_runs_moores_set_through_the_leaning_rider_model() {
     let band = &stability["stable_intervals"][0];
     let (from, to) = (band[0].as_f64().unwrap(), band[1].as_f64().unwrap());
     assert!((3.0..5.0).contains(&from) && (5.0..7.0).contains(&to), "{stability}");
+    // Those crossings are the weave's and capsize's (Meijaard et al. 2007's
+    // definitions: the oscillatory mode turning stable, the real root
+    // turning unstable), whatever the rider's lean does between them (its
+    // slow root merges with capsize near 5.5 m/s).
+    assert!((stability["weave_speed"].as_f64().unwrap() - from).abs() < 1e-9, "{stability}");
+    assert!((stability["capsize_speed"].as_f64().unwrap() - to).abs() < 1e-9, "{stability}");
     // `params show` writes the converted bicycle, the rider's keys with
     // it, as a file that reads back as the same bicycle.
     let shown = text(&bikedyn(&["params", "show", "--bike", &fixture_arg(FIXTURE)]).stdout);
@@ -338,4 +344,35 @@ fn the_command_line_runs_moores_set_through_the_leaning_rider_model() {
     let band_again = &again["stable_intervals"][0];
     assert!((band_again[0].as_f64().unwrap() - from).abs() < 1e-9, "{again}");
     assert!((band_again[1].as_f64().unwrap() - to).abs() < 1e-9, "{again}");
+}
+
+#[test]
+fn moores_leaning_rider_modes_are_named_as_the_rigid_riders_are() {
+    // Below the weave speed the oscillatory pair is the weave, the larger
+    // real root capsize; at standstill the weave is the two positive real
+    // roots that merge into it (as on the benchmark bicycle), and above
+    // the capsize speed the root that crossed is capsize.
+    let eig = ok_json(&["eig", "--bike", &fixture_arg(FIXTURE), "--speeds", "0:8:0.5", "--json"]);
+    let points = eig.as_array().unwrap_or_else(|| panic!("{eig}"));
+    for p in points {
+        let v = p["v"].as_f64().unwrap();
+        let modes: Vec<&str> = p["modes"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
+        let values: Vec<(f64, f64)> = p["eigenvalues"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|z| (z[0].as_f64().unwrap(), z[1].as_f64().unwrap()))
+            .collect();
+        let weave: Vec<(f64, f64)> = (0..4).filter(|&k| modes[k] == "weave").map(|k| values[k]).collect();
+        assert_eq!(weave.len(), 2, "{v} m/s: {modes:?} {values:?}");
+        if v == 0.0 {
+            assert!(weave.iter().all(|z| z.0 > 0.0 && z.1 == 0.0), "{v} m/s: {modes:?} {values:?}");
+        } else if (1.0..=5.0).contains(&v) {
+            assert!(weave.iter().all(|z| z.1 != 0.0), "{v} m/s: {modes:?} {values:?}");
+            assert!(modes.contains(&"capsize") && modes.contains(&"castering"), "{v} m/s: {modes:?}");
+        } else if v >= 7.0 {
+            let k = modes.iter().position(|m| *m == "capsize").unwrap_or_else(|| panic!("{v} m/s: {modes:?}"));
+            assert!(values[k].0 > 0.0 && values[k].1 == 0.0, "{v} m/s: {modes:?} {values:?}");
+        }
+    }
 }

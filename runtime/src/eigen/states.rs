@@ -16,7 +16,11 @@
 //! steer in it than the weave at higher speeds, but it lives on the tyre
 //! forces.) The bicycle's modes are labelled and tracked as in
 //! [`crate::eigen`] (through their characteristic quartic) and give the weave
-//! and capsize speeds. Every other eigenvalue is an extra mode. Crossings
+//! and capsize speeds. Where a bicycle mode merges with an extra one (a
+//! leaning rider's slow lean with capsize, the fast lean with castering),
+//! the chosen four change at once; the tracking does not carry labels across
+//! such a jump but names the roots again by their pattern (the complex pair
+//! is the weave, the larger real root capsize). Every other eigenvalue is an extra mode. Crossings
 //! are found on the whole spectrum (where the count of eigenvalues with
 //! positive real part changes) and labelled by the root that crosses; an
 //! extra mode's is `Other(EXTRA)`.
