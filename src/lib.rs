@@ -36,6 +36,9 @@ pub mod models;
 pub mod monte_carlo;
 pub mod progress;
 pub mod sensitivity;
+/// `bikedyn serve` (not in the WebAssembly build: no sockets there).
+#[cfg(not(target_arch = "wasm32"))]
+pub mod serve;
 pub mod simulate;
 pub mod stability;
 pub mod sweep;

@@ -38,6 +38,7 @@ fn run(cli: Cli) -> Result<bool> {
             json,
         } => cli::verify::run(model, states, seed, json),
         Command::Models { json } => cli::models::run(json),
+        Command::Serve { dir, port } => cli::serve::run(dir, port),
         Command::Canonical { bike, speeds, json } => cli::canonical::run(bike, speeds, json),
         Command::Eig {
             bike,

@@ -128,6 +128,17 @@ pub enum Command {
         #[arg(long, default_value = "bikedyn-report")]
         out: PathBuf,
     },
+    /// The stability explorer in the browser: serve wasm/explorer/ on this
+    /// machine (127.0.0.1) and print its address. Build its module first
+    /// with `bash wasm/build.sh`.
+    Serve {
+        /// The explorer folder.
+        #[arg(long, default_value = "wasm/explorer")]
+        dir: PathBuf,
+        /// Port on 127.0.0.1 (0: a free one).
+        #[arg(long, default_value_t = 8000)]
+        port: u16,
+    },
     /// List the generated models: coordinates, parameters and effects.
     Models {
         /// JSON output: a list of {name, doc, base, free_speed, effects, coordinates, parameters}.

@@ -18,6 +18,7 @@ pub mod params;
 mod progress;
 pub mod report;
 pub mod sensitivity;
+pub mod serve;
 pub mod simulate;
 pub mod stability;
 pub mod sweep;

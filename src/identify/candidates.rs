@@ -126,6 +126,21 @@ pub fn candidates<R: ModelRegistry>(
             .filter(|f| !f.shape)
             .any(|f| bike.effects.get(f.symbol).is_some_and(|&v| v != 0.0));
         if declared_by_bike || (speed_imposed && d.speed_decay) {
+            // Asked for by name, it is not dropped without a word.
+            if only.iter().any(|o| o == effect) {
+                return Err(IdentifyError::ExcludedCandidate {
+                    effect: effect.to_string(),
+                    reason: if declared_by_bike {
+                        format!(
+                            "the bicycle `{}` sets its parameters (a known input of the experiment, not something to find)",
+                            bike.name
+                        )
+                    } else {
+                        "the runs' speed is imposed (a motor held it), so a loss of speed has nothing to explain"
+                            .to_string()
+                    },
+                });
+            }
             continue;
         }
         let unit = |sym: &str| {

@@ -23,6 +23,10 @@ pub enum IdentifyError {
     /// An effect asked for is not a candidate of the identification models.
     #[error("--effects: `{effect}` is not a candidate effect of the identification models ({})", known.join(", "))]
     NotACandidate { effect: String, known: Vec<&'static str> },
+    /// An effect asked for is not something to find in these runs: the
+    /// bicycle file declares it, or the logs' speed is imposed.
+    #[error("--effects: `{effect}` is not a candidate here: {reason}")]
+    ExcludedCandidate { effect: String, reason: String },
     /// An effect asked for cannot be tried from an eigenvalue table.
     #[error(
         "--effects: `{effect}` cannot be tried from an eigenvalue table ({reason}); effects that can: {}",

@@ -7,4 +7,5 @@ mod inputs_and_outputs;
 mod plots;
 mod reliability;
 mod sensitivity_and_bode;
+mod serve;
 mod user_files;

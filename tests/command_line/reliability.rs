@@ -428,7 +428,13 @@ fn an_identify_report_is_checked_first_and_replaced_whole() {
     // The file handling is under test, not the search: one candidate.
     let quick = ["--effects", "steer_damping", "--corrections", "0", "--no-discover"];
     let earlier = tmp("report-earlier");
-    let out = bikedyn(&[&["identify", set.to_str().unwrap(), "--report", earlier.to_str().unwrap()], &quick[..]].concat());
+    let out = bikedyn(
+        &[
+            &["identify", set.to_str().unwrap(), "--report", earlier.to_str().unwrap()],
+            &quick[..],
+        ]
+        .concat(),
+    );
     assert!(out.status.success(), "{}", text(&out.stderr));
     // An earlier report with a plot this one does not draw (listed among
     // the files bikedyn wrote, as a report of another version would be).
@@ -436,7 +442,13 @@ fn an_identify_report_is_checked_first_and_replaced_whole() {
     let marker = earlier.join(".bikedyn-output");
     let listed = std::fs::read_to_string(&marker).unwrap() + "stale_plot.svg\n";
     std::fs::write(&marker, listed).unwrap();
-    let out = bikedyn(&[&["identify", set.to_str().unwrap(), "--report", earlier.to_str().unwrap()], &quick[..]].concat());
+    let out = bikedyn(
+        &[
+            &["identify", set.to_str().unwrap(), "--report", earlier.to_str().unwrap()],
+            &quick[..],
+        ]
+        .concat(),
+    );
     assert!(out.status.success(), "{}", text(&out.stderr));
     let files = entries(&earlier);
     assert!(

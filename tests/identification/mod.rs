@@ -628,56 +628,6 @@ fn a_higher_front_mass_centre_is_corrected_as_a_whole() {
     }
 }
 
-/// The TU Delft steer-by-wire logs (`../shared/realdata/tudelft_sbw_kicks`,
-/// four logs, about a hundred kicks) with their bicycle file, whose assist
-/// is a declared input: identify reads them with the roll rate and the
-/// fork angle as channels and the measured speed imposed, never proposes
-/// the declared controller as a candidate, cross-validates by log (each
-/// log predicted with the values fitted to the other three), and whatever
-/// it selects does not make any held-out error worse than the base model's.
-#[test]
-fn the_tudelft_logs_are_identified_with_their_assist_declared() {
-    let Some(dir) = shared("realdata/tudelft_sbw_kicks") else {
-        return;
-    };
-    let logs = dir.join("logs");
-    let bike = dir.join("bicycle.toml");
-    // (The dictionary's searches beyond the library are not what this
-    // test checks, and through the nonlinear fits of about a hundred kicks
-    // they would double its time.)
-    let v = ok_json(&[
-        "identify",
-        logs.to_str().unwrap(),
-        "--bike",
-        bike.to_str().unwrap(),
-        "--no-discover",
-        "--json",
-    ]);
-    assert_eq!(v["speed_imposed"], true);
-    assert_eq!(v["roll_channel"], "rate");
-    assert_eq!(v["folds"], 4, "one fold per log");
-    let kicks = v["kicks"].as_u64().unwrap();
-    assert!(kicks >= 60, "{kicks} kicks");
-    for c in v["candidates"].as_array().unwrap() {
-        let name = c["name"].as_str().unwrap();
-        assert!(
-            !["steer_controller", "rolling_resistance", "aero_drag"].contains(&name),
-            "{name} is not a candidate here"
-        );
-    }
-    let (b, a) = (&v["error_before"]["held_out"], &v["error_after"]["held_out"]);
-    for k in ["roll_rms", "steer_rms"] {
-        let (b, a) = (b[k].as_f64().unwrap(), a[k].as_f64().unwrap());
-        assert!(a <= b * (1.0 + 1e-9), "held-out {k} {b} -> {a}");
-    }
-    // The pooled eigenvalue error counts weave fits only, with reasons for
-    // the others.
-    let excluded = v["eigen_excluded"].as_array().unwrap();
-    assert!(excluded.iter().all(|e| !e["reason"].as_str().unwrap().is_empty()));
-    let eig = v["error_before"]["eigen_rms"].as_f64().unwrap();
-    assert!(eig.is_finite() && eig < 10.0, "weave eigenvalue RMS {eig}");
-}
-
 /// `identify --eigenvalues`: effects fitted to a table of measured weave
 /// eigenvalues (no time series), with a header row in the authors' own
 /// words and semicolons. A table of the thesis bicycle with steer damping

@@ -328,8 +328,14 @@ fn the_command_line_runs_moores_set_through_the_leaning_rider_model() {
     // definitions: the oscillatory mode turning stable, the real root
     // turning unstable), whatever the rider's lean does between them (its
     // slow root merges with capsize near 5.5 m/s).
-    assert!((stability["weave_speed"].as_f64().unwrap() - from).abs() < 1e-9, "{stability}");
-    assert!((stability["capsize_speed"].as_f64().unwrap() - to).abs() < 1e-9, "{stability}");
+    assert!(
+        (stability["weave_speed"].as_f64().unwrap() - from).abs() < 1e-9,
+        "{stability}"
+    );
+    assert!(
+        (stability["capsize_speed"].as_f64().unwrap() - to).abs() < 1e-9,
+        "{stability}"
+    );
     // `params show` writes the converted bicycle, the rider's keys with
     // it, as a file that reads back as the same bicycle.
     let shown = text(&bikedyn(&["params", "show", "--bike", &fixture_arg(FIXTURE)]).stdout);
@@ -356,7 +362,12 @@ fn moores_leaning_rider_modes_are_named_as_the_rigid_riders_are() {
     let points = eig.as_array().unwrap_or_else(|| panic!("{eig}"));
     for p in points {
         let v = p["v"].as_f64().unwrap();
-        let modes: Vec<&str> = p["modes"].as_array().unwrap().iter().map(|m| m.as_str().unwrap()).collect();
+        let modes: Vec<&str> = p["modes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|m| m.as_str().unwrap())
+            .collect();
         let values: Vec<(f64, f64)> = p["eigenvalues"]
             .as_array()
             .unwrap()
@@ -366,12 +377,21 @@ fn moores_leaning_rider_modes_are_named_as_the_rigid_riders_are() {
         let weave: Vec<(f64, f64)> = (0..4).filter(|&k| modes[k] == "weave").map(|k| values[k]).collect();
         assert_eq!(weave.len(), 2, "{v} m/s: {modes:?} {values:?}");
         if v == 0.0 {
-            assert!(weave.iter().all(|z| z.0 > 0.0 && z.1 == 0.0), "{v} m/s: {modes:?} {values:?}");
+            assert!(
+                weave.iter().all(|z| z.0 > 0.0 && z.1 == 0.0),
+                "{v} m/s: {modes:?} {values:?}"
+            );
         } else if (1.0..=5.0).contains(&v) {
             assert!(weave.iter().all(|z| z.1 != 0.0), "{v} m/s: {modes:?} {values:?}");
-            assert!(modes.contains(&"capsize") && modes.contains(&"castering"), "{v} m/s: {modes:?}");
+            assert!(
+                modes.contains(&"capsize") && modes.contains(&"castering"),
+                "{v} m/s: {modes:?}"
+            );
         } else if v >= 7.0 {
-            let k = modes.iter().position(|m| *m == "capsize").unwrap_or_else(|| panic!("{v} m/s: {modes:?}"));
+            let k = modes
+                .iter()
+                .position(|m| *m == "capsize")
+                .unwrap_or_else(|| panic!("{v} m/s: {modes:?}"));
             assert!(values[k].0 > 0.0 && values[k].1 == 0.0, "{v} m/s: {modes:?} {values:?}");
         }
     }

@@ -239,9 +239,12 @@
       app.state.model = $("model").value;
       schedule();
     });
-    $("file").addEventListener("change", async () => {
+    // Reading a file is asynchronous: `app.importing` is the import in
+    // flight, for whoever must wait for it (the self-test; a slow machine
+    // reads a file later than any fixed wait).
+    $("file").addEventListener("change", () => {
       const f = $("file").files[0];
-      if (f) app.importFile({ name: f.name, text: await f.text() });
+      if (f) app.importing = f.text().then((text) => app.importFile({ name: f.name, text }));
       $("file").value = "";
     });
     const drop = $("drop");
@@ -252,11 +255,11 @@
     document.addEventListener("dragleave", (e) => {
       if (!e.relatedTarget) drop.classList.remove("over");
     });
-    document.addEventListener("drop", async (e) => {
+    document.addEventListener("drop", (e) => {
       e.preventDefault();
       drop.classList.remove("over");
       const f = e.dataTransfer && e.dataTransfer.files[0];
-      if (f) app.importFile({ name: f.name, text: await f.text() });
+      if (f) app.importing = f.text().then((text) => app.importFile({ name: f.name, text }));
     });
     $("reset-all").addEventListener("click", () => {
       app.state.edits = {};

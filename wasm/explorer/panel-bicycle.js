@@ -17,7 +17,41 @@
     $("warnings").textContent = w.map((x) => `warning: ${x}`).join("\n");
     renderParams();
     renderDerived();
+    renderFeedback();
     syncEffects();
+  }
+
+  // The file's [feedback] gain schedule, read only: a gain per row (its
+  // name as in the file, e.g. kTdel_phid = steer torque from roll rate),
+  // a knot speed per column.
+  function renderFeedback() {
+    const f = app.current && app.current.feedback;
+    $("feedback").hidden = !f;
+    const table = $("feedback-table");
+    table.tHead.innerHTML = "";
+    table.tBodies[0].innerHTML = "";
+    if (!f) return;
+    const head = document.createElement("tr");
+    for (const t of ["gain", ...f.speeds.map((v) => `${sig(v, 4)} m/s`)]) {
+      const th = document.createElement("th");
+      th.textContent = t;
+      head.appendChild(th);
+    }
+    table.tHead.appendChild(head);
+    for (const [name, values] of f.gains) {
+      const tr = document.createElement("tr");
+      const td = document.createElement("td");
+      td.className = "sym";
+      td.textContent = name;
+      tr.appendChild(td);
+      for (const v of values) {
+        const c = document.createElement("td");
+        c.className = "num";
+        c.textContent = sig(v, 5);
+        tr.appendChild(c);
+      }
+      table.tBodies[0].appendChild(tr);
+    }
   }
 
   function renderParams() {

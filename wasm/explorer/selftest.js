@@ -36,6 +36,13 @@
         check(input && Number(input.value) === v && det.querySelector("input[type=checkbox]").checked, `the link's effect ${k} = ${v} is not on`);
       }
       check(Math.abs(Number($("speed").value) - given.speed) < 1e-9, `the slider is at ${$("speed").value}, the link says ${given.speed}`);
+      // A file's [feedback] controller is shown as the file gives it.
+      if (given.file && given.file.text.includes("[feedback]")) {
+        const shown = $("feedback-table").textContent;
+        check(!$("feedback").hidden && shown.includes("kTdel_phid") && shown.includes("-12.48") && shown.includes("1.5 m/s"), `the file's controller is not shown: "${shown}"`);
+      } else {
+        check($("feedback").hidden, "a controller is shown for a bicycle without one");
+      }
       // 1. The benchmark bicycle: Meijaard et al. (2007) give v_w = 4.292 and v_c = 6.024 m/s.
       app.state = Object.assign(S.defaults(), { selftest: true });
       await applyState();
@@ -86,8 +93,10 @@
       showError("");
       const dt = new DataTransfer();
       dt.items.add(new File([bad.text], bad.name, { type: "text/plain" }));
+      app.importing = null;
       document.dispatchEvent(new DragEvent("drop", { dataTransfer: dt, bubbles: true, cancelable: true }));
-      for (let k = 0; k < 100 && $("error").hidden; k += 1) await new Promise((r) => setTimeout(r, 20));
+      check(app.importing, "the drop started no import");
+      await app.importing;
       check(!$("error").hidden && $("error").textContent === expected, `the error shown is "${$("error").textContent}", expected "${expected}"`);
       check($("bike").value === "benchmark", "a bad file replaced the bicycle");
       // A valid file, in TOML.

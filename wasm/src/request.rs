@@ -176,7 +176,19 @@ struct BicycleAnswer {
     uncertainties: BTreeMap<String, f64>,
     warnings: Vec<String>,
     derived_geometry: Vec<GeometryRow>,
+    /// The file's `[feedback]` controller (the linear analyses close the
+    /// loop with it), if any.
+    feedback: Option<FeedbackAnswer>,
     toml: String,
+}
+
+/// A `[feedback]` gain schedule as the file gives it: knot speeds (m/s)
+/// and each non-zero gain over them (N m/rad, N m s/rad), by its file name
+/// (`kTdel_phid`: steer torque from roll rate).
+#[derive(Serialize)]
+struct FeedbackAnswer {
+    speeds: Vec<f64>,
+    gains: Vec<(&'static str, Vec<f64>)>,
 }
 
 #[derive(Serialize)]
@@ -277,6 +289,15 @@ fn bicycle_answer(b: &Bicycle, model: Option<&str>) -> Result<BicycleAnswer, Bic
                 what,
             })
             .collect(),
+        feedback: b.feedback.as_ref().map(|f| FeedbackAnswer {
+            speeds: f.speeds().to_vec(),
+            gains: bikedyn::runtime::feedback::GAIN_NAMES
+                .iter()
+                .enumerate()
+                .map(|(j, name)| (*name, f.gains().iter().map(|k| k[(j / 4, j % 4)]).collect::<Vec<f64>>()))
+                .filter(|(_, values)| values.iter().any(|&x| x != 0.0))
+                .collect(),
+        }),
         toml,
     })
 }

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The stability explorer in a real browser: headless Chromium opens the
-# page with `#selftest`, served (python3 -m http.server on a free localhost
-# port) and as a file (file://); the page loads the benchmark bicycle,
+# page with `#selftest`, served (`bikedyn serve` on a free localhost port)
+# and as a file (file://); the page loads the benchmark bicycle,
 # checks the weave and capsize speeds shown (4.2924 and 6.0243 m/s), edits
 # the trail, switches steer damping on, imports an invalid and a valid
 # file, computes a small stability map and simulates a kick, and writes
@@ -11,8 +11,9 @@
 #
 #   bash wasm/tests/explorer.sh
 #
-# Needs the built module (bash wasm/build.sh), python3 and Chromium
-# (Debian: apt-get install -y chromium; or set CHROMIUM=/path/to/chrome).
+# Needs the built module (bash wasm/build.sh), the bikedyn binary
+# (target/release/bikedyn, or BIKEDYN=/path), python3 and Chromium (Debian:
+# apt-get install -y chromium; or set CHROMIUM=/path/to/chrome).
 set -uo pipefail
 here="$(cd "$(dirname "$0")/.." && pwd)"
 explorer="$here/explorer"
@@ -33,6 +34,11 @@ for f in bikedyn.wasm bikedyn-wasm.js; do
   fi
 done
 
+bikedyn="${BIKEDYN:-$here/../target/release/bikedyn}"
+if [ ! -x "$bikedyn" ]; then
+  echo "explorer test: no bikedyn binary at $bikedyn (cargo build --release, or set BIKEDYN=/path)" >&2
+  exit 2
+fi
 profile="$(mktemp -d)"
 server_pid=""
 cleanup() {
@@ -41,14 +47,20 @@ cleanup() {
 }
 trap cleanup EXIT
 
-# A free port, then the server on it.
-port="$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1]); s.close()')"
-(cd "$explorer" && exec python3 -m http.server "$port" --bind 127.0.0.1 >"$profile/server.log" 2>&1) &
+# `bikedyn serve` on a free port: its first line gives the address.
+"$bikedyn" serve --port 0 --dir "$explorer" >"$profile/server.out" 2>"$profile/server.log" &
 server_pid=$!
-for _ in $(seq 1 50); do
-  if python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$port/index.html')" 2>/dev/null; then break; fi
+port=""
+for _ in $(seq 1 100); do
+  port="$(sed -n 's|.*http://127.0.0.1:\([0-9]*\)/.*|\1|p' "$profile/server.out")"
+  [ -n "$port" ] && break
   sleep 0.1
 done
+if [ -z "$port" ]; then
+  echo "explorer test: bikedyn serve did not start:" >&2
+  cat "$profile/server.log" >&2
+  exit 1
+fi
 
 # The page's DOM after the self-test (virtual time runs the page's timers
 # without waiting; the module's computations take real time).
