@@ -555,17 +555,18 @@ impl Labelled {
     }
 }
 
-/// Anchor pattern: exactly one complex pair and two real roots (input sorted desc).
+/// Anchor pattern: exactly one complex pair and two real roots, in any
+/// order: the pair is the weave, the larger real root capsize and the
+/// smaller castering.
 fn classify_anchor(z: &[C64; 4]) -> Option<[Mode; 4]> {
-    let n_real = z.iter().filter(|x| x.im == 0.0).count();
-    if n_real != 2 {
-        return None;
-    }
-    let mut l = [Mode::Weave; 4];
     let reals: Vec<usize> = (0..4).filter(|&i| z[i].im == 0.0).collect();
-    // sorted descending: reals[0] larger -> capsize, reals[1] -> castering
-    l[reals[0]] = Mode::Capsize;
-    l[reals[1]] = Mode::Castering;
+    let [a, b] = reals[..] else {
+        return None;
+    };
+    let (big, small) = if z[a].re >= z[b].re { (a, b) } else { (b, a) };
+    let mut l = [Mode::Weave; 4];
+    l[big] = Mode::Capsize;
+    l[small] = Mode::Castering;
     Some(l)
 }
 
@@ -683,21 +684,6 @@ fn jumped(prev: &[C64; 4], new: &[C64; 4]) -> bool {
     moved > 1e-3 * size
 }
 
-/// The anchor's pattern (one complex pair, two real roots) in any order of
-/// the roots: the pair is the weave, the larger real root capsize and the
-/// smaller castering.
-fn classify_pattern(z: &[C64; 4]) -> Option<[Mode; 4]> {
-    let mut idx = [0usize, 1, 2, 3];
-    idx.sort_by(|&i, &j| z[j].re.total_cmp(&z[i].re).then(z[j].im.total_cmp(&z[i].im)));
-    let sorted: [C64; 4] = std::array::from_fn(|k| z[idx[k]]);
-    let l = classify_anchor(&sorted)?;
-    let mut out = [Mode::Weave; 4];
-    for k in 0..4 {
-        out[idx[k]] = l[k];
-    }
-    Some(out)
-}
-
 /// Continue labelled roots from `v0` (>= 0) to `v1` (>= 0) adaptively.
 fn continue_to<S: Spectrum + ?Sized>(cp: &S, start: Labelled, v0: f64, v1: f64) -> Result<Labelled, EigenError> {
     let mut cur = start;
@@ -726,7 +712,7 @@ fn continue_to<S: Spectrum + ?Sized>(cp: &S, start: Labelled, v0: f64, v1: f64) 
             // A jump is no continuation: the labels start again from the
             // pattern of the roots where it applies.
             let labels = if !ok && jumped(&cur.roots, &m) {
-                classify_pattern(&m).unwrap_or_else(|| pair_rule(&m, cur.labels))
+                classify_anchor(&m).unwrap_or_else(|| pair_rule(&m, cur.labels))
             } else {
                 pair_rule(&m, cur.labels)
             };
