@@ -10,7 +10,8 @@
 
 use crate::bicycle::{Bicycle, BicycleError, Linear};
 use crate::registry::ModelRegistry;
-use bikedyn_runtime::canonical::CanonicalMatrices;
+/// M, C1, K0 and K2 of the canonical form (the numerics' own result type).
+pub use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::eigen::{EigenError, LinearBicycle};
 use nalgebra::Matrix2;
 use serde::Serialize;

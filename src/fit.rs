@@ -9,12 +9,13 @@ use crate::progress::{OnProgress, Progress};
 use crate::registry::BuiltIn;
 use bikedyn_report::plot::PlotError;
 use bikedyn_report::staged::{FolderKind, StagedDir};
-use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::experiment::{
-    self, accept,
-    angles::{AngleMethod, Calibration},
-    compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
+    self, accept, angles::Calibration, compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
 };
+// Types of the options and results of a fit, named by front ends from here.
+pub use bikedyn_runtime::eigen::LinearBicycle;
+pub use bikedyn_runtime::experiment::angles::AngleMethod;
+pub use bikedyn_runtime::experiment::STEER_AXIS_APART;
 use bikedyn_runtime::parameters::ParameterError;
 use bikedyn_runtime::registry::ModelRegistry;
 use serde_json::{json, Value};

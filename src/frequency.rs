@@ -13,7 +13,9 @@
 use crate::bicycle::{Bicycle, BicycleError};
 use crate::registry::ModelRegistry;
 use bikedyn_runtime::eigen::LinearBicycle;
-use bikedyn_runtime::frequency::{frequency_response as response_of, log_grid, FrequencyError, FrequencyResponse};
+/// The transfer functions at each frequency (the numerics' own result type).
+pub use bikedyn_runtime::frequency::FrequencyResponse;
+use bikedyn_runtime::frequency::{frequency_response as response_of, log_grid, FrequencyError};
 use serde::Serialize;
 use thiserror::Error;
 

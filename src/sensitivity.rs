@@ -27,9 +27,11 @@ use crate::registry::ModelRegistry;
 use bikedyn_runtime::canonical::CanonicalMatrices;
 use bikedyn_runtime::eigen::critical_speeds;
 use bikedyn_runtime::parameters::{Form, ParameterSet};
+/// Why the numerics could not differentiate (a double eigenvalue, a
+/// crossing tangent to the axis), the source of [`SensitivityError::Runtime`].
+pub use bikedyn_runtime::sensitivity::SensitivityError as RuntimeError;
 use bikedyn_runtime::sensitivity::{
     critical_speed_sensitivities, eigenvalue_sensitivities, CanonicalJacobian, CriticalSensitivity, ModeSensitivity,
-    SensitivityError as RuntimeError,
 };
 use serde::Serialize;
 use thiserror::Error;

@@ -11,7 +11,9 @@ use crate::bicycle::{Bicycle, BicycleError};
 use crate::monte_carlo::{monte_carlo_speeds, MonteCarloOptions, MonteCarloSpeeds};
 use crate::registry::ModelRegistry;
 use crate::sensitivity::{speed_uncertainties, SensitivityError, SensitivityOptions, StabilityUncertainty};
-use bikedyn_runtime::eigen::{critical_speeds_of, CriticalSpeeds, CrossingKind, EigenError};
+use bikedyn_runtime::eigen::{critical_speeds_of, EigenError};
+/// The weave and capsize speeds and each crossing of the eigenvalues.
+pub use bikedyn_runtime::eigen::{CriticalSpeeds, CrossingDirection, CrossingKind};
 use serde::Serialize;
 
 /// What the `stability` job computes.

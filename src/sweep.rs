@@ -10,6 +10,8 @@
 use crate::bicycle::{Bicycle, BicycleError};
 use crate::registry::ModelRegistry;
 use crate::sensitivity::{speed_spread_over, SensitivityOptions, SweepSpread};
+/// The quantity a stability map shows in each cell.
+pub use bikedyn_runtime::sweep::MapQuantity;
 use bikedyn_runtime::sweep::{
     parameter_sweep, stability_map, CellResult, CellStage, OnCellDone, ParamAxis, ParameterSweep, StabilityMap,
     SweepOptions as SpeedRange,

@@ -5,9 +5,7 @@ use crate::models::{effect_parameters_in, fits, index};
 use crate::registry::BuiltIn;
 use bikedyn_runtime::feedback::GainSchedule;
 use bikedyn_runtime::linearize::LinearizeError;
-use bikedyn_runtime::parameters::{
-    moore, BenchmarkParameters, LoadedSet, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
-};
+use bikedyn_runtime::parameters::{moore, BenchmarkParameters, LoadedSet, ParameterError, ParameterSet};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
 use std::collections::BTreeMap;
 use std::marker::PhantomData;
@@ -16,6 +14,9 @@ use thiserror::Error;
 
 mod linear;
 pub use linear::{canonical_of, Linear};
+// The runtime's parameter types that appear in a bicycle and its options:
+// front ends name them from here, not from the runtime.
+pub use bikedyn_runtime::parameters::{Form, ParameterWarning, ThesisParameters};
 
 /// Built-in bicycles.
 pub const BUILT_IN: &[(&str, &str)] = &[

@@ -89,7 +89,7 @@ pub fn run(
 
 /// The table: per input-output pair, the static gain and the peak of the
 /// magnitude on the grid (the whole grid is in the CSV and JSON).
-fn summary(r: &bikedyn::runtime::frequency::FrequencyResponse) -> String {
+fn summary(r: &bikedyn::frequency::FrequencyResponse) -> String {
     let f = |x: f64| format_significant(x, 5);
     let header: Vec<String> = [
         "input",

@@ -7,9 +7,8 @@ use anyhow::{bail, Result};
 use bikedyn::fit::{
     calibration_text, kick_json, kicks_table, plots, refused_text, residuals, run_fit, speed_form_text, FitOptions,
 };
+use bikedyn::fit::{AngleMethod, LinearBicycle, STEER_AXIS_APART};
 use bikedyn::report::experiment::compare;
-use bikedyn::runtime::eigen::LinearBicycle;
-use bikedyn::runtime::experiment::angles::AngleMethod;
 use serde_json::Value;
 
 /// The library's options from the command line.
@@ -60,11 +59,7 @@ pub fn run(args: &FitArgs) -> Result<bool> {
     }
     for r in &out.reports {
         // A steer axis apart is among the warnings already.
-        for n in r
-            .notes
-            .iter()
-            .filter(|n| !n.starts_with(bikedyn::runtime::experiment::STEER_AXIS_APART))
-        {
+        for n in r.notes.iter().filter(|n| !n.starts_with(STEER_AXIS_APART)) {
             eprintln!("{}: {n}", r.run.display());
         }
         show_gaps(&r.gaps);

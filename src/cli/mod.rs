@@ -130,7 +130,7 @@ pub fn set_verbose(verbose: bool) {
 /// triangle inequality, names kept aside) are one summary line each, with
 /// what they mean; the rest in full.
 pub fn show_warnings<R: bikedyn::registry::ModelRegistry>(b: &bikedyn::bicycle::Bicycle<R>) {
-    use bikedyn::runtime::parameters::ParameterWarning;
+    use bikedyn::bicycle::ParameterWarning;
     static SHOWN: std::sync::Mutex<Vec<String>> = std::sync::Mutex::new(Vec::new());
     let verbose = VERBOSE.load(Ordering::Relaxed);
     let built_in = matches!(b.name.as_str(), "thesis" | "benchmark");

@@ -5,10 +5,10 @@
 use super::args::{BikeArg, FormName, Format, OutputArgs, PlotArgs};
 use super::{emit, plot_options};
 use anyhow::{bail, Context, Result};
+use bikedyn::bicycle::Form;
 use bikedyn::report::plot::sensitivity::plot_sensitivity;
 use bikedyn::report::plot::subject;
 use bikedyn::report::sensitivity::{sensitivity_table, write_sensitivity_csv};
-use bikedyn::runtime::parameters::Form;
 use bikedyn::sensitivity::{sensitivity, SensitivityError, SensitivityOptions};
 use std::path::PathBuf;
 
@@ -53,7 +53,7 @@ pub fn run(
             )
         }
         SensitivityError::Runtime {
-            source: bikedyn::runtime::sensitivity::SensitivityError::DoubleEigenvalue { .. },
+            source: bikedyn::sensitivity::RuntimeError::DoubleEigenvalue { .. },
             ..
         } => anyhow::Error::new(e).context(format!("--speed {}", speed.unwrap_or_default())),
         e => anyhow::Error::new(e),

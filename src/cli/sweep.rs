@@ -8,7 +8,7 @@ use anyhow::{bail, Result};
 use bikedyn::report::output;
 use bikedyn::report::plot::sweep::plot_parameter_sweep;
 use bikedyn::report::plot::{plot_stability_map, subject, PlotOptions};
-use bikedyn::runtime::sweep::MapQuantity;
+use bikedyn::sweep::MapQuantity;
 use bikedyn::sweep::{stability_map_row, sweep, sweep_model, SweepOptions, SweepReport, SweptParameter};
 
 /// Run `bikedyn sweep`.

@@ -5,7 +5,7 @@
 use super::args::SynthArgs;
 use anyhow::{Context, Result};
 use bikedyn::progress::Progress;
-use bikedyn::runtime::experiment::read::MAX_SPEED_M_S;
+use bikedyn::synth::MAX_SPEED_M_S;
 use bikedyn::synth::{synth, SynthOptions, SynthRun};
 use std::path::Path;
 

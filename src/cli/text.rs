@@ -4,9 +4,9 @@
 
 use anyhow::Result;
 use bikedyn::bicycle::Bicycle;
+use bikedyn::canonical::CanonicalMatrices;
 use bikedyn::report::output;
-use bikedyn::runtime::eigen::{CriticalSpeeds, CrossingDirection, CrossingKind};
-use bikedyn::runtime::CanonicalMatrices;
+use bikedyn::stability::{CriticalSpeeds, CrossingDirection, CrossingKind};
 
 /// The stability of bicycle `name` in words; `controlled`: its file's
 /// `[feedback]` closes the loop, so it is stable with it, not self-stable.
@@ -96,7 +96,7 @@ pub fn params_show_text(b: &Bicycle, model: Option<&str>) -> Result<String> {
         .filter(|&(i, p)| {
             p.effect.is_none()
                 && info.forward_speed_parameter != Some(i)
-                && !bikedyn_runtime::parameters::ThesisParameters::SYMBOLS.contains(&p.name)
+                && !bikedyn::bicycle::ThesisParameters::SYMBOLS.contains(&p.name)
         })
         .map(|(_, p)| p)
         .collect();

@@ -36,6 +36,10 @@ pub(super) struct Problem<'s, 'a> {
     pub(super) x0: Vec<[f64; NUISANCE]>,
     /// Last residuals per segment, for the Jacobian at the same point.
     pub(super) cache: Mutex<Option<(Vec<f64>, Vec<Vec<f64>>)>>,
+    /// Effect parameters (indices into `g`) whose being held on their floor
+    /// settles the fit's verdict: a trial's own dissipative parameters
+    /// (see [`lm_fit`]). Empty for every other fit.
+    pub(super) settled_on_floor: Vec<usize>,
 }
 
 impl<'s, 'a> Problem<'s, 'a> {
@@ -55,6 +59,7 @@ impl<'s, 'a> Problem<'s, 'a> {
             g,
             x0,
             cache: Mutex::new(None),
+            settled_on_floor: Vec::new(),
         }
     }
 }
@@ -367,6 +372,16 @@ impl Default for IdentifyOptions {
 /// the parameters' uncertainty is far larger than what further iterations
 /// would change), or after `patience` times the parameters of one segment
 /// (plus one) residual evaluations.
+///
+/// A trial fit also ends when one of its own dissipative parameters
+/// (`settled_on_floor`) has been held on its floor, the data pulling it
+/// below, through [`SETTLED_STEPS`] accepted steps in a row that each
+/// lowered the cost by less than [`SLOW_STEP`] relative: the trial's verdict
+/// is then settled (a dissipative parameter on its floor is not physics, and
+/// a trial that is not physical is never added to the model, so nothing is
+/// built on the unconverged rest). Such a fit used to crawl to its budget:
+/// the tyre candidate's relaxation length on its 1 cm floor, with stiff
+/// lagged force states, spent 911 of an identification's 1240 s.
 pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
     const TOL: f64 = 1e-6;
     let k = if p.free == Free::Nuisance { 0 } else { p.setup.k() };
@@ -383,6 +398,7 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
 
     let mut evals = 1;
     let mut lambda = 1e-3;
+    let mut settling = FloorSettling::default();
     'outer: while evals < budget {
         let (Some(blocks), Some(res)) = (p.jacobian_blocks(), p.all_residuals()) else {
             break;
@@ -410,7 +426,11 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
                 -(data + priors)
             })
             .collect();
-        for j in held_on_bound(&p.setup.parameters[..k], &x[..k], &descent) {
+        let held = held_on_bound(&p.setup.parameters[..k], &x[..k], &descent);
+        let on_floor = held.iter().any(|j| {
+            p.settled_on_floor.contains(j) && matches!(p.setup.parameters[*j].on_bound(x[*j]), Some(Bound::Floor(_)))
+        });
+        for j in held {
             prior.push((j, 1e-9 * p.setup.parameters[j].scale, 0.0));
         }
         loop {
@@ -443,6 +463,9 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
                     if df <= TOL || dn <= TOL * (xn + TOL) {
                         break 'outer;
                     }
+                    if settling.settled_after(on_floor, df) {
+                        break 'outer;
+                    }
                     break;
                 }
                 _ => {
@@ -456,6 +479,31 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
         }
     }
     p
+}
+
+/// Accepted steps in a row, each lowering the cost by less than
+/// [`SLOW_STEP`] with a trial's own dissipative parameter held on its floor,
+/// that settle the trial's verdict (see [`lm_fit`]).
+const SETTLED_STEPS: usize = 3;
+/// Relative cost decrease below which an accepted step is slow: a thousand
+/// times the fits' convergence tolerance.
+const SLOW_STEP: f64 = 1e-3;
+
+/// The count behind a trial's verdict settled on a floor (see [`lm_fit`]).
+#[derive(Default)]
+struct FloorSettling {
+    /// Accepted slow steps in a row with a settling parameter held.
+    steps: usize,
+}
+
+impl FloorSettling {
+    /// After an accepted step that lowered the cost by `df` (relative),
+    /// taken with (`on_floor`) or without one of the trial's own
+    /// dissipative parameters held on its floor: whether the fit ends.
+    fn settled_after(&mut self, on_floor: bool, df: f64) -> bool {
+        self.steps = if on_floor && df < SLOW_STEP { self.steps + 1 } else { 0 };
+        self.steps >= SETTLED_STEPS
+    }
 }
 
 /// The parameters to hold on their bound for one iteration: those on a
@@ -490,6 +538,41 @@ pub fn fit_candidate(
     opts: &IdentifyOptions,
     reference: Option<&CandidateFit>,
 ) -> Result<CandidateFit, IdentifyError> {
+    fit_model(setup, effects, g0, x0, fold_of, opts, reference, Vec::new())
+}
+
+/// [`fit_candidate`] for a trial of the search: `own` are the indices of
+/// the trial's own parameters (those after the current model's), and a fit
+/// that holds one of its dissipative ones on its floor while the cost no
+/// longer falls ends there, not physical (see [`lm_fit`]).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn fit_trial(
+    setup: &Setup<'_>,
+    effects: Vec<String>,
+    g0: &[f64],
+    x0: &[[f64; NUISANCE]],
+    fold_of: &[usize],
+    opts: &IdentifyOptions,
+    reference: Option<&CandidateFit>,
+    own: std::ops::Range<usize>,
+) -> Result<CandidateFit, IdentifyError> {
+    let settled: Vec<usize> = own
+        .filter(|&j| setup.parameters.get(j).is_some_and(|q| q.dissipative))
+        .collect();
+    fit_model(setup, effects, g0, x0, fold_of, opts, reference, settled)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn fit_model(
+    setup: &Setup<'_>,
+    effects: Vec<String>,
+    g0: &[f64],
+    x0: &[[f64; NUISANCE]],
+    fold_of: &[usize],
+    opts: &IdentifyOptions,
+    reference: Option<&CandidateFit>,
+    settled_on_floor: Vec<usize>,
+) -> Result<CandidateFit, IdentifyError> {
     let nseg = setup.segments.len();
     if nseg == 0 {
         return Err(IdentifyError::NoData);
@@ -499,10 +582,9 @@ pub fn fit_candidate(
     // A fit where every segment's initial state moves: effect parameters
     // and states together (the base model: states alone).
     let free = if setup.k() == 0 { Free::Nuisance } else { Free::All };
-    let full = lm_fit(
-        Problem::new(setup, all.clone(), free, g0.to_vec(), x0.to_vec()),
-        opts.patience,
-    );
+    let mut problem = Problem::new(setup, all.clone(), free, g0.to_vec(), x0.to_vec());
+    problem.settled_on_floor = settled_on_floor;
+    let full = lm_fit(problem, opts.patience);
     let simulations = || setup.simulations.load(Ordering::Relaxed) - sims_before;
     let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
         run: setup.segments[0].run.clone(),
@@ -609,6 +691,30 @@ mod tests {
         free.lower = None;
         free.upper = None;
         assert!(held_on_bound(&[free], &[0.1], &[1.0]).is_empty());
+    }
+
+    #[test]
+    fn a_trial_settles_on_its_floor_only_after_slow_steps_in_a_row_held_there() {
+        let slow = SLOW_STEP / 2.0;
+        let fast = SLOW_STEP * 2.0;
+        let mut s = FloorSettling::default();
+        assert!(!s.settled_after(true, slow));
+        assert!(!s.settled_after(true, slow));
+        assert!(s.settled_after(true, slow), "three slow steps held on the floor");
+        // A fast step, or a step with the parameter released, starts the count again.
+        let mut s = FloorSettling::default();
+        for (on_floor, df) in [
+            (true, slow),
+            (true, slow),
+            (true, fast),
+            (true, slow),
+            (false, slow),
+            (true, slow),
+        ] {
+            assert!(!s.settled_after(on_floor, df), "after ({on_floor}, {df})");
+        }
+        assert!(!s.settled_after(true, slow));
+        assert!(s.settled_after(true, slow));
     }
 
     #[test]

@@ -39,6 +39,7 @@ pub use super::criterion::{bic, PLAUSIBLE_PRIOR_SDS};
 use super::criterion::{farthest_from_prior, with_priors_on_the_data_scale};
 pub use super::cross_validation::{folds_by_run, paired_gain};
 pub use super::elimination::MemberCheck;
+use super::fit::fit_trial;
 use super::screen;
 use super::search_order::{added_of, first_passing, SearchOrder};
 use super::{
@@ -544,8 +545,9 @@ impl<'s> Search<'s> {
         let small = |q: &EffectParameter| q.initial.unwrap_or(0.1 * q.scale);
         let g0 = start_with(&|_, q| small(q));
         let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
+        let ks = current.values.len();
         let fit_from = |g0: &[f64]| {
-            fit_candidate(
+            fit_trial(
                 &setup,
                 effects.clone(),
                 g0,
@@ -553,6 +555,7 @@ impl<'s> Search<'s> {
                 self.fold_of,
                 self.opts,
                 Some(self.reference),
+                ks..g0.len(),
             )
         };
         let mut fitted = fit_from(&g0);
@@ -612,7 +615,6 @@ impl<'s> Search<'s> {
         }
         match fitted {
             Ok(f) => {
-                let ks = current.values.len();
                 let farthest = self.farthest_from_prior(&p.members, &f.values[ks.min(f.values.len())..]);
                 if !f.physical {
                     p.verdict = Some(Verdict::NotPhysical);
