@@ -538,13 +538,14 @@ pub fn fit_candidate(
     opts: &IdentifyOptions,
     reference: Option<&CandidateFit>,
 ) -> Result<CandidateFit, IdentifyError> {
-    fit_model(setup, effects, g0, x0, fold_of, opts, reference, Vec::new())
+    fit_trial(setup, effects, g0, x0, fold_of, opts, reference, 0..0)
 }
 
 /// [`fit_candidate`] for a trial of the search: `own` are the indices of
-/// the trial's own parameters (those after the current model's), and a fit
-/// that holds one of its dissipative ones on its floor while the cost no
-/// longer falls ends there, not physical (see [`lm_fit`]).
+/// the trial's own parameters (those after the current model's; empty for
+/// any other fit), and a fit that holds one of its dissipative ones on its
+/// floor while the cost no longer falls ends there, not physical (see
+/// [`lm_fit`]).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn fit_trial(
     setup: &Setup<'_>,
@@ -556,23 +557,6 @@ pub(super) fn fit_trial(
     reference: Option<&CandidateFit>,
     own: std::ops::Range<usize>,
 ) -> Result<CandidateFit, IdentifyError> {
-    let settled: Vec<usize> = own
-        .filter(|&j| setup.parameters.get(j).is_some_and(|q| q.dissipative))
-        .collect();
-    fit_model(setup, effects, g0, x0, fold_of, opts, reference, settled)
-}
-
-#[allow(clippy::too_many_arguments)]
-fn fit_model(
-    setup: &Setup<'_>,
-    effects: Vec<String>,
-    g0: &[f64],
-    x0: &[[f64; NUISANCE]],
-    fold_of: &[usize],
-    opts: &IdentifyOptions,
-    reference: Option<&CandidateFit>,
-    settled_on_floor: Vec<usize>,
-) -> Result<CandidateFit, IdentifyError> {
     let nseg = setup.segments.len();
     if nseg == 0 {
         return Err(IdentifyError::NoData);
@@ -583,7 +567,9 @@ fn fit_model(
     // and states together (the base model: states alone).
     let free = if setup.k() == 0 { Free::Nuisance } else { Free::All };
     let mut problem = Problem::new(setup, all.clone(), free, g0.to_vec(), x0.to_vec());
-    problem.settled_on_floor = settled_on_floor;
+    problem.settled_on_floor = own
+        .filter(|&j| setup.parameters.get(j).is_some_and(|q| q.dissipative))
+        .collect();
     let full = lm_fit(problem, opts.patience);
     let simulations = || setup.simulations.load(Ordering::Relaxed) - sims_before;
     let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
