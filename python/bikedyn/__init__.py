@@ -810,11 +810,11 @@ def identify(
     spec = None if bike is None else _bicycle(bike)._as_spec(stack)
     if isinstance(paths_or_eigen_table, (str, os.PathLike)) and os.fspath(paths_or_eigen_table).lower().endswith(".csv"):
         table = _paths(paths_or_eigen_table, "identify")[0]
-        return IdentifyResult._from_table(
+        return IdentifyResult._from_json(
             _bikedyn.identify_eigenvalues(table, spec, list(effects), corrections, bool(discover))
         )
     cal = None if calibration is None else _paths(calibration, "calibration")[0]
-    return IdentifyResult._from_runs(
+    return IdentifyResult._from_json(
         _bikedyn.identify(
             _paths(paths_or_eigen_table, "identify"),
             cal,

@@ -58,10 +58,8 @@ __all__ = [
 PathLike = Union[str, "os.PathLike[str]"]
 
 # What the extension's parameter intervals are: value +- 1.96 standard
-# errors (src/identify/report.rs `outcome_json`: "low": v - 1.96 * se; the
-# table's summary, src/identify/eigen_table/report.rs: "+- 95 % interval").
+# errors (src/identify/result.rs, `Estimate`: `low`, `high`).
 CONFIDENCE = 0.95
-_Z95 = 1.96
 
 
 def _complex(pair: Any) -> Optional[complex]:
@@ -940,8 +938,7 @@ class Estimate:
         low: lower end of the 95 % interval, ``value - 1.96 stderr``.
         high: upper end of the 95 % interval, ``value + 1.96 stderr``.
         confidence: the interval's level: 0.95.
-        unit: the unit (SI), or ``None`` where the JSON gives none (a
-            table's identification).
+        unit: the unit (SI).
         tied: symbols tied to this one (they take its value).
         prior: ``(mean, sd)`` of the stated prior (a correction of a
             declared-uncertain parameter), or ``None``.
@@ -977,10 +974,6 @@ class Estimate:
             on_bound=d.get("on_bound"),
         )
 
-    @classmethod
-    def _of_table(cls, value: Any, stderr: Any) -> "Estimate":
-        v, se = _float(value), _float(stderr)
-        return cls(value=v, stderr=se, low=v - _Z95 * se, high=v + _Z95 * se)
 
 
 @dataclass(frozen=True)
@@ -1272,48 +1265,27 @@ class IdentifyResult(_FromJson):
         return self.selected
 
     @classmethod
-    def _from_runs(cls, raw: Any) -> "IdentifyResult":
+    def _from_json(cls, raw: Any) -> "IdentifyResult":
+        """Runs, logs and tables share one JSON schema
+        (``src/identify/result.rs``); ``source`` says which it was."""
         text = raw.json()
         d = json.loads(text)
+        table = d["source"] == "eigenvalue_table"
         out = cls(
-            source="runs",
+            source=str(d["source"]),
             selected=tuple(d["selected_effects"]),
             parameters={k: Estimate._of_runs(v) for k, v in d["parameters"].items()},
             error_before=Errors._of_runs(d["error_before"]),
             error_after=Errors._of_runs(d["error_after"]),
-            model=d["model"],
+            model=d["driven_model"] if table else d["model"],
             driven_model=d["driven_model"],
             discovery=Discovery._of(d.get("discovery")),
             time_series_discovery=Discovery._of(d.get("time_series_discovery")),
             skipped=tuple(d.get("skipped", ())),
-            kicks=int(d["kicks"]),
-            table=None,
-            rows=None,
+            kicks=None if table else int(d["kicks"]),
+            table=str(d["table"]) if table else None,
+            rows=len(d["points"]) if table else None,
             roll_channel=d.get("roll_channel"),
-            not_tried=(),
-        )
-        return _attach(out, _json=text, _raw=raw)
-
-    @classmethod
-    def _from_table(cls, raw: Any) -> "IdentifyResult":
-        text = raw.json()
-        d = json.loads(text)
-        held = _opt_float(d.get("eigen_rms_held_out"))
-        out = cls(
-            source="eigenvalue_table",
-            selected=tuple(d["selected"]),
-            parameters={k: Estimate._of_table(v, se) for k, (v, se) in d["parameters"].items()},
-            error_before=Errors(_opt_float(d.get("eigen_rms_before"))),
-            error_after=Errors(_opt_float(d.get("eigen_rms_after")), held_out=Errors(held)),
-            model=d["driven_model"],
-            driven_model=d["driven_model"],
-            discovery=Discovery._of(d.get("discovery")),
-            time_series_discovery=None,
-            skipped=(),
-            kicks=None,
-            table=str(d["table"]),
-            rows=len(d.get("points", ())),
-            roll_channel=None,
             not_tried=tuple((str(n), str(w)) for n, w in d.get("not_tried", ())),
         )
         return _attach(out, _json=text, _raw=raw)

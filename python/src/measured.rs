@@ -170,7 +170,7 @@ pub(crate) fn identify(
     });
     progress.raised()?;
     let outcome = outcome?;
-    let json = serde_json::to_string_pretty(&identify_report::outcome_json(&outcome)).expect("JSON of plain values");
+    let json = serde_json::to_string_pretty(&identify_report::result(&outcome)).expect("JSON of plain values");
     let summary = identify_report::summary(&outcome);
     Ok(PyIdentifyResult {
         outcome,

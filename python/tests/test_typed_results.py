@@ -261,7 +261,7 @@ def test_identify_from_a_table_discovers_a_typed_term(tmp_path):
     # The table's estimates carry the same 95 % interval as the runs'.
     for e in r.parameters.values():
         assert e.high - e.value == pytest.approx(1.96 * e.stderr, rel=1e-12)
-    assert r.error_after.held_out.eigen_rms == r.to_dict()["eigen_rms_held_out"]
+    assert r.error_after.held_out.eigen_rms == r.to_dict()["error_after"]["held_out"]["eigen_rms"]
 
 
 # --------------------------------------------------------------------------

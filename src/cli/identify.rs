@@ -86,7 +86,7 @@ pub fn run(a: &IdentifyArgs) -> Result<bool> {
         report::write_report(&o, &request, dir, &plot_opts)?;
     }
     if a.json {
-        outln!("{}", serde_json::to_string_pretty(&report::outcome_json(&o))?);
+        outln!("{}", serde_json::to_string_pretty(&report::result(&o))?);
     } else {
         outln!("{}", report::summary(&o));
         if let Some(dir) = &a.report {

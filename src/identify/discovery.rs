@@ -110,7 +110,15 @@ pub fn discover_on_table<R: bikedyn_runtime::registry::ModelRegistry>(
             .flatten()
             .unwrap_or_else(|| vec![None; speeds.len()])
     };
-    Ok(search(rows, &plant, &library, bike.feedback.is_some(), max_folds, None))
+    Ok(search(
+        rows,
+        &plant,
+        &library,
+        bike.feedback.is_some(),
+        max_folds,
+        None,
+        None,
+    ))
 }
 
 /// The search on `rows` with the plant and library parameters given, and
@@ -122,6 +130,7 @@ fn search(
     controller: bool,
     max_folds: usize,
     folds: Option<&[usize]>,
+    reference: Option<&[Option<[f64; 2]>]>,
 ) -> DiscoveryOutcome {
     let problem = Problem {
         rows,
@@ -131,6 +140,7 @@ fn search(
         max_terms: MAX_TERMS,
         max_folds,
         folds,
+        reference,
     };
     let d = match discover(&problem) {
         Ok(d) => d,
@@ -152,13 +162,16 @@ fn search(
 /// kick's own: a friction's describing function depends on its
 /// amplitude), the kicks of a run or log held out together (`folds`). The
 /// library's values stay as the time-series fit left them (no library
-/// parameter is refitted here).
+/// parameter is refitted here), so a term must also predict the held-out
+/// kicks consistently better than the base model (`base`: its weave at
+/// each row), not only than those values.
 pub fn discover_on_kicks<R: bikedyn_runtime::registry::ModelRegistry>(
     driven: &ModelInfo,
     bike: &Bicycle<R>,
     rows: &[Row],
     values: &[BTreeMap<String, f64>],
     folds: &[usize],
+    base: &[Option<[f64; 2]>],
 ) -> Result<DiscoveryOutcome, IdentifyError> {
     let mut fixed = Vec::with_capacity(rows.len());
     for (row, vals) in rows.iter().zip(values) {
@@ -190,6 +203,7 @@ pub fn discover_on_kicks<R: bikedyn_runtime::registry::ModelRegistry>(
         bike.feedback.is_some(),
         distinct,
         Some(folds),
+        Some(base),
     ))
 }
 

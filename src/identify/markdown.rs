@@ -2,12 +2,12 @@
 //! the fits, the errors before and after, the diagnosis and the plots.
 
 use super::candidates::not_candidates;
-use super::report::{errors_json, fmt_c, median, summary, verdict_text};
+use super::report::{errors, fmt_c, median, nan, summary, verdict_text};
+use super::result::{Errors, HeldOutErrors};
 use super::{IdentifyRequest, Outcome};
 use bikedyn_runtime::identify::confounding::CONFOUNDED;
 use bikedyn_runtime::identify::Trial;
 use bikedyn_runtime::registry::ModelRegistry;
-use serde_json::Value;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -48,7 +48,7 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
         let _ = writeln!(s, "5b. Each channel's residual after identification (every sample of every kick) was regressed on the simulated states (the roll channel and its rate, the steer angle and its rate), with an F test on the effective sample size of correlated samples; its lag-1 autocorrelation measures how far it is from white noise. Outcome: {}.", super::remaining::state_correlation_sentence(&o.state_correlation));
     }
     if let Some(d) = &o.discovery {
-        let _ = writeln!(s, "6. Where a structured residual remains, a dictionary of generalized forces on the roll and steer equations (angles, rates and accelerations, times 1, v or v^2, at once or through a first-order lag) was searched on the counted kicks' weave eigenvalues, with the library's values as fitted; a term is kept when it lowers the criterion and the held-out error of the same folds of runs, consistently over the kicks. Outcome: {}.", super::discovery::kicks_sentence(d).replace('\n', "; "));
+        let _ = writeln!(s, "6. Where a structured residual remains, a dictionary of generalized forces on the roll and steer equations (angles, rates and accelerations, times 1, v or v^2, at once or through a first-order lag) was searched on the counted kicks' weave eigenvalues, with the library's values as fitted; a term is kept when it lowers the criterion and the held-out error of the same folds of runs, consistently over the kicks, than the library's values and than the base model (the time series' fit may have moved the kicks' eigenvalues away from those measured), and when its coefficient's 95 % interval excludes zero. Outcome: {}.", super::discovery::kicks_sentence(d).replace('\n', "; "));
     }
     if let Some(t) = &o.time_series {
         let _ = writeln!(s, "7. Where a structured residual remains (in the weave or in the time series), the dictionary's terms that the model carries (angles and rates times 1, v or v^2, a bias, a Coulomb-like torque, on the roll and steer equations) were tried one at a time through the nonlinear simulation of every kick, with the library's selection refitted beside them and the same tests as its candidates; then every member was tested against the final model without it. Outcome: {}.", super::time_series::sentence(t, unit, 1f64.to_degrees()).replace('\n', "; "));
@@ -151,25 +151,39 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
         }
         let _ = writeln!(s);
     }
-    let b = errors_json(o, false);
-    let af = errors_json(o, true);
-    let g = |v: &Value, k: &str| v[k].as_f64().unwrap_or(f64::NAN);
+    let b = errors(o, false);
+    let af = errors(o, true);
+    let row = |e: &Errors| {
+        [
+            e.eigen_rms,
+            nan(e.eigen_weighted_rms),
+            nan(e.roll_rms),
+            nan(e.steer_rms),
+            nan(e.speed_rms),
+        ]
+    };
+    let held = |e: &HeldOutErrors| {
+        [
+            e.eigen_rms,
+            nan(e.eigen_weighted_rms),
+            nan(e.roll_rms),
+            nan(e.steer_rms),
+            nan(e.speed_rms),
+        ]
+    };
     let counted = o.weave_kicks.iter().filter(|&&k| k).count();
     let _ = writeln!(s, "## Error before and after\n\nThe weave eigenvalue figures are over the {counted} of {} kicks whose measured eigenvalue is a weave (the others are listed below with the reason; their time series are fitted all the same); the weighted figure weighs each kick by the inverse variance of its measured eigenvalue.\n\n| | weave eigenvalue RMS (1/s) | weighted (1/s) | {roll} RMS ({unit}) | steer RMS (deg) | speed RMS (m/s) |\n|---|---|---|---|---|---|", o.segments.len());
-    for (label, v) in [
-        ("fitted runs, before", &b),
-        ("fitted runs, after", &af),
-        ("held-out runs, before", &b["held_out"]),
-        ("held-out runs, after", &af["held_out"]),
+    for (label, [eigen, weighted, roll_rms, steer_rms, speed_rms]) in [
+        ("fitted runs, before", row(&b)),
+        ("fitted runs, after", row(&af)),
+        ("held-out runs, before", held(&b.held_out)),
+        ("held-out runs, after", held(&af.held_out)),
     ] {
         let _ = writeln!(
             s,
-            "| {label} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
-            g(v, "eigen_rms"),
-            g(v, "eigen_weighted_rms"),
-            g(v, "roll_rms").to_degrees(),
-            g(v, "steer_rms").to_degrees(),
-            g(v, "speed_rms")
+            "| {label} | {eigen:.4} | {weighted:.4} | {:.4} | {:.4} | {speed_rms:.4} |",
+            roll_rms.to_degrees(),
+            steer_rms.to_degrees(),
         );
     }
     let _ = writeln!(s, "\nPer kick ({roll} RMS in {unit}; weave eigenvalues in 1/s):\n\n| run | window start (s) | speed over the eigenvalue fit (m/s) | measured weave | predicted before | predicted after | {roll} before | {roll} after | {roll} after, held out |\n|---|---|---|---|---|---|---|---|---|");

@@ -21,6 +21,7 @@ mod markdown;
 pub mod predict;
 mod remaining;
 pub mod report;
+pub mod result;
 pub mod segments;
 pub mod time_series;
 pub mod weave_errors;
@@ -428,6 +429,7 @@ pub fn run_plan<R: ModelRegistry>(
         let mut rows = Vec::new();
         let mut values = Vec::new();
         let mut folds = Vec::new();
+        let mut base = Vec::new();
         for &i in &kicks {
             let Some((m, se)) = segs[i].weave else { continue };
             rows.push(bikedyn_runtime::identify::discovery::Row {
@@ -437,11 +439,12 @@ pub fn run_plan<R: ModelRegistry>(
             });
             values.push(linear_equivalent(driven, &values_after, steer_rate[i]));
             folds.push(id.fold_of[i]);
+            base.push(predicted_before[i]);
         }
         // The library's result stands whatever the search meets: a failure
         // of the search is its outcome, not the identification's.
         Some(
-            discovery::discover_on_kicks(driven, bike, &rows, &values, &folds)
+            discovery::discover_on_kicks(driven, bike, &rows, &values, &folds, &base)
                 .unwrap_or_else(|e| discovery::DiscoveryOutcome::NotRun { reason: e.to_string() }),
         )
     } else {

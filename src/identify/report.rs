@@ -6,7 +6,11 @@ use super::candidates::identification_models;
 use super::confounded::confounding_lines;
 use super::markdown::report_markdown;
 use super::predict::{linear_equivalent, predict};
-use super::weave_errors::{eigen_rms, eigen_weighted_rms, Excluded};
+use super::result::{
+    CandidateTrial, Confounded, Details, Errors, Estimate, ExcludedKick, FittedValue, HeldOutErrors, IdentifyResult,
+    KickErrors, MemberCheck, Prior, RunDetails, Source,
+};
+use super::weave_errors::{eigen_rms, eigen_weighted_rms};
 use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
 use bikedyn_report::experiment::accept::rejected_text;
@@ -15,7 +19,6 @@ use bikedyn_report::output::{save_json, write_string_atomic};
 use bikedyn_report::staged::{FolderKind, StagedDir};
 use bikedyn_runtime::identify::{pooled_rms, Candidate, Verdict, PLAUSIBLE_PRIOR_SDS};
 use bikedyn_runtime::registry::ModelRegistry;
-use serde_json::{json, Value};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -28,7 +31,10 @@ fn display_name(c: &Candidate) -> String {
     }
 }
 
-pub(super) fn errors_json<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Value {
+/// The errors at one stage: before identification (the base model, whose
+/// held-out errors are its own) or after (the selection, each run held out
+/// predicted with the values fitted to the others).
+pub(super) fn errors<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Errors {
     let id = &o.identification;
     let fit = if after { &id.after } else { &id.before };
     let pred = if after { &o.predicted_after } else { &o.predicted_before };
@@ -37,158 +43,146 @@ pub(super) fn errors_json<R: ModelRegistry>(o: &Outcome<R>, after: bool) -> Valu
     } else {
         &o.predicted_before
     };
-    json!({
-        "eigen_rms": eigen_rms(&o.segments, pred, &o.weave_kicks),
-        "eigen_weighted_rms": eigen_weighted_rms(&o.segments, pred, &o.weave_kicks),
-        "median_run_roll_rms": median(fit.errors.iter().map(|e| e.roll_rms)),
-        "median_run_steer_rms": median(fit.errors.iter().map(|e| e.steer_rms)),
-        "roll_rms": pooled_rms(&fit.errors, 0),
-        "steer_rms": pooled_rms(&fit.errors, 1),
-        "speed_rms": pooled_rms(&fit.errors, 2),
-        "held_out": {
-            "eigen_rms": eigen_rms(&o.segments, held_pred, &o.weave_kicks),
-            "eigen_weighted_rms": eigen_weighted_rms(&o.segments, held_pred, &o.weave_kicks),
-            "roll_rms": pooled_rms(&fit.held_out, 0),
-            "steer_rms": pooled_rms(&fit.held_out, 1),
-            "speed_rms": pooled_rms(&fit.held_out, 2),
+    Errors {
+        eigen_rms: eigen_rms(&o.segments, pred, &o.weave_kicks),
+        eigen_weighted_rms: Some(eigen_weighted_rms(&o.segments, pred, &o.weave_kicks)),
+        median_run_roll_rms: Some(median(fit.errors.iter().map(|e| e.roll_rms))),
+        median_run_steer_rms: Some(median(fit.errors.iter().map(|e| e.steer_rms))),
+        roll_rms: Some(pooled_rms(&fit.errors, 0)),
+        steer_rms: Some(pooled_rms(&fit.errors, 1)),
+        speed_rms: Some(pooled_rms(&fit.errors, 2)),
+        held_out: HeldOutErrors {
+            eigen_rms: eigen_rms(&o.segments, held_pred, &o.weave_kicks),
+            eigen_weighted_rms: Some(eigen_weighted_rms(&o.segments, held_pred, &o.weave_kicks)),
+            roll_rms: Some(pooled_rms(&fit.held_out, 0)),
+            steer_rms: Some(pooled_rms(&fit.held_out, 1)),
+            speed_rms: Some(pooled_rms(&fit.held_out, 2)),
         },
-        "per_run": o.segments.iter().enumerate().map(|(i, s)| json!({
-            "run": s.run,
-            "window_start": s.t0,
-            "roll_rms": fit.errors[i].roll_rms,
-            "steer_rms": fit.errors[i].steer_rms,
-            "speed_rms": fit.errors[i].speed_rms,
-            "held_out_roll_rms": fit.held_out[i].roll_rms,
-            "measured_weave": s.weave.map(|w| w.0),
-            "weave_counted": o.weave_kicks[i],
-            "predicted_weave": pred[i],
-        })).collect::<Vec<_>>(),
-    })
+        per_run: o
+            .segments
+            .iter()
+            .enumerate()
+            .map(|(i, s)| KickErrors {
+                run: s.run.clone(),
+                window_start: s.t0,
+                roll_rms: fit.errors[i].roll_rms,
+                steer_rms: fit.errors[i].steer_rms,
+                speed_rms: fit.errors[i].speed_rms,
+                held_out_roll_rms: fit.held_out[i].roll_rms,
+                measured_weave: s.weave.map(|w| w.0),
+                weave_counted: o.weave_kicks[i],
+                predicted_weave: pred[i],
+            })
+            .collect(),
+    }
 }
 
-/// The JSON summary (schema in docs/identification.md, "What it does", step 5).
-pub fn outcome_json<R: ModelRegistry>(o: &Outcome<R>) -> Value {
+/// The result of an identification from runs or logs, in the schema a
+/// table's shares (`super::result`).
+pub fn result<R: ModelRegistry>(o: &Outcome<R>) -> IdentifyResult {
     let id = &o.identification;
-    let sel: Vec<String> = id
+    let selected_effects: Vec<String> = id
         .selected
         .iter()
         .filter_map(|n| o.candidates.iter().find(|c| &c.name == n))
         .map(display_name)
         .collect();
-    let mut params = serde_json::Map::new();
-    for (p, (v, se)) in id
+    // The stated prior of a symbol is its candidate's, as the plan declared
+    // it (the fit's parameter carries it too; the plan's is the source).
+    let parameters = id
         .after
         .parameters
         .iter()
         .zip(id.after.values.iter().zip(&id.after.stderr))
-    {
-        params.insert(
-            p.symbol.clone(),
-            json!({
-                "value": v, "low": v - 1.96 * se, "high": v + 1.96 * se, "stderr": se, "unit": p.unit, "tied": p.tied,
-                "prior": stated_prior(o, &p.symbol).map(|(mean, sd)| json!({"mean": mean, "sd": sd})),
-                "prior_sds": stated_prior(o, &p.symbol).map(|(mean, sd)| (v - mean) / sd),
-                // A value on its floor or ceiling is a limit, not an estimate.
-                "on_bound": p.on_bound(*v).map(|b| match b {
-                    bikedyn_runtime::identify::Bound::Floor(lo) => json!({"floor": lo}),
-                    bikedyn_runtime::identify::Bound::Ceiling(hi) => json!({"ceiling": hi}),
-                }),
-            }),
-        );
-    }
-    let mut cands = Vec::new();
+        .map(|(p, (&v, &se))| {
+            let mut e = Estimate::of(p, v, se);
+            let prior = stated_prior(o, &p.symbol);
+            e.prior = prior.map(|(mean, sd)| Prior { mean, sd });
+            e.prior_sds = prior.map(|(mean, sd)| (v - mean) / sd);
+            (p.symbol.clone(), e)
+        })
+        .collect();
+    let mut candidates = Vec::new();
     for (k, step) in id.steps.iter().enumerate() {
         for t in &step.trials {
             let fitted = t.fit.as_ref();
-            cands.push(json!({
-                "step": k + 1,
-                "name": t.name,
-                "members": t.members,
-                "extends": step.base,
-                "score": fitted.map(|f| f.bic - step.base_bic),
-                "predicted_score": t.predicted_bic_change,
-                "cv": fitted.map(|f| f.cv).filter(|cv| cv.is_finite()),
-                "base_cv": step.base_cv,
-                "values": fitted.map(|f| f.values.clone()),
-                "selected": t.verdict.added(),
-                "outcome": t.verdict,
-                "verdict": verdict_text(&t.verdict),
-            }));
+            candidates.push(CandidateTrial {
+                step: k + 1,
+                name: t.name.clone(),
+                members: t.members.clone(),
+                extends: step.base.clone(),
+                score: fitted.map(|f| f.bic - step.base_bic),
+                predicted_score: t.predicted_bic_change,
+                cv: fitted.map(|f| f.cv).filter(|cv| cv.is_finite()),
+                base_cv: step.base_cv,
+                values: fitted.map(|f| {
+                    f.parameters
+                        .iter()
+                        .zip(f.values.iter().zip(&f.stderr))
+                        .map(|(p, (&value, &stderr))| FittedValue {
+                            symbol: p.symbol.clone(),
+                            value,
+                            stderr,
+                        })
+                        .collect()
+                }),
+                selected: t.verdict.added(),
+                outcome: t.verdict.clone(),
+                verdict: verdict_text(&t.verdict),
+            });
         }
     }
-    let confounded: Vec<Value> = id
+    let confounded = id
         .steps
         .iter()
         .enumerate()
         .flat_map(|(k, step)| {
-            step.confounded.iter().map(move |c| {
-                json!({
-                    "step": k + 1,
-                    "chosen": c.chosen,
-                    "rival": c.rival,
-                    "correlation": c.correlation,
-                    "held_out_gain": c.held_out_gain.map(|h| h.gain),
-                    "held_out_gain_stderr": c.held_out_gain.map(|h| h.stderr),
-                    "predicts_alike": c.predicts_alike(),
-                    "confounded": c.not_separated(),
-                    "designs": c.designs,
-                })
+            step.confounded.iter().map(move |c| Confounded {
+                step: k + 1,
+                chosen: c.chosen.clone(),
+                rival: c.rival.clone(),
+                correlation: c.correlation,
+                held_out_gain: c.held_out_gain.map(|h| h.gain),
+                held_out_gain_stderr: c.held_out_gain.map(|h| h.stderr),
+                predicts_alike: c.predicts_alike(),
+                confounded: c.not_separated(),
+                designs: c.designs.clone(),
             })
         })
         .collect();
-    let final_check: Vec<Value> = id
-        .final_check
-        .iter()
-        .map(|c| {
-            json!({
-                "name": c.name,
-                "model": c.model,
-                "removed": c.removed,
-                "bic_change": Some(c.bic_change).filter(|x| x.is_finite()),
-                "cv_with": Some(c.cv_with).filter(|x| x.is_finite()),
-                "cv_without": Some(c.cv_without).filter(|x| x.is_finite()),
-                "outcome": c.verdict,
-                "verdict": verdict_text(&c.verdict),
-            })
-        })
-        .collect();
-    json!({
-        "selected_effects": sel,
-        "parameters": params,
-        "candidates": cands,
-        "final_check": final_check,
-        "confounded": confounded,
-        "error_before": errors_json(o, false),
-        "error_after": errors_json(o, true),
-        "model": o.model,
-        "driven_model": o.driven_model,
-        "roll_channel": o.roll_channel(),
-        "speed_imposed": o.speed_imposed,
-        "kicks": o.segments.len(),
-        "skipped": o.skipped,
-        "eigen_excluded": o.eigen_excluded.iter().map(excluded_json).collect::<Vec<_>>(),
-        "findings": o.findings,
-        "remaining": o.remaining,
-        "state_correlation": o.state_correlation,
-        "discovery": o.discovery,
-        "time_series_discovery": o.time_series,
-        "weights": id.weights,
-        "folds": id.folds,
-        "simulations": id.simulations,
-        "seconds": o.seconds,
-    })
+    IdentifyResult {
+        source: Source::Runs,
+        selected_effects,
+        parameters,
+        candidates,
+        error_before: errors(o, false),
+        error_after: errors(o, true),
+        driven_model: o.driven_model,
+        remaining: o.remaining.clone(),
+        discovery: o.discovery.clone(),
+        details: Details::Runs(Box::new(RunDetails {
+            model: o.model,
+            roll_channel: o.roll_channel(),
+            speed_imposed: o.speed_imposed,
+            kicks: o.segments.len(),
+            skipped: o.skipped.clone(),
+            eigen_excluded: o.eigen_excluded.iter().map(ExcludedKick::from).collect(),
+            findings: o.findings.clone(),
+            state_correlation: o.state_correlation.clone(),
+            time_series_discovery: o.time_series.clone(),
+            final_check: id.final_check.iter().map(MemberCheck::from).collect(),
+            confounded,
+            weights: id.weights.clone(),
+            folds: id.folds,
+            simulations: id.simulations,
+            seconds: o.seconds,
+        })),
+    }
 }
 
-/// A kick kept out of the eigenvalue figures: where, the test it failed
-/// with its numbers (`rejected`), and why in words (`reason`).
-fn excluded_json(e: &Excluded) -> Value {
-    json!({
-        "kick": e.kick,
-        "run": e.run,
-        "window_start": e.window_start,
-        "rejected": e.rejected,
-        "reason": rejected_text(&e.rejected),
-    })
+/// An error a source may not have, NaN where it has none (as printed).
+pub(super) fn nan(x: Option<f64>) -> f64 {
+    x.unwrap_or(f64::NAN)
 }
 
 pub(super) fn median(x: impl Iterator<Item = f64>) -> f64 {
@@ -204,8 +198,8 @@ pub(super) fn fmt_c(z: Option<[f64; 2]>) -> String {
 /// Five-line summary.
 pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     let id = &o.identification;
-    let b = errors_json(o, false);
-    let a = errors_json(o, true);
+    let b = errors(o, false);
+    let a = errors(o, true);
     let mut s = String::new();
     let (roll, unit) = (o.roll_channel().describe(), o.roll_channel().unit_deg());
     let _ = writeln!(
@@ -272,9 +266,10 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
         if vals.is_empty() { "-".into() } else { vals.join(", ") }
     );
     // The headline: runs predicted with the values fitted to the others.
-    let held = |e: &Value, key: &str| e["held_out"][key].as_f64().unwrap_or(f64::NAN);
-    let lower = |key: &str| held(&a, key) < held(&b, key);
-    let confirmed = if !id.selected.is_empty() && !(lower("eigen_rms") || lower("roll_rms")) {
+    let held_roll = |e: &Errors| nan(e.held_out.roll_rms);
+    let confirmed = if !id.selected.is_empty()
+        && !(a.held_out.eigen_rms < b.held_out.eigen_rms || held_roll(&a) < held_roll(&b))
+    {
         "; not confirmed on held-out data: neither the weave eigenvalue nor the roll error of the held-out runs falls"
     } else {
         ""
@@ -282,10 +277,10 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     let _ = writeln!(
         s,
         "held-out runs: weave RMS {:.3} -> {:.3} 1/s, {roll} RMS {:.3} -> {:.3} {unit} ({} folds, {} simulations, {:.1} s){confirmed}",
-        held(&b, "eigen_rms"),
-        held(&a, "eigen_rms"),
-        held(&b, "roll_rms").to_degrees(),
-        held(&a, "roll_rms").to_degrees(),
+        b.held_out.eigen_rms,
+        a.held_out.eigen_rms,
+        held_roll(&b).to_degrees(),
+        held_roll(&a).to_degrees(),
         id.folds,
         id.simulations,
         o.seconds
@@ -293,18 +288,18 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     let _ = write!(
         s,
         "fitted runs, error before -> after: weave eigenvalue RMS {:.3} -> {:.3} 1/s (weighted {:.3} -> {:.3}; {} of {} kicks a weave), {roll} RMS {:.3} -> {:.3} {unit} (median run {:.3} -> {:.3}), steer RMS {:.3} -> {:.3} deg",
-        b["eigen_rms"].as_f64().unwrap_or(f64::NAN),
-        a["eigen_rms"].as_f64().unwrap_or(f64::NAN),
-        b["eigen_weighted_rms"].as_f64().unwrap_or(f64::NAN),
-        a["eigen_weighted_rms"].as_f64().unwrap_or(f64::NAN),
+        b.eigen_rms,
+        a.eigen_rms,
+        nan(b.eigen_weighted_rms),
+        nan(a.eigen_weighted_rms),
         o.weave_kicks.iter().filter(|&&k| k).count(),
         o.segments.len(),
-        b["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
-        a["roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
-        b["median_run_roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
-        a["median_run_roll_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
-        b["steer_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
-        a["steer_rms"].as_f64().unwrap_or(f64::NAN).to_degrees(),
+        nan(b.roll_rms).to_degrees(),
+        nan(a.roll_rms).to_degrees(),
+        nan(b.median_run_roll_rms).to_degrees(),
+        nan(a.median_run_roll_rms).to_degrees(),
+        nan(b.steer_rms).to_degrees(),
+        nan(a.steer_rms).to_degrees(),
     );
     // Whether the library ran out: a pattern left beyond the kicks' scatter.
     if let Some(r) = &o.remaining {
@@ -374,7 +369,7 @@ pub fn write_report<R: ModelRegistry>(
     let staged = StagedDir::new(dir, FolderKind::IdentifyReport)?;
     let out = staged.path();
     let bike = Bicycle::<R>::resolve_in(&o.bike)?;
-    save_json(out.join("report.json"), &outcome_json(o))?;
+    save_json(out.join("report.json"), &result(o))?;
     write_string_atomic(out.join("fitted.toml"), &fitted_toml(&bike, &o.values_after, o)?)?;
     // Continuation diagram before and after.
     let vmax = o.segments.iter().map(|s| s.speed_interval[1]).fold(7.0, f64::max) + 1.0;
@@ -569,6 +564,13 @@ pub fn verdict_text(v: &Verdict) -> String {
         Verdict::LagNotResolved { time_constant } => {
             format!("rejected: a lag fitted to {time_constant:.2e} s, outside what the data resolve (from a hundredth of the shortest weave period, where it is the direct term tried on its own, to ten of the longest)")
         }
+        Verdict::NotDistinctFromZero { value, stderr } => format!(
+            "rejected: its coefficient {value:.4} +- {:.4} (95 %) holds zero: the data do not show the force (not cross-validated)",
+            1.96 * stderr
+        ),
+        Verdict::NotBetterThanReference { gain, stderr } => format!(
+            "rejected: it predicts the held-out kicks better than the library's values, but not consistently better than the base model (mean gain per kick {gain:.4}, standard error {stderr:.4}): it takes back how far the time series' fit moved the kicks' eigenvalues from the measured ones"
+        ),
         Verdict::NoCriterionGain { bic_change } => {
             format!("rejected: BIC {bic_change:+.1} (no gain beyond its added parameters; not cross-validated)")
         }

@@ -22,8 +22,14 @@ use std::path::PathBuf;
 /// lab, `k (v_s - v)` on the roll rate below `v_s = 4.7 m/s` (benchmark
 /// signs: steer torque `k (v_s - v) phi'`), written in a copy of its
 /// bicycleparameters file. Thesis signs flip the steer torque.
+///
+/// Each call writes its own file: tests run in parallel, and one test
+/// rewriting a shared file while another reads it gave the reader an
+/// empty file (CI of stop 52).
 fn balance_assist_file(k: f64) -> PathBuf {
-    let dir = scratch("any-bicycle");
+    static CALLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let call = CALLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = scratch("any-bicycle").join(format!("call-{call}"));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(format!("Balanceassistv1_k{k}.txt"));
     let mut text = std::fs::read_to_string(fixture_arg("Balanceassistv1Benchmark.txt")).unwrap();

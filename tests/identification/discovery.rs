@@ -123,7 +123,7 @@ fn found_terms(v: &Value) -> Vec<Value> {
 
 fn held_out_halved(v: &Value) {
     let (before, held) = (
-        v["eigen_rms_before"].as_f64().unwrap(),
+        v["error_before"]["eigen_rms"].as_f64().unwrap(),
         v["discovery"]["rms_held_out"].as_f64().unwrap(),
     );
     assert!(held <= 0.5 * before, "held out {held} against {before} before");

@@ -71,12 +71,13 @@ fn a_long_eigenvalue_table_is_identified_in_time_growing_with_its_rows() {
     ]);
     let took = start.elapsed().as_secs_f64();
     assert_eq!(v["points"].as_array().unwrap().len(), 100, "{v}");
-    assert_eq!(v["selected"], serde_json::json!(["steer_damping"]), "{v}");
-    let c = v["parameters"]["c_steer"][0].as_f64().unwrap();
+    assert_eq!(v["source"], "eigenvalue_table");
+    assert_eq!(v["selected_effects"], serde_json::json!(["steer_damping"]), "{v}");
+    let c = v["parameters"]["c_steer"]["value"].as_f64().unwrap();
     assert!((c - 0.3).abs() < 0.003, "c_steer {c}");
     let (after, held) = (
-        v["eigen_rms_after"].as_f64().unwrap(),
-        v["eigen_rms_held_out"].as_f64().unwrap(),
+        v["error_after"]["eigen_rms"].as_f64().unwrap(),
+        v["error_after"]["held_out"]["eigen_rms"].as_f64().unwrap(),
     );
     assert!(held < 1.5 * after && held < 0.1, "held out {held}, after {after}");
     eprintln!("a table of 100 speeds identified in {took:.1} s");

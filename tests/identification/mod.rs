@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 
 mod discovery;
 mod eigenvalue_tables;
+mod result_schema;
 
 fn synth(name: &str, effects: &str, seed: u64) -> PathBuf {
     synth_with(name, None, effects, seed)
@@ -649,11 +650,12 @@ fn measured_eigenvalue_tables_are_identified() {
         "thesis",
         "--json",
     ]);
-    assert_eq!(v["selected"], serde_json::json!(["steer_damping"]), "{v}");
-    let c = v["parameters"]["c_steer"][0].as_f64().unwrap();
+    assert_eq!(v["selected_effects"], serde_json::json!(["steer_damping"]), "{v}");
+    let c = v["parameters"]["c_steer"]["value"].as_f64().unwrap();
     assert!((c - 0.3).abs() < 0.015, "c_steer {c}");
-    assert!(v["eigen_rms_after"].as_f64().unwrap() < 0.5 * v["eigen_rms_before"].as_f64().unwrap());
-    assert!(v["eigen_rms_held_out"].as_f64().unwrap() < 0.5 * v["eigen_rms_before"].as_f64().unwrap());
+    let before = v["error_before"]["eigen_rms"].as_f64().unwrap();
+    assert!(v["error_after"]["eigen_rms"].as_f64().unwrap() < 0.5 * before);
+    assert!(v["error_after"]["held_out"]["eigen_rms"].as_f64().unwrap() < 0.5 * before);
     // With the damping found, what remains is the rows' scatter.
     assert_eq!(v["remaining"]["structured"], false, "{:#}", v["remaining"]);
     // A library without damping cannot explain it: a lateral mass offset
@@ -688,7 +690,7 @@ fn measured_eigenvalue_tables_are_identified() {
         "thesis",
         "--json",
     ]);
-    assert_eq!(v["selected"], serde_json::json!([]), "{v}");
+    assert_eq!(v["selected_effects"], serde_json::json!([]), "{v}");
 
     let bad = dir.join("bad.csv");
     std::fs::write(&bad, "v,re,im\n4,-1,5\n5,-1.2,6\n6,-1.3,7,0.1\n").unwrap();

@@ -191,7 +191,10 @@ fn the_refit_with_the_derived_model_gives_the_discovered_value_and_the_error_of_
     let _ = std::fs::remove_file(&req.path);
     let _ = std::fs::remove_file(&bike);
     assert_eq!(refit.selected, ["discovered"]);
-    let (value, stderr) = refit.parameters["discovered_k0"];
+    let (value, stderr) = (
+        refit.parameters["discovered_k0"].value,
+        refit.parameters["discovered_k0"].stderr,
+    );
     let expected = model_coefficient(found).unwrap();
     // The same weighted residuals, fitted by another path: the same
     // optimum to the fits' tolerance.

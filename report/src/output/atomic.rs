@@ -6,8 +6,6 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use serde_json::Value;
-
 /// Boxed error of a writer callback.
 pub type BoxError = Box<dyn std::error::Error + Send + Sync + 'static>;
 
@@ -385,7 +383,7 @@ pub fn write_string_atomic(path: impl AsRef<Path>, contents: &str) -> Result<(),
 }
 
 /// Atomically save a JSON value (pretty-printed, trailing newline).
-pub fn save_json(path: impl AsRef<Path>, value: &Value) -> Result<(), OutputError> {
+pub fn save_json<T: serde::Serialize + ?Sized>(path: impl AsRef<Path>, value: &T) -> Result<(), OutputError> {
     write_atomic(path, |w| -> Result<(), BoxError> {
         serde_json::to_writer_pretty(&mut *w, value)?;
         w.write_all(b"\n")?;

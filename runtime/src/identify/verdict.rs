@@ -80,6 +80,16 @@ pub enum Verdict {
     /// resolve: far shorter than a weave period (the direct term, which the
     /// dictionary also holds) or far longer (a torque that never builds).
     LagNotResolved { time_constant: f64 },
+    /// A discovered term whose coefficient's 95 % interval contains zero
+    /// (`|value| < 1.96 stderr`): the data do not show the force exists,
+    /// however much it lowers the criterion by moving other values.
+    NotDistinctFromZero { value: f64, stderr: f64 },
+    /// A discovered term on runs' kicks that predicts the held-out kicks
+    /// consistently better than the library's values, but not than the
+    /// base model (mean paired gain per kick within two standard errors of
+    /// zero): it takes back what the time series' fit moved the kicks'
+    /// eigenvalues away from the measured ones, and shows no force.
+    NotBetterThanReference { gain: f64, stderr: f64 },
 }
 
 impl Verdict {

@@ -35,6 +35,7 @@ use serde::Serialize;
 
 mod read;
 mod report;
+use super::result::{estimates, Estimate, IdentifyResult};
 pub use read::{read_eigen_table, EigenPoint};
 pub use report::{table_summary, write_table_report};
 use std::collections::BTreeMap;
@@ -75,15 +76,18 @@ pub struct TableTrial {
     pub verdict: Verdict,
 }
 
-/// What identification from a table found.
+/// What identification from a table found. Its JSON is the
+/// identification's one schema ([`IdentifyResult`], `source:
+/// "eigenvalue_table"`).
 #[derive(Clone, Debug, Serialize)]
+#[serde(into = "IdentifyResult")]
 pub struct TableOutcome {
     pub table: PathBuf,
     pub driven_model: &'static str,
     pub points: Vec<EigenPoint>,
     pub selected: Vec<String>,
-    /// Fitted values by symbol: `(value, stderr)`.
-    pub parameters: BTreeMap<String, (f64, f64)>,
+    /// Fitted values by symbol.
+    pub parameters: BTreeMap<String, Estimate>,
     pub trials: Vec<TableTrial>,
     /// Candidates not tried, with the reason.
     pub not_tried: Vec<(String, String)>,
@@ -375,23 +379,17 @@ pub fn identify_table_in<R: bikedyn_runtime::registry::ModelRegistry>(
     } else {
         None
     };
-    let names = selected
-        .iter()
-        .flat_map(|c| c.parameters.iter().map(|p| p.symbol.clone()));
+    let parameters = estimates(
+        selected.iter().flat_map(|c| c.parameters.iter()),
+        &current_fit.values,
+        &current_fit.stderr,
+    );
     Ok(TableOutcome {
         discovery,
         table: req.path.clone(),
         driven_model: driven.name,
         selected: selected.iter().map(|c| c.name.clone()).collect(),
-        parameters: names
-            .zip(
-                current_fit
-                    .values
-                    .iter()
-                    .zip(&current_fit.stderr)
-                    .map(|(v, s)| (*v, *s)),
-            )
-            .collect(),
+        parameters,
         trials,
         not_tried,
         eigen_rms_before: rms(&before),

@@ -24,7 +24,7 @@ pub fn table_summary(o: &TableOutcome) -> String {
     let vals: Vec<String> = o
         .parameters
         .iter()
-        .map(|(k, (v, se))| format!("{k} = {v:.4} +- {:.4}", 1.96 * se))
+        .map(|(k, e)| format!("{k} = {:.4} +- {:.4} {}", e.value, e.high - e.value, e.unit))
         .collect();
     s += &format!(
         "parameters (+- 95 % interval): {}\n",
