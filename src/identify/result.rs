@@ -19,7 +19,7 @@ use super::weave_errors::Excluded;
 use bikedyn_runtime::identify::confounding::Design;
 use bikedyn_runtime::identify::remaining::Remaining;
 use bikedyn_runtime::identify::state_correlation::StateCorrelation;
-use bikedyn_runtime::identify::{Bound, Candidate, EffectParameter, Verdict, Weights};
+use bikedyn_runtime::identify::{Bound, EffectParameter, Verdict, Weights};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -187,8 +187,8 @@ impl Estimate {
     }
 }
 
-/// The parameters of the candidates `candidates` fitted to `values` with
-/// `stderr` (one per parameter, in the candidates' order), by symbol.
+/// `parameters` fitted to `values` with `stderr` (one of each per
+/// parameter, in order), by symbol.
 pub fn estimates<'a>(
     parameters: impl IntoIterator<Item = &'a EffectParameter>,
     values: &[f64],
@@ -199,15 +199,6 @@ pub fn estimates<'a>(
         .zip(values.iter().zip(stderr))
         .map(|(p, (&v, &se))| (p.symbol.clone(), Estimate::of(p, v, se)))
         .collect()
-}
-
-/// The stated prior of `symbol` among `candidates`' parameters.
-pub fn prior_of(candidates: &[Candidate], symbol: &str) -> Option<(f64, f64)> {
-    candidates
-        .iter()
-        .flat_map(|c| &c.parameters)
-        .find(|p| p.symbol == symbol)
-        .and_then(|p| p.prior)
 }
 
 /// A fitted value of a candidate's fit.
