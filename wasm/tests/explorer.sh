@@ -89,12 +89,26 @@ for mode in served file link filelink; do
     link) url="http://127.0.0.1:$port/index.html#$link" ;;
     filelink) url="http://127.0.0.1:$port/index.html#$filelink" ;;
   esac
-  run "$url" "$mode"
-  result="$(grep -o 'SELFTEST [A-Z]*[^<]*' "$profile/$mode.html" | head -1)"
+  # Virtual time runs the page's timers at once, but the module's
+  # compilation and computations take real time: on a loaded machine the
+  # budget can run out before the self-test has written its result (stop
+  # 53's CI, once, with the page still computing and no error). Such a run
+  # is tried again, once, with what the page showed printed; a result that
+  # the self-test wrote is never retried.
+  result=""
+  for attempt in 1 2; do
+    run "$url" "$mode"
+    code=$?
+    why="Chromium exit $code"
+    [ "$code" = 124 ] && why="$why: the 180 s limit"
+    result="$(grep -o 'SELFTEST [A-Z]*[^<]*' "$profile/$mode.html" | head -1)"
+    [ -n "$result" ] && break
+    echo "explorer test ($mode, attempt $attempt): no self-test result yet ($why); the page's status: $(grep -o '<span id="status"[^<]*' "$profile/$mode.html" | sed 's/.*>//')" >&2
+  done
   if [ -z "$result" ]; then
     echo "explorer test ($mode, ${url:0:160}): no self-test result in the page" >&2
     grep -o '<div id="error"[^<]*<[^<]*' "$profile/$mode.html" >&2 || true
-    tail -20 "$profile/$mode.log" >&2
+    grep -v 'dbus' "$profile/$mode.log" | tail -20 >&2
     status=1
   elif [ "${result#SELFTEST PASS}" != "$result" ]; then
     echo "explorer test ($mode): $result"
