@@ -13,7 +13,7 @@
 //! computations run without the GIL, so other Python threads go on.
 
 use bikedyn::bicycle::{Bicycle, BicycleError, Linear};
-use bikedyn::fit::{kick_json, plots_into, run_fit, FitOptions, FitOutcome};
+use bikedyn::fit::{plots_into, run_fit, FitOptions, FitOutcome};
 use bikedyn::identify::eigen_table::{identify_table, write_table_report, TableOutcome, TableRequest};
 use bikedyn::identify::{report as identify_report, run as identify_run, IdentifyRequest, Outcome};
 use bikedyn::report::output::write_atomic;

@@ -82,11 +82,11 @@ pub(crate) fn fit(
         // The figures name the bicycle (given, or the thesis default).
         let subject = Some(bikedyn::report::plot::subject(&outcome.bike, None));
         let linear = &outcome.linear as &dyn LinearBicycle;
-        let kicks: Vec<serde_json::Value> = outcome
+        let kicks: Vec<bikedyn::fit::KickRecord> = outcome
             .reports
             .iter()
             .flat_map(|r| r.kicks.iter())
-            .map(|k| kick_json(k, linear))
+            .map(|k| bikedyn::fit::KickRecord::of(k, linear))
             .collect();
         let json = serde_json::json!({
             "kicks": kicks,
