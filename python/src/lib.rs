@@ -205,11 +205,11 @@ fn finite_speeds(speeds: &[f64], what: &str) -> Result<(), Failure> {
 /// The generated models, as `bikedyn models --json` lists them.
 #[pyfunction]
 fn models() -> String {
-    let list: Vec<serde_json::Value> = bikedyn::models::models()
+    let list: Vec<bikedyn::models::ModelRecord> = bikedyn::models::models()
         .iter()
-        .map(bikedyn::models::model_json)
+        .map(bikedyn::models::ModelRecord::of)
         .collect();
-    serde_json::Value::Array(list).to_string()
+    serde_json::to_string(&list).expect("JSON of plain values")
 }
 
 /// Panic inside the guard every call runs in, for the test that a panic
