@@ -23,7 +23,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use thiserror::Error;
 
 mod record;
-pub use record::{FailedFit, FormFit, KickRecord, Refusal, RefusedFit};
+pub use record::{FailedFit, FitRecord, FormFit, KickRecord, Refusal, RefusedFit};
 
 /// What `fit` processes and how.
 #[derive(Clone, Debug, Default)]

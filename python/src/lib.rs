@@ -19,7 +19,6 @@ use bikedyn::identify::{report as identify_report, run as identify_run, Identify
 use bikedyn::report::output::write_atomic;
 use bikedyn::report::plot::PlotOptions;
 use bikedyn::report::staged::{FolderKind, StagedDir};
-use bikedyn::runtime::eigen::LinearBicycle;
 use bikedyn::runtime::experiment::angles::AngleMethod;
 use bikedyn::runtime::parameters::ParameterSet;
 use bikedyn::runtime::simulate::{

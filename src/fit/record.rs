@@ -11,7 +11,7 @@
 //! that. A number that is not finite (the mean speed of a window without a
 //! speed record) is `null`, as serde_json writes it.
 
-use super::NO_SPEED;
+use super::{calibration_text, FitOutcome, NO_SPEED};
 use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::experiment::accept::{Rejected, SpeedFormRejected};
 use bikedyn_runtime::experiment::compare::{self, Prediction};
@@ -20,6 +20,46 @@ use bikedyn_runtime::experiment::kicks::WindowEnd;
 use bikedyn_runtime::experiment::sync::ClockOffset;
 use bikedyn_runtime::experiment::KickFit;
 use serde::Serialize;
+
+/// A whole fit as Python's `bikedyn.fit` returns it (`FitResult`,
+/// python/bikedyn/results.py reads it): the kicks as `bikedyn fit --json`
+/// prints them, and what the command line says on standard error.
+#[derive(Clone, Debug, Serialize)]
+pub struct FitRecord {
+    /// One record per kick.
+    pub kicks: Vec<KickRecord>,
+    /// Runs, logs and kicks left out, each with the reason.
+    pub skipped: Vec<String>,
+    /// Notes on the runs, each after its run's path.
+    pub notes: Vec<String>,
+    /// Each set's calibration in words (misalignment, noise at rest).
+    pub calibration: String,
+    /// The generated model that predicts each kick's weave.
+    pub prediction_model: &'static str,
+}
+
+impl FitRecord {
+    /// The record of a fit's outcome.
+    pub fn of(out: &FitOutcome) -> FitRecord {
+        let linear = &out.linear as &dyn LinearBicycle;
+        FitRecord {
+            kicks: out
+                .reports
+                .iter()
+                .flat_map(|r| r.kicks.iter())
+                .map(|k| KickRecord::of(k, linear))
+                .collect(),
+            skipped: out.errors.clone(),
+            notes: out
+                .reports
+                .iter()
+                .flat_map(|r| r.notes.iter().map(move |n| format!("{}: {n}", r.run.display())))
+                .collect(),
+            calibration: calibration_text(out),
+            prediction_model: out.linear.model,
+        }
+    }
+}
 
 /// One kick: its window, every fit, the verdict on the reported one and
 /// the bicycle's prediction.
