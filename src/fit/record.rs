@@ -1,5 +1,7 @@
-//! One kick of `bikedyn fit --json` as data (Python's `FitResult.kicks`,
-//! `kicks.json` of its report). These types are the schema: the JSON is
+//! A fit's results as data: one record per kick, as `bikedyn fit --json`
+//! prints them ([`KickRecord`]), and the whole fit as Python's `FitResult`
+//! and its `kicks.json` get it ([`FitRecord`]). These types are the
+//! schema: the JSON is
 //! their derived serialization (described in docs/measured-runs.md,
 //! "Output"), and `tests/measured_runs/result_schema.rs` checks its shape
 //! against the committed `tests/data/fit_schema.json`.
