@@ -18,10 +18,12 @@ pub use bikedyn_runtime::experiment::angles::AngleMethod;
 pub use bikedyn_runtime::experiment::STEER_AXIS_APART;
 use bikedyn_runtime::parameters::ParameterError;
 use bikedyn_runtime::registry::ModelRegistry;
-use serde_json::{json, Value};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use thiserror::Error;
+
+mod record;
+pub use record::{FailedFit, FitRecord, FormFit, KickRecord, Refusal, RefusedFit};
 
 /// What `fit` processes and how.
 #[derive(Clone, Debug, Default)]
@@ -424,89 +426,6 @@ fn no_speed_reason(r: &RunReport, k: &KickFit) -> String {
 
 /// Why a kick has no predicted weave although it was fitted.
 const NO_SPEED: &str = "no usable speed record in the fit window (the wheel sensor gave no speed there), so no speed to predict the weave at";
-
-fn pair(x: [f64; 2]) -> Value {
-    json!([x[0], x[1]])
-}
-
-/// The fields of a verdict (its test and numbers) and its sentence.
-fn verdict_json<T: serde::Serialize>(verdict: &T, reason: String) -> Value {
-    let mut v = serde_json::to_value(verdict).expect("JSON of plain values");
-    v["reason"] = json!(reason);
-    v
-}
-
-/// JSON entry of one kick (schema in docs/measured-runs.md, "Output"): `weave`,
-/// its standard errors, r² and form only for a measured weave eigenvalue;
-/// a refused fit under `refused`, with the test it failed.
-pub fn kick_json(k: &KickFit, linear: &dyn LinearBicycle) -> Value {
-    use bikedyn_report::experiment::accept::{rejected_text, speed_form_text};
-    let mut v = json!({
-        "run": k.run.display().to_string(),
-        "kick_time": k.kick_time,
-        "window": pair(k.window),
-        "window_end": k.window_end,
-        "speed_interval": pair(k.speed_interval),
-        "mean_speed": k.mean_speed,
-        "fits": k.fits.iter().map(|f| json!({
-            "form": f.form.name(),
-            "eigenvalue": pair(f.eigenvalue),
-            "stderr": pair(f.eigenvalue_stderr),
-            "slope_per_mps": f.slope.map(pair),
-            "slope_stderr": f.slope_stderr.map(pair),
-            "r2": f.r2, "rms": f.rms, "aic": f.aic, "bic": f.bic, "n": f.n,
-        })).collect::<Vec<_>>(),
-        "failed_fits": k.failed.iter().map(|(f, e)| json!({"form": f.name(), "error": e})).collect::<Vec<_>>(),
-    });
-    if let Some(f) = k.measured_weave() {
-        v["weave"] = pair(f.eigenvalue);
-        v["weave_stderr"] = pair(f.eigenvalue_stderr);
-        v["r2"] = json!(f.r2);
-        v["form"] = json!(f.form.name());
-    } else {
-        v["weave"] = Value::Null;
-        v["weave_stderr"] = Value::Null;
-        v["r2"] = Value::Null;
-        v["form"] = Value::Null;
-    }
-    v["refused"] = match &k.rejected {
-        Some(r) => {
-            let mut e = verdict_json(r, rejected_text(r));
-            if let Some(f) = k.chosen_fit() {
-                e["fit"] = json!({
-                    "form": f.form.name(),
-                    "eigenvalue": pair(f.eigenvalue),
-                    "stderr": pair(f.eigenvalue_stderr),
-                    "r2": f.r2,
-                });
-            }
-            e
-        }
-        None => Value::Null,
-    };
-    v["speed_varying_refused"] = match &k.speed_form {
-        Some(r) => verdict_json(r, speed_form_text(r)),
-        None => Value::Null,
-    };
-    if let Some(o) = k.clock_offset {
-        v["clock_offset"] = json!({"value": o.value, "stderr": o.stderr, "from_data": o.from_data});
-    }
-    if !k.mean_speed.is_finite() {
-        v["predicted_weave"] = Value::Null;
-        v["no_prediction"] = json!(NO_SPEED);
-    } else {
-        let [lo, hi] = k.speed_interval;
-        v["predicted_weave"] = match compare::predict(linear, k.mean_speed, lo, hi) {
-            Some(p) => json!({
-                "at_mean_speed": pair(p.at_mean_speed),
-                "real_range": pair(p.real_range),
-                "imag_range": pair(p.imag_range),
-            }),
-            None => Value::Null,
-        };
-    }
-    v
-}
 
 /// Residual rows (measured against predicted at the mean speed), of the
 /// measured weave eigenvalues.

@@ -25,6 +25,10 @@ pub mod registry {
     pub type BuiltIn = crate::generated::Registry;
 }
 
+/// `bikedyn bench` (not in the WebAssembly build: its clock and temporary
+/// folder are not there).
+#[cfg(not(target_arch = "wasm32"))]
+pub mod bench;
 pub mod bicycle;
 pub mod canonical;
 pub mod eigen;

@@ -11,6 +11,7 @@ use bikedyn_runtime::verify::{verify, with_effects_switched_on};
 /// The verification job's options and per-model report.
 pub use bikedyn_runtime::verify::{VerifyOptions, VerifyReport};
 use bikedyn_runtime::MultibodyModel;
+use serde::Serialize;
 use std::any::TypeId;
 use std::sync::{Mutex, OnceLock, PoisonError};
 
@@ -297,23 +298,84 @@ pub(crate) fn index<R: ModelRegistry>() -> &'static Index {
     i
 }
 
-/// JSON record of a model, as `bikedyn models --json` prints it.
-pub fn model_json(m: &ModelInfo) -> serde_json::Value {
-    serde_json::json!({
-        "name": m.name,
-        "doc": m.doc,
-        "base": m.base,
-        "free_speed": m.free_speed,
-        "effects": m.effects,
-        "coordinates": m.coordinates.iter().enumerate().map(|(i, c)| serde_json::json!({
-            "name": c,
-            "independent": m.independent.contains(&i),
-        })).collect::<Vec<_>>(),
-        "states": m.states,
-        "parameters": m.parameters.iter().map(|p| serde_json::json!({
-            "name": p.name, "doc": p.doc, "default": p.default, "effect": p.effect,
-        })).collect::<Vec<_>>(),
-    })
+/// A generated model as `bikedyn models --json` lists it (also the
+/// explorer's and Python's `models()`): the JSON is this type's derived
+/// serialization.
+#[derive(Clone, Debug, Serialize)]
+pub struct ModelRecord {
+    /// The model's name (`--model NAME`).
+    pub name: &'static str,
+    /// What it models, in words.
+    pub doc: &'static str,
+    /// The base model its effects are added to.
+    pub base: &'static str,
+    /// Whether the forward speed is a state (else the speed is imposed).
+    pub free_speed: bool,
+    /// The effects applied, by name.
+    pub effects: &'static [&'static str],
+    /// The generalized coordinates, in the model's order.
+    pub coordinates: Vec<CoordinateRecord>,
+    /// Extra first-order states (lagged tyre forces, a controller's).
+    pub states: &'static [&'static str],
+    /// Every parameter, in the model's order.
+    pub parameters: Vec<ParameterRecord>,
+}
+
+/// A generalized coordinate of a model.
+#[derive(Clone, Debug, Serialize)]
+pub struct CoordinateRecord {
+    /// Its name (angles in rad, positions in m).
+    pub name: &'static str,
+    /// Whether it is independent (else solved from the constraints).
+    pub independent: bool,
+}
+
+/// A parameter of a model.
+#[derive(Clone, Debug, Serialize)]
+pub struct ParameterRecord {
+    /// Its symbol (as in parameter files).
+    pub name: &'static str,
+    /// Meaning and unit.
+    pub doc: &'static str,
+    /// The value used when a bicycle does not give it (in its unit; for an
+    /// effect's parameter the value at which the effect is absent), or
+    /// `null`: the bicycle must give it.
+    pub default: Option<f64>,
+    /// The effect that declared it, or `null` for the bicycle's own.
+    pub effect: Option<&'static str>,
+}
+
+impl ModelRecord {
+    /// The record of model `m`.
+    pub fn of(m: &ModelInfo) -> ModelRecord {
+        ModelRecord {
+            name: m.name,
+            doc: m.doc,
+            base: m.base,
+            free_speed: m.free_speed,
+            effects: m.effects,
+            coordinates: m
+                .coordinates
+                .iter()
+                .enumerate()
+                .map(|(i, &name)| CoordinateRecord {
+                    name,
+                    independent: m.independent.contains(&i),
+                })
+                .collect(),
+            states: m.states,
+            parameters: m
+                .parameters
+                .iter()
+                .map(|p| ParameterRecord {
+                    name: p.name,
+                    doc: p.doc,
+                    default: p.default,
+                    effect: p.effect,
+                })
+                .collect(),
+        }
+    }
 }
 
 /// The free-speed variant of a model: same base and effects, free speed

@@ -22,7 +22,7 @@ use bikedyn_report::staged::{FolderKind, StagedDir};
 use bikedyn_runtime::eigen::{eigenvalues_of, EigenError};
 /// The fastest run the measured-run reader accepts (m/s): a synthetic run is held to it.
 pub use bikedyn_runtime::experiment::read::MAX_SPEED_M_S;
-use bikedyn_runtime::experiment::synth::{rest_trajectory, RunKind, SensorModel};
+use bikedyn_runtime::experiment::synth::{rest_trajectory, RunKind, SensorModel, SynthTruth};
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
 use bikedyn_runtime::model::CoordinateRole;
 use bikedyn_runtime::parameters::ThesisParameters;
@@ -31,6 +31,8 @@ use bikedyn_runtime::registry::{ModelRegistry, ModelVisitor};
 use bikedyn_runtime::simulate::trajectory::{trajectory_for_run, RunPlan, Trajectory};
 use bikedyn_runtime::simulate::{SimOptions, SimulateError, Simulation};
 use bikedyn_runtime::MultibodyModel;
+use serde::Serialize;
+use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -79,7 +81,7 @@ impl Default for SynthOptions {
 }
 
 /// One run written.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Serialize)]
 pub struct SynthRun {
     /// Run folder name (`run01`, ...).
     pub name: String,
@@ -89,6 +91,58 @@ pub struct SynthRun {
     pub stop: String,
     /// The generated model that simulated it.
     pub model: &'static str,
+}
+
+/// What a synthetic run truly is, as `truth/<run>_truth.json` holds it
+/// (the JSON is this type's derived serialization): what `fit` and
+/// `identify` on the set should recover.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunTruth {
+    /// The generated model that simulated the run.
+    pub model: &'static str,
+    /// The bicycle, as given (built-in name or parameter file).
+    pub bike: String,
+    /// The run plan (launch, release speed, kick; s, rad, m/s, N s).
+    pub plan: RunPlan,
+    /// The model's parameter vector by symbol (each in its unit; the
+    /// forward speed's entry is the release speed).
+    pub parameters: BTreeMap<&'static str, f64>,
+    /// The state at release.
+    pub release: ReleaseState,
+    /// Kick time on the simulation's clock (s from the launch).
+    pub kick_time: f64,
+    /// Kick time on the IMU clock of the run's files (s).
+    pub kick_time_on_imu_clock: f64,
+    /// Why the simulation stopped.
+    pub stop: String,
+    /// Largest holonomic-constraint residual over the run.
+    pub max_constraint_residual: f64,
+    /// Mean forward speed from the release to the end (m/s).
+    pub mean_speed_after_release: f64,
+    /// Eigenvalues `[real, imag]` (1/s, rad/s) of the model's linear
+    /// equations frozen at `mean_speed_after_release`.
+    pub frozen_speed_eigenvalues: Vec<[f64; 2]>,
+    /// The sensors' truth: misalignments, clock offset, magnets.
+    pub sensors: SynthTruth,
+}
+
+/// The state of a synthetic run at release (angles in rad, rates in rad/s).
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ReleaseState {
+    /// Time of the release from the launch (s).
+    pub time: f64,
+    /// Roll angle.
+    pub roll: f64,
+    /// Steer angle.
+    pub steer: f64,
+    /// Yaw angle.
+    pub yaw: f64,
+    /// Roll rate, or `null` for a model that declares no roll.
+    pub roll_rate: Option<f64>,
+    /// Steer rate, or `null` for a model that declares no steer.
+    pub steer_rate: Option<f64>,
+    /// Forward speed at release (m/s).
+    pub speed: f64,
 }
 
 /// Why a synthetic set could not be made.
@@ -132,9 +186,6 @@ pub enum SynthError {
     /// A trajectory or truth file could not be written.
     #[error(transparent)]
     Output(#[from] OutputError),
-    /// The sensor truth could not be put into JSON.
-    #[error(transparent)]
-    Json(#[from] serde_json::Error),
 }
 
 /// Refuse a non-empty output folder without `force` (with it, the staged
@@ -194,7 +245,7 @@ fn sensor_trajectory(tr: &Trajectory) -> Trajectory {
     out
 }
 
-fn write_physical_run(dir: &Path, name: &str, tr: &Trajectory, truth: &serde_json::Value) -> Result<(), SynthError> {
+fn write_physical_run(dir: &Path, name: &str, tr: &Trajectory, truth: &RunTruth) -> Result<(), SynthError> {
     create_dir(dir)?;
     write_atomic(dir.join(format!("{name}_trajectory.csv")), |w: &mut dyn Write| {
         writeln!(w, "t,yaw,roll,pitch,steer,rear_wheel_angle,speed")?;
@@ -315,24 +366,6 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
         let mean_speed = tr.speed[release..].iter().sum::<f64>() / (tr.speed.len() - release).max(1) as f64;
         let ev = eigenvalues_of(&linear, mean_speed)?;
         let name = format!("run{:02}", k + 1);
-        let truth = serde_json::json!({
-            "model": sim.model,
-            "bike": a.bike,
-            "plan": plan,
-            "parameters": names.iter().zip(&param).map(|(n, v)| (n.to_string(), serde_json::Value::from(*v))).collect::<serde_json::Map<_, _>>(),
-            "release": {
-                "time": plan.launch_duration,
-                "roll": tr.roll[release], "steer": tr.steer[release], "yaw": tr.yaw[release],
-                "roll_rate": sim.rate_of(CoordinateRole::Roll).map(|r| r[0]), "steer_rate": sim.rate_of(CoordinateRole::Steer).map(|r| r[0]),
-                "speed": plan.speed,
-            },
-            "kick_time": plan.launch_duration + plan.kick_delay,
-            "kick_time_on_imu_clock": REST_BEFORE_LAUNCH + plan.launch_duration + plan.kick_delay,
-            "stop": sim.stop.to_string(),
-            "max_constraint_residual": sim.max_constraint_residual(),
-            "mean_speed_after_release": mean_speed,
-            "frozen_speed_eigenvalues": ev.iter().map(|z| [z.re, z.im]).collect::<Vec<_>>(),
-        });
         if k == 0 {
             // The calibration run: the bicycle held at rest, upright, at the
             // pitch of the model's upright configuration.
@@ -359,8 +392,28 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
             &sensors,
             a.seed.wrapping_add(1 + k as u64),
         )?;
-        let mut truth = truth;
-        truth["sensors"] = serde_json::to_value(&sensor_truth)?;
+        let truth = RunTruth {
+            model: sim.model,
+            bike: a.bike.clone(),
+            plan,
+            parameters: names.iter().copied().zip(param.iter().copied()).collect(),
+            release: ReleaseState {
+                time: plan.launch_duration,
+                roll: tr.roll[release],
+                steer: tr.steer[release],
+                yaw: tr.yaw[release],
+                roll_rate: sim.rate_of(CoordinateRole::Roll).map(|r| r[0]),
+                steer_rate: sim.rate_of(CoordinateRole::Steer).map(|r| r[0]),
+                speed: plan.speed,
+            },
+            kick_time: plan.launch_duration + plan.kick_delay,
+            kick_time_on_imu_clock: REST_BEFORE_LAUNCH + plan.launch_duration + plan.kick_delay,
+            stop: sim.stop.to_string(),
+            max_constraint_residual: sim.max_constraint_residual(),
+            mean_speed_after_release: mean_speed,
+            frozen_speed_eigenvalues: ev.iter().map(|z| [z.re, z.im]).collect(),
+            sensors: sensor_truth,
+        };
         write_physical_run(&out.join("truth"), &name, &tr, &truth)?;
         on_run(&SynthRun {
             model: info.name,

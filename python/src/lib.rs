@@ -13,13 +13,12 @@
 //! computations run without the GIL, so other Python threads go on.
 
 use bikedyn::bicycle::{Bicycle, BicycleError, Linear};
-use bikedyn::fit::{kick_json, plots_into, run_fit, FitOptions, FitOutcome};
+use bikedyn::fit::{plots_into, run_fit, FitOptions, FitOutcome};
 use bikedyn::identify::eigen_table::{identify_table, write_table_report, TableOutcome, TableRequest};
 use bikedyn::identify::{report as identify_report, run as identify_run, IdentifyRequest, Outcome};
 use bikedyn::report::output::write_atomic;
 use bikedyn::report::plot::PlotOptions;
 use bikedyn::report::staged::{FolderKind, StagedDir};
-use bikedyn::runtime::eigen::LinearBicycle;
 use bikedyn::runtime::experiment::angles::AngleMethod;
 use bikedyn::runtime::parameters::ParameterSet;
 use bikedyn::runtime::simulate::{
@@ -205,11 +204,11 @@ fn finite_speeds(speeds: &[f64], what: &str) -> Result<(), Failure> {
 /// The generated models, as `bikedyn models --json` lists them.
 #[pyfunction]
 fn models() -> String {
-    let list: Vec<serde_json::Value> = bikedyn::models::models()
+    let list: Vec<bikedyn::models::ModelRecord> = bikedyn::models::models()
         .iter()
-        .map(bikedyn::models::model_json)
+        .map(bikedyn::models::ModelRecord::of)
         .collect();
-    serde_json::Value::Array(list).to_string()
+    serde_json::to_string(&list).expect("JSON of plain values")
 }
 
 /// Panic inside the guard every call runs in, for the test that a panic

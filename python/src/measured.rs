@@ -81,22 +81,8 @@ pub(crate) fn fit(
         }
         // The figures name the bicycle (given, or the thesis default).
         let subject = Some(bikedyn::report::plot::subject(&outcome.bike, None));
-        let linear = &outcome.linear as &dyn LinearBicycle;
-        let kicks: Vec<serde_json::Value> = outcome
-            .reports
-            .iter()
-            .flat_map(|r| r.kicks.iter())
-            .map(|k| kick_json(k, linear))
-            .collect();
-        let json = serde_json::json!({
-            "kicks": kicks,
-            "skipped": outcome.errors,
-            "notes": outcome.reports.iter().flat_map(|r| r.notes.iter().map(move |n| format!("{}: {n}", r.run.display()))).collect::<Vec<_>>(),
-            "calibration": bikedyn::fit::calibration_text(&outcome),
-            "prediction_model": outcome.linear.model,
-        });
         Ok(PyFitResult {
-            json: serde_json::to_string_pretty(&json).expect("JSON of plain values"),
+            json: serde_json::to_string_pretty(&bikedyn::fit::FitRecord::of(&outcome)).expect("JSON of plain values"),
             outcome,
             subject,
         })

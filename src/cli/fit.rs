@@ -5,11 +5,10 @@ use super::args::FitArgs;
 use super::ProgressDisplay;
 use anyhow::{bail, Result};
 use bikedyn::fit::{
-    calibration_text, kick_json, kicks_table, plots, refused_text, residuals, run_fit, speed_form_text, FitOptions,
+    calibration_text, kicks_table, plots, refused_text, residuals, run_fit, speed_form_text, FitOptions,
 };
-use bikedyn::fit::{AngleMethod, LinearBicycle, STEER_AXIS_APART};
+use bikedyn::fit::{AngleMethod, KickRecord, LinearBicycle, STEER_AXIS_APART};
 use bikedyn::report::experiment::compare;
-use serde_json::Value;
 
 /// The library's options from the command line.
 pub fn options(args: &FitArgs) -> Result<FitOptions> {
@@ -75,11 +74,11 @@ pub fn run(args: &FitArgs) -> Result<bool> {
     if args.json {
         eprint!("{}", calibration_text(&out));
         eprintln!("prediction model: {}", out.linear.model);
-        let list: Vec<Value> = out
+        let list: Vec<KickRecord> = out
             .reports
             .iter()
             .flat_map(|r| r.kicks.iter())
-            .map(|k| kick_json(k, &out.linear as &dyn LinearBicycle))
+            .map(|k| KickRecord::of(k, &out.linear as &dyn LinearBicycle))
             .collect();
         outln!("{}", serde_json::to_string_pretty(&list)?);
     } else {

@@ -21,7 +21,7 @@ pub fn request(a: &IdentifyArgs) -> IdentifyRequest {
 }
 
 /// Plan, say which model runs, then identify with the progress on stderr.
-pub fn run_with_progress(request: &IdentifyRequest) -> Result<Outcome> {
+fn run_with_progress(request: &IdentifyRequest) -> Result<Outcome> {
     let plan = plan(request)?;
     eprintln!(
         "identify: model {} (driven twin {})",

@@ -7,7 +7,7 @@ use anyhow::Result;
 pub fn run(json: bool) -> Result<bool> {
     let ms = bikedyn::models::models();
     if json {
-        let v: Vec<_> = ms.iter().map(bikedyn::models::model_json).collect();
+        let v: Vec<_> = ms.iter().map(bikedyn::models::ModelRecord::of).collect();
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         out!("{}", models_text(ms));

@@ -7,7 +7,6 @@ use anyhow::{Context, Result};
 use bikedyn::progress::Progress;
 use bikedyn::synth::MAX_SPEED_M_S;
 use bikedyn::synth::{synth, SynthOptions, SynthRun};
-use std::path::Path;
 
 /// `SYMBOL=VALUE` of `--effects`.
 fn effect(e: &str) -> Result<(String, f64)> {
@@ -47,7 +46,9 @@ fn speeds(s: &str) -> Result<[f64; 2]> {
     Ok([lo, hi])
 }
 
-fn print_run(r: &SynthRun) -> Result<()> {
+/// One run's line (and the model's before the first), as `bikedyn synth`
+/// and `bikedyn bench --identify` print them.
+pub(super) fn print_run(r: &SynthRun) -> Result<()> {
     let plan = &r.plan;
     if r.name == "run01" {
         outln!("model: {}", r.model);
@@ -105,18 +106,5 @@ pub fn run(a: SynthArgs) -> Result<bool> {
         seed: a.seed,
         out: a.out,
         force: a.force,
-    })
-}
-
-/// A synthetic set of the thesis bicycle at 4-6.5 m/s with `effects`
-/// (`SYMBOL=VALUE`) hidden (for the identification bench).
-pub fn thesis_set(out: &Path, runs: usize, seed: u64, effects: &[&str]) -> Result<bool> {
-    make(&SynthOptions {
-        effects: self::effects(&effects.iter().map(|e| e.to_string()).collect::<Vec<_>>())?,
-        speeds: [4.0, 6.5],
-        runs,
-        seed,
-        out: out.to_path_buf(),
-        ..SynthOptions::default()
     })
 }

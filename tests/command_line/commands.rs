@@ -336,3 +336,52 @@ fn canonical_json_writes_structural_zeros_as_zero() {
     // Meijaard et al. (2007), the benchmark's C1[0][1] to 14 digits.
     assert!((at("C1", 0, 1) - 33.866_413_914_924_94).abs() < 1e-12);
 }
+
+/// `bikedyn bench --quick` is the library's `bench` printed section by
+/// section: every section measures something (timings are the machine's,
+/// so only their being positive and finite is checked), the counts follow
+/// the quick options, and the printed sections are those of
+/// docs/performance.md.
+#[test]
+fn bench_quick_measures_and_prints_every_section() {
+    use bikedyn::bench::{bench, BenchOptions};
+    let f = bench(&BenchOptions { quick: true }).unwrap();
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    assert!(f.codegen.derived != f.codegen.models.is_empty(), "{:?}", f.codegen);
+    let g = &f.generated_functions;
+    assert_eq!((g.model, g.calls, g.functions.len()), ("thesis_whipple", 20_000, 15));
+    assert!(g.functions.iter().all(|t| positive(t.ns_per_call)));
+    let mass = g.functions.iter().find(|t| t.name == "mass_matrix").unwrap();
+    assert!(mass.flops > 0 && g.sum_flops >= mass.flops && g.all_quantities_flops > 0);
+    let l = &f.linearization;
+    assert!(l.reduced_equations_flops > 0);
+    assert!([l.linearization_us, l.general_linearization_us, l.eigenvalues_ns]
+        .into_iter()
+        .all(positive));
+    let s = &f.sweep;
+    assert_eq!((s.designs, s.speeds), (100, 1000));
+    // Stable only between the weave and capsize speeds: some points, not all.
+    assert!(s.stable_points > 0 && s.stable_points < s.designs * s.speeds, "{s:?}");
+    let m = &f.measured_runs;
+    assert!(positive(m.calibration_ms) && positive(m.run_ms), "{m:?}");
+    let sim = &f.simulation;
+    assert_eq!((sim.outputs.len(), sim.variants.len()), (2, 3));
+    assert!(sim
+        .outputs
+        .iter()
+        .all(|o| o.rhs_evaluations > 0 && positive(o.real_time)));
+    let out = bikedyn(&["bench", "--quick"]);
+    let stdout = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    for section in [
+        "== code generation",
+        "== generated functions of thesis_whipple (f64, one state per call, 20000 calls) ==",
+        "== linearization and eigenvalues",
+        "design x speed sweep: 100 designs x 1000 speeds",
+        "== measured runs (bikedyn fit), median of 5, one thread ==",
+        "== nonlinear simulation",
+        "(extended_free)",
+    ] {
+        assert!(stdout.contains(section), "{section} missing in\n{stdout}");
+    }
+}

@@ -6,6 +6,8 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+pub mod schema;
+
 /// Runs the `bikedyn` binary of this build with `args`.
 pub fn bikedyn(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_bikedyn")).args(args).output().unwrap()

@@ -5,4 +5,5 @@ mod acceptance;
 mod calibration_and_sensors;
 mod fit_command;
 mod kick_detection;
+mod result_schema;
 mod synthetic_runs;

@@ -11,7 +11,6 @@ use bikedyn::simulate::{simulate, SimulateRequest};
 use bikedyn::stability::{stability, StabilityOptions};
 use bikedyn::sweep::{stability_map_row, sweep, SweepOptions, SweptParameter};
 use serde::{Deserialize, Serialize};
-use serde_json::Value;
 use std::collections::BTreeMap;
 
 /// The answer to a request: the result's JSON, or an error's.
@@ -310,9 +309,9 @@ pub fn answer(bytes: &[u8]) -> Answer {
     };
     match request {
         Request::Models => {
-            let v: Vec<Value> = bikedyn::models::models()
+            let v: Vec<bikedyn::models::ModelRecord> = bikedyn::models::models()
                 .iter()
-                .map(bikedyn::models::model_json)
+                .map(bikedyn::models::ModelRecord::of)
                 .collect();
             result(&v)
         }
