@@ -17,6 +17,34 @@ python3 - "$module" wasm/explorer <<'PY'
 import base64, os, sys
 module, folder = sys.argv[1], sys.argv[2]
 data = open(module, "rb").read()
+
+def without_custom_sections(wasm):
+    """The module without its custom sections (id 0: symbol names,
+    wasm-bindgen's descriptors that plotters' web-sys brings, producers):
+    no engine reads them to run the module, and they were 0.74 of its 8 MB.
+    Every other section is kept byte for byte, in order."""
+    if wasm[:4] != b"\0asm":
+        sys.exit("wasm/build.sh: %s is not a WebAssembly module" % module)
+    out, i = bytearray(wasm[:8]), 8
+    while i < len(wasm):
+        start, sid = i, wasm[i]
+        i += 1
+        size, shift = 0, 0
+        while True:
+            b = wasm[i]
+            i += 1
+            size |= (b & 0x7F) << shift
+            shift += 7
+            if b < 0x80:
+                break
+        i += size
+        if i > len(wasm):
+            sys.exit("wasm/build.sh: %s is truncated" % module)
+        if sid != 0:
+            out += wasm[start:i]
+    return bytes(out)
+
+data = without_custom_sections(data)
 def write(name, content, mode):
     # Written beside, then renamed: a page never reads half a file.
     path = os.path.join(folder, name)
