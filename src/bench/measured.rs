@@ -2,9 +2,9 @@
 //! thesis-style run end to end (read, angles, speed, clock, kick, fits) and
 //! a TU Delft log.
 
-use super::{median, scratch, BenchError, BenchOptions};
+use super::{scratch, BenchError, BenchOptions};
 use bikedyn_report::experiment::synth::write_run;
-use bikedyn_runtime::experiment::angles::Calibration;
+use bikedyn_runtime::experiment::angles::{median, Calibration};
 use bikedyn_runtime::experiment::synth::{rest_trajectory, ResponseSpec, SensorModel};
 use bikedyn_runtime::experiment::{self, read, PipelineOptions};
 use serde::Serialize;
@@ -88,7 +88,7 @@ fn time_pipeline(
         black_box(Calibration::estimate(&cal_run, opt.frame_pitch));
         times.push(t.elapsed().as_secs_f64());
     }
-    let calibration_ms = 1e3 * median(times);
+    let calibration_ms = 1e3 * median(&times);
     let cal = Calibration::estimate(&cal_run, opt.frame_pitch);
     let mut times = Vec::new();
     for _ in 0..reps {
@@ -97,7 +97,7 @@ fn time_pipeline(
         black_box(experiment::process_thesis_run(&run, &cal, &opt));
         times.push(t.elapsed().as_secs_f64());
     }
-    let run_ms = 1e3 * median(times);
+    let run_ms = 1e3 * median(&times);
     let log = match log.filter(|l| l.is_file()) {
         Some(path) => {
             let mut times = Vec::new();
@@ -111,7 +111,7 @@ fn time_pipeline(
             Some(LogTiming {
                 path,
                 kicks,
-                ms: 1e3 * median(times),
+                ms: 1e3 * median(&times),
             })
         }
         None => None,

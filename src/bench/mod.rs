@@ -129,12 +129,6 @@ fn per_call(reps: usize, mut f: impl FnMut(usize)) -> f64 {
     t.elapsed().as_secs_f64() / reps as f64
 }
 
-/// The median of `v` (the upper one of an even count; NaN when empty).
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
 /// A scratch folder `name-<pid>` in the system's temporary folder, which
 /// must exist: a bench never creates a missing `TMPDIR` (nor leaves one).
 fn scratch(name: &str) -> Result<PathBuf, BenchError> {
