@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 
 mod discovery;
 mod eigenvalue_tables;
+mod kick_fits;
 mod result_schema;
 
 fn synth(name: &str, effects: &str, seed: u64) -> PathBuf {
