@@ -444,6 +444,14 @@ pub(crate) trait Spectrum {
     /// Whether `roots(-v) = -roots(v)` (true for the canonical form, whose
     /// equations are even in `v` up to the sign of time).
     fn mirror_symmetric(&self) -> bool;
+    /// The discriminant at speed `v` (zero where roots collide) and the
+    /// number of real roots, if the family has them (the quartic's): where
+    /// roots merge can then be bracketed without solving and labelling at
+    /// every speed of a grid. `None`: not available (a spectrum chosen from
+    /// a larger one).
+    fn discriminant(&self, _v: f64) -> Option<(f64, Option<u8>)> {
+        None
+    }
 }
 
 impl Spectrum for CharPoly {
@@ -461,6 +469,9 @@ impl Spectrum for CharPoly {
     }
     fn mirror_symmetric(&self) -> bool {
         true
+    }
+    fn discriminant(&self, v: f64) -> Option<(f64, Option<u8>)> {
+        quartic::discriminant(&self.coeffs(v))
     }
 }
 
@@ -597,11 +608,18 @@ fn classify_fallback(z: &[C64; 4]) -> [Mode; 4] {
 /// Best matching of `new` roots to `prev` branches. Returns the reordered new roots
 /// and whether the matching is unambiguous.
 fn match_roots(prev: &Labelled, new: &[C64; 4]) -> ([C64; 4], bool) {
+    // The 16 squared distances once, then the 24 sums of four.
+    let mut d = [[0.0f64; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            d[i][j] = (prev.roots[i] - new[j]).norm_sqr();
+        }
+    }
     let mut best = (f64::INFINITY, 0usize);
     for (pi, p) in PERMS.iter().enumerate() {
         let mut cost = 0.0;
         for i in 0..4 {
-            cost += (prev.roots[i] - new[p[i]]).norm_sqr();
+            cost += d[i][p[i]];
         }
         if cost < best.0 {
             best = (cost, pi);
@@ -609,18 +627,20 @@ fn match_roots(prev: &Labelled, new: &[C64; 4]) -> ([C64; 4], bool) {
     }
     let p = PERMS[best.1];
     let out = [new[p[0]], new[p[1]], new[p[2]], new[p[3]]];
-    let mut dmax = 0.0f64;
-    let mut sep = f64::INFINITY;
+    // Squared distances (no square root or `hypot` in this inner loop of
+    // every continuation): `dmax <= 0.3 sep`.
+    let mut dmax2 = 0.0f64;
+    let mut sep2 = f64::INFINITY;
     for i in 0..4 {
-        dmax = dmax.max((prev.roots[i] - out[i]).norm());
+        dmax2 = dmax2.max((prev.roots[i] - out[i]).norm_sqr());
         for j in i + 1..4 {
             if prev.labels[i] != prev.labels[j] {
-                sep = sep.min((prev.roots[i] - prev.roots[j]).norm());
-                sep = sep.min((out[i] - out[j]).norm());
+                sep2 = sep2.min((prev.roots[i] - prev.roots[j]).norm_sqr());
+                sep2 = sep2.min((out[i] - out[j]).norm_sqr());
             }
         }
     }
-    (out, dmax <= 0.3 * sep)
+    (out, dmax2 <= 0.09 * sep2)
 }
 
 /// A complex-conjugate pair is one mode: when two named real modes `A`, `B`

@@ -208,7 +208,9 @@
     }
     app.current = b.ok;
     const speeds = S.speedRange(app.state);
-    const e = call(withModel({ job: "eig", bicycle: spec, speeds, critical_speeds: true }));
+    // The diagram draws eigenvalues and modes; the slider asks for its
+    // speed's mode shapes itself.
+    const e = call(withModel({ job: "eig", bicycle: spec, speeds, critical_speeds: true, mode_shapes: false }));
     if (e.error) {
       showError(e.error);
       status("error");

@@ -93,6 +93,12 @@ enum Request {
         /// Also give the table as `bikedyn eig --format csv` writes it.
         #[serde(default)]
         csv: bool,
+        /// Give each speed's mode shapes (default: yes). The explorer's
+        /// diagram over speed asks without them: it draws eigenvalues and
+        /// modes only, and the mode shapes were two thirds of its answer's
+        /// JSON (the speed slider asks for its one speed with them).
+        #[serde(default = "yes")]
+        mode_shapes: bool,
     },
     /// `bikedyn stability --json`.
     Stability {
@@ -323,6 +329,7 @@ pub fn answer(bytes: &[u8]) -> Answer {
             critical_speeds,
             standard_deviations,
             csv,
+            mode_shapes,
         } => {
             let speeds = match speeds {
                 SpeedsSpec::List(v) => Speeds::List(v),
@@ -341,7 +348,11 @@ pub fn answer(bytes: &[u8]) -> Answer {
                     capsize_speed: r.critical.as_ref().and_then(|c| c.capsize_speed),
                     weave_real_pair_merge_speed: r.critical.as_ref().and_then(|c| c.weave_real_pair_merge),
                     csv: csv.then(|| eigen_csv(&r)),
-                    points: r,
+                    points: if mode_shapes {
+                        EigPoints::Full(r)
+                    } else {
+                        EigPoints::WithoutModeShapes(r.points.iter().map(PointWithoutModeShapes::of).collect())
+                    },
                 })
             })
         }
@@ -463,8 +474,9 @@ fn sweep_options(
 #[derive(Serialize)]
 struct EigAnswer {
     model: String,
-    /// `bikedyn eig --format json`: one entry per speed.
-    points: bikedyn::eigen::EigenSweepReport,
+    /// `bikedyn eig --format json`: one entry per speed (without
+    /// `mode_shapes` when the request says `mode_shapes: false`).
+    points: EigPoints,
     /// With `critical_speeds`: `v_w`, `v_c` and `v_d` in the speeds' range
     /// (m/s).
     weave_speed: Option<f64>,
@@ -473,6 +485,41 @@ struct EigAnswer {
     /// With `csv`: the table of `bikedyn eig --format csv`.
     #[serde(skip_serializing_if = "Option::is_none")]
     csv: Option<String>,
+}
+
+/// The points of an `eig` answer.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum EigPoints {
+    /// As `bikedyn eig --format json` writes them.
+    Full(bikedyn::eigen::EigenSweepReport),
+    /// The same without their mode shapes.
+    WithoutModeShapes(Vec<PointWithoutModeShapes>),
+}
+
+/// An [`bikedyn::eigen::EigenAtSpeed`] without its mode shapes (the same
+/// fields, names and order otherwise).
+#[derive(Serialize)]
+struct PointWithoutModeShapes {
+    eigenvalues: [[f64; 2]; 4],
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    extra_eigenvalues: Vec<[f64; 2]>,
+    modes: [&'static str; 4],
+    #[serde(skip_serializing_if = "Option::is_none")]
+    standard_deviations: Option<Vec<[f64; 2]>>,
+    v: f64,
+}
+
+impl PointWithoutModeShapes {
+    fn of(p: &bikedyn::eigen::EigenAtSpeed) -> Self {
+        PointWithoutModeShapes {
+            eigenvalues: p.eigenvalues,
+            extra_eigenvalues: p.extra_eigenvalues.clone(),
+            modes: p.modes,
+            standard_deviations: p.standard_deviations.clone(),
+            v: p.v,
+        }
+    }
 }
 
 /// The rows `bikedyn eig --format csv` writes, from the report's own

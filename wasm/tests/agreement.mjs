@@ -152,6 +152,14 @@ for (const [bike, spec] of bicycles) {
     () => ({ job: "canonical", bicycle: spec, speeds: [0, 2, 4, 6, 8, 10] }));
 }
 
+// The explorer's diagram asks without mode shapes: the same points, less
+// their `mode_shapes`.
+const withoutModeShapes = (text) => JSON.parse(text).map(({ mode_shapes, ...rest }) => rest);
+for (const [bike, spec] of [bicycles[0], bicycles[2], bicycles[bicycles.length - 1]]) {
+  check(`eig without mode shapes ${bike}`, ["eig", "--bike", bike, "--speeds", "0:10:0.25", "--format", "json"],
+    (n) => ({ job: "eig", bicycle: spec, speeds: n.ok ? speedsOf(n.ok) : [0], mode_shapes: false }), withoutModeShapes, (w) => w.points);
+}
+
 // The eigenvalue table as `eig --format csv` writes it (the explorer's
 // download): the same header, and each cell the same text or number.
 const table = (t) => t.trim().split("\n").map((r) => r.split(",").map((c) => (c === "" || isNaN(Number(c)) ? c : Number(c))));

@@ -171,9 +171,20 @@ pub(crate) fn finish<S: Spectrum + ?Sized>(
     v_min: f64,
     v_max: f64,
 ) -> Result<CriticalSpeeds, EigenError> {
-    // Labels at the crossing speeds.
-    let speeds: Vec<f64> = cands.iter().map(|x| x.0).collect();
-    let labelled = track(cp, &speeds)?;
+    // Labels at the crossing speeds, and at the grid speeds of the weave
+    // merge's search near a collision of roots (one continuation from the
+    // anchor for both).
+    let (merge_lo, merge_hi) = (v_min.max(0.0), v_max);
+    let grid = merge_grid(merge_lo, merge_hi);
+    let near = if merge_hi > merge_lo {
+        near_collisions(cp, &grid)
+    } else {
+        Some(Vec::new())
+    };
+    let mut speeds: Vec<f64> = cands.iter().map(|x| x.0).collect();
+    speeds.extend(near.iter().flatten().map(|&i| grid[i]));
+    let mut labelled = track(cp, &speeds)?;
+    let near_labelled = labelled.split_off(cands.len());
     let mut crossings = Vec::new();
     for ((v, kind, w), l) in cands.iter().zip(&labelled) {
         let target = C64::new(0.0, *w);
@@ -205,7 +216,11 @@ pub(crate) fn finish<S: Spectrum + ?Sized>(
         Ok(cp.roots_at(v)?.iter().all(|z| z.re < 0.0))
     })?;
 
-    let (weave_real_pair_merge, weave_merge_eigenvalue) = match weave_merge(cp, v_min.max(0.0), v_max)? {
+    let merge = match near {
+        Some(near) => merge_near(cp, &grid, &near, &near_labelled)?,
+        None => weave_merge_on_labelled_grid(cp, merge_lo, merge_hi)?,
+    };
+    let (weave_real_pair_merge, weave_merge_eigenvalue) = match merge {
         Some((v, s)) => (Some(v), Some(s)),
         None => (None, None),
     };
@@ -302,52 +317,142 @@ fn weave_mean(l: &Labelled) -> f64 {
     w.iter().sum::<f64>() / w.len().max(1) as f64
 }
 
-/// `(v_d, s_d)`: lowest speed in `[lo, hi]` where the two weave roots turn from real
-/// to complex, and the double root there. The grid cell is bisected on the state
-/// of the *weave-labelled* roots (labels carried by continuation from the cell's
-/// lower end, so another pair merging in the same cell cannot be mistaken for it),
-/// then `(s, v)` is polished by Newton on `p = p_s = 0`.
-fn weave_merge<S: Spectrum + ?Sized>(cp: &S, lo: f64, hi: f64) -> Result<Option<(f64, f64)>, EigenError> {
+/// `(v_d, s_d)`: lowest speed of the grid's range where the two weave roots turn
+/// from real to complex, and the double root there. The merge is bracketed on a grid
+/// of `MERGE_GRID` cells ([`merge_grid`]), bisected on the state of the
+/// *weave-labelled* roots (labels carried by continuation from the bracket's lower
+/// end, so another pair merging in the same bracket cannot be mistaken for it), then
+/// `(s, v)` is polished by Newton on `p = p_s = 0` ([`merge_in`]).
+///
+/// Only the cells near a collision of roots can hold a merge (elsewhere the labels
+/// cannot change): `near` ([`near_collisions`]) holds the grid speeds at their ends,
+/// `labelled` their labelled roots, and the cells are searched lowest first. A
+/// family without a discriminant labels every grid speed instead
+/// ([`weave_merge_on_labelled_grid`]); both find the same merge
+/// (`weave_merge_is_bracketed_alike_by_the_discriminant`).
+fn merge_near<S: Spectrum + ?Sized>(
+    cp: &S,
+    grid: &[f64],
+    near: &[usize],
+    labelled: &[Labelled],
+) -> Result<Option<(f64, f64)>, EigenError> {
+    for k in 1..near.len() {
+        if near[k] != near[k - 1] + 1 {
+            continue;
+        }
+        let (a, b) = ((grid[near[k - 1]], labelled[k - 1]), (grid[near[k]], labelled[k]));
+        if let Some(found) = merge_in(cp, a, b)? {
+            return Ok(Some(found));
+        }
+    }
+    Ok(None)
+}
+
+/// The grid of the merge search on `[lo, hi]`.
+fn merge_grid(lo: f64, hi: f64) -> Vec<f64> {
+    (0..=MERGE_GRID)
+        .map(|i| lo + (hi - lo) * (i as f64 / MERGE_GRID as f64))
+        .collect()
+}
+
+/// The indices (ascending) of the grid speeds near which roots may collide, so
+/// that a merge can only lie in a cell between two of them: within one cell of
+/// a cell where the number of real roots changes (by the discriminant's
+/// invariants; a repeated root counts as a number of its own), and within two
+/// of a local minimum of the discriminant's magnitude over the grid (two
+/// collisions in one cell that leave the number as it was, such as the weave
+/// merging as capsize and castering part, dip it toward zero between grid
+/// speeds of one sign). A grid speed within rounding of a collision may take
+/// the wrong count: hence the cell on either side. `None` if the family has no
+/// discriminant or it is not finite somewhere on the grid.
+fn near_collisions<S: Spectrum + ?Sized>(cp: &S, grid: &[f64]) -> Option<Vec<usize>> {
+    let mut delta = Vec::with_capacity(grid.len());
+    let mut real = Vec::with_capacity(grid.len());
+    for &v in grid {
+        let (d, n) = cp.discriminant(v)?;
+        if !d.is_finite() {
+            return None;
+        }
+        delta.push(d.abs());
+        real.push(n);
+    }
+    let last = grid.len() - 1;
+    let mut near = vec![false; grid.len()];
+    let mut mark = |lo: usize, hi: usize| {
+        for n in near.iter_mut().take(hi.min(last) + 1).skip(lo) {
+            *n = true;
+        }
+    };
+    for i in 0..last {
+        if real[i] != real[i + 1] {
+            mark(i.saturating_sub(1), i + 2);
+        }
+    }
+    for i in 0..=last {
+        let below = i == 0 || delta[i] <= delta[i - 1];
+        let above = i == last || delta[i] <= delta[i + 1];
+        if below && above {
+            mark(i.saturating_sub(2), i + 2);
+        }
+    }
+    Some((0..grid.len()).filter(|&i| near[i]).collect())
+}
+
+/// [`merge_near`] with every grid speed labelled (for a family without a
+/// discriminant).
+pub(super) fn weave_merge_on_labelled_grid<S: Spectrum + ?Sized>(
+    cp: &S,
+    lo: f64,
+    hi: f64,
+) -> Result<Option<(f64, f64)>, EigenError> {
     if !(hi > lo) {
         return Ok(None);
     }
-    let grid: Vec<f64> = (0..=MERGE_GRID)
-        .map(|i| lo + (hi - lo) * (i as f64 / MERGE_GRID as f64))
-        .collect();
+    let grid = merge_grid(lo, hi);
     let lab = track(cp, &grid)?;
     for i in 0..MERGE_GRID {
-        if weave_state(&lab[i]) != Some(true) || weave_state(&lab[i + 1]) != Some(false) {
-            continue;
+        if let Some(found) = merge_in(cp, (grid[i], lab[i]), (grid[i + 1], lab[i + 1]))? {
+            return Ok(Some(found));
         }
-        let (mut a, mut b) = (grid[i], grid[i + 1]);
-        let (mut la, mut lb) = (lab[i], lab[i + 1]);
-        for _ in 0..200 {
-            let m = 0.5 * (a + b);
-            if m <= a || m >= b {
-                break;
-            }
-            let lm = continue_to(cp, la, a, m)?.canonical();
-            if weave_state(&lm) == Some(true) {
-                a = m;
-                la = lm;
-            } else {
-                b = m;
-                lb = lm;
-            }
-        }
-        let vm = 0.5 * (a + b);
-        // the double root: real part of the (just formed) weave pair above the merge
-        // (below it the two weave-labelled roots need not be the merging ones, see
-        // the pair rule in the module docs)
-        let s0 = weave_mean(&lb);
-        return Ok(Some(match double_root_newton(cp, s0, vm) {
-            Some((v, s)) if (v - vm).abs() <= 1e-9 * vm.abs().max(1.0) && (s - s0).abs() <= 1e-3 * (1.0 + s0.abs()) => {
-                (v, s)
-            }
-            _ => (vm, s0),
-        }));
     }
     Ok(None)
+}
+
+/// The weave merge in the bracket `[a, b]` with the labelled roots at its
+/// ends, if the weave roots are real at `a` and form a pair at `b`.
+fn merge_in<S: Spectrum + ?Sized>(
+    cp: &S,
+    (mut a, mut la): (f64, Labelled),
+    (mut b, mut lb): (f64, Labelled),
+) -> Result<Option<(f64, f64)>, EigenError> {
+    if weave_state(&la) != Some(true) || weave_state(&lb) != Some(false) {
+        return Ok(None);
+    }
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if m <= a || m >= b {
+            break;
+        }
+        let lm = continue_to(cp, la, a, m)?.canonical();
+        if weave_state(&lm) == Some(true) {
+            a = m;
+            la = lm;
+        } else {
+            b = m;
+            lb = lm;
+        }
+    }
+    let vm = 0.5 * (a + b);
+    // the double root: real part of the (just formed) weave pair above the merge
+    // (below it the two weave-labelled roots need not be the merging ones, see
+    // the pair rule in the module docs)
+    let s0 = weave_mean(&lb);
+    Ok(Some(match double_root_newton(cp, s0, vm) {
+        Some((v, s)) if (v - vm).abs() <= 1e-9 * vm.abs().max(1.0) && (s - s0).abs() <= 1e-3 * (1.0 + s0.abs()) => {
+            (v, s)
+        }
+        _ => (vm, s0),
+    }))
 }
 
 /// Newton on `p(s, v) = 0`, `p_s(s, v) = 0` (real `s`).
@@ -371,4 +476,119 @@ fn double_root_newton<S: Spectrum + ?Sized>(cp: &S, mut s: f64, mut v: f64) -> O
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::closed_form::meijaard_canonical_in;
+    use crate::parameters::BenchmarkParameters;
+    use crate::random::SplitMix64;
+    use nalgebra::Matrix2;
+
+    /// Random designs about the benchmark bicycle: every value scaled by
+    /// 0.6-1.4, the trail and steer-axis tilt drawn over wide ranges (some
+    /// designs have no weave merge in the range, some merge other pairs).
+    fn random_family(rng: &mut SplitMix64) -> Option<CharPoly> {
+        let draws: Vec<f64> = (0..26).map(|_| rng.next_f64()).collect();
+        family(|sym, x| {
+            let u = draws[BenchmarkParameters::SYMBOLS
+                .iter()
+                .position(|s| *s == sym)
+                .expect("a symbol")];
+            let within = |lo: f64, hi: f64| lo + (hi - lo) * u;
+            match sym {
+                "g" => x,
+                "c" => within(-0.1, 0.3),
+                "lam" => within(-0.3, 0.8),
+                "xB" | "xH" | "IBxz" | "IHxz" => x * within(-0.5, 2.0),
+                _ => x * within(0.6, 1.4),
+            }
+        })
+    }
+
+    /// The canonical form's characteristic polynomial of the benchmark
+    /// bicycle with values changed by `change`.
+    fn family(change: impl Fn(&str, f64) -> f64) -> Option<CharPoly> {
+        let p = BenchmarkParameters::benchmark_bicycle();
+        let x: [f64; 26] = BenchmarkParameters::SYMBOLS.map(|k| change(k, p.get(k).expect("a benchmark symbol")));
+        let m = meijaard_canonical_in(&x);
+        let c = CanonicalMatrices {
+            m0: Matrix2::from_fn(|i, j| m.m0[i][j]),
+            c1: Matrix2::from_fn(|i, j| m.c1[i][j]),
+            k0: Matrix2::from_fn(|i, j| m.k0[i][j]),
+            k2: Matrix2::from_fn(|i, j| m.k2[i][j]),
+            g: m.g,
+        };
+        CharPoly::new(&c).ok()
+    }
+
+    /// The same merge or none, by both methods, on `[lo, hi]`; whether one
+    /// was found.
+    fn same_merge(cp: &CharPoly, lo: f64, hi: f64) -> Option<bool> {
+        let (Ok(fast), Ok(grid)) = (finish(cp, Vec::new(), lo, hi), weave_merge_on_labelled_grid(cp, lo, hi)) else {
+            return None;
+        };
+        let fast = fast.weave_real_pair_merge.zip(fast.weave_merge_eigenvalue);
+        match (fast, grid) {
+            (None, None) => Some(false),
+            (Some((v, s)), Some((vg, sg))) => {
+                assert!(
+                    (v - vg).abs() <= 1e-12 * vg.abs().max(1.0),
+                    "{v} vs {vg} on [{lo}, {hi}]: {cp:?}"
+                );
+                assert!(
+                    (s - sg).abs() <= 1e-9 * sg.abs().max(1.0),
+                    "{s} vs {sg} on [{lo}, {hi}]: {cp:?}"
+                );
+                Some(true)
+            }
+            other => panic!("{other:?} on [{lo}, {hi}]: {cp:?}"),
+        }
+    }
+
+    /// Over the explorer's map of trail and steer-axis tilt (101 x 101
+    /// designs, 0-10 m/s), where some designs have the weave merge and the
+    /// capsize-castering merge in one cell of the grid (four real roots on
+    /// one side, none on the other: the discriminant keeps its sign, the
+    /// number of real roots does not), both methods find the same merge.
+    #[test]
+    fn weave_merge_of_the_trail_and_tilt_map_is_bracketed_alike() {
+        let mut found = 0;
+        for i in 0..=100 {
+            for j in 0..=100 {
+                let (c, lam) = (0.02 + 0.0012 * i as f64, 0.1 + 0.004 * j as f64);
+                let cp = family(|k, x| match k {
+                    "c" => c,
+                    "lam" => lam,
+                    _ => x,
+                })
+                .expect("a valid design");
+                found += usize::from(same_merge(&cp, 0.0, 10.0).expect("both methods succeed"));
+            }
+        }
+        assert!(found > 5000, "{found}");
+    }
+
+    /// The weave merge bracketed by the discriminant's sign changes is the
+    /// one a labelled grid finds, on a thousand random designs and three
+    /// speed ranges: the same speed and double root to 1e-12, or neither.
+    #[test]
+    fn weave_merge_is_bracketed_alike_by_the_discriminant() {
+        let mut rng = SplitMix64::new(20261129);
+        let (mut compared, mut found) = (0, 0);
+        for _ in 0..1000 {
+            let Some(cp) = random_family(&mut rng) else { continue };
+            for (lo, hi) in [(0.0, 10.0), (0.0, 3.0), (2.0, 40.0)] {
+                if let Some(merged) = same_merge(&cp, lo, hi) {
+                    compared += 1;
+                    found += usize::from(merged);
+                }
+            }
+        }
+        assert!(
+            compared > 2000 && found > 500,
+            "{compared} compared, {found} with a merge"
+        );
+    }
 }

@@ -177,6 +177,9 @@ impl Spectrum for General<'_> {
     fn mirror_symmetric(&self) -> bool {
         false
     }
+    fn discriminant(&self, v: f64) -> Option<(f64, Option<u8>)> {
+        quartic::discriminant(&self.checked(v).ok()?)
+    }
 }
 
 /// The four eigenvalues at speed `v` (no labels), sorted by descending real
@@ -326,4 +329,63 @@ fn vectors(m: &SpeedMatrices, roots: &[C64; 4]) -> [[Complex<f64>; 4]; 4] {
         };
     }
     vecs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::critical::weave_merge_on_labelled_grid;
+    use super::*;
+    use crate::closed_form::meijaard_canonical;
+    use crate::parameters::BenchmarkParameters;
+
+    /// The benchmark bicycle with trail `c` and a steer damper
+    /// `c_steer` (N m s/rad): no canonical form, so the general path.
+    struct Damped {
+        canonical: CanonicalMatrices,
+        c_steer: f64,
+    }
+
+    impl LinearBicycle for Damped {
+        fn at_speed(&self, v: f64) -> Result<SpeedMatrices, EigenError> {
+            let mut m = self.canonical.at_speed(v)?;
+            m.damping[(1, 1)] += self.c_steer;
+            Ok(m)
+        }
+    }
+
+    /// On the general path (steer damping: no canonical form) the weave
+    /// merge bracketed by the discriminant is the one a labelled grid
+    /// finds, over trails and dampers, or neither finds one.
+    #[test]
+    fn weave_merge_of_damped_designs_is_bracketed_alike_by_the_discriminant() {
+        let mut found = 0;
+        for i in 0..=40 {
+            for j in 0..=10 {
+                let mut p = BenchmarkParameters::benchmark_bicycle();
+                p.trail = -0.02 + 0.005 * i as f64;
+                let bike = Damped {
+                    canonical: meijaard_canonical(&p),
+                    c_steer: 0.05 * j as f64,
+                };
+                let family = General::new(&bike).expect("a design");
+                let fast = finish(&family, Vec::new(), 0.0, 10.0).expect("critical speeds");
+                let grid = weave_merge_on_labelled_grid(&family, 0.0, 10.0).expect("the labelled grid");
+                match (fast.weave_real_pair_merge.zip(fast.weave_merge_eigenvalue), grid) {
+                    (None, None) => {}
+                    (Some((v, s)), Some((vg, sg))) => {
+                        found += 1;
+                        assert!(
+                            (v - vg).abs() <= 1e-12 * vg.max(1.0),
+                            "{v} vs {vg}, c {}, c_steer {}",
+                            p.trail,
+                            bike.c_steer
+                        );
+                        assert!((s - sg).abs() <= 1e-9 * sg.abs().max(1.0), "{s} vs {sg}");
+                    }
+                    other => panic!("{other:?}, c {}, c_steer {}", p.trail, bike.c_steer),
+                }
+            }
+        }
+        assert!(found > 200, "{found}");
+    }
 }

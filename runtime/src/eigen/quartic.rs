@@ -42,31 +42,11 @@ fn pow2_near(r: f64) -> f64 {
 /// Returns `None` only if no method produced finite roots with a small backward error.
 pub(crate) fn quartic_roots(k: &[f64; 5]) -> Option<[C64; 4]> {
     let k4 = k[4];
-    if k4 == 0.0 || !k.iter().all(|x| x.is_finite()) {
-        return None;
-    }
-    let a = k[3] / k4;
-    let b = k[2] / k4;
-    let c = k[1] / k4;
-    let d = k[0] / k4;
-    if !(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite()) {
-        return None;
-    }
+    let ([a, b, c, d], rho) = monic_scaled(k)?;
     if a == 0.0 && b == 0.0 && c == 0.0 && d == 0.0 {
         return Some([C64::new(0.0, 0.0); 4]);
     }
-    // rho ~ max(|a|, |b|^(1/2), |c|^(1/3), |d|^(1/4)) as a power of two, from exponents.
-    let ex = |x: f64, n: i64| -> i64 {
-        if x == 0.0 {
-            i64::MIN / 2
-        } else {
-            (((x.to_bits() >> 52) & 0x7ff) as i64 - 1023).div_euclid(n)
-        }
-    };
-    let er = ex(a, 1).max(ex(b, 2)).max(ex(c, 3)).max(ex(d, 4)).clamp(-1000, 1000);
-    let rho = f64::from_bits(((er + 1023) as u64) << 52);
     let (r1, r2) = (rho, rho * rho);
-    let (a, b, c, d) = (a / r1, b / r2, c / (r2 * r1), d / (r2 * r2));
     // Unnormalised coefficients in the scaled variable, divided by a power of two
     // near |k4|: e[i] = k[i] rho^i / sigma (exact scalings).
     let sigma = pow2_near(k4.abs());
@@ -93,6 +73,89 @@ pub(crate) fn quartic_roots(k: &[f64; 5]) -> Option<[C64; 4]> {
     }
     sort_desc(&mut z);
     Some(z)
+}
+
+/// The quartic made monic and scaled, `z^4 + a z^3 + b z^2 + c z + d` with
+/// `s = rho z` and `rho` a power of two near the largest root magnitude
+/// (exact scalings), as `([a, b, c, d], rho)`; `None` if `k[4] = 0` or a
+/// coefficient is not finite. An all-zero lower part gives `rho = 1`.
+fn monic_scaled(k: &[f64; 5]) -> Option<([f64; 4], f64)> {
+    let k4 = k[4];
+    if k4 == 0.0 || !k.iter().all(|x| x.is_finite()) {
+        return None;
+    }
+    let (a, b, c, d) = (k[3] / k4, k[2] / k4, k[1] / k4, k[0] / k4);
+    if !(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite()) {
+        return None;
+    }
+    if a == 0.0 && b == 0.0 && c == 0.0 && d == 0.0 {
+        return Some(([0.0; 4], 1.0));
+    }
+    // rho ~ max(|a|, |b|^(1/2), |c|^(1/3), |d|^(1/4)) as a power of two, from exponents.
+    let ex = |x: f64, n: i64| -> i64 {
+        if x == 0.0 {
+            i64::MIN / 2
+        } else {
+            (((x.to_bits() >> 52) & 0x7ff) as i64 - 1023).div_euclid(n)
+        }
+    };
+    let er = ex(a, 1).max(ex(b, 2)).max(ex(c, 3)).max(ex(d, 4)).clamp(-1000, 1000);
+    let rho = f64::from_bits(((er + 1023) as u64) << 52);
+    let (r1, r2) = (rho, rho * rho);
+    Some(([a / r1, b / r2, c / (r2 * r1), d / (r2 * r2)], rho))
+}
+
+/// The discriminant of the quartic `k`, made monic and scaled as in
+/// [`quartic_roots`] (positive factors that keep its sign), and the number of
+/// its real roots from the discriminant's sign and two more invariants (no
+/// root is solved for): `None` as [`monic_scaled`]. A negative discriminant
+/// means two real roots and a complex pair; a positive one four real roots
+/// (when `P = 8 b - 3 a^2` and `D = 64 d - 16 b^2 + 16 a^2 b - 16 a c - 3 a^4`
+/// are both negative) or two complex pairs; zero, a repeated root (the count
+/// is then `None`). So where roots collide the discriminant is zero, and where
+/// the number of real roots changes, the count does (about 50 flops, against a
+/// root solve's 200 and a labelling).
+pub(crate) fn discriminant(k: &[f64; 5]) -> Option<(f64, Option<u8>)> {
+    // Monic only (one division): the scaling by `rho` changes none of the
+    // three signs and, being by a power of two, no rounding; it is needed
+    // only where the unscaled terms would overflow or underflow.
+    let r = 1.0 / k[4];
+    let monic = [k[3] * r, k[2] * r, k[1] * r, k[0] * r];
+    match monic_invariants(monic) {
+        Some((delta, real)) if delta.is_finite() && delta != 0.0 => Some((delta, real)),
+        _ => monic_invariants(monic_scaled(k)?.0),
+    }
+}
+
+/// The discriminant and real-root count of `z^4 + a z^3 + b z^2 + c z + d`
+/// (see [`discriminant`]); `None` if a coefficient is not finite.
+fn monic_invariants([a, b, c, d]: [f64; 4]) -> Option<(f64, Option<u8>)> {
+    if !(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite()) {
+        return None;
+    }
+    let (a2, b2, c2, d2) = (a * a, b * b, c * c, d * d);
+    let delta = 256.0 * d2 * d - 192.0 * a * c * d2 - 128.0 * b2 * d2 + 144.0 * b * c2 * d - 27.0 * c2 * c2
+        + 144.0 * a2 * b * d2
+        - 6.0 * a2 * c2 * d
+        - 80.0 * a * b2 * c * d
+        + 18.0 * a * b * c2 * c
+        + 16.0 * b2 * b2 * d
+        - 4.0 * b2 * b * c2
+        - 27.0 * a2 * a2 * d2
+        + 18.0 * a2 * a * b * c * d
+        - 4.0 * a2 * a * c2 * c
+        - 4.0 * a2 * b2 * b * d
+        + a2 * b2 * c2;
+    let p = 8.0 * b - 3.0 * a2;
+    let dd = 64.0 * d - 16.0 * b2 + 16.0 * a2 * b - 16.0 * a * c - 3.0 * a2 * a2;
+    let real = if delta < 0.0 {
+        Some(2)
+    } else if delta > 0.0 {
+        Some(if p < 0.0 && dd < 0.0 { 4 } else { 0 })
+    } else {
+        None
+    };
+    Some((delta, real))
 }
 
 /// Sort by descending real part, then descending imaginary part.
@@ -444,4 +507,84 @@ fn polish_complex(e: &[f64; 5], z0: C64, gap: f64) -> Option<C64> {
     }
     let _ = p;
     (z.re.is_finite() && z.im.is_finite() && p2 <= BACKWARD_TOL * BACKWARD_TOL * sc * sc).then_some(z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `k` of `prod (s - r)` for four roots given as real numbers and
+    /// conjugate pairs.
+    fn from_roots(r: [C64; 4]) -> [f64; 5] {
+        let mut p = [
+            C64::new(1.0, 0.0),
+            C64::new(0.0, 0.0),
+            C64::new(0.0, 0.0),
+            C64::new(0.0, 0.0),
+            C64::new(0.0, 0.0),
+        ];
+        for (n, z) in r.iter().enumerate() {
+            for i in (1..=n + 1).rev() {
+                p[i] = p[i - 1] - *z * p[i];
+            }
+            p[0] = -*z * p[0];
+        }
+        // p[i] multiplies s^(n - i) so far: reverse to `k[i]` of `s^i`.
+        let mut k = [0.0; 5];
+        for i in 0..5 {
+            k[i] = p[4 - i].re;
+        }
+        k
+    }
+
+    /// The discriminant's sign is that of `prod_{i<j} (r_i - r_j)^2`, and the
+    /// count of real roots is right, for four real roots, two complex pairs,
+    /// and two real roots and a pair, whatever the scale of the roots or the
+    /// leading coefficient.
+    #[test]
+    fn discriminant_sign_and_real_root_count() {
+        let re = |x: f64| C64::new(x, 0.0);
+        let cases = [
+            ([re(1.0), re(2.0), re(-3.0), re(4.5)], 1.0, 4),
+            ([C64::new(0.5, 2.0), C64::new(0.5, -2.0), re(-1.0), re(3.0)], -1.0, 2),
+            (
+                [
+                    C64::new(-0.5, 6.0),
+                    C64::new(-0.5, -6.0),
+                    C64::new(2.0, 1.0),
+                    C64::new(2.0, -1.0),
+                ],
+                1.0,
+                0,
+            ),
+            (
+                [
+                    C64::new(2.75, 0.06),
+                    C64::new(2.75, -0.06),
+                    C64::new(-3.1, 0.04),
+                    C64::new(-3.1, -0.04),
+                ],
+                1.0,
+                0,
+            ),
+            (
+                [C64::new(-0.1, 0.01), C64::new(-0.1, -0.01), re(-12.0), re(5.0)],
+                -1.0,
+                2,
+            ),
+            ([re(-0.1), re(-0.1001), re(-12.0), re(5.0)], 1.0, 4),
+        ];
+        for (roots, sign, real) in cases {
+            for scale in [1e-3, 1.0, 1e4] {
+                let mut k = from_roots(roots.map(|z| z * scale));
+                for x in k.iter_mut() {
+                    *x *= -7.5;
+                }
+                let (d, n) = discriminant(&k).unwrap();
+                assert_eq!((d.signum(), n), (sign, Some(real)), "{roots:?} x {scale}: {d}");
+            }
+        }
+        assert_eq!(discriminant(&[0.0, 0.0, 0.0, 0.0, 1.0]), Some((0.0, None)));
+        assert_eq!(discriminant(&[1.0, 0.0, 0.0, 0.0, f64::NAN]), None);
+    }
 }
