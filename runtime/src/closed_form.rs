@@ -28,8 +28,13 @@ use nalgebra::Matrix2;
 /// `SR = IRyy/rR`, `SF = IFyy/rF`, `ST = SR + SF`, and the static moment
 /// `SA = mA uA + mu mT xT`.
 pub fn meijaard_canonical(p: &BenchmarkParameters) -> CanonicalMatrices {
-    let values: [f64; 26] = BenchmarkParameters::SYMBOLS.map(|k| p.get(k).expect("a benchmark symbol"));
-    let m = meijaard_canonical_in(&values);
+    meijaard_canonical_of_values(&BenchmarkParameters::SYMBOLS.map(|k| p.get(k).expect("a benchmark symbol")))
+}
+
+/// [`meijaard_canonical`] from the values in the order of
+/// [`BenchmarkParameters::SYMBOLS`] (SI units).
+pub fn meijaard_canonical_of_values(values: &[f64; 26]) -> CanonicalMatrices {
+    let m = meijaard_canonical_in(values);
     CanonicalMatrices {
         m0: Matrix2::from_fn(|i, j| m.m0[i][j]),
         c1: Matrix2::from_fn(|i, j| m.c1[i][j]),

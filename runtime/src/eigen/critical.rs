@@ -481,10 +481,9 @@ fn double_root_newton<S: Spectrum + ?Sized>(cp: &S, mut s: f64, mut v: f64) -> O
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::closed_form::meijaard_canonical_in;
+    use crate::closed_form::meijaard_canonical_of_values;
     use crate::parameters::BenchmarkParameters;
     use crate::random::SplitMix64;
-    use nalgebra::Matrix2;
 
     /// Random designs about the benchmark bicycle: every value scaled by
     /// 0.6-1.4, the trail and steer-axis tilt drawn over wide ranges (some
@@ -512,14 +511,7 @@ mod tests {
     fn family(change: impl Fn(&str, f64) -> f64) -> Option<CharPoly> {
         let p = BenchmarkParameters::benchmark_bicycle();
         let x: [f64; 26] = BenchmarkParameters::SYMBOLS.map(|k| change(k, p.get(k).expect("a benchmark symbol")));
-        let m = meijaard_canonical_in(&x);
-        let c = CanonicalMatrices {
-            m0: Matrix2::from_fn(|i, j| m.m0[i][j]),
-            c1: Matrix2::from_fn(|i, j| m.c1[i][j]),
-            k0: Matrix2::from_fn(|i, j| m.k0[i][j]),
-            k2: Matrix2::from_fn(|i, j| m.k2[i][j]),
-            g: m.g,
-        };
+        let c = meijaard_canonical_of_values(&x);
         CharPoly::new(&c).ok()
     }
 
