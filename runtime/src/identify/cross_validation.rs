@@ -4,7 +4,8 @@
 //! logs), so a held-out error is that of data the effect never saw, and a
 //! selection step compares two models run by run ([`paired_gain`]).
 
-use super::fit::{lm_fit, Free, Problem};
+use super::fit::{Free, Problem};
+use super::levenberg_marquardt::lm_fit;
 use super::{CandidateFit, IdentifyOptions, Segment, SegmentError, Setup, Weights};
 use std::sync::atomic::Ordering;
 

@@ -5,9 +5,10 @@
 //! dissipative parameters stay positive. The held-out half of judging a fit
 //! is [`cross_validate`](super::cross_validate).
 
+use super::levenberg_marquardt::{lm_fit, SPEED};
 use super::normal::{Normal, SegmentJacobian};
 use super::nuisance::nuisance_scale;
-use super::{bic, cross_validate, Bound, EffectParameter, IdentifyError, Segment, Setup, Weights, NUISANCE};
+use super::{bic, cross_validate, EffectParameter, IdentifyError, Segment, Setup, Weights, NUISANCE};
 use nalgebra::DMatrix;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -40,6 +41,10 @@ pub(super) struct Problem<'s, 'a> {
     /// settles the fit's verdict: a trial's own dissipative parameters
     /// (see [`lm_fit`]). Empty for every other fit.
     pub(super) settled_on_floor: Vec<usize>,
+    /// Hold each segment's initial speed where it is (its Jacobian column
+    /// zeroed, so a step never moves it): the first stage of a fit from
+    /// the measured speed (see [`fit_each_segment`]).
+    pub(super) anchor_speed: bool,
 }
 
 impl<'s, 'a> Problem<'s, 'a> {
@@ -60,19 +65,20 @@ impl<'s, 'a> Problem<'s, 'a> {
             x0,
             cache: Mutex::new(None),
             settled_on_floor: Vec::new(),
+            anchor_speed: false,
         }
     }
 }
 
 impl Problem<'_, '_> {
-    fn n_free(&self) -> usize {
+    pub(super) fn n_free(&self) -> usize {
         match self.free {
             Free::All => self.setup.k() + self.setup.nuisance() * self.segs.len(),
             Free::Shared => self.setup.k(),
             Free::Nuisance => self.setup.nuisance() * self.segs.len(),
         }
     }
-    fn pack(&self) -> Vec<f64> {
+    pub(super) fn pack(&self) -> Vec<f64> {
         let mut x = Vec::with_capacity(self.n_free());
         if self.free != Free::Nuisance {
             x.extend(&self.g);
@@ -84,7 +90,7 @@ impl Problem<'_, '_> {
         }
         x
     }
-    fn unpack(&mut self, x: &[f64]) {
+    pub(super) fn unpack(&mut self, x: &[f64]) {
         let mut i = 0;
         if self.free != Free::Nuisance {
             let k = self.setup.k();
@@ -102,7 +108,7 @@ impl Problem<'_, '_> {
         }
     }
     /// The parameters with a prior while they are free: `(column, sd)`.
-    fn prior_rows(&self) -> Vec<(usize, f64)> {
+    pub(super) fn prior_rows(&self) -> Vec<(usize, f64)> {
         if self.free == Free::Nuisance {
             return Vec::new();
         }
@@ -114,7 +120,7 @@ impl Problem<'_, '_> {
             .collect()
     }
     /// Residuals of the priors (after the data's).
-    fn prior_residuals(&self) -> Vec<f64> {
+    pub(super) fn prior_residuals(&self) -> Vec<f64> {
         self.prior_rows()
             .into_iter()
             .map(|(j, sd)| {
@@ -125,7 +131,7 @@ impl Problem<'_, '_> {
     }
     /// The priors' penalty: Huber's, `r^2` within `gross_beyond` (c) of
     /// the mean and `2 c |r| - c^2` beyond ([`EffectParameter::gross_beyond`]).
-    fn prior_penalty(&self) -> f64 {
+    pub(super) fn prior_penalty(&self) -> f64 {
         self.prior_rows()
             .into_iter()
             .zip(self.prior_residuals())
@@ -136,7 +142,7 @@ impl Problem<'_, '_> {
     /// with Huber's weight `min(1, c / |r|)` folded into the standard
     /// deviation and the residual (iteratively reweighted: the step is
     /// Gauss-Newton on the penalty's quadratic model at the current value).
-    fn prior_normal_rows(&self) -> Vec<(usize, f64, f64)> {
+    pub(super) fn prior_normal_rows(&self) -> Vec<(usize, f64, f64)> {
         self.prior_rows()
             .into_iter()
             .zip(self.prior_residuals())
@@ -235,12 +241,17 @@ impl Problem<'_, '_> {
             let m = if nuisance { &mut blocks[p].b } else { &mut blocks[p].a };
             m.column_mut(j).copy_from_slice(&d);
         }
+        if self.anchor_speed && nn > SPEED {
+            for b in &mut blocks {
+                b.b.column_mut(SPEED).fill(0.0);
+            }
+        }
         Some(blocks)
     }
 
     /// Scale of each free parameter in packed order (steps are measured
     /// against it).
-    fn scales(&self) -> Vec<f64> {
+    pub(super) fn scales(&self) -> Vec<f64> {
         let mut x = Vec::with_capacity(self.n_free());
         if self.free != Free::Nuisance {
             x.extend(self.setup.parameters.iter().map(|p| p.scale));
@@ -362,201 +373,6 @@ impl Default for IdentifyOptions {
             max_fits_per_step: 8,
         }
     }
-}
-
-/// Levenberg-Marquardt on the block-arrow problem (see [`Normal`]):
-/// Marquardt's damping of the normal equations, the damping lowered after
-/// a step that lowers the cost and raised until one does. It stops when an
-/// accepted step changes the cost or the parameters (on their scales) by
-/// less than 1e-6 relative (the simulations are accurate to about 1e-8, and
-/// the parameters' uncertainty is far larger than what further iterations
-/// would change), or after `patience` times the parameters of one segment
-/// (plus one) residual evaluations.
-///
-/// With no effect parameter free the segments are independent problems,
-/// and each is fitted on its own ([`fit_each_segment`]): its own damping,
-/// convergence test and budget.
-///
-/// A trial fit also ends when one of its own dissipative parameters
-/// (`settled_on_floor`) has been held on its floor, the data pulling it
-/// below, through [`SETTLED_STEPS`] accepted steps in a row that each
-/// lowered the cost by less than [`SLOW_STEP`] relative: the trial's verdict
-/// is then settled (a dissipative parameter on its floor is not physics, and
-/// a trial that is not physical is never added to the model, so nothing is
-/// built on the unconverged rest). Such a fit used to crawl to its budget:
-/// the tyre candidate's relaxation length on its 1 cm floor, with stiff
-/// lagged force states, spent 911 of an identification's 1240 s.
-pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
-    const TOL: f64 = 1e-6;
-    let k = if p.free == Free::Nuisance { 0 } else { p.setup.k() };
-    if p.n_free() == 0 {
-        return p;
-    }
-    let cost = |p: &Problem<'_, '_>| -> Option<f64> {
-        let r = p.all_residuals()?;
-        Some(r.iter().flatten().map(|x| x * x).sum::<f64>() + p.prior_penalty())
-    };
-    // With no shared parameter free the problem separates: each segment's
-    // initial state is its own least-squares problem. Fitted together under
-    // one damping and one accept-or-reject, the segment the model fits
-    // worst (a kick below the weave speed, its fall sensitive to the start)
-    // held every other one to its short steps, and the fit ran out of
-    // budget unconverged (the base fit of the oracle's steer_damping_small:
-    // 110 of 112 evaluations, two kicks holding 95 % of the cost). Apart,
-    // each segment gets its own damping, convergence test and budget, and
-    // the minimum is the same.
-    if k == 0 && p.segs.len() > 1 {
-        fit_each_segment(&mut p, patience);
-        return p;
-    }
-    let Some(mut c) = cost(&p) else { return p };
-    let scales = p.scales();
-    let budget = patience.max(1) * (k + p.setup.nuisance() + 1) * 4;
-
-    let mut evals = 1;
-    let mut lambda = 1e-3;
-    let mut settling = FloorSettling::default();
-    'outer: while evals < budget {
-        let (Some(blocks), Some(res)) = (p.jacobian_blocks(), p.all_residuals()) else {
-            break;
-        };
-        let mut prior = p.prior_normal_rows();
-        let x = p.pack();
-        // Active set: a parameter on its floor or ceiling whose descent
-        // direction points beyond it is held there for this iteration (a
-        // stiff prior row), so the other parameters take a full step rather
-        // than one computed as if it could move and then cut by projection.
-        // The gradient is needed only for parameters on a bound (most fits
-        // have none): it is not computed for the others.
-        let descent: Vec<f64> = (0..k)
-            .map(|j| {
-                if p.setup.parameters[j].on_bound(x[j]).is_none() {
-                    return 0.0;
-                }
-                let data: f64 = blocks
-                    .iter()
-                    .zip(&res)
-                    .filter(|(b, _)| b.a.ncols() > j)
-                    .map(|(b, r)| b.a.column(j).iter().zip(r).map(|(a, r)| a * r).sum::<f64>())
-                    .sum();
-                let priors: f64 = prior.iter().filter(|row| row.0 == j).map(|&(_, sd, r)| r / sd).sum();
-                -(data + priors)
-            })
-            .collect();
-        let held = held_on_bound(&p.setup.parameters[..k], &x[..k], &descent);
-        let on_floor = held.iter().any(|j| {
-            p.settled_on_floor.contains(j) && matches!(p.setup.parameters[*j].on_bound(x[*j]), Some(Bound::Floor(_)))
-        });
-        for j in held {
-            prior.push((j, 1e-9 * p.setup.parameters[j].scale, 0.0));
-        }
-        loop {
-            let step = Normal::new(&blocks, &res, &prior, k, lambda).and_then(|n| n.step());
-            let Some(dx) = step.filter(|d| d.iter().all(|v| v.is_finite())) else {
-                lambda *= 10.0;
-                if lambda > 1e12 {
-                    break 'outer;
-                }
-                continue;
-            };
-            // A step beyond a parameter's floor or ceiling is projected back
-            // onto it (projected Levenberg-Marquardt): the parameter stays
-            // where the response still moves with it, so a later step can
-            // bring it back inside.
-            let mut trial: Vec<f64> = x.iter().zip(&dx).map(|(a, b)| a + b).collect();
-            for (t, q) in trial.iter_mut().zip(&p.setup.parameters).take(k) {
-                *t = q.simulated(*t);
-            }
-            let dx: Vec<f64> = trial.iter().zip(&x).map(|(t, a)| t - a).collect();
-            p.unpack(&trial);
-            evals += 1;
-            match cost(&p) {
-                Some(ct) if ct < c => {
-                    let df = (c - ct) / c.max(f64::MIN_POSITIVE);
-                    let dn = dx.iter().zip(&scales).map(|(d, s)| (d / s).powi(2)).sum::<f64>().sqrt();
-                    let xn = x.iter().zip(&scales).map(|(v, s)| (v / s).powi(2)).sum::<f64>().sqrt();
-                    c = ct;
-                    lambda = (lambda / 3.0).max(1e-12);
-                    if df <= TOL || dn <= TOL * (xn + TOL) {
-                        break 'outer;
-                    }
-                    if settling.settled_after(on_floor, df) {
-                        break 'outer;
-                    }
-                    break;
-                }
-                _ => {
-                    p.unpack(&x);
-                    lambda *= 4.0;
-                    if lambda > 1e12 || evals >= budget {
-                        break 'outer;
-                    }
-                }
-            }
-        }
-    }
-    p
-}
-
-/// Fit each segment's initial state on its own (in parallel) with the
-/// effect parameters held at `p.g`, starting from `p.x0`.
-fn fit_each_segment(p: &mut Problem<'_, '_>, patience: usize) {
-    let fitted: Vec<(usize, [f64; NUISANCE])> = p
-        .segs
-        .par_iter()
-        .map(|&s| {
-            let one = Problem::new(p.setup, vec![s], Free::Nuisance, p.g.clone(), p.x0.clone());
-            (s, lm_fit(one, patience).x0[s])
-        })
-        .collect();
-    for (s, x) in fitted {
-        p.x0[s] = x;
-    }
-}
-
-/// Accepted steps in a row, each lowering the cost by less than
-/// [`SLOW_STEP`] with a trial's own dissipative parameter held on its floor,
-/// that settle the trial's verdict (see [`lm_fit`]).
-const SETTLED_STEPS: usize = 3;
-/// Relative cost decrease below which an accepted step is slow: a thousand
-/// times the fits' convergence tolerance.
-const SLOW_STEP: f64 = 1e-3;
-
-/// The count behind a trial's verdict settled on a floor (see [`lm_fit`]).
-#[derive(Default)]
-struct FloorSettling {
-    /// Accepted slow steps in a row with a settling parameter held.
-    steps: usize,
-}
-
-impl FloorSettling {
-    /// After an accepted step that lowered the cost by `df` (relative),
-    /// taken with (`on_floor`) or without one of the trial's own
-    /// dissipative parameters held on its floor: whether the fit ends.
-    fn settled_after(&mut self, on_floor: bool, df: f64) -> bool {
-        self.steps = if on_floor && df < SLOW_STEP { self.steps + 1 } else { 0 };
-        self.steps >= SETTLED_STEPS
-    }
-}
-
-/// The parameters to hold on their bound for one iteration: those on a
-/// floor or ceiling whose steepest-descent direction `descent` (minus the
-/// gradient of the cost) points beyond it. The test is the gradient's sign
-/// (projected Newton), not the Gauss-Newton step's, so a parameter the
-/// data pull back inside is released at the next iteration even when a
-/// correlated parameter would make the full step point outward.
-fn held_on_bound(parameters: &[EffectParameter], x: &[f64], descent: &[f64]) -> Vec<usize> {
-    parameters
-        .iter()
-        .zip(x.iter().zip(descent))
-        .enumerate()
-        .filter(|(_, (q, (&v, &d)))| match q.on_bound(v) {
-            Some(Bound::Floor(_)) => d < 0.0,
-            Some(Bound::Ceiling(_)) => d > 0.0,
-            None => false,
-        })
-        .map(|(j, _)| j)
-        .collect()
 }
 
 /// Fit a model with the setup's effect parameters free, starting from `g0`
@@ -689,52 +505,6 @@ pub fn pooled_rms(errors: &[SegmentError], channel: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn bounded(symbol: &str) -> EffectParameter {
-        let mut q = super::super::candidate::smoothing_rate(Some(0.002), Some(0.1));
-        q.symbol = symbol.into();
-        q
-    }
-
-    #[test]
-    fn a_parameter_on_its_bound_is_held_only_while_the_data_pull_it_outward() {
-        let q = vec![bounded("a"), bounded("b"), bounded("c"), bounded("d"), bounded("e")];
-        // a: on the ceiling, pulled up (outward): held. b: on the ceiling,
-        // pulled down (inward): released. c: on the floor, pulled down:
-        // held. d: on the floor, pulled up: released. e: inside: free.
-        let x = [0.1, 0.1, 0.002, 0.002, 0.03];
-        let descent = [1.0, -1.0, -1.0, 1.0, 1.0];
-        assert_eq!(held_on_bound(&q, &x, &descent), vec![0, 2]);
-        // Unbounded parameters are never held.
-        let mut free = bounded("f");
-        free.lower = None;
-        free.upper = None;
-        assert!(held_on_bound(&[free], &[0.1], &[1.0]).is_empty());
-    }
-
-    #[test]
-    fn a_trial_settles_on_its_floor_only_after_slow_steps_in_a_row_held_there() {
-        let slow = SLOW_STEP / 2.0;
-        let fast = SLOW_STEP * 2.0;
-        let mut s = FloorSettling::default();
-        assert!(!s.settled_after(true, slow));
-        assert!(!s.settled_after(true, slow));
-        assert!(s.settled_after(true, slow), "three slow steps held on the floor");
-        // A fast step, or a step with the parameter released, starts the count again.
-        let mut s = FloorSettling::default();
-        for (on_floor, df) in [
-            (true, slow),
-            (true, slow),
-            (true, fast),
-            (true, slow),
-            (false, slow),
-            (true, slow),
-        ] {
-            assert!(!s.settled_after(on_floor, df), "after ({on_floor}, {df})");
-        }
-        assert!(!s.settled_after(true, slow));
-        assert!(s.settled_after(true, slow));
-    }
 
     #[test]
     fn residual_statistics_unweight_and_count_channels() {

@@ -16,7 +16,10 @@
 //!   times, each channel divided by its noise scale ([`Weights`]).
 //! * **Fitting** (`fit.rs`). Effect parameters are shared by all segments; the
 //!   initial states are per-segment nuisance parameters (`nuisance.rs`). Both
-//!   are fitted together by Levenberg-Marquardt on the block-arrow structure of
+//!   are fitted together by Levenberg-Marquardt (`levenberg_marquardt.rs`:
+//!   joint steps while they are accepted, then steps over the shared
+//!   parameters' profile with each segment refitted on its own; a base fit
+//!   fits each segment alone, also from its measured speed) on the block-arrow structure of
 //!   the problem (`normal.rs`: a segment depends only on the shared parameters
 //!   and its own initial state): the normal equations are reduced to the shared
 //!   parameters by eliminating each segment's 6x6 block (10x10 with the tyre model), so an iteration costs
@@ -66,6 +69,7 @@ mod elimination;
 mod encompassing;
 mod fit;
 pub mod least_squares;
+mod levenberg_marquardt;
 mod normal;
 mod nuisance;
 pub mod remaining;

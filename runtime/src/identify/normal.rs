@@ -42,6 +42,22 @@ impl Normal {
         k: usize,
         lambda: f64,
     ) -> Option<Normal> {
+        Normal::damped(blocks, res, prior, k, lambda, lambda)
+    }
+
+    /// [`Normal::new`] with the shared block damped by `lambda` and each
+    /// segment's block by `lambda_segment`: a segment's block left (almost)
+    /// undamped is eliminated exactly, which is the step of the shared
+    /// parameters on the profile where every segment's initial state is
+    /// at its own optimum (Kaufman's variable-projection step).
+    pub(super) fn damped(
+        blocks: &[SegmentJacobian],
+        res: &[Vec<f64>],
+        prior: &[(usize, f64, f64)],
+        k: usize,
+        lambda: f64,
+        lambda_segment: f64,
+    ) -> Option<Normal> {
         let mut hgg = DMatrix::<f64>::zeros(k, k);
         let mut bg = DVector::<f64>::zeros(k);
         for (blk, r) in blocks.iter().zip(res) {
@@ -55,20 +71,20 @@ impl Normal {
             hgg[(j, j)] += 1.0 / (sd * sd);
             bg[j] -= pr / sd;
         }
-        let damp = |m: &mut DMatrix<f64>| {
+        let damp = |m: &mut DMatrix<f64>, lambda: f64| {
             for j in 0..m.nrows() {
                 let d = m[(j, j)];
                 m[(j, j)] = d + lambda * d.max(1e-12);
             }
         };
-        damp(&mut hgg);
+        damp(&mut hgg, lambda);
         let mut s = hgg;
         let mut rhs = bg;
         let mut segs = Vec::with_capacity(blocks.len());
         for (blk, r) in blocks.iter().zip(res) {
             let r = DVector::from_column_slice(r);
             let mut c = blk.b.tr_mul(&blk.b);
-            damp(&mut c);
+            damp(&mut c, lambda_segment);
             let c_inv = if c.nrows() == 0 { c } else { c.try_inverse()? };
             let e = blk.a.tr_mul(&blk.b);
             let bi = -blk.b.tr_mul(&r);
