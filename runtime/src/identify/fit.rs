@@ -45,6 +45,13 @@ pub(super) struct Problem<'s, 'a> {
     /// zeroed, so a step never moves it): the first stage of a fit from
     /// the measured speed (see [`fit_each_segment`]).
     pub(super) anchor_speed: bool,
+    /// With no effect parameter free: also fit each segment from its
+    /// measured initial speed and keep the better fit (see
+    /// [`fit_each_segment_from`](super::levenberg_marquardt)). Set for the
+    /// fits whose states every later fit starts from (a model's own fit),
+    /// not for the held-out kicks of a cross-validation, which start from
+    /// those.
+    pub(super) from_measured_speed: bool,
 }
 
 impl<'s, 'a> Problem<'s, 'a> {
@@ -66,6 +73,7 @@ impl<'s, 'a> Problem<'s, 'a> {
             cache: Mutex::new(None),
             settled_on_floor: Vec::new(),
             anchor_speed: false,
+            from_measured_speed: false,
         }
     }
 }
@@ -416,6 +424,7 @@ pub(super) fn fit_trial(
     // and states together (the base model: states alone).
     let free = if setup.k() == 0 { Free::Nuisance } else { Free::All };
     let mut problem = Problem::new(setup, all.clone(), free, g0.to_vec(), x0.to_vec());
+    problem.from_measured_speed = true;
     problem.settled_on_floor = own
         .filter(|&j| setup.parameters.get(j).is_some_and(|q| q.dissipative))
         .collect();

@@ -56,7 +56,8 @@ pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem
     // each segment gets its own damping, convergence test and budget, and
     // the minimum is the same.
     if k == 0 {
-        fit_each_segment_from(&mut p, patience, true);
+        let from_measured_speed = p.from_measured_speed;
+        fit_each_segment_from(&mut p, patience, from_measured_speed);
         return p;
     }
     let profile_when_refused = p.free == Free::All && p.segs.len() > 1;
