@@ -79,6 +79,15 @@ impl<'s, 'a> Problem<'s, 'a> {
 }
 
 impl Problem<'_, '_> {
+    /// Effect parameters at the head of the packed vector: all of them,
+    /// unless only the initial states are free.
+    pub(super) fn k_packed(&self) -> usize {
+        if self.free == Free::Nuisance {
+            0
+        } else {
+            self.setup.k()
+        }
+    }
     pub(super) fn n_free(&self) -> usize {
         match self.free {
             Free::All => self.setup.k() + self.setup.nuisance() * self.segs.len(),
@@ -186,7 +195,7 @@ impl Problem<'_, '_> {
     /// simulation of one segment).
     pub(super) fn jacobian_blocks(&self) -> Option<Vec<SegmentJacobian>> {
         let base = self.all_residuals()?;
-        let k = if self.free == Free::Nuisance { 0 } else { self.setup.k() };
+        let k = self.k_packed();
         let nn = if self.free == Free::Shared {
             0
         } else {

@@ -42,7 +42,7 @@ use rayon::prelude::*;
 /// the tyre candidate's relaxation length on its 1 cm floor, with stiff
 /// lagged force states, spent 911 of an identification's 1240 s.
 pub(super) fn lm_fit<'s, 'a>(mut p: Problem<'s, 'a>, patience: usize) -> Problem<'s, 'a> {
-    let k = if p.free == Free::Nuisance { 0 } else { p.setup.k() };
+    let k = p.k_packed();
     if p.n_free() == 0 {
         return p;
     }
@@ -93,7 +93,7 @@ struct LmState {
 
 impl LmState {
     fn new(p: &Problem<'_, '_>, patience: usize) -> Self {
-        let k = if p.free == Free::Nuisance { 0 } else { p.setup.k() };
+        let k = p.k_packed();
         LmState {
             lambda: 1e-3,
             settling: FloorSettling::default(),
@@ -183,7 +183,7 @@ fn scaled_norm(d: &[f64], scales: &[f64]) -> f64 {
 /// one step, one damping, one accept-or-reject. With `stop_when_refused`,
 /// it hands over to [`profiled_lm`] at the first refused step.
 fn joint_lm(p: &mut Problem<'_, '_>, state: &mut LmState, stop_when_refused: bool) -> JointEnd {
-    let k = if p.free == Free::Nuisance { 0 } else { p.setup.k() };
+    let k = p.k_packed();
     let Some(mut c) = cost(p) else { return JointEnd::Done };
     let scales = p.scales();
     while state.evals < state.budget {
