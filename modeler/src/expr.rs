@@ -8,6 +8,41 @@
 use std::collections::BTreeSet;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
+// The handles of a model's frames, points and bodies are declared here, with
+// the expressions that refer to them, so that this module depends on no
+// other; `crate::model` names them too.
+
+/// Axis of an elementary rotation, in the frame being rotated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    /// Index 0, 1, 2.
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+}
+
+/// Handle of a frame. [`GROUND`] is the inertial frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameId(pub usize);
+/// The inertial (ground) frame.
+pub const GROUND: FrameId = FrameId(0);
+/// Handle of a point.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PointId(pub usize);
+/// Handle of a body.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BodyId(pub usize);
+
 /// A scalar expression in parameters, coordinates, their rates and time.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Expr {
@@ -287,22 +322,22 @@ pub fn dot3(a: &Vec3, b: &Vec3) -> Expr {
 }
 
 /// Global position of a point, as expressions.
-pub fn position(p: crate::model::PointId) -> Vec3 {
+pub fn position(p: PointId) -> Vec3 {
     [0u8, 1, 2].map(|k| Expr::Position(p.0, k))
 }
 
 /// Global velocity of a point (time rate of its declared position).
-pub fn velocity(p: crate::model::PointId) -> Vec3 {
+pub fn velocity(p: PointId) -> Vec3 {
     [0u8, 1, 2].map(|k| Expr::Velocity(p.0, k))
 }
 
 /// Unit axis `axis` of `frame`, in ground components.
-pub fn frame_axis(frame: crate::model::FrameId, axis: crate::model::Axis) -> Vec3 {
+pub fn frame_axis(frame: FrameId, axis: Axis) -> Vec3 {
     [0u8, 1, 2].map(|k| Expr::FrameAxis(frame.0, axis.index() as u8, k))
 }
 
 /// Angular velocity of `frame`, in ground components.
-pub fn angular_velocity(frame: crate::model::FrameId) -> Vec3 {
+pub fn angular_velocity(frame: FrameId) -> Vec3 {
     [0u8, 1, 2].map(|k| Expr::AngularVelocity(frame.0, k))
 }
 
@@ -313,7 +348,7 @@ pub fn smooth_norm(v: &Vec3, eps: Expr) -> Expr {
 }
 
 /// Velocity (ground components) of the material point of `body` at `point`.
-pub fn material_velocity(body: crate::model::BodyId, point: crate::model::PointId) -> Vec3 {
+pub fn material_velocity(body: BodyId, point: PointId) -> Vec3 {
     [0u8, 1, 2].map(|k| Expr::MaterialVelocity(body.0, point.0, k))
 }
 

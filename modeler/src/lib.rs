@@ -22,6 +22,8 @@ pub mod effects;
 #[cfg(feature = "derive")]
 pub mod emit;
 pub mod expr;
+pub mod hash;
+pub mod identification;
 pub mod model;
 pub mod models;
 pub mod registry;

@@ -6,40 +6,13 @@
 //! ([`ModelError::Invalid`]), then freezes it into a [`Model`] that the
 //! derivation stage ([`crate::derive`]) consumes.
 
+// The handles live with the expressions that refer to them (`expr`
+// depends on no other module); they are the model's vocabulary, so they are
+// named from here too.
+pub use crate::expr::{Axis, BodyId, FrameId, PointId, GROUND};
 use crate::expr::{Expr, Tensor3, Vec3};
 use std::collections::BTreeSet;
 use std::fmt;
-
-/// Axis of an elementary rotation, in the frame being rotated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Axis {
-    X,
-    Y,
-    Z,
-}
-
-impl Axis {
-    /// Index 0, 1, 2.
-    pub fn index(self) -> usize {
-        match self {
-            Axis::X => 0,
-            Axis::Y => 1,
-            Axis::Z => 2,
-        }
-    }
-}
-
-/// Handle of a frame. [`GROUND`] is the inertial frame.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct FrameId(pub usize);
-/// The inertial (ground) frame.
-pub const GROUND: FrameId = FrameId(0);
-/// Handle of a point.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct PointId(pub usize);
-/// Handle of a body.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct BodyId(pub usize);
 
 /// How the runtime treats a coordinate when it reduces the equations
 /// (generalized coordinate partitioning, thesis section 3.8).
@@ -203,9 +176,9 @@ pub struct State {
 pub struct EffectInfo {
     pub name: String,
     pub doc: String,
-    /// How identification tests it (see [`crate::effects::Identification`]);
+    /// How identification tests it (see [`crate::identification::Identification`]);
     /// `None` for an effect declared without the effect library's `apply`.
-    pub identification: Option<crate::effects::Identification>,
+    pub identification: Option<crate::identification::Identification>,
 }
 
 /// A frame: its parent and the elementary rotations (about the rotated
@@ -635,7 +608,7 @@ impl ModelBuilder {
         }
         self.m.sources.push(Source {
             path: file.path.to_string(),
-            text_hash: file.text.map(|t| crate::registry::fnv1a(t.as_bytes())),
+            text_hash: file.text.map(|t| crate::hash::fnv1a(t.as_bytes())),
         });
     }
     /// Declare a coordinate (and its rate).
@@ -749,7 +722,7 @@ impl ModelBuilder {
         self.effect = Some(name.to_string());
     }
     /// How identification tests the effect being applied.
-    pub fn declare_identification(&mut self, identification: crate::effects::Identification) {
+    pub fn declare_identification(&mut self, identification: crate::identification::Identification) {
         if let Some(e) = self.m.effects.last_mut() {
             e.identification = Some(identification);
         }

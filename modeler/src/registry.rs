@@ -6,6 +6,8 @@ use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 use std::fmt;
 
+pub use crate::hash::fnv1a;
+
 /// Emission errors.
 #[derive(Debug)]
 pub enum EmitError {
@@ -97,16 +99,6 @@ pub fn emit_registry(models: &[crate::model::Model]) -> Result<String, EmitError
         models.len(),
         prettyplease::unparse(&file)
     ))
-}
-
-/// FNV-1a, for the header's model hash (stable across platforms and runs).
-pub fn fnv1a(data: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf29ce484222325;
-    for b in data {
-        h ^= *b as u64;
-        h = h.wrapping_mul(0x100000001b3);
-    }
-    h
 }
 
 pub(crate) fn camel(s: &str) -> String {

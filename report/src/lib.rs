@@ -9,8 +9,8 @@
 //! map, fonts), [`simulate`] (time-history CSV and plot), [`identify`]
 //! (identification plots), [`experiment`] (measured-run plots, the residual
 //! table, the synthetic sensor files), [`staged`] (output folders written
-//! as a whole and recognised as bikedyn's, cleanup of killed runs'
-//! temporaries).
+//! as a whole and recognised as bikedyn's), [`temporaries`] (cleanup of
+//! killed runs' temporaries).
 // The same allowances as the runtime, whose code this was: index loops over
 // grid cells read more plainly than zipped iterators.
 #![allow(clippy::needless_range_loop)]
@@ -25,3 +25,4 @@ pub mod plot;
 pub mod sensitivity;
 pub mod simulate;
 pub mod staged;
+pub mod temporaries;

@@ -70,6 +70,20 @@ use quartic::{quartic_roots, sort_desc, C64};
 pub use states::{LateralStates, StateSpaceBicycle};
 use tracking::*;
 
+// Shared by the general model's and the state-space model's crossing
+// searches (`general`, `states`), so neither child reaches into the other.
+/// The grid of [`CROSSING_GRID`] cells over `[v_min, v_max]`.
+fn crossing_grid(v_min: f64, v_max: f64) -> Vec<f64> {
+    (0..=CROSSING_GRID)
+        .map(|i| v_min + (v_max - v_min) * (i as f64 / CROSSING_GRID as f64))
+        .collect()
+}
+
+/// Grid intervals over the speed range that bracket the crossings of a
+/// general model (crossings closer than a cell apart may be missed; a
+/// bicycle's are tenths of m/s apart or more over 0-10 m/s).
+const CROSSING_GRID: usize = 400;
+
 /// Errors of the eigen analysis. Functions never panic and never return NaN.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum EigenError {

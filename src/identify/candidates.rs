@@ -7,6 +7,7 @@ use crate::bicycle::Bicycle;
 use bikedyn_runtime::identify::{Candidate, EffectParameter};
 use bikedyn_runtime::model::{unit_of, CandidateDeclaration, EffectIdentification, LinearEquivalent};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
+use std::collections::BTreeMap;
 
 /// The identification model, its driven twin, and the alternative model
 /// (free speed, with states: the tyre model) if the registry has one. Each is
@@ -33,7 +34,7 @@ pub fn identification_models<R: ModelRegistry>(
                 && free
                     .effects
                     .iter()
-                    .filter(|e| **e != super::time_series::DICTIONARY_EFFECT)
+                    .filter(|e| **e != DICTIONARY_EFFECT)
                     .all(|e| m.effects.contains(e))
         })
         .max_by_key(|m| m.effects.len());
@@ -204,4 +205,28 @@ pub fn not_candidates(info: &ModelInfo) -> Vec<(&'static str, String)> {
             None => Some((e.name, "its effect file declares no identification".to_string())),
         })
         .collect()
+}
+
+/// The effect that carries the dictionary in the derived models.
+pub const DICTIONARY_EFFECT: &str = "generalized_forces";
+
+/// The values of a candidate set's parameters (tied symbols and held
+/// companions included) by symbol.
+pub(super) fn values_map(set: &[&Candidate], values: &[f64]) -> BTreeMap<String, f64> {
+    let mut m = BTreeMap::new();
+    let mut it = values.iter();
+    for c in set {
+        for (s, v) in &c.fixed {
+            m.insert(s.clone(), *v);
+        }
+        for p in &c.parameters {
+            let v = *it.next().unwrap_or(&0.0);
+            let v = p.lower.map_or(v, |lo| v.max(lo));
+            m.insert(p.symbol.clone(), v);
+            for t in &p.tied {
+                m.insert(t.clone(), v);
+            }
+        }
+    }
+    m
 }

@@ -92,7 +92,7 @@ pub fn discover_on_table<R: bikedyn_runtime::registry::ModelRegistry>(
         })
         .collect();
     let speeds: Vec<f64> = rows.iter().map(|r| r.speed).collect();
-    let start = super::eigen_table::values_map(selected, values);
+    let start = super::candidates::values_map(selected, values);
     if plants(driven, bike, &start, &speeds)?.is_none() {
         let alt = identification_models(bike, false)?
             .2
@@ -104,7 +104,7 @@ pub fn discover_on_table<R: bikedyn_runtime::registry::ModelRegistry>(
         });
     }
     let plant = |x: &[f64]| -> Vec<Option<PlantAt>> {
-        let vals = super::eigen_table::values_map(selected, x);
+        let vals = super::candidates::values_map(selected, x);
         plants(driven, bike, &vals, &speeds)
             .ok()
             .flatten()
@@ -284,7 +284,7 @@ pub fn trials_markdown(d: &TableDiscovery) -> String {
             tau,
             t.bic_change,
             t.cv,
-            crate::identify::report::verdict_text(&t.verdict)
+            super::words::verdict_text(&t.verdict)
         );
     }
     s

@@ -17,7 +17,6 @@ pub mod discovery;
 pub mod eigen_table;
 mod error;
 mod fits;
-mod markdown;
 pub mod predict;
 mod remaining;
 pub mod report;
@@ -25,6 +24,7 @@ pub mod result;
 pub mod segments;
 pub mod time_series;
 pub mod weave_errors;
+mod words;
 
 pub use error::IdentifyError;
 

@@ -2,22 +2,26 @@
 //! (schema in docs/identification.md, "What it does", step 5), and the report
 //! folder (`report.md`, `report.json`, plots, the fitted parameter file).
 
+mod markdown;
+
+use markdown::report_markdown;
+
 use super::candidates::identification_models;
 use super::confounded::confounding_lines;
-use super::markdown::report_markdown;
 use super::predict::{linear_equivalent, predict};
 use super::result::{
     CandidateTrial, Confounded, Details, Errors, Estimate, ExcludedKick, FittedValue, HeldOutErrors, IdentifyResult,
     KickErrors, MemberCheck, Prior, RunDetails, Source,
 };
 use super::weave_errors::{eigen_rms, eigen_weighted_rms};
+use super::words::{bound_text, median, nan, verdict_text};
 use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::Bicycle;
 use bikedyn_report::experiment::accept::rejected_text;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic};
 use bikedyn_report::staged::{FolderKind, StagedDir};
-use bikedyn_runtime::identify::{pooled_rms, Candidate, Verdict, PLAUSIBLE_PRIOR_SDS};
+use bikedyn_runtime::identify::{pooled_rms, Candidate};
 use bikedyn_runtime::registry::ModelRegistry;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -178,21 +182,6 @@ pub fn result<R: ModelRegistry>(o: &Outcome<R>) -> IdentifyResult {
             seconds: o.seconds,
         })),
     }
-}
-
-/// An error a source may not have, NaN where it has none (as printed).
-pub(super) fn nan(x: Option<f64>) -> f64 {
-    x.unwrap_or(f64::NAN)
-}
-
-pub(super) fn median(x: impl Iterator<Item = f64>) -> f64 {
-    let mut v: Vec<f64> = x.filter(|a| a.is_finite()).collect();
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-}
-
-pub(super) fn fmt_c(z: Option<[f64; 2]>) -> String {
-    z.map_or("-".into(), |z| format!("{:.3}{:+.3}i", z[0], z[1]))
 }
 
 /// Five-line summary.
@@ -528,67 +517,6 @@ pub fn write_report<R: ModelRegistry>(
     Ok(())
 }
 
-/// A candidate's verdict in words, with its numbers (changes of the
-/// criterion against the step's base; negative is better).
-pub fn verdict_text(v: &Verdict) -> String {
-    match v {
-        Verdict::Added { bic_change, cv, base_cv } => {
-            format!("warranted: BIC {bic_change:+.1}, held-out error {cv:.4} (was {base_cv:.4})")
-        }
-        Verdict::NoPredictedGain { predicted_bic_change } => format!(
-            "not fitted: linearised at the current fit (score test), its best BIC change is {predicted_bic_change:+.1}, no gain"
-        ),
-        Verdict::BehindAdded { predicted_bic_change, added } => format!(
-            "not fitted: predicted BIC change {predicted_bic_change:+.1}; the step added {added} before reaching it (tried again in the next step)"
-        ),
-        Verdict::BeyondBudget { predicted_bic_change, budget } => format!(
-            "not fitted: predicted BIC change {predicted_bic_change:+.1}; the step had fitted its budget of {budget} candidates before reaching it (a compute limit, not a verdict)"
-        ),
-        Verdict::CriterionAboveAdded { bic_change, added } => {
-            format!("not added: BIC {bic_change:+.1}, above that of {added} (not cross-validated)")
-        }
-        Verdict::PassedHeldOutBelow { bic_change, cv, added, added_cv } => format!(
-            "passed (BIC {bic_change:+.1}, held-out error {cv:.4}), not added: {added} predicts the held-out runs consistently better ({added_cv:.4}; the gain run by run beyond two standard errors)"
-        ),
-        Verdict::PassedCriterionAbove { bic_change, cv, added } => format!(
-            "passed (BIC {bic_change:+.1}, held-out error {cv:.4}), not added: {added} is ahead in the criterion, and this one's held-out gain over it is not consistent run by run"
-        ),
-        Verdict::FitFailed { reason } => format!("fit failed: {reason}"),
-        Verdict::ImplausibleUnderPrior { symbol, value, prior_sds } => format!(
-            "rejected: {symbol} = {value:.4} lies {prior_sds:.1} prior standard deviations from its measured value (beyond {PLAUSIBLE_PRIOR_SDS}: implausible under the measurement, more likely it absorbs a missing effect; tried only when no plausible candidate passes)"
-        ),
-        Verdict::NotPhysical => "rejected: a dissipative parameter fitted at or below zero, or at its floor (not physics; not cross-validated)".into(),
-        Verdict::TakenOver { z } => format!(
-            "dropped: refitted with the terms added after it, its coefficient is {z:.2} standard errors from zero; they took it over"
-        ),
-        Verdict::LagNotResolved { time_constant } => {
-            format!("rejected: a lag fitted to {time_constant:.2e} s, outside what the data resolve (from a hundredth of the shortest weave period, where it is the direct term tried on its own, to ten of the longest)")
-        }
-        Verdict::NotDistinctFromZero { value, stderr } => format!(
-            "rejected: its coefficient {value:.4} +- {:.4} (95 %) holds zero: the data do not show the force (not cross-validated)",
-            1.96 * stderr
-        ),
-        Verdict::NotBetterThanReference { gain, stderr } => format!(
-            "rejected: it predicts the held-out kicks better than the library's values, but not consistently better than the base model (mean gain per kick {gain:.4}, standard error {stderr:.4}): it takes back how far the time series' fit moved the kicks' eigenvalues from the measured ones"
-        ),
-        Verdict::NoCriterionGain { bic_change } => {
-            format!("rejected: BIC {bic_change:+.1} (no gain beyond its added parameters; not cross-validated)")
-        }
-        Verdict::HeldOutNotLower { cv, base_cv } => {
-            format!("rejected: held-out error {cv:.4} not below {base_cv:.4} (does not generalise)")
-        }
-        Verdict::HeldOutGainNotConsistent { gain, stderr, sigmas } => format!(
-            "rejected: mean held-out gain per run (per row or kick in the dictionary's search) {gain:.4}, within {} standard errors of zero (standard error {stderr:.4}; not a consistent improvement)",
-            if (*sigmas - 2.0).abs() < 1e-9 { "two".to_string() } else { format!("{sigmas:.2}") }
-        ),
-        Verdict::Encompassed { by, t, remains } => format!(
-            "replaced by {by}: fitted together with it, its parameters keep {:.0} % of their shift alone ({t:.1} standard errors from their absence) while {by} stays significant; it stood in for {by}",
-            100.0 * remains
-        ),
-        Verdict::NotAdded => "fitted for the encompassing test only (not a candidate of its own)".into(),
-    }
-}
-
 /// The stated prior `(measured value, standard deviation)` of a corrected
 /// parameter (the bicycle file's `+/-`, or the model's default for its
 /// kind), as the plan's candidates declare it.
@@ -598,13 +526,4 @@ pub fn stated_prior<R: ModelRegistry>(o: &Outcome<R>, symbol: &str) -> Option<(f
         .flat_map(|c| &c.parameters)
         .find(|p| p.symbol == symbol)
         .and_then(|p| p.prior)
-}
-
-/// A fitted value that ended on its floor or ceiling is a limit: the data
-/// asked for a value beyond it, and it has no interval.
-pub(crate) fn bound_text(b: bikedyn_runtime::identify::Bound) -> String {
-    match b {
-        bikedyn_runtime::identify::Bound::Floor(lo) => format!("on its floor {lo}: the data ask for less"),
-        bikedyn_runtime::identify::Bound::Ceiling(hi) => format!("on its ceiling {hi}: the data ask for more"),
-    }
 }

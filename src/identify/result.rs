@@ -12,10 +12,9 @@
 //! is `null` (a table has no time series, so no roll error), never absent.
 
 use super::discovery::DiscoveryOutcome;
-use super::eigen_table::{EigenPoint, TableOutcome};
-use super::report::verdict_text;
 use super::time_series::TimeSeriesOutcome;
 use super::weave_errors::Excluded;
+use super::words::verdict_text;
 use bikedyn_runtime::identify::confounding::Design;
 use bikedyn_runtime::identify::remaining::Remaining;
 use bikedyn_runtime::identify::state_correlation::StateCorrelation;
@@ -27,6 +26,19 @@ use std::path::PathBuf;
 /// The two-sided 95 % point of the normal distribution, as the reports
 /// print it: a parameter's interval is `value +- 1.96 stderr`.
 pub const Z_95: f64 = 1.96;
+
+/// One row of a measured eigenvalue table.
+#[derive(Clone, Debug, Serialize)]
+pub struct EigenPoint {
+    /// Line of the file.
+    pub line: usize,
+    /// Forward speed (m/s).
+    pub speed: f64,
+    /// Measured weave eigenvalue `[re, im]` (1/s).
+    pub eigenvalue: [f64; 2],
+    /// Its standard errors, if the table gives them.
+    pub stderr: Option<[f64; 2]>,
+}
 
 /// What was identified from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -369,82 +381,4 @@ pub struct Confounded {
     pub confounded: bool,
     /// Kicks that would separate them.
     pub designs: Vec<Design>,
-}
-
-impl From<TableOutcome> for IdentifyResult {
-    fn from(o: TableOutcome) -> Self {
-        IdentifyResult::from(&o)
-    }
-}
-
-impl From<&TableOutcome> for IdentifyResult {
-    fn from(o: &TableOutcome) -> Self {
-        let errors = |eigen_rms: f64, held: f64| Errors {
-            eigen_rms,
-            eigen_weighted_rms: None,
-            median_run_roll_rms: None,
-            median_run_steer_rms: None,
-            roll_rms: None,
-            steer_rms: None,
-            speed_rms: None,
-            held_out: HeldOutErrors {
-                eigen_rms: held,
-                eigen_weighted_rms: None,
-                roll_rms: None,
-                steer_rms: None,
-                speed_rms: None,
-            },
-            per_run: Vec::new(),
-        };
-        let mut base: Vec<String> = Vec::new();
-        let mut candidates = Vec::new();
-        let mut step = 0;
-        for t in &o.trials {
-            if t.step != step {
-                step = t.step;
-                base = o.selected[..(step - 1).min(o.selected.len())].to_vec();
-            }
-            candidates.push(CandidateTrial {
-                step: t.step,
-                name: t.name.clone(),
-                members: vec![t.name.clone()],
-                extends: base.clone(),
-                score: Some(t.bic_change).filter(|x| x.is_finite()),
-                predicted_score: None,
-                cv: Some(t.cv).filter(|x| x.is_finite()),
-                base_cv: t.base_cv,
-                values: Some(
-                    t.values
-                        .iter()
-                        .map(|(s, &(value, stderr))| FittedValue {
-                            symbol: s.clone(),
-                            value,
-                            stderr,
-                        })
-                        .collect(),
-                ),
-                selected: t.verdict.added(),
-                outcome: t.verdict.clone(),
-                verdict: verdict_text(&t.verdict),
-            });
-        }
-        IdentifyResult {
-            source: Source::EigenvalueTable,
-            selected_effects: o.selected.clone(),
-            parameters: o.parameters.clone(),
-            candidates,
-            error_before: errors(o.eigen_rms_before, o.eigen_rms_before),
-            error_after: errors(o.eigen_rms_after, o.eigen_rms_held_out),
-            driven_model: o.driven_model,
-            remaining: o.remaining.clone(),
-            discovery: o.discovery.clone(),
-            details: Details::Table(TableDetails {
-                table: o.table.clone(),
-                points: o.points.clone(),
-                not_tried: o.not_tried.clone(),
-                predicted_before: o.predicted_before.clone(),
-                predicted_after: o.predicted_after.clone(),
-            }),
-        }
-    }
 }

@@ -19,8 +19,7 @@ use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
 use bikedyn_runtime::MultibodyModel;
 use serde::Serialize;
 
-/// The effect that carries the dictionary in the derived models.
-pub const DICTIONARY_EFFECT: &str = "generalized_forces";
+pub use super::candidates::DICTIONARY_EFFECT;
 
 /// Most terms the search adds.
 pub const MAX_TERMS: usize = 2;
@@ -274,7 +273,7 @@ pub fn markdown(f: &TimeSeriesFound) -> String {
         s,
         "\n## Discovery in the time series: terms of the dictionary\n\nGeneralized forces on the roll and steer equations that the model carries (`{DICTIONARY_EFFECT}`, every coefficient zero by default, in the model's signs: steer positive to the left), each tried as a candidate of its own after the library's search, with the library's selection refitted beside it and the same tests (criterion, held-out error of the same folds of runs, a gain consistent run by run). At most {MAX_TERMS} terms are added.\n"
     );
-    super::markdown::steps_markdown(&mut s, &f.search.steps, 1);
+    super::words::steps_markdown(&mut s, &f.search.steps, 1);
     let _ = writeln!(
         s,
         "Roll channel RMS (the fitted kicks; held out by the folds of runs): base model {:.4} ({:.4}), with the library {:.4} ({:.4}), with the discovered terms {:.4} ({:.4}) (rad or rad/s).",

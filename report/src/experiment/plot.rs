@@ -5,7 +5,6 @@
 //! every figure ([`crate::plot`]).
 
 use super::accept::rejected_label;
-use crate::identify::plot::{measured_parts, MeasuredWeave};
 use crate::plot::style::{self, Area, Frame, Icon, Legend, Marker, Measured, Stroke};
 use crate::plot::{de, label_area_width, render, DrawErr, Figure, PlotError, PlotOptions};
 use crate::simulate::plot::speed_range;
@@ -25,6 +24,31 @@ pub(crate) fn range(x: impl Iterator<Item = f64>) -> (f64, f64) {
     }
     let pad = ((hi - lo) * 0.08).max(1e-6);
     (lo - pad, hi + pad)
+}
+
+/// A measured weave eigenvalue on its speed segment (m/s; 1/s).
+pub struct MeasuredWeave {
+    pub speed_interval: [f64; 2],
+    pub mean_speed: f64,
+    pub eigenvalue: [f64; 2],
+    pub stderr: [f64; 2],
+}
+
+/// Measured real parts (filled points) and imaginary parts (open points)
+/// with their error bars and speed intervals.
+pub(crate) fn measured_parts(measured: &[MeasuredWeave]) -> [Vec<Measured>; 2] {
+    let part = |k: usize| {
+        measured
+            .iter()
+            .map(|m| Measured {
+                x: m.mean_speed,
+                y: m.eigenvalue[k],
+                err: Some(m.stderr[k]),
+                x_span: Some((m.speed_interval[0], m.speed_interval[1])),
+            })
+            .collect()
+    };
+    [part(0), part(1)]
 }
 
 /// Measured roll (deg) or roll rate (deg/s, for roll-rate fits) with the

@@ -5,8 +5,11 @@
 //! and the residual time series of one run before and after. Same style
 //! and options as every figure ([`crate::plot`]).
 
-use crate::experiment::plot::range;
-use crate::plot::style::{self, Area, Frame, Icon, Legend, Marker, Measured, Stroke};
+// A measured eigenvalue is the measured runs' own (`experiment`); its
+// type is here too, for the continuation figure's callers.
+pub use crate::experiment::plot::MeasuredWeave;
+use crate::experiment::plot::{measured_parts, range};
+use crate::plot::style::{self, Area, Frame, Icon, Legend, Marker, Stroke};
 use crate::plot::{de, label_area_width, render, DrawErr, Figure, PlotError, PlotOptions};
 use plotters::prelude::*;
 use std::path::Path;
@@ -14,14 +17,6 @@ use std::path::Path;
 const BEFORE: RGBColor = style::BLUE;
 const AFTER: RGBColor = style::VERMILION;
 const MEASURED: RGBColor = style::DATA;
-
-/// A measured weave eigenvalue on its speed segment (m/s; 1/s).
-pub struct MeasuredWeave {
-    pub speed_interval: [f64; 2],
-    pub mean_speed: f64,
-    pub eigenvalue: [f64; 2],
-    pub stderr: [f64; 2],
-}
 
 /// Weave eigenvalue curves `(speed, re, im)` of the model before and after,
 /// and the measured eigenvalues. The default size (when `opts` gives none)
@@ -52,23 +47,6 @@ struct Continuation<'a> {
     after: &'a [(f64, f64, f64)],
     after_label: &'a str,
     measured: &'a [MeasuredWeave],
-}
-
-/// Measured real parts (filled points) and imaginary parts (open points)
-/// with their error bars and speed intervals.
-pub(crate) fn measured_parts(measured: &[MeasuredWeave]) -> [Vec<Measured>; 2] {
-    let part = |k: usize| {
-        measured
-            .iter()
-            .map(|m| Measured {
-                x: m.mean_speed,
-                y: m.eigenvalue[k],
-                err: Some(m.stderr[k]),
-                x_span: Some((m.speed_interval[0], m.speed_interval[1])),
-            })
-            .collect()
-    };
-    [part(0), part(1)]
 }
 
 impl Figure for Continuation<'_> {

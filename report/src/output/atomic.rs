@@ -152,7 +152,7 @@ fn create_temp(path: &Path) -> Result<(File, PathBuf), OutputError> {
     };
     let dir = existing_dir_of(path)?;
     // Temporaries of killed runs in the same folder go now (issue 35).
-    crate::staged::clean_stale(&dir);
+    crate::temporaries::clean_stale(&dir);
     // Keep the extension last: some encoders choose the format from it.
     let stem = path
         .file_stem()
@@ -205,7 +205,7 @@ fn commit(tmp: &Path, path: &Path) -> Result<(), OutputError> {
     }
     fs::rename(tmp, path).map_err(|e| io_err("rename temporary file", e))?;
     // Best effort: some file systems do not support fsync on directories.
-    crate::staged::sync_dir(path);
+    crate::temporaries::sync_dir(path);
     Ok(())
 }
 

@@ -268,18 +268,6 @@ fn crossing_candidates<S: Spectrum + ?Sized>(
     Ok(cands)
 }
 
-/// The grid of [`CROSSING_GRID`] cells over `[v_min, v_max]`.
-pub(crate) fn crossing_grid(v_min: f64, v_max: f64) -> Vec<f64> {
-    (0..=CROSSING_GRID)
-        .map(|i| v_min + (v_max - v_min) * (i as f64 / CROSSING_GRID as f64))
-        .collect()
-}
-
-/// Grid intervals over the speed range that bracket the crossings of a
-/// general model (crossings closer than a cell apart may be missed; a
-/// bicycle's are tenths of m/s apart or more over 0-10 m/s).
-pub(crate) const CROSSING_GRID: usize = 400;
-
 /// The zero of `f(coefficients(v))` in `[a, b]` when `fa`, `fb` have opposite
 /// signs (bisection to rounding), `None` otherwise. An exact zero at the
 /// lower end counts for the cell below, so a grid point is found once.

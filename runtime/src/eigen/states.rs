@@ -26,8 +26,8 @@
 //! extra mode's is `Other(EXTRA)`.
 
 use super::critical::{check_range, finish, named_speeds, stable_intervals};
-use super::general::{crossing_grid, CROSSING_GRID};
 use super::*;
+use super::{crossing_grid, CROSSING_GRID};
 use nalgebra::{DMatrix, DVector};
 
 /// The label of a crossing of an extra (non roll-steer) mode.

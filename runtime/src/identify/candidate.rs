@@ -131,7 +131,7 @@ pub(super) fn smoothing_rate(lower: Option<f64>, upper: Option<f64>) -> EffectPa
         upper,
         shape: true,
         prior: None,
-        gross_beyond: crate::identify::PLAUSIBLE_PRIOR_SDS,
+        gross_beyond: PLAUSIBLE_PRIOR_SDS,
     }
 }
 
@@ -157,3 +157,8 @@ mod tests {
         assert!(!free.held_at_bound(1e9));
     }
 }
+
+/// A correction further than this many prior standard deviations from its
+/// measured value is no plausible rival explanation (beyond three, a
+/// Gaussian prior gives it odds below 1 in 370).
+pub const PLAUSIBLE_PRIOR_SDS: f64 = 3.0;

@@ -2,7 +2,9 @@
 //! with effective sample sizes, the candidates' priors on the data's scale,
 //! and how far a fitted correction lies from its measured value.
 
-use super::{Candidate, CandidateFit};
+use super::candidate::Candidate;
+pub use super::candidate::PLAUSIBLE_PRIOR_SDS;
+use super::fitted::CandidateFit;
 
 /// The candidates with their priors put on the scale of the weighted data.
 /// The weighted sum of squares counts every sample as independent with
@@ -82,8 +84,3 @@ pub(super) fn farthest_from_prior(
     }
     out
 }
-
-/// A correction further than this many prior standard deviations from its
-/// measured value is no plausible rival explanation (beyond three, a
-/// Gaussian prior gives it odds below 1 in 370).
-pub const PLAUSIBLE_PRIOR_SDS: f64 = 3.0;

@@ -4,9 +4,10 @@
 //! logs), so a held-out error is that of data the effect never saw, and a
 //! selection step compares two models run by run ([`paired_gain`]).
 
-use super::fit::{Free, Problem};
+use super::fitted::{CandidateFit, IdentifyOptions, SegmentError};
 use super::levenberg_marquardt::lm_fit;
-use super::{CandidateFit, IdentifyOptions, Segment, SegmentError, Setup, Weights};
+use super::problem::{Free, Problem};
+use super::{Segment, Setup, Weights};
 use std::sync::atomic::Ordering;
 
 /// Cross-validate a fit of `setup`: for each fold, the effect parameters

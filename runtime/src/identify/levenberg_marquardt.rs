@@ -7,9 +7,9 @@
 //! while the data pull them outward (projected Levenberg-Marquardt), and a
 //! trial whose own dissipative parameter is settled on its floor ends.
 
-use super::fit::{Free, Problem};
 use super::normal::{Normal, SegmentJacobian};
-use super::nuisance::INITIAL_MOTION;
+use super::nuisance::SPEED;
+use super::problem::{Free, Problem};
 use super::{Bound, EffectParameter, NUISANCE};
 use rayon::prelude::*;
 
@@ -334,9 +334,6 @@ fn profiled_lm(p: &mut Problem<'_, '_>, patience: usize, state: &mut LmState) {
         }
     }
 }
-
-/// Where the initial forward speed sits in a segment's nuisances.
-pub(super) const SPEED: usize = INITIAL_MOTION - 1;
 
 /// Fit each segment's initial state on its own (in parallel) with the
 /// effect parameters held at `p.g`, starting from `p.x0`.

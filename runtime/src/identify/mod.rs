@@ -56,7 +56,7 @@
 //!   when the best fails, the next is tried, and pairs when no single candidate
 //!   passes. After the forward search, every candidate followed by a later
 //!   addition is tested again against the final model without it
-//!   (`elimination.rs`). Sensor nuisances (mounting misalignment, clock offset) are
+//!   (`selection/elimination.rs`). Sensor nuisances (mounting misalignment, clock offset) are
 //!   estimated per set by the measured-run pipeline before, and are never
 //!   candidates.
 
@@ -65,13 +65,14 @@ pub mod confounding;
 mod criterion;
 mod cross_validation;
 pub mod discovery;
-mod elimination;
 mod encompassing;
 mod fit;
+mod fitted;
 pub mod least_squares;
 mod levenberg_marquardt;
 mod normal;
 mod nuisance;
+mod problem;
 pub mod remaining;
 mod residuals;
 mod rivals;
@@ -84,7 +85,8 @@ mod verdict;
 pub use candidate::{Bound, Candidate, EffectParameter};
 pub use confounding::{Confounding, Design, HeldOutGain, CONFOUNDED};
 pub use cross_validation::{cross_validate, folds_by_run, paired_gain};
-pub use fit::{fit_candidate, pooled_rms, CandidateFit, IdentifyOptions, SegmentError};
+pub use fit::fit_candidate;
+pub use fitted::{pooled_rms, CandidateFit, IdentifyOptions, SegmentError};
 pub use nuisance::{at_rest, EXTRA_STATES, INITIAL_MOTION, NUISANCE, STEER_BIAS};
 pub use residuals::{Factory, ModelFactory, Setup, Sim};
 pub use segment::{RollChannel, Segment, Weights};

@@ -18,6 +18,10 @@
 /// those entries at zero. The last entry ([`STEER_BIAS`]) is a sensor
 /// nuisance, not a state: the measured steer's offset over the window.
 pub const NUISANCE: usize = INITIAL_MOTION + 2 * EXTRA_STATES + 1;
+
+/// Where the initial forward speed sits in a segment's nuisances.
+pub(super) const SPEED: usize = INITIAL_MOTION - 1;
+
 /// Where a kick's steer bias (rad) sits in its nuisances: the offset of the
 /// measured steer angle over the window, fitted per kick. A steer angle
 /// taken from two orientation sensors (frame and handlebar) inherits the

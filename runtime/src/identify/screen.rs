@@ -24,8 +24,8 @@
 //! finite one (on an independent set, a fitted gain 54 times the
 //! prediction), so it is always fitted.
 
-use super::fit::{Free, Problem};
 use super::normal::{Normal, SegmentJacobian};
+use super::problem::{Free, Problem};
 use super::Candidate;
 use super::{bic, CandidateFit, ModelFactory, Segment, SegmentError, Weights};
 use nalgebra::{DMatrix, DVector};

@@ -26,7 +26,7 @@
 //! explains most of what it did (the encompassing test, [`Verdict::Encompassed`]);
 //! and after the forward search every candidate that a later one followed
 //! is tested again against the final model without it (the backward check,
-//! [`super::elimination`]); one that fails is removed and the forward
+//! [`elimination`]); one that fails is removed and the forward
 //! search resumes once.
 //!
 //! The criterion of every fit, at every step, is computed with the
@@ -34,11 +34,12 @@
 //! the whole search), so the steps' figures add up: a step's base is the
 //! previous step's base plus the change it selected.
 
+mod elimination;
+
 use super::confounding::Confounding;
 pub use super::criterion::{bic, PLAUSIBLE_PRIOR_SDS};
 use super::criterion::{farthest_from_prior, with_priors_on_the_data_scale};
 pub use super::cross_validation::{folds_by_run, paired_gain};
-pub use super::elimination::MemberCheck;
 use super::fit::fit_trial;
 use super::screen;
 use super::search_order::{added_of, first_passing, SearchOrder};
@@ -47,6 +48,7 @@ use super::{
     ModelFactory, RollChannel, Segment, SegmentError, Setup, Weights, NUISANCE,
 };
 use crate::model::MultibodyModel;
+pub use elimination::MemberCheck;
 use serde::Serialize;
 use std::sync::atomic::Ordering;
 
@@ -106,7 +108,7 @@ pub struct Identification {
     pub steps: Vec<Step>,
     /// The backward check: each selected candidate followed by a later
     /// addition, tested against the final model without it
-    /// ([`super::elimination`]).
+    /// ([`elimination`]).
     pub final_check: Vec<MemberCheck>,
     /// Folds of the cross-validation.
     pub folds: usize,

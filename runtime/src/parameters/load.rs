@@ -12,6 +12,7 @@ use toml::Spanned;
 use crate::feedback::{GainSchedule, GAIN_NAMES};
 use nalgebra::Matrix2x4;
 
+use super::file::{missing, missing_all, read};
 use super::moore::{self, MOORE_FORM};
 use super::{BenchmarkParameters, MeasuredBenchmark, ParameterError, ParameterWarning, ThesisParameters};
 
@@ -370,17 +371,6 @@ impl BenchmarkParameters {
     }
 }
 
-pub(crate) fn read(path: &Path) -> Result<String, ParameterError> {
-    // Capped: a parameter file is kilobytes; `--bike /dev/zero` must not
-    // grow without end.
-    crate::experiment::read::read_text_capped(path, crate::experiment::read::MAX_TEXT_FILE_BYTES).map_err(|source| {
-        ParameterError::Io {
-            path: path.to_path_buf(),
-            source,
-        }
-    })
-}
-
 /// Whether a parameter file is TOML: by its extension `.toml`, else by its
 /// content, so a file read through `/dev/stdin`, `<(...)`, a `.txt` name
 /// or no extension is read in the format it is in. The text format
@@ -396,25 +386,6 @@ pub(crate) fn is_toml(path: &Path, text: &str) -> bool {
     text.lines().map(str::trim).any(|l| {
         !l.starts_with('#') && (l.starts_with('[') || l.contains('"') || l.contains('\'') || l.starts_with("form"))
     })
-}
-
-/// The error for absent required fields: all of them at once.
-pub(crate) fn missing_all(path: &Path, absent: &[&str]) -> Option<ParameterError> {
-    match absent {
-        [] => None,
-        [one] => Some(missing(path, one)),
-        many => Some(ParameterError::MissingFields {
-            path: path.to_path_buf(),
-            fields: many.iter().map(|s| s.to_string()).collect(),
-        }),
-    }
-}
-
-fn missing(path: &Path, field: &str) -> ParameterError {
-    ParameterError::MissingField {
-        path: path.to_path_buf(),
-        field: field.to_string(),
-    }
 }
 
 fn wrong_form(path: &Path, expected: Form, found: Form) -> ParameterError {

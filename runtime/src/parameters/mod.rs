@@ -35,6 +35,7 @@ mod benchmark;
 mod convert;
 pub use convert::thesis_to_benchmark_in;
 mod error;
+mod file;
 mod load;
 pub mod moore;
 mod text;

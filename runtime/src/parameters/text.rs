@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::load::read;
+use super::file::read;
 use super::{BenchmarkParameters, ParameterError, ParameterWarning};
 
 /// Names accepted in text files beside the Table 1 symbols, with their
@@ -189,7 +189,7 @@ impl MeasuredBenchmark {
             .copied()
             .filter(|s| !values.contains_key(*s))
             .collect();
-        if let Some(err) = super::load::missing_all(&pb(), &absent) {
+        if let Some(err) = super::file::missing_all(&pb(), &absent) {
             return Err(err);
         }
         let parameters = BenchmarkParameters::from_lookup(|sym| {

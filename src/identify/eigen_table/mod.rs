@@ -19,7 +19,7 @@
 //! residual scale: `n ln(chi2 / n) + k ln n`) and the leave-one-speed-out
 //! error (each row predicted with the values fitted to the others).
 
-use super::candidates::{candidates, identification_models};
+use super::candidates::{candidates, identification_models, values_map};
 use super::corrections;
 use super::discovery::{discover_on_table, DiscoveryOutcome};
 use super::predict::predict;
@@ -35,8 +35,13 @@ use serde::Serialize;
 
 mod read;
 mod report;
-use super::result::{estimates, Estimate, IdentifyResult};
-pub use read::{read_eigen_table, EigenPoint};
+pub use super::result::EigenPoint;
+use super::result::{
+    estimates, CandidateTrial, Details, Errors, Estimate, FittedValue, HeldOutErrors, IdentifyResult, Source,
+    TableDetails,
+};
+use super::words::verdict_text;
+pub use read::read_eigen_table;
 pub use report::{table_summary, write_table_report};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -105,6 +110,84 @@ pub struct TableOutcome {
     /// What the dictionary of generalized forces found beyond the library
     /// (`None`: not requested).
     pub discovery: Option<DiscoveryOutcome>,
+}
+
+impl From<TableOutcome> for IdentifyResult {
+    fn from(o: TableOutcome) -> Self {
+        IdentifyResult::from(&o)
+    }
+}
+
+impl From<&TableOutcome> for IdentifyResult {
+    fn from(o: &TableOutcome) -> Self {
+        let errors = |eigen_rms: f64, held: f64| Errors {
+            eigen_rms,
+            eigen_weighted_rms: None,
+            median_run_roll_rms: None,
+            median_run_steer_rms: None,
+            roll_rms: None,
+            steer_rms: None,
+            speed_rms: None,
+            held_out: HeldOutErrors {
+                eigen_rms: held,
+                eigen_weighted_rms: None,
+                roll_rms: None,
+                steer_rms: None,
+                speed_rms: None,
+            },
+            per_run: Vec::new(),
+        };
+        let mut base: Vec<String> = Vec::new();
+        let mut candidates = Vec::new();
+        let mut step = 0;
+        for t in &o.trials {
+            if t.step != step {
+                step = t.step;
+                base = o.selected[..(step - 1).min(o.selected.len())].to_vec();
+            }
+            candidates.push(CandidateTrial {
+                step: t.step,
+                name: t.name.clone(),
+                members: vec![t.name.clone()],
+                extends: base.clone(),
+                score: Some(t.bic_change).filter(|x| x.is_finite()),
+                predicted_score: None,
+                cv: Some(t.cv).filter(|x| x.is_finite()),
+                base_cv: t.base_cv,
+                values: Some(
+                    t.values
+                        .iter()
+                        .map(|(s, &(value, stderr))| FittedValue {
+                            symbol: s.clone(),
+                            value,
+                            stderr,
+                        })
+                        .collect(),
+                ),
+                selected: t.verdict.added(),
+                outcome: t.verdict.clone(),
+                verdict: verdict_text(&t.verdict),
+            });
+        }
+        IdentifyResult {
+            source: Source::EigenvalueTable,
+            selected_effects: o.selected.clone(),
+            parameters: o.parameters.clone(),
+            candidates,
+            error_before: errors(o.eigen_rms_before, o.eigen_rms_before),
+            error_after: errors(o.eigen_rms_after, o.eigen_rms_held_out),
+            driven_model: o.driven_model,
+            remaining: o.remaining.clone(),
+            discovery: o.discovery.clone(),
+            details: Details::Table(TableDetails {
+                table: o.table.clone(),
+                points: o.points.clone(),
+                not_tried: o.not_tried.clone(),
+                predicted_before: o.predicted_before.clone(),
+                predicted_after: o.predicted_after.clone(),
+            }),
+        }
+    }
 }
 
 struct Fit {
@@ -414,27 +497,6 @@ fn needs_amplitude(info: &ModelInfo, effect: &str) -> bool {
                 }))
             )
     })
-}
-
-/// The values of a candidate set's parameters (tied symbols and held
-/// companions included) by symbol.
-pub(super) fn values_map(set: &[&Candidate], values: &[f64]) -> BTreeMap<String, f64> {
-    let mut m = BTreeMap::new();
-    let mut it = values.iter();
-    for c in set {
-        for (s, v) in &c.fixed {
-            m.insert(s.clone(), *v);
-        }
-        for p in &c.parameters {
-            let v = *it.next().unwrap_or(&0.0);
-            let v = p.lower.map_or(v, |lo| v.max(lo));
-            m.insert(p.symbol.clone(), v);
-            for t in &p.tied {
-                m.insert(t.clone(), v);
-            }
-        }
-    }
-    m
 }
 
 /// Levenberg-Marquardt over the parameters of `set` (a few), with their

@@ -1,22 +1,9 @@
 //! Reading a measured eigenvalue table (format in the parent module's doc).
 
-use super::super::IdentifyError;
+use crate::identify::result::EigenPoint;
+use crate::identify::IdentifyError;
 use bikedyn_runtime::experiment::read::{read_text_capped, MAX_SPEED_M_S, MAX_TEXT_FILE_BYTES};
-use serde::Serialize;
 use std::path::Path;
-
-/// One row of a measured eigenvalue table.
-#[derive(Clone, Debug, Serialize)]
-pub struct EigenPoint {
-    /// Line of the file.
-    pub line: usize,
-    /// Forward speed (m/s).
-    pub speed: f64,
-    /// Measured weave eigenvalue `[re, im]` (1/s).
-    pub eigenvalue: [f64; 2],
-    /// Its standard errors, if the table gives them.
-    pub stderr: Option<[f64; 2]>,
-}
 
 /// Read a measured eigenvalue table (see the module doc).
 ///

@@ -88,7 +88,7 @@ pub fn write_table_report(o: &TableOutcome, dir: &Path) -> Result<(), IdentifyEr
             vals.join(", "),
             t.bic_change,
             t.cv,
-            crate::identify::report::verdict_text(&t.verdict)
+            crate::identify::words::verdict_text(&t.verdict)
         );
     }
     if let Some(DiscoveryOutcome::Ran(d)) = &o.discovery {

@@ -1,12 +1,11 @@
 //! The identification's `report.md`: what was measured, the candidates,
 //! the fits, the errors before and after, the diagnosis and the plots.
 
-use super::candidates::not_candidates;
-use super::report::{errors, fmt_c, median, nan, summary, verdict_text};
-use super::result::{Errors, HeldOutErrors};
-use super::{IdentifyRequest, Outcome};
-use bikedyn_runtime::identify::confounding::CONFOUNDED;
-use bikedyn_runtime::identify::Trial;
+use super::{errors, summary};
+use crate::identify::candidates::not_candidates;
+use crate::identify::result::{Errors, HeldOutErrors};
+use crate::identify::words::{fmt_c, median, nan, steps_markdown, verdict_text};
+use crate::identify::{IdentifyRequest, Outcome};
 use bikedyn_runtime::registry::ModelRegistry;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -42,16 +41,16 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     let _ = writeln!(s, "3. The residual pattern of the model without any added effect was related to the effects of the library (below).");
     let _ = writeln!(s, "4. Candidates were added one at a time and fitted jointly over all kicks (Levenberg-Marquardt). One was kept only if it lowers the Bayesian information criterion (effective sample sizes for correlated residuals), lowers the error on held-out runs ({}-fold cross-validation by run: each run's or log's kicks are predicted with the values fitted to the others), and its dissipative parameters are positive; of the candidates of a step that pass, the criterion's first is added unless another predicts the held-out runs consistently better (run by run, beyond two standard errors). The search stops when no candidate passes.", id.folds);
     if let Some(r) = &o.remaining {
-        let _ = writeln!(s, "5. The identified model's weave residuals (measured minus predicted eigenvalue of each kick counted) were regressed on the states a missing effect would act through ({}); an F test asks whether that pattern exceeds the kicks' own scatter about it, which is the floor a perfect model would reach. Outcome: {}.", super::remaining::regressors_text(r), super::remaining::remaining_sentence(r, "kicks"));
+        let _ = writeln!(s, "5. The identified model's weave residuals (measured minus predicted eigenvalue of each kick counted) were regressed on the states a missing effect would act through ({}); an F test asks whether that pattern exceeds the kicks' own scatter about it, which is the floor a perfect model would reach. Outcome: {}.", crate::identify::remaining::regressors_text(r), crate::identify::remaining::remaining_sentence(r, "kicks"));
     }
     if !o.state_correlation.is_empty() {
-        let _ = writeln!(s, "5b. Each channel's residual after identification (every sample of every kick) was regressed on the simulated states (the roll channel and its rate, the steer angle and its rate), with an F test on the effective sample size of correlated samples; its lag-1 autocorrelation measures how far it is from white noise. Outcome: {}.", super::remaining::state_correlation_sentence(&o.state_correlation));
+        let _ = writeln!(s, "5b. Each channel's residual after identification (every sample of every kick) was regressed on the simulated states (the roll channel and its rate, the steer angle and its rate), with an F test on the effective sample size of correlated samples; its lag-1 autocorrelation measures how far it is from white noise. Outcome: {}.", crate::identify::remaining::state_correlation_sentence(&o.state_correlation));
     }
     if let Some(d) = &o.discovery {
-        let _ = writeln!(s, "6. Where a structured residual remains, a dictionary of generalized forces on the roll and steer equations (angles, rates and accelerations, times 1, v or v^2, at once or through a first-order lag) was searched on the counted kicks' weave eigenvalues, with the library's values as fitted; a term is kept when it lowers the criterion and the held-out error of the same folds of runs, consistently over the kicks, than the library's values and than the base model (the time series' fit may have moved the kicks' eigenvalues away from those measured), and when its coefficient's 95 % interval excludes zero. Outcome: {}.", super::discovery::kicks_sentence(d).replace('\n', "; "));
+        let _ = writeln!(s, "6. Where a structured residual remains, a dictionary of generalized forces on the roll and steer equations (angles, rates and accelerations, times 1, v or v^2, at once or through a first-order lag) was searched on the counted kicks' weave eigenvalues, with the library's values as fitted; a term is kept when it lowers the criterion and the held-out error of the same folds of runs, consistently over the kicks, than the library's values and than the base model (the time series' fit may have moved the kicks' eigenvalues away from those measured), and when its coefficient's 95 % interval excludes zero. Outcome: {}.", crate::identify::discovery::kicks_sentence(d).replace('\n', "; "));
     }
     if let Some(t) = &o.time_series {
-        let _ = writeln!(s, "7. Where a structured residual remains (in the weave or in the time series), the dictionary's terms that the model carries (angles and rates times 1, v or v^2, a bias, a Coulomb-like torque, on the roll and steer equations) were tried one at a time through the nonlinear simulation of every kick, with the library's selection refitted beside them and the same tests as its candidates; then every member was tested against the final model without it. Outcome: {}.", super::time_series::sentence(t, unit, 1f64.to_degrees()).replace('\n', "; "));
+        let _ = writeln!(s, "7. Where a structured residual remains (in the weave or in the time series), the dictionary's terms that the model carries (angles and rates times 1, v or v^2, a bias, a Coulomb-like torque, on the roll and steer equations) were tried one at a time through the nonlinear simulation of every kick, with the library's selection refitted beside them and the same tests as its candidates; then every member was tested against the final model without it. Outcome: {}.", crate::identify::time_series::sentence(t, unit, 1f64.to_degrees()).replace('\n', "; "));
     }
     let _ = writeln!(s);
     let med = |f: &dyn Fn(&bikedyn_runtime::identify::Weights) -> f64| median(id.weights.iter().map(f));
@@ -133,7 +132,7 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
             .zip(id.after.values.iter().zip(&id.after.stderr))
         {
             let interval = match p.on_bound(*v) {
-                Some(b) => super::report::bound_text(b),
+                Some(b) => crate::identify::words::bound_text(b),
                 None => format!("[{:.5}, {:.5}]", v - 1.96 * se, v + 1.96 * se),
             };
             let _ = writeln!(
@@ -255,118 +254,4 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     let fitted = dir.join("fitted.toml");
     let _ = writeln!(s, "## Reproduce\n\nThe identified bicycle is `{}`: the bicycle's parameters plus the fitted effect values, for the model `{}` (driven speed) or `{}` (free speed). To refit from it, and to simulate it:\n\n```sh\nbikedyn identify {} --bike {}\nbikedyn simulate --bike {} --model {} --speed 5 --kick 0.5:3 --duration 6 --plot kick.svg\n```\n\nThe refit starts from the identified bicycle: the effects found here are part of its model, so the refit should warrant nothing more.", fitted.display(), o.driven_model, o.model, inputs.join(" "), fitted.display(), fitted.display(), o.model);
     s
-}
-
-/// The steps of a forward search as tables: each candidate tried with its
-/// fit, criterion, held-out error and verdict, and the rivals of the one
-/// added (steps numbered from `first`).
-pub(super) fn steps_markdown(s: &mut String, steps: &[bikedyn_runtime::identify::Step], first: usize) {
-    for (k, step) in steps.iter().enumerate() {
-        let base = if step.base.is_empty() {
-            "the base model".to_string()
-        } else {
-            step.base.join(" + ")
-        };
-        let _ = writeln!(
-            s,
-            "Step {}: added to {base} (BIC {:.1}, held-out error {:.4}).\n",
-            first + k,
-            step.base_bic,
-            step.base_cv
-        );
-        let _ = writeln!(
-            s,
-            "| candidate | fitted values (+- one standard error) | BIC change | held-out error | verdict |\n|---|---|---|---|---|"
-        );
-        // Fitted trials by their criterion, then those not fitted by their
-        // predicted change.
-        let key = |t: &Trial| match &t.fit {
-            Some(f) => (0, f.bic - step.base_bic),
-            None => (1, t.predicted_bic_change.unwrap_or(f64::INFINITY)),
-        };
-        let mut rows: Vec<&Trial> = step.trials.iter().collect();
-        rows.sort_by(|x, y| {
-            let (a, b) = (key(x), key(y));
-            a.0.cmp(&b.0).then(a.1.total_cmp(&b.1))
-        });
-        for t in rows {
-            let name = &t.name;
-            let why = verdict_text(&t.verdict);
-            match &t.fit {
-                Some(f) => {
-                    let vals: Vec<String> = f
-                        .parameters
-                        .iter()
-                        .zip(f.values.iter().zip(&f.stderr))
-                        .map(|(p, (v, se))| format!("{} = {:.4} +- {:.4}", p.symbol, v, se))
-                        .collect();
-                    let cv = if f.cv.is_finite() {
-                        format!("{:.4}", f.cv)
-                    } else {
-                        "-".into()
-                    };
-                    let _ = writeln!(
-                        s,
-                        "| `{name}` | {} | {:+.1} | {cv} | {why} |",
-                        vals.join(", "),
-                        f.bic - step.base_bic
-                    );
-                }
-                None => match t.predicted_bic_change {
-                    Some(p) => {
-                        let _ = writeln!(s, "| `{name}` | not fitted | {p:+.1} (predicted) | - | {why} |");
-                    }
-                    None => {
-                        let _ = writeln!(s, "| `{name}` | - | - | - | {why} |");
-                    }
-                },
-            }
-        }
-        let _ = writeln!(s);
-        if !step.confounded.is_empty() {
-            let _ = writeln!(
-                s,
-                "How far the data tell the added candidate from each rival that also lowered the criterion. Correlation: the largest canonical correlation of their parameters in the Fisher information, after every kick's initial state is fitted (1: indistinguishable; at or above {CONFOUNDED}: not separable). Held-out gain: for a rival that passed cross-validation too, how much better it predicts the held-out runs, paired run by run, +- one standard error (within two standard errors of zero: not separated by these runs).\n"
-            );
-            let _ = writeln!(
-                s,
-                "| added | rival | correlation | held-out gain of the rival | kicks that would separate them (correlation) |\n|---|---|---|---|---|"
-            );
-            for c in &step.confounded {
-                let designs: Vec<String> = c
-                    .designs
-                    .iter()
-                    .take(4)
-                    .map(|d| format!("{} ({:.2})", d.description, d.correlation))
-                    .collect();
-                let gain = match c.held_out_gain {
-                    Some(h) => format!(
-                        "{:+.4} +- {:.4} (1 SE){}",
-                        h.gain,
-                        h.stderr,
-                        if h.within_scatter() { " (not separated)" } else { "" }
-                    ),
-                    None => "-".to_string(),
-                };
-                let _ = writeln!(
-                    s,
-                    "| `{}` | `{}` | {:.3}{} | {gain} | {} |",
-                    c.chosen,
-                    c.rival,
-                    c.correlation,
-                    if c.correlation >= CONFOUNDED {
-                        " (not separable)"
-                    } else {
-                        ""
-                    },
-                    if designs.is_empty() {
-                        "-".to_string()
-                    } else {
-                        designs.join("; ")
-                    }
-                );
-            }
-            let _ = writeln!(s);
-        }
-    }
 }

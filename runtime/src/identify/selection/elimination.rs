@@ -15,9 +15,9 @@
 //! and the others tested again. (The last one added was tested against
 //! exactly the model without it when it entered.)
 
-use super::criterion::bic;
-use super::selection::{Search, Verdict};
-use super::{cross_validate, fit_candidate, Candidate, CandidateFit, IdentifyError};
+use super::{Search, Verdict};
+use crate::identify::criterion::bic;
+use crate::identify::{cross_validate, fit_candidate, Candidate, CandidateFit, IdentifyError};
 use serde::Serialize;
 
 /// A selected candidate tested against the final model without it.
@@ -50,7 +50,7 @@ impl<'s> Search<'s> {
     /// decay apart: every run slows, and its law is chosen in a phase of its
     /// own) against `current` without it; remove those that fail, one at a
     /// time. Returns the checks in the order made.
-    pub(super) fn eliminate(
+    pub(in crate::identify) fn eliminate(
         &self,
         current: &mut CandidateFit,
         selected: &mut Vec<&Candidate>,
