@@ -10,6 +10,8 @@
 //! - `generated_code`: finite-difference verification and committed copies.
 //! - `simulation`: the nonlinear motion against the linear solution, events,
 //!   energy, the stiff integrator.
+//! - `parameter_files`: bicycle parameter files of every format, read,
+//!   validated, converted and written back.
 //! - `effects`: the effect library in parameter files and the equations.
 //! - `any_bicycle`: real bicycles with effect parameters through every job.
 //! - `measured_runs`: `fit` on measured-style and synthetic runs.
@@ -25,4 +27,5 @@ mod generated_code;
 mod identification;
 mod linear_analysis;
 mod measured_runs;
+mod parameter_files;
 mod simulation;

@@ -1,6 +1,7 @@
 //! `_Bicycle`: a bicycle's linear analysis, stability and uncertainties.
 
 use super::*;
+use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::eigen::{eigenvalues, EigenJob, EigenOptions, EigenSweepError, Speeds};
 use bikedyn::runtime::eigen::EigenPoint;
 

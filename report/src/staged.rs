@@ -26,7 +26,7 @@
 //!
 //! # Stale temporaries
 //! The temporaries of killed runs are removed by
-//! [`clean_stale`](crate::temporaries::clean_stale), before any output is
+//! [`clean_stale`], before any output is
 //! written to a folder.
 
 use std::collections::BTreeSet;

@@ -1,17 +1,20 @@
 //! Bicycles as users name them (built-in names or parameter files), mapped to
 //! the generated model that represents them and to their canonical matrices.
+//! The files' formats are read and written in [`files`].
 
 use crate::models::{effect_parameters_in, fits, index};
 use crate::registry::BuiltIn;
 use bikedyn_runtime::feedback::GainSchedule;
 use bikedyn_runtime::linearize::LinearizeError;
-use bikedyn_runtime::parameters::{moore, BenchmarkParameters, LoadedSet, ParameterError, ParameterSet};
+use bikedyn_runtime::parameters::{moore, BenchmarkParameters, ParameterError, ParameterSet};
 use bikedyn_runtime::registry::{ModelInfo, ModelRegistry};
+use files::{LoadedSet, ParameterSetFile};
 use std::collections::BTreeMap;
 use std::marker::PhantomData;
 use std::path::Path;
 use thiserror::Error;
 
+pub mod files;
 mod linear;
 pub use linear::{canonical_of, Linear};
 // The runtime's parameter types that appear in a bicycle and its options:

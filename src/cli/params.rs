@@ -4,6 +4,7 @@ use super::args::{FormName, ParamsCommand};
 use super::text::params_show_text;
 use super::{emit, load};
 use anyhow::Result;
+use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::report::output;
 
 /// Run `bikedyn params ...`.

@@ -3,6 +3,7 @@
 //! commands that print them and by `report`.
 
 use anyhow::Result;
+use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::bicycle::Bicycle;
 use bikedyn::canonical::CanonicalMatrices;
 use bikedyn::report::output;

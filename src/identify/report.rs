@@ -16,6 +16,7 @@ use super::result::{
 use super::weave_errors::{eigen_rms, eigen_weighted_rms};
 use super::words::{bound_text, median, nan, verdict_text};
 use super::{IdentifyError, IdentifyRequest, Outcome};
+use crate::bicycle::files::ParameterFile;
 use crate::bicycle::Bicycle;
 use bikedyn_report::experiment::accept::rejected_text;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};

@@ -4,6 +4,7 @@
 //! the linearization.
 
 use crate::common::*;
+use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::bicycle::{Bicycle, BicycleError};
 use bikedyn::generated::{Extended, ThesisWhipple, WhippleOffset};
 use bikedyn::models::{default_bicycle, model_names};

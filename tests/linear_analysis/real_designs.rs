@@ -6,6 +6,7 @@
 //! `tests/data/SOURCE.txt`.
 
 use crate::common::*;
+use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::bicycle::{canonical_of, Bicycle};
 use bikedyn::runtime::closed_form::meijaard_canonical;
 use bikedyn::runtime::eigen::critical_speeds;

@@ -2,6 +2,7 @@
 //! as JSON fields (SI units, the command line's defaults), each result the
 //! library's typed result serialized.
 
+use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::bicycle::{Bicycle, BicycleError};
 use bikedyn::canonical::{canonical, CanonicalOptions};
 use bikedyn::eigen::{eigen_sweep, EigenOptions, Speeds};

@@ -5,6 +5,7 @@
 //! by this crate's `build.rs` with Symbolica), and the refit with the
 //! derived model.
 
+use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::bicycle::Bicycle;
 use bikedyn::identify::discovery::{effect_file, model_coefficient, DiscoveryOutcome, TableDiscovery};
 use bikedyn::identify::eigen_table::{identify_table, identify_table_in, TableOutcome, TableRequest};

@@ -82,6 +82,7 @@ const HIDDEN_IN_RUNS: f64 = 3.0;
 ///   same roll error.
 #[test]
 fn in_runs_the_force_found_in_the_time_series_is_written_derived_and_refitted() {
+    use bikedyn::bicycle::files::ParameterFile;
     use bikedyn::bicycle::Bicycle;
     use bikedyn::identify::discovery::{effect_file, model_coefficient};
     use bikedyn::identify::run_in;

@@ -170,7 +170,7 @@ impl BenchmarkParameters {
 
     /// Build a set by asking `value` for every symbol of [`Self::SYMBOLS`]
     /// (in that order); the first error is returned.
-    pub(crate) fn from_lookup<E>(mut value: impl FnMut(&'static str) -> Result<f64, E>) -> Result<Self, E> {
+    pub fn from_lookup<E>(mut value: impl FnMut(&'static str) -> Result<f64, E>) -> Result<Self, E> {
         Ok(BenchmarkParameters {
             wheelbase: value("w")?,
             trail: value("c")?,

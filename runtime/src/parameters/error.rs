@@ -353,7 +353,7 @@ pub enum ParameterError {
 }
 
 /// `text` cut to at most `max` characters, with the number left out.
-pub(crate) fn cut(text: &str, max: usize) -> String {
+pub fn cut(text: &str, max: usize) -> String {
     let n = text.chars().count();
     if n <= max {
         text.to_string()
@@ -389,7 +389,7 @@ fn fmt_line(line: Option<usize>) -> String {
 impl ParameterError {
     /// Attach a file (and the line of the field, looked up with `line_of`) to
     /// validation errors that have no origin yet. Other errors are unchanged.
-    pub(crate) fn located(self, path: &Path, line_of: impl Fn(&str) -> Option<usize>) -> Self {
+    pub fn located(self, path: &Path, line_of: impl Fn(&str) -> Option<usize>) -> Self {
         match self {
             ParameterError::NotFinite { field, value, origin } if origin.path.is_none() => ParameterError::NotFinite {
                 origin: Origin::new(path, line_of(&field)),
@@ -520,8 +520,8 @@ pub enum ParameterWarning {
     /// A name in a text file that is not a Table 1 parameter but is known from
     /// the HumanControl / BicycleParameters files (nominal speed `v`, lateral
     /// offsets `yB`, `yH`, the sub-bodies `G` and `S` of the front frame, ...).
-    /// It is kept in [`MeasuredBenchmark::extras`](super::MeasuredBenchmark)
-    /// and does not enter the model.
+    /// It is kept in the text file's `MeasuredBenchmark::extras`
+    /// (`bikedyn::bicycle::files`) and does not enter the model.
     ExtraField {
         /// The name.
         field: String,

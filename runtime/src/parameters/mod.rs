@@ -1,19 +1,18 @@
 //! Bicycle parameter sets: the thesis form (Martin Recuero 2009, section 4.4)
-//! and the benchmark form (Meijaard et al. 2007, Table 1), loading,
-//! validation and conversion between them.
+//! and the benchmark form (Meijaard et al. 2007, Table 1), validation and
+//! conversion between them. Their files (TOML of either form, the text files
+//! of BicycleParameters and HumanControl) are the application's: read and
+//! written by `bikedyn::bicycle::files`.
 //!
 //! - [`ThesisParameters`] / [`BenchmarkParameters`]: the two forms, with the
 //!   reference bicycles [`ThesisParameters::thesis_bicycle`] and
 //!   [`BenchmarkParameters::benchmark_bicycle`] (also embedded as TOML:
 //!   [`THESIS_BICYCLE_TOML`], [`BENCHMARK_BICYCLE_TOML`]).
-//! - [`ParameterSet::load`]: TOML files of either form (detected from the keys
-//!   or forced with `form = "..."`) and the benchmark text files of
-//!   BicycleParameters / HumanControl ([`MeasuredBenchmark`] keeps their
-//!   `+/-` uncertainties).
+//! - [`ParameterSet`]: a set of either [`Form`].
 //! - J. K. Moore's (2012) parameters with a leaning rider, as
-//!   bicycleparameters names them (`MooreRiderLean2012ParameterSet`), in
-//!   either file format: told by their keys and converted on reading to the
-//!   benchmark form and the `rider_lean` model's rider ([`moore`]).
+//!   bicycleparameters names them (`MooreRiderLean2012ParameterSet`): told
+//!   by their keys and converted to the benchmark form and the `rider_lean`
+//!   model's rider ([`moore`]).
 //! - `validate()`: errors ([`ParameterError`]) for non-finite values,
 //!   non-positive masses/radii/inertias and non-positive-definite tensors;
 //!   warnings ([`ParameterWarning`]) for principal moments that violate the
@@ -35,16 +34,13 @@ mod benchmark;
 mod convert;
 pub use convert::thesis_to_benchmark_in;
 mod error;
-mod file;
-mod load;
 pub mod moore;
-mod text;
+mod set;
 mod thesis;
 mod validate;
 
 pub use benchmark::{BenchmarkParameters, BENCHMARK_BICYCLE_TOML};
-pub use error::{Origin, ParameterError, ParameterWarning};
-pub use load::{Form, LoadedSet, ParameterSet};
-pub use text::{MeasuredBenchmark, EXTRA_TEXT_FIELDS};
+pub use error::{cut, Origin, ParameterError, ParameterWarning};
+pub use set::{Form, ParameterSet};
 pub use thesis::{ThesisParameters, THESIS_BICYCLE_TOML};
 pub use validate::body;

@@ -338,7 +338,7 @@ pub fn convert(values: &BTreeMap<String, (f64, usize)>, path: &Path) -> Result<M
 /// (`extras`: effect parameters, by name): its rider's parameters are added
 /// to them, which must be among the `accepted` names (the registry's models
 /// have a leaning rider) and not given in the file as well.
-pub(crate) fn join_rider(
+pub fn join_rider(
     conversion: &MooreConversion,
     extras: &mut BTreeMap<String, f64>,
     accepted: &[&str],

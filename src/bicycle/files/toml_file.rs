@@ -1,6 +1,22 @@
-//! Reading and writing parameter sets: TOML files of either form, and (via
-//! [`MeasuredBenchmark`]) the benchmark text files of BicycleParameters and
-//! HumanControl.
+//! Parameter files in TOML, of either form.
+//!
+//! Keys are the symbols of one form ([`ThesisParameters::SYMBOLS`] or
+//! [`BenchmarkParameters::SYMBOLS`]), either at the top level or inside a
+//! `[parameters]` table. When a `[parameters]` table exists it is used and the
+//! other tables are ignored (so a reference file such as `meijaard2007.toml`,
+//! with `[canonical]` and `[[eigenvalues]]` beside its `[parameters]`, loads).
+//! The form is detected from the keys (thesis-only symbols such as `Rt`, `x3`
+//! against benchmark-only ones such as `w`, `lam`; `g` is shared) or forced
+//! with `form = "thesis"` or `form = "benchmark"`. Values are TOML integers or
+//! floats (`nan` and `inf` parse, then fail validation). Every key must be
+//! known; the thesis `d4` may be omitted (it defaults to 0). Loading validates
+//! the set and returns the warnings beside it.
+//!
+//! A file of J. K. Moore's (2012) parameters (bicycleparameters'
+//! `MooreRiderLean2012ParameterSet`; TOML or text, told by its keys or
+//! `form = "MooreRiderLean2012"`) is converted on reading to the benchmark
+//! form, its leaning rider to the `rider_lean` model's parameters, returned
+//! with the extra symbols (`bikedyn_runtime::parameters::moore`).
 
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -9,99 +25,17 @@ use std::path::{Path, PathBuf};
 use toml::de::{DeTable, DeValue};
 use toml::Spanned;
 
-use crate::feedback::{GainSchedule, GAIN_NAMES};
+use bikedyn_runtime::feedback::{GainSchedule, GAIN_NAMES};
+use bikedyn_runtime::parameters::moore::{self, MOORE_FORM};
+use bikedyn_runtime::parameters::{
+    BenchmarkParameters, Form, ParameterError, ParameterSet, ParameterWarning, ThesisParameters,
+};
 use nalgebra::Matrix2x4;
 
-use super::file::{missing, missing_all, read};
-use super::moore::{self, MOORE_FORM};
-use super::{BenchmarkParameters, MeasuredBenchmark, ParameterError, ParameterWarning, ThesisParameters};
+use super::text_file::{moore_from_text_str_with_extra, text_is_moore, MeasuredBenchmark};
+use super::{missing, missing_all, read, LoadedSet, ParameterFile, ParameterSetFile};
 
-/// Which parameterization a set uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Form {
-    /// [`ThesisParameters`] (Martin Recuero 2009).
-    Thesis,
-    /// [`BenchmarkParameters`] (Meijaard et al. 2007, Table 1).
-    Benchmark,
-}
-
-impl Form {
-    /// `"thesis"` or `"benchmark"` (the values of the TOML key `form`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Form::Thesis => "thesis",
-            Form::Benchmark => "benchmark",
-        }
-    }
-
-    /// The symbols of this form.
-    pub fn symbols(self) -> &'static [&'static str] {
-        match self {
-            Form::Thesis => &ThesisParameters::SYMBOLS,
-            Form::Benchmark => &BenchmarkParameters::SYMBOLS,
-        }
-    }
-
-    fn from_name(name: &str) -> Option<Form> {
-        match name {
-            "thesis" => Some(Form::Thesis),
-            "benchmark" => Some(Form::Benchmark),
-            _ => None,
-        }
-    }
-}
-
-/// A parameter set of either form, as read from a file.
-///
-/// # TOML
-///
-/// Keys are the symbols of one form ([`ThesisParameters::SYMBOLS`] or
-/// [`BenchmarkParameters::SYMBOLS`]), either at the top level or inside a
-/// `[parameters]` table. When a `[parameters]` table exists it is used and the
-/// other tables are ignored (so a reference file such as `meijaard2007.toml`,
-/// with `[canonical]` and `[[eigenvalues]]` beside its `[parameters]`, loads).
-/// The form is detected from the keys (thesis-only symbols such as `Rt`, `x3`
-/// against benchmark-only ones such as `w`, `lam`; `g` is shared) or forced
-/// with `form = "thesis"` or `form = "benchmark"`. Values are TOML integers or
-/// floats (`nan` and `inf` parse, then fail validation). Every key must be
-/// known; the thesis `d4` may be omitted (it defaults to 0). Loading validates
-/// the set and returns the warnings beside it.
-///
-/// A file of J. K. Moore's (2012) parameters (bicycleparameters'
-/// `MooreRiderLean2012ParameterSet`; TOML or text, told by its keys or
-/// `form = "MooreRiderLean2012"`) is converted on reading to the benchmark
-/// form, its leaning rider to the `rider_lean` model's parameters, returned
-/// with the extra symbols ([`super::moore`]).
-///
-/// ```
-/// use bikedyn_runtime::parameters::{ParameterSet, ThesisParameters};
-/// let text = ThesisParameters::thesis_bicycle().to_toml_string();
-/// let (set, warnings) = ParameterSet::from_toml_str(&text, "thesis.toml").unwrap();
-/// assert_eq!(set, ParameterSet::Thesis(ThesisParameters::thesis_bicycle()));
-/// assert_eq!(warnings.len(), 2); // handlebar and front wheel triangle inequality
-/// ```
-#[derive(Clone, Debug, PartialEq)]
-pub enum ParameterSet {
-    /// Thesis form.
-    Thesis(ThesisParameters),
-    /// Benchmark form.
-    Benchmark(BenchmarkParameters),
-}
-
-/// A parameter file as read by [`ParameterSet::load_with_extra`].
-#[derive(Clone, Debug)]
-pub struct LoadedSet {
-    pub set: ParameterSet,
-    /// Effect parameters given, by symbol.
-    pub effects: BTreeMap<String, f64>,
-    /// Standard deviations given as `value+/-std`, by symbol.
-    pub uncertainties: BTreeMap<String, f64>,
-    pub warnings: Vec<ParameterWarning>,
-    /// The controller a TOML file declares in its `[feedback]` table.
-    pub feedback: Option<GainSchedule>,
-}
-
-impl ParameterSet {
+impl ParameterFile for ParameterSet {
     /// Read and validate a parameter file. Files ending in `.toml`, and
     /// others whose content is TOML (quoted values, `[tables]`, `form = `:
     /// a pipe, `/dev/stdin`, a `.txt` name), are read as TOML
@@ -111,12 +45,12 @@ impl ParameterSet {
     /// Returns the set and its warnings (triangle inequality, extra names of
     /// text files). To keep the `+/-` uncertainties of a text file, use
     /// [`MeasuredBenchmark::load`].
-    pub fn load(path: impl AsRef<Path>) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
+    fn load(path: impl AsRef<Path>) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         let text = read(path)?;
         if is_toml(path, &text) {
             Self::from_toml_str(&text, path)
-        } else if super::text::text_is_moore(&text) {
+        } else if text_is_moore(&text) {
             Self::from_file_text_with_extra(&text, path, &[]).map(|l| (l.set, l.warnings))
         } else {
             Self::from_text_str(&text, path)
@@ -125,18 +59,29 @@ impl ParameterSet {
 
     /// Parse and validate TOML text (format in [`ParameterSet`]); `path` is
     /// only used in messages.
-    pub fn from_toml_str(
+    fn from_toml_str(
         text: &str,
         path: impl AsRef<Path>,
     ) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
         Self::from_toml_str_with_extra(text, path, &[]).map(|(set, _, w)| (set, w))
     }
 
+    /// TOML text with `form = "..."` and one commented line per symbol; it
+    /// reads back to exactly this set.
+    fn to_toml_string(&self) -> String {
+        match self {
+            ParameterSet::Thesis(p) => p.to_toml_string(),
+            ParameterSet::Benchmark(p) => p.to_toml_string(),
+        }
+    }
+}
+
+impl ParameterSetFile for ParameterSet {
     /// Like [`from_toml_str`](Self::from_toml_str), also accepting the
     /// symbols in `extra` (e.g. effect parameters such as `c_steer`), which
     /// are returned by name. Any other unknown symbol is still an error
     /// naming the file and line.
-    pub fn from_toml_str_with_extra(
+    fn from_toml_str_with_extra(
         text: &str,
         path: impl AsRef<Path>,
         extra: &[&str],
@@ -195,7 +140,7 @@ impl ParameterSet {
     /// [`from_toml_str_with_extra`](Self::from_toml_str_with_extra),
     /// [`MeasuredBenchmark::from_text_str_with_extra`]). The `+/-`
     /// uncertainties of a text file are kept (by symbol).
-    pub fn load_with_extra(path: impl AsRef<Path>, extra: &[&str]) -> Result<LoadedSet, ParameterError> {
+    fn load_with_extra(path: impl AsRef<Path>, extra: &[&str]) -> Result<LoadedSet, ParameterError> {
         let path = path.as_ref();
         let text = read(path)?;
         Self::from_file_text_with_extra(&text, path, extra)
@@ -204,7 +149,7 @@ impl ParameterSet {
     /// [`load_with_extra`](Self::load_with_extra) of a file's text already
     /// read (a file dropped on the browser explorer): TOML or the text
     /// form, told apart as for a file; `path` names it in messages.
-    pub fn from_file_text_with_extra(
+    fn from_file_text_with_extra(
         text: &str,
         path: impl AsRef<Path>,
         extra: &[&str],
@@ -220,8 +165,8 @@ impl ParameterSet {
                 warnings,
                 feedback,
             })
-        } else if super::text::text_is_moore(&text) {
-            super::text::moore_from_text_str_with_extra(&text, path, extra).map(|(set, effects, warnings)| LoadedSet {
+        } else if text_is_moore(&text) {
+            moore_from_text_str_with_extra(&text, path, extra).map(|(set, effects, warnings)| LoadedSet {
                 set: ParameterSet::Benchmark(set),
                 effects,
                 uncertainties: BTreeMap::new(),
@@ -243,72 +188,20 @@ impl ParameterSet {
     /// `name = value+/-std` per line, see [`MeasuredBenchmark`]); the
     /// uncertainties are dropped and the extra names (`v`, ...) are reported as
     /// [`ParameterWarning::ExtraField`]. `path` is only used in messages.
-    pub fn from_text_str(
+    fn from_text_str(
         text: &str,
         path: impl AsRef<Path>,
     ) -> Result<(ParameterSet, Vec<ParameterWarning>), ParameterError> {
         let (measured, warnings) = MeasuredBenchmark::from_text_str(text, path)?;
         Ok((ParameterSet::Benchmark(measured.parameters), warnings))
     }
-
-    /// The form of this set.
-    pub fn form(&self) -> Form {
-        match self {
-            ParameterSet::Thesis(_) => Form::Thesis,
-            ParameterSet::Benchmark(_) => Form::Benchmark,
-        }
-    }
-
-    /// Value by symbol of this set's form.
-    pub fn get(&self, symbol: &str) -> Option<f64> {
-        match self {
-            ParameterSet::Thesis(p) => p.get(symbol),
-            ParameterSet::Benchmark(p) => p.get(symbol),
-        }
-    }
-
-    /// Validate (see [`ThesisParameters::validate`],
-    /// [`BenchmarkParameters::validate`]).
-    pub fn validate(&self) -> Result<Vec<ParameterWarning>, ParameterError> {
-        match self {
-            ParameterSet::Thesis(p) => p.validate(),
-            ParameterSet::Benchmark(p) => p.validate(),
-        }
-    }
-
-    /// The thesis form, converting a benchmark set
-    /// ([`BenchmarkParameters::to_thesis`]).
-    pub fn to_thesis(&self) -> Result<ThesisParameters, ParameterError> {
-        match self {
-            ParameterSet::Thesis(p) => Ok(*p),
-            ParameterSet::Benchmark(p) => p.to_thesis(),
-        }
-    }
-
-    /// The benchmark form, converting a thesis set
-    /// ([`ThesisParameters::to_benchmark`]).
-    pub fn to_benchmark(&self) -> Result<BenchmarkParameters, ParameterError> {
-        match self {
-            ParameterSet::Thesis(p) => p.to_benchmark(),
-            ParameterSet::Benchmark(p) => Ok(*p),
-        }
-    }
-
-    /// TOML text with `form = "..."` and one commented line per symbol; it
-    /// reads back to exactly this set.
-    pub fn to_toml_string(&self) -> String {
-        match self {
-            ParameterSet::Thesis(p) => p.to_toml_string(),
-            ParameterSet::Benchmark(p) => p.to_toml_string(),
-        }
-    }
 }
 
-impl ThesisParameters {
+impl ParameterFile for ThesisParameters {
     /// Parse and validate TOML text that must hold the thesis form (detected
     /// or forced); a benchmark-form file is [`ParameterError::WrongForm`]
     /// (convert it with [`ParameterSet::to_thesis`] instead).
-    pub fn from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+    fn from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         match ParameterSet::from_toml_str(text, path)? {
             (ParameterSet::Thesis(p), w) => Ok((p, w)),
@@ -317,14 +210,14 @@ impl ThesisParameters {
     }
 
     /// Read and validate a thesis-form TOML file.
-    pub fn load(path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+    fn load(path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         Self::from_toml_str(&read(path)?, path)
     }
 
     /// TOML text (`form = "thesis"`, one commented `symbol = value` line per
     /// symbol, shortest round-trip float representation): reads back exactly.
-    pub fn to_toml_string(&self) -> String {
+    fn to_toml_string(&self) -> String {
         write_toml(
             Form::Thesis,
             |s| self.get(s),
@@ -335,11 +228,11 @@ impl ThesisParameters {
     }
 }
 
-impl BenchmarkParameters {
+impl ParameterFile for BenchmarkParameters {
     /// Parse and validate TOML text that must hold the benchmark form
     /// (detected or forced); a thesis-form file is
     /// [`ParameterError::WrongForm`].
-    pub fn from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+    fn from_toml_str(text: &str, path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         match ParameterSet::from_toml_str(text, path)? {
             (ParameterSet::Benchmark(p), w) => Ok((p, w)),
@@ -348,9 +241,9 @@ impl BenchmarkParameters {
     }
 
     /// Read and validate a benchmark-form file: TOML when the name ends in
-    /// `.toml` or the content is TOML (see [`is_toml`]), else the text format (uncertainties dropped; see
-    /// [`MeasuredBenchmark::load`] to keep them).
-    pub fn load(path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
+    /// `.toml` or the content is TOML, else the text format (uncertainties
+    /// dropped; see [`MeasuredBenchmark::load`] to keep them).
+    fn load(path: impl AsRef<Path>) -> Result<(Self, Vec<ParameterWarning>), ParameterError> {
         let path = path.as_ref();
         match ParameterSet::load(path)? {
             (ParameterSet::Benchmark(p), w) => Ok((p, w)),
@@ -360,7 +253,7 @@ impl BenchmarkParameters {
 
     /// TOML text (`form = "benchmark"`, one commented `symbol = value` line per
     /// symbol, shortest round-trip float representation): reads back exactly.
-    pub fn to_toml_string(&self) -> String {
+    fn to_toml_string(&self) -> String {
         write_toml(
             Form::Benchmark,
             |s| self.get(s),
@@ -637,7 +530,7 @@ fn detect_form(
 
 /// The controller a TOML parameter file declares, if any: a top-level
 /// `[feedback]` table of full-state feedback gains `u = -K(v) x`
-/// ([`crate::feedback`]; bicycleparameters' gain names, benchmark signs).
+/// ([`bikedyn_runtime::feedback`]; bicycleparameters' gain names, benchmark signs).
 /// Each gain is a number (constant) or a list of its values at the
 /// table's `speeds` (m/s, increasing): linear between them, held beyond.
 /// Gains not given are zero.

@@ -3,8 +3,9 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::file::read;
-use super::{BenchmarkParameters, ParameterError, ParameterWarning};
+use super::{missing_all, read};
+use bikedyn_runtime::parameters::moore;
+use bikedyn_runtime::parameters::{BenchmarkParameters, Origin, ParameterError, ParameterWarning};
 
 /// Names accepted in text files beside the Table 1 symbols, with their
 /// meaning. They do not enter the model; they are kept in
@@ -129,8 +130,8 @@ impl MeasuredBenchmark {
             let syntax = |reason: String| ParameterError::Syntax {
                 path: pb(),
                 line,
-                text: super::error::cut(raw.trim(), 80),
-                reason: super::error::cut(&reason, 160),
+                text: bikedyn_runtime::parameters::cut(raw.trim(), 80),
+                reason: bikedyn_runtime::parameters::cut(&reason, 160),
             };
             if let Some(&(_, first_line)) = values.get(name) {
                 return Err(ParameterError::DuplicateField {
@@ -189,7 +190,7 @@ impl MeasuredBenchmark {
             .copied()
             .filter(|s| !values.contains_key(*s))
             .collect();
-        if let Some(err) = super::file::missing_all(&pb(), &absent) {
+        if let Some(err) = missing_all(&pb(), &absent) {
             return Err(err);
         }
         let parameters = BenchmarkParameters::from_lookup(|sym| {
@@ -231,8 +232,8 @@ fn parse_line(raw: &str, line: usize, path: &Path) -> Result<Option<(String, f64
     let syntax = |reason: String| ParameterError::Syntax {
         path: path.to_path_buf(),
         line,
-        text: super::error::cut(raw.trim(), 80),
-        reason: super::error::cut(&reason, 160),
+        text: bikedyn_runtime::parameters::cut(raw.trim(), 80),
+        reason: bikedyn_runtime::parameters::cut(&reason, 160),
     };
     let Some((name, rhs)) = content.split_once('=') else {
         return Err(syntax("expected `name = value`".to_string()));
@@ -253,13 +254,13 @@ fn parse_line(raw: &str, line: usize, path: &Path) -> Result<Option<(String, f64
 }
 
 /// Whether a text file holds J. K. Moore's (2012) parameters
-/// ([`super::moore::is_moore_set`] of its names).
-pub(crate) fn text_is_moore(text: &str) -> bool {
+/// ([`moore::is_moore_set`] of its names).
+pub(super) fn text_is_moore(text: &str) -> bool {
     let names = text.lines().filter_map(|raw| {
         let content = raw.split('#').next().unwrap_or("").trim();
         content.split_once('=').map(|(n, _)| n.trim())
     });
-    super::moore::is_moore_set(names)
+    moore::is_moore_set(names)
 }
 
 /// A text file of J. K. Moore's (2012) parameters (`name = value` per
@@ -269,7 +270,7 @@ pub(crate) fn text_is_moore(text: &str) -> bool {
 /// and the warnings. Uncertainties (`+/-`) are refused: they would not
 /// reach the converted parameters.
 #[allow(clippy::type_complexity)]
-pub(crate) fn moore_from_text_str_with_extra(
+pub(super) fn moore_from_text_str_with_extra(
     text: &str,
     path: &Path,
     accepted: &[&str],
@@ -304,11 +305,11 @@ pub(crate) fn moore_from_text_str_with_extra(
                 return Err(ParameterError::NotFinite {
                     field: name,
                     value,
-                    origin: super::Origin::new(path, Some(line)),
+                    origin: Origin::new(path, Some(line)),
                 });
             }
             accepted_values.insert(name.clone(), value);
-        } else if !super::moore::is_moore_symbol(&name) {
+        } else if !moore::is_moore_symbol(&name) {
             return Err(ParameterError::UnknownField {
                 path: path.to_path_buf(),
                 line,
@@ -321,8 +322,8 @@ pub(crate) fn moore_from_text_str_with_extra(
     for k in accepted_values.keys() {
         values.remove(k);
     }
-    let conversion = super::moore::convert(&values, path)?;
-    super::moore::join_rider(&conversion, &mut accepted_values, accepted, path)?;
+    let conversion = moore::convert(&values, path)?;
+    moore::join_rider(&conversion, &mut accepted_values, accepted, path)?;
     Ok((conversion.benchmark, accepted_values, conversion.warnings))
 }
 
@@ -334,7 +335,7 @@ fn is_identifier(name: &str) -> bool {
 
 /// Evaluate a value: a number, or an expression of numbers, `pi`, `nan`,
 /// `inf` with `+ - * /`, unary signs and parentheses.
-pub(crate) fn evaluate(text: &str) -> Result<f64, String> {
+pub(super) fn evaluate(text: &str) -> Result<f64, String> {
     let mut parser = Expr {
         s: text.trim().as_bytes(),
         pos: 0,
