@@ -14,11 +14,10 @@ use super::result::{
     KickErrors, MemberCheck, Prior, RunDetails, Source,
 };
 use super::weave_errors::{eigen_rms, eigen_weighted_rms};
-use super::words::{bound_text, median, nan, verdict_text};
+use super::words::{bound_text, excluded_kick_text, median, nan, verdict_text};
 use super::{IdentifyError, IdentifyRequest, Outcome};
 use crate::bicycle::files::ParameterFile;
 use crate::bicycle::Bicycle;
-use bikedyn_report::experiment::accept::rejected_text;
 use bikedyn_report::identify::plot::{plot_continuation, plot_run, Channel, MeasuredWeave};
 use bikedyn_report::output::{save_json, write_string_atomic};
 use bikedyn_report::staged::{FolderKind, StagedDir};
@@ -212,10 +211,8 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
     for e in &o.eigen_excluded {
         let _ = writeln!(
             s,
-            "not a weave (kept out of the eigenvalue figures): {} at {:.2} s: {}",
-            e.run,
-            e.window_start,
-            rejected_text(&e.rejected)
+            "not a weave (kept out of the eigenvalue figures): {}",
+            excluded_kick_text(e)
         );
     }
     let sel = if id.selected.is_empty() {

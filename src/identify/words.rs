@@ -7,6 +7,8 @@ use bikedyn_runtime::identify::confounding::CONFOUNDED;
 use bikedyn_runtime::identify::{Bound, Trial, Verdict, PLAUSIBLE_PRIOR_SDS};
 use std::fmt::Write as _;
 
+use super::weave_errors::Excluded;
+
 /// An error a source may not have, NaN where it has none (as printed).
 pub(crate) fn nan(x: Option<f64>) -> f64 {
     x.unwrap_or(f64::NAN)
@@ -204,4 +206,15 @@ pub(crate) fn steps_markdown(s: &mut String, steps: &[bikedyn_runtime::identify:
             let _ = writeln!(s);
         }
     }
+}
+
+/// A kick kept out of the eigenvalue figures: its run, window start and
+/// why, as the summary and `report.md` both list it.
+pub(crate) fn excluded_kick_text(e: &Excluded) -> String {
+    format!(
+        "{} at {:.2} s: {}",
+        e.run,
+        e.window_start,
+        bikedyn_report::experiment::accept::rejected_text(&e.rejected)
+    )
 }

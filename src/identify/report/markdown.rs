@@ -4,7 +4,7 @@
 use super::{errors, summary};
 use crate::identify::candidates::not_candidates;
 use crate::identify::result::{Errors, HeldOutErrors};
-use crate::identify::words::{fmt_c, median, nan, steps_markdown, verdict_text};
+use crate::identify::words::{excluded_kick_text, fmt_c, median, nan, steps_markdown, verdict_text};
 use crate::identify::{IdentifyRequest, Outcome};
 use bikedyn_runtime::registry::ModelRegistry;
 use std::fmt::Write as _;
@@ -234,13 +234,7 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
     if !o.eigen_excluded.is_empty() {
         let _ = writeln!(s, "\nKicks kept out of the eigenvalue figures:\n");
         for e in &o.eigen_excluded {
-            let _ = writeln!(
-                s,
-                "* {} at {:.2} s: {}",
-                e.run,
-                e.window_start,
-                bikedyn_report::experiment::accept::rejected_text(&e.rejected)
-            );
+            let _ = writeln!(s, "* {}", excluded_kick_text(e));
         }
     }
     let _ = writeln!(s, "\n## Plots\n\n* `continuation.svg`: weave eigenvalue over speed, model before (thin) and after (thick), with each measured eigenvalue on its speed interval.\n* `run_residuals.svg`: measured and simulated {roll}, steer and speed of a typical kick (median error), before and after.\n");
