@@ -1,17 +1,19 @@
 //! `bikedyn fit`: measured weave eigenvalues from raw logs (thesis-style run
-//! sets and TU Delft kick logs), with the bicycle model's prediction. Which
-//! fitted eigenvalues are measured ones is judged against that model
+//! sets and TU Delft kick logs), with the bicycle model's prediction. The
+//! paths given are walked and their runs read by [`crate::runs`], and
+//! processed by the runtime's pipeline (`bikedyn_runtime::experiment`).
+//! Which fitted eigenvalues are measured ones is judged against that model
 //! (`bikedyn_runtime::experiment::accept`), once, here: `identify` uses
 //! these verdicts.
 
 use crate::bicycle::{Bicycle, BicycleError, Linear};
+use crate::capped::MAX_DATA_FILE_BYTES;
 use crate::progress::{OnProgress, Progress};
 use crate::registry::BuiltIn;
+use crate::runs::{self, Input, InputError};
 use bikedyn_report::plot::PlotError;
 use bikedyn_report::staged::{FolderKind, StagedDir};
-use bikedyn_runtime::experiment::{
-    self, accept, angles::Calibration, compare, read, Input, KickFit, PipelineOptions, RunError, RunReport,
-};
+use bikedyn_runtime::experiment::{self, accept, angles::Calibration, compare, KickFit, PipelineOptions, RunReport};
 // Types of the options and results of a fit, named by front ends from here.
 pub use bikedyn_runtime::eigen::LinearBicycle;
 pub use bikedyn_runtime::experiment::angles::AngleMethod;
@@ -147,7 +149,7 @@ fn hash_file(path: &Path, h: &mut impl std::hash::Hasher) -> Option<()> {
     let mut file = std::fs::File::open(path).ok()?;
     let len = file.metadata().ok()?.len();
     h.write_u64(len);
-    if len > read::MAX_DATA_FILE_BYTES {
+    if len > MAX_DATA_FILE_BYTES {
         return Some(());
     }
     let mut buf = vec![0u8; 1 << 16];
@@ -244,7 +246,7 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
     let mut errors = Vec::new();
     let mut warnings = Vec::new();
     for p in &opts.inputs {
-        match experiment::classify_reporting(p) {
+        match runs::classify_reporting(p) {
             Ok((i, left_out)) => {
                 inputs.extend(i);
                 warnings.extend(left_out.iter().map(|e| e.to_string()));
@@ -299,7 +301,7 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
     for input in inputs {
         match input {
             Input::Log(path) => {
-                match read::read_tudelft(&path) {
+                match runs::read_tudelft(&path) {
                     Ok(log) => reports.push(experiment::process_tudelft(&log, &opt)),
                     Err(e) => errors.push(e.to_string()),
                 }
@@ -320,7 +322,7 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
                     let expected = runs[0].parent().unwrap_or(Path::new(".")).join("calibration");
                     for r in &runs {
                         errors.push(
-                            RunError::NoCalibration {
+                            InputError::NoCalibration {
                                 run: r.clone(),
                                 expected: expected.clone(),
                             }
@@ -329,7 +331,7 @@ pub fn run_fit_in<R: ModelRegistry>(opts: &FitOptions, progress: OnProgress<'_>)
                     }
                     continue;
                 };
-                match experiment::process_set(&runs, &cal, &opt, &tick) {
+                match runs::process_set(&runs, &cal, &opt, &tick) {
                     Ok((c, results)) => {
                         calibrations.push((cal.clone(), c));
                         for r in results {

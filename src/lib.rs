@@ -31,6 +31,7 @@ pub mod registry {
 pub mod bench;
 pub mod bicycle;
 pub mod canonical;
+pub mod capped;
 pub mod eigen;
 pub mod fit;
 pub mod frequency;
@@ -39,6 +40,7 @@ pub mod main_report;
 pub mod models;
 pub mod monte_carlo;
 pub mod progress;
+pub mod runs;
 pub mod sensitivity;
 /// `bikedyn serve` (not in the WebAssembly build: no sockets there).
 #[cfg(not(target_arch = "wasm32"))]

@@ -16,12 +16,12 @@
 
 use crate::bicycle::{canonical_of, Bicycle, BicycleError};
 use crate::registry::BuiltIn;
+/// The fastest run the measured-run reader accepts (m/s): a synthetic run is held to it.
+pub use crate::runs::MAX_SPEED_M_S;
 use bikedyn_report::experiment::synth::{write_run, WriteRunError};
 use bikedyn_report::output::{save_json, write_atomic, OutputError};
 use bikedyn_report::staged::{FolderKind, StagedDir};
 use bikedyn_runtime::eigen::{eigenvalues_of, EigenError};
-/// The fastest run the measured-run reader accepts (m/s): a synthetic run is held to it.
-pub use bikedyn_runtime::experiment::read::MAX_SPEED_M_S;
 use bikedyn_runtime::experiment::synth::{rest_trajectory, RunKind, SensorModel, SynthTruth};
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
 use bikedyn_runtime::model::CoordinateRole;

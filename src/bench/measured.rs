@@ -3,10 +3,12 @@
 //! a TU Delft log.
 
 use super::{scratch, BenchError, BenchOptions};
+use crate::runs::{read_run, read_tudelft};
 use bikedyn_report::experiment::synth::write_run;
 use bikedyn_runtime::experiment::angles::{median, Calibration};
+use bikedyn_runtime::experiment::records::RunKind;
 use bikedyn_runtime::experiment::synth::{rest_trajectory, ResponseSpec, SensorModel};
-use bikedyn_runtime::experiment::{self, read, PipelineOptions};
+use bikedyn_runtime::experiment::{self, PipelineOptions};
 use serde::Serialize;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -58,12 +60,12 @@ pub fn measured_runs(opts: &BenchOptions) -> Result<MeasuredRunFigures, BenchErr
         write_run(
             &d.join("calibration"),
             "calibration",
-            read::RunKind::Calibration,
+            RunKind::Calibration,
             &rest_trajectory(10.0, spec.frame_pitch, 0.3),
             &s,
             1,
         )?;
-        write_run(&d.join("run01"), "run01", read::RunKind::Run, &spec.trajectory(), &s, 2)?;
+        write_run(&d.join("run01"), "run01", RunKind::Run, &spec.trajectory(), &s, 2)?;
         (d.join("run01"), d.join("calibration"), None)
     };
     let figures = time_pipeline(reps, run_dir, &cal_dir, log);
@@ -81,7 +83,7 @@ fn time_pipeline(
     log: Option<PathBuf>,
 ) -> Result<MeasuredRunFigures, BenchError> {
     let opt = PipelineOptions::default();
-    let cal_run = read::read_run(cal_dir)?;
+    let cal_run = read_run(cal_dir)?;
     let mut times = Vec::new();
     for _ in 0..reps {
         let t = Instant::now();
@@ -93,7 +95,7 @@ fn time_pipeline(
     let mut times = Vec::new();
     for _ in 0..reps {
         let t = Instant::now();
-        let run = read::read_run(&run_dir)?;
+        let run = read_run(&run_dir)?;
         black_box(experiment::process_thesis_run(&run, &cal, &opt));
         times.push(t.elapsed().as_secs_f64());
     }
@@ -104,7 +106,7 @@ fn time_pipeline(
             let mut kicks = 0;
             for _ in 0..reps.min(10) {
                 let t = Instant::now();
-                let l = read::read_tudelft(&path)?;
+                let l = read_tudelft(&path)?;
                 kicks = experiment::process_tudelft(&l, &opt).kicks.len();
                 times.push(t.elapsed().as_secs_f64());
             }

@@ -23,9 +23,9 @@ pub use measured::{measured_runs, LogTiming, MeasuredRunFigures};
 pub use simulate::{simulation, OutputTiming, SimulationFigures, VariantTiming};
 
 use crate::bicycle::BicycleError;
+use crate::runs::ReadError;
 use bikedyn_runtime::constraints::ConstraintError;
 use bikedyn_runtime::eigen::EigenError;
-use bikedyn_runtime::experiment::read::ReadError;
 use bikedyn_runtime::linearize::LinearizeError;
 use bikedyn_runtime::simulate::SimulateError;
 use serde::Serialize;

@@ -53,7 +53,7 @@ pub enum IdentifyError {
     MixedInputs { inputs: Vec<String> },
     /// An input path is neither a run, a set nor a log.
     #[error(transparent)]
-    Input(#[from] bikedyn_runtime::experiment::RunError),
+    Input(#[from] crate::runs::InputError),
     /// A measured eigenvalue table could not be read.
     #[error("{}{}: {message}", path.display(), if *line > 0 { format!(":{line}") } else { String::new() })]
     EigenTable {

@@ -97,7 +97,7 @@ impl IdentifyRequest {
         let inputs: Vec<_> = self
             .inputs
             .iter()
-            .filter_map(|p| bikedyn_runtime::experiment::classify(p).ok())
+            .filter_map(|p| crate::runs::classify(p).ok())
             .flatten()
             .collect();
         Ok(bicycle_for(self.bike.as_deref(), &inputs).map_err(FitError::from)?)

@@ -103,7 +103,7 @@ pub fn segments(out: &FitOutcome) -> Segments {
 /// the symmetric models; only a lateral mass offset would flip.)
 fn log_segments(
     r: &bikedyn_runtime::experiment::RunReport,
-    log: &bikedyn_runtime::experiment::read::TudelftLog,
+    log: &bikedyn_runtime::experiment::records::TudelftLog,
     segs: &mut Segments,
 ) {
     for k in &r.kicks {
@@ -163,7 +163,7 @@ fn keep(
 /// it is imposed on the model) rather than thesis-style runs (free speed
 /// after the release). Both in one request is an error.
 pub fn speed_imposed(inputs: &[std::path::PathBuf]) -> Result<bool, super::IdentifyError> {
-    use bikedyn_runtime::experiment::{classify, Input};
+    use crate::runs::{classify, Input};
     let (mut logs, mut runs) = (Vec::new(), Vec::new());
     for path in inputs {
         for input in classify(path)? {

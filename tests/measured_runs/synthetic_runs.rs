@@ -8,7 +8,8 @@
 
 use crate::common::*;
 use bikedyn::bicycle::Bicycle;
-use bikedyn::runtime::experiment::{self, PipelineOptions};
+use bikedyn::runs;
+use bikedyn::runtime::experiment::PipelineOptions;
 use nalgebra::Rotation3;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -53,7 +54,7 @@ fn synth_runs_recover_misalignments_kicks_clock_offsets_and_eigenvalues() {
         frame_pitch: bike.thesis().unwrap().frame_pitch().unwrap(),
         ..PipelineOptions::default()
     };
-    let (cal, reports) = experiment::process_set(&runs, &dir.join("calibration"), &opt, &|| {}).unwrap();
+    let (cal, reports) = runs::process_set(&runs, &dir.join("calibration"), &opt, &|| {}).unwrap();
 
     let t1 = truth("run01");
     let e = |a: [f64; 3]| Rotation3::from_euler_angles(a[0], a[1], a[2]);

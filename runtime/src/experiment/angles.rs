@@ -17,7 +17,7 @@
 //!   through by `e = sin roll`, so it stays finite at upright) and mixes the
 //!   frame and handlebar noise with the roll error.
 
-use super::read::{ImuRecord, ThesisRun};
+use super::records::{ImuRecord, ThesisRun};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 
 /// How roll and steer are computed from the orientations.

@@ -17,7 +17,7 @@
 //! dominates).
 
 use super::angles::{median, robust_sigma};
-use super::read::Gap;
+use super::records::Gap;
 
 /// Options of the kick detector and window selection. Physical time scales,
 /// not tuned to a file.

@@ -1,22 +1,25 @@
 //! Measured runs: from raw logs to measured weave eigenvalues with standard
 //! errors (thesis sections 5-7; Kooijman et al. 2008).
 //!
-//! Pipeline of a thesis-style run ([`process_thesis_run`]): read and check
-//! ([`read`]), misalignments from the calibration run and roll/steer angles
+//! Pipeline of a thesis-style run ([`process_thesis_run`]), from its
+//! records ([`records`]; reading them from files is the application's,
+//! `bikedyn::runs`): misalignments from the calibration run and roll/steer angles
 //! ([`angles`]), speed from the reed switch ([`speed`]), clock offset of the
 //! two loggers ([`sync`]), kick and free-response window ([`kicks`]), fits
 //! ([`fit`]). A TU Delft log ([`process_tudelft`]) skips the first four:
 //! it records roll, roll rate and speed directly. [`accept`] says which
 //! fitted eigenvalues are measured weave eigenvalues (and which form is
 //! reported); [`compare`] sets them against the model; [`synth`] writes
-//! synthetic runs.
+//! synthetic runs. A set of runs ([`process_set`]) shares one calibration,
+//! its steer axis taken from the runs that agree on it; the runs come from
+//! a [`RunSource`], read one at a time.
 
 pub mod accept;
 pub mod angles;
 pub mod compare;
 pub mod fit;
 pub mod kicks;
-pub mod read;
+pub mod records;
 mod set;
 pub mod speed;
 pub mod sync;
@@ -25,13 +28,13 @@ pub mod synth;
 use angles::{AngleMethod, Angles, Calibration};
 use fit::{FitForm, FitResult};
 use kicks::{Kick, KickOptions};
-use read::{ReadError, RunKind, ThesisRun, TudelftLog};
+use records::{ThesisRun, TudelftLog};
 use serde::Serialize;
 use speed::SpeedProfile;
 use std::path::{Path, PathBuf};
 use sync::ClockOffset;
 
-pub use set::{process_set, MAX_MISALIGNMENT_RAD, MIN_SETTLED_S};
+pub use set::{process_set, RunSource, MAX_MISALIGNMENT_RAD, MIN_SETTLED_S};
 
 /// Options of the pipeline.
 #[derive(Clone, Debug)]
@@ -164,20 +167,10 @@ pub struct RunReport {
     pub log: Option<TudelftLog>,
 }
 
-/// Why a run could not be processed.
+/// Why a set's calibration or one of its runs fails the pipeline's own
+/// checks (reading it is the source's: [`RunSource::Error`]).
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
-    /// A reading problem (file and line named).
-    #[error(transparent)]
-    Read(#[from] ReadError),
-    /// A thesis-style run without a calibration run.
-    #[error("{}: no calibration run (expected {} or --calibration)", run.display(), expected.display())]
-    NoCalibration {
-        /// The run.
-        run: PathBuf,
-        /// Where it was looked for.
-        expected: PathBuf,
-    },
     /// The calibration run's bicycle moved: its mounting misalignments
     /// would carry the motion into every angle.
     #[error(
@@ -262,29 +255,6 @@ pub enum RunError {
         as_swapped: f64,
         /// The same from the calibration's sensor of the same name (rad).
         as_named: f64,
-    },
-    /// The named path is neither a run, a set nor a log.
-    #[error("{}: not a run folder (run.toml), a set of runs, or a log file", path.display())]
-    NotARun {
-        /// The path.
-        path: PathBuf,
-    },
-    /// The named folder could not be listed (missing, or no permission).
-    #[error("{}: cannot be read: {source}", path.display())]
-    Unreadable {
-        /// The path.
-        path: PathBuf,
-        /// Cause.
-        source: std::io::Error,
-    },
-    /// A folder of a set that holds a run's files but no readable
-    /// `run.toml`: it is left out, and said so.
-    #[error("{}: left out of the set: {why} (a run folder needs its run.toml beside the data files)", path.display())]
-    NoRunToml {
-        /// The folder.
-        path: PathBuf,
-        /// `run.toml` missing, or not a file.
-        why: &'static str,
     },
 }
 
@@ -570,129 +540,4 @@ pub fn process_tudelft(log: &TudelftLog, opt: &PipelineOptions) -> RunReport {
         speed: None,
         log: Some(log.clone()),
     }
-}
-
-/// What a path on the command line stands for.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Input {
-    /// A thesis-style set: runs and the calibration folder.
-    Set {
-        /// Run folders.
-        runs: Vec<PathBuf>,
-        /// Calibration folder, if present.
-        calibration: Option<PathBuf>,
-    },
-    /// A TU Delft log file.
-    Log(PathBuf),
-}
-
-fn is_run_dir(p: &Path) -> bool {
-    p.join("run.toml").is_file()
-}
-
-fn kind_of(p: &Path) -> Option<RunKind> {
-    read::read_meta(&p.join("run.toml")).ok().map(|m| m.kind)
-}
-
-/// Classify a command-line path: a set folder (all its runs; calibration =
-/// `calibration/` or the folder whose run.toml says so), a run folder (the
-/// calibration beside it), a log file, or a folder of log files.
-pub fn classify(path: &Path) -> Result<Vec<Input>, RunError> {
-    classify_reporting(path).map(|(inputs, _)| inputs)
-}
-
-/// [`classify`], with the folders of a set left out because they look like
-/// runs (they hold IMU or speed-switch CSV files, or a `run.toml` that is
-/// no file) but have no
-/// `run.toml` to read ([`RunError::NoRunToml`]): a run is never dropped
-/// without a word. Other folders (notes, plots) are not runs and pass
-/// unremarked.
-pub fn classify_reporting(path: &Path) -> Result<(Vec<Input>, Vec<RunError>), RunError> {
-    if path.is_file() {
-        return Ok((vec![Input::Log(path.to_path_buf())], vec![]));
-    }
-    if is_run_dir(path) {
-        let cal = path.parent().map(|p| p.join("calibration")).filter(|c| is_run_dir(c));
-        if kind_of(path) == Some(RunKind::Calibration) {
-            return Ok((
-                vec![Input::Set {
-                    runs: vec![],
-                    calibration: Some(path.to_path_buf()),
-                }],
-                vec![],
-            ));
-        }
-        return Ok((
-            vec![Input::Set {
-                runs: vec![path.to_path_buf()],
-                calibration: cal,
-            }],
-            vec![],
-        ));
-    }
-    let rd = std::fs::read_dir(path).map_err(|source| match source.kind() {
-        // A file that is not a regular one (a device) or a folder whose
-        // run.toml is no file: no run, not an I/O fault.
-        std::io::ErrorKind::NotADirectory => RunError::NotARun {
-            path: path.to_path_buf(),
-        },
-        _ => RunError::Unreadable {
-            path: path.to_path_buf(),
-            source,
-        },
-    })?;
-    let mut entries: Vec<PathBuf> = rd.filter_map(|e| e.ok().map(|e| e.path())).collect();
-    entries.sort();
-    let mut runs = Vec::new();
-    let mut calibration = None;
-    let mut logs = Vec::new();
-    let mut left_out = Vec::new();
-    for e in entries {
-        if is_run_dir(&e) {
-            let named = e.file_name().is_some_and(|n| n == "calibration");
-            if named || (calibration.is_none() && kind_of(&e) == Some(RunKind::Calibration)) {
-                calibration = Some(e);
-            } else {
-                runs.push(e);
-            }
-        } else if e.is_file() && e.extension().is_some_and(|x| x == "log") {
-            logs.push(Input::Log(e));
-        } else if let Some(why) = looks_like_a_run(&e) {
-            left_out.push(RunError::NoRunToml { path: e, why });
-        }
-    }
-    if runs.is_empty() && logs.is_empty() && calibration.is_none() {
-        return Err(left_out.into_iter().next().unwrap_or(RunError::NotARun {
-            path: path.to_path_buf(),
-        }));
-    }
-    let mut out = Vec::new();
-    if !runs.is_empty() || calibration.is_some() {
-        // A calibration alone is listed (and skipped with its reason by
-        // `fit`), not "not a run folder".
-        out.push(Input::Set { runs, calibration });
-    }
-    out.extend(logs);
-    Ok((out, left_out))
-}
-
-/// Why a folder of a set without a readable `run.toml` looks like a run
-/// that was meant: its `run.toml` is something other than a file, or it
-/// holds IMU or speed-switch records. Hidden folders (bikedyn's own temporaries) are not.
-fn looks_like_a_run(p: &Path) -> Option<&'static str> {
-    let hidden = p.file_name().is_some_and(|n| n.to_string_lossy().starts_with('.'));
-    if hidden || !p.is_dir() {
-        return None;
-    }
-    let toml = p.join("run.toml");
-    if toml.exists() {
-        return Some("its run.toml is not a file");
-    }
-    // A run's records by their usual names (FORMAT.md); other CSV files
-    // (a synthetic set's `truth/` trajectories) are no run.
-    let has_records = std::fs::read_dir(p).ok()?.filter_map(|e| e.ok()).any(|e| {
-        let name = e.file_name().to_string_lossy().to_ascii_lowercase();
-        name.ends_with(".csv") && (name.starts_with("imu") || name.starts_with("speed_switch"))
-    });
-    has_records.then_some("it holds a run's records (IMU or speed-switch CSV) but no run.toml")
 }

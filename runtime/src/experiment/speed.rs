@@ -9,7 +9,7 @@
 //! standard error. Times are on the DAQ clock.
 
 use super::angles::{median, robust_sigma};
-use super::read::{RunMeta, SwitchRecord};
+use super::records::{RunMeta, SwitchRecord};
 
 /// Speed record of one run.
 #[derive(Clone, Debug, Default, serde::Serialize)]

@@ -5,7 +5,7 @@
 //! report layer writes the readings as a run's files (its
 //! `experiment::synth::write_run`).
 
-pub use super::read::RunKind;
+pub use super::records::RunKind;
 use crate::random::SplitMix64;
 use crate::simulate::trajectory::Trajectory;
 use crate::CanonicalMatrices;

@@ -86,11 +86,10 @@ pub struct LoadedSet {
 fn read(path: &Path) -> Result<String, ParameterError> {
     // Capped: a parameter file is kilobytes; `--bike /dev/zero` must not
     // grow without end.
-    bikedyn_runtime::experiment::read::read_text_capped(path, bikedyn_runtime::experiment::read::MAX_TEXT_FILE_BYTES)
-        .map_err(|source| ParameterError::Io {
-            path: path.to_path_buf(),
-            source,
-        })
+    crate::capped::read_text_capped(path, crate::capped::MAX_TEXT_FILE_BYTES).map_err(|source| ParameterError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// The error for absent required fields: all of them at once.

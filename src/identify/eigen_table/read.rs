@@ -1,8 +1,9 @@
 //! Reading a measured eigenvalue table (format in the parent module's doc).
 
+use crate::capped::{read_text_capped, MAX_TEXT_FILE_BYTES};
 use crate::identify::result::EigenPoint;
 use crate::identify::IdentifyError;
-use bikedyn_runtime::experiment::read::{read_text_capped, MAX_SPEED_M_S, MAX_TEXT_FILE_BYTES};
+use crate::runs::MAX_SPEED_M_S;
 use std::path::Path;
 
 /// Read a measured eigenvalue table (see the module doc).

@@ -1,33 +1,24 @@
-//! Measured runs (issue 8): the pipeline on synthetic runs with known truth,
-//! on `shared/data/dev`, on the TU Delft kick logs, and on corrupt inputs.
-//! Here rather than in the runtime because the synthetic runs are written
-//! by the report layer's `write_run` and read back by the runtime.
+//! Measured runs (issue 8): the pipeline on runs written here with known
+//! truth, on `shared/data/dev` and on the TU Delft kick logs. The
+//! synthetic runs are written by the report layer's `write_run` and read
+//! back by the application's readers (`bikedyn::runs`).
 
-use bikedyn_report::experiment::synth::write_run;
-use bikedyn_runtime::experiment::angles::AngleMethod;
-use bikedyn_runtime::experiment::{
+use crate::common::*;
+use bikedyn::report::experiment::synth::write_run;
+use bikedyn::runs;
+use bikedyn::runtime::experiment::angles::AngleMethod;
+use bikedyn::runtime::experiment::{
     self,
-    read::{self, ReadError, RunKind},
+    records::RunKind,
     synth::{rest_trajectory, ResponseSpec, SensorModel},
     PipelineOptions,
 };
 use nalgebra::Rotation3;
 use std::path::{Path, PathBuf};
 
-/// `../../shared/<sub>` relative to the crate, or `None` (with a skip
-/// message) when the shared data is not checked out.
-fn shared(sub: &str) -> Option<PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared").join(sub);
-    if p.exists() {
-        Some(p)
-    } else {
-        eprintln!("skipped: {} not found", p.display());
-        None
-    }
-}
-
+/// A fresh folder `name` of this group's scratch folder.
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("bikedyn-exp-{}-{name}", std::process::id()));
+    let d = scratch("measured-pipeline").join(name);
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
@@ -106,7 +97,7 @@ fn synthetic_runs_recover_misalignment_kick_eigenvalue_speed_and_clock() {
         frame_pitch: ResponseSpec::default().frame_pitch,
         ..PipelineOptions::default()
     };
-    let (cal, reports) = experiment::process_set(&runs, &dir.join("calibration"), &opt, &noop).unwrap();
+    let (cal, reports) = runs::process_set(&runs, &dir.join("calibration"), &opt, &noop).unwrap();
     let e = |a: [f64; 3]| Rotation3::from_euler_angles(a[0], a[1], a[2]);
     let (tf, th) = (&truths[0].1.frame_misalignment, &truths[0].1.handlebar_misalignment);
     let err_f = cal.frame.angle_to(&e(*tf)).to_degrees();
@@ -196,11 +187,11 @@ fn angle_methods_compared_on_a_synthetic_run() {
         ..PipelineOptions::default()
     };
     let runs: Vec<PathBuf> = (1..=3).map(|i| dir.join(format!("run{i:02}"))).collect();
-    let (cal, _) = experiment::process_set(&runs, &dir.join("calibration"), &opt, &noop).unwrap();
+    let (cal, _) = runs::process_set(&runs, &dir.join("calibration"), &opt, &noop).unwrap();
     let mut rms = [[0.0; 2]; 2];
     let mut count = 0.0;
     for (i, (spec, _)) in truths.iter().enumerate() {
-        let run = read::read_run(&runs[i]).unwrap();
+        let run = runs::read_run(&runs[i]).unwrap();
         let traj = spec.trajectory();
         let d = experiment::angles::angles(&run, &cal, AngleMethod::Direct);
         let th = experiment::angles::angles(&run, &cal, AngleMethod::Thesis);
@@ -235,9 +226,9 @@ fn angle_methods_compared_on_a_synthetic_run() {
 /// eq. 94; observed below 3 %).
 #[test]
 fn linear_model_runs_give_the_models_weave_eigenvalue() {
-    use bikedyn_runtime::closed_form::meijaard_canonical;
-    use bikedyn_runtime::experiment::{compare::predicted_weave, synth::linear_model_trajectory};
-    use bikedyn_runtime::parameters::BenchmarkParameters;
+    use bikedyn::runtime::closed_form::meijaard_canonical;
+    use bikedyn::runtime::experiment::{compare::predicted_weave, synth::linear_model_trajectory};
+    use bikedyn::runtime::parameters::BenchmarkParameters;
     let c = meijaard_canonical(&BenchmarkParameters::benchmark_bicycle());
     let lam = std::f64::consts::PI / 10.0;
     let dir = tmp("linear");
@@ -271,7 +262,7 @@ fn linear_model_runs_give_the_models_weave_eigenvalue() {
         frame_pitch: -lam,
         ..PipelineOptions::default()
     };
-    let (_, reports) = experiment::process_set(&runs, &dir.join("calibration"), &opt, &noop).unwrap();
+    let (_, reports) = runs::process_set(&runs, &dir.join("calibration"), &opt, &noop).unwrap();
     for rep in reports {
         let rep = rep.unwrap();
         let k = &rep.kicks[0];
@@ -299,182 +290,6 @@ fn linear_model_runs_give_the_models_weave_eigenvalue() {
     }
 }
 
-fn write_good_run(dir: &Path, seed: u64) {
-    let spec = ResponseSpec {
-        after_kick: 2.0,
-        ..ResponseSpec::default()
-    };
-    write_run(
-        dir,
-        "r",
-        RunKind::Run,
-        &spec.trajectory(),
-        &SensorModel::default(),
-        seed,
-    )
-    .unwrap();
-}
-
-fn replace_line(path: &Path, line: usize, text: &str) {
-    let s = std::fs::read_to_string(path).unwrap();
-    let mut lines: Vec<String> = s.lines().map(str::to_string).collect();
-    lines[line - 1] = text.to_string();
-    std::fs::write(path, lines.join("\n") + "\n").unwrap();
-}
-
-/// Issue 8, point 1: each kind of corrupt input gives an error naming the
-/// file and the line; tolerable variants are read.
-#[test]
-fn corrupt_inputs_are_reported_with_file_and_line() {
-    let base = tmp("corrupt");
-    let good = base.join("good");
-    write_good_run(&good, 3);
-    let copy = |name: &str| -> PathBuf {
-        let d = base.join(name);
-        std::fs::create_dir_all(&d).unwrap();
-        for f in ["imu_frame.csv", "imu_handlebar.csv", "speed_switch.csv", "run.toml"] {
-            std::fs::copy(good.join(f), d.join(f)).unwrap();
-        }
-        d
-    };
-    let frame = |d: &Path| d.join("imu_frame.csv");
-    let row = |d: &Path, line: usize| -> String {
-        std::fs::read_to_string(frame(d))
-            .unwrap()
-            .lines()
-            .nth(line - 1)
-            .unwrap()
-            .to_string()
-    };
-    let err = |d: &Path| read::read_run(d).unwrap_err();
-    let msg_has = |e: &ReadError, file: &str, line: usize| {
-        let m = e.to_string();
-        assert!(m.contains(file) && m.contains(&format!(":{line}:")), "message `{m}`");
-    };
-
-    // Malformed row.
-    let d = copy("malformed");
-    replace_line(&frame(&d), 10, "0.0750,0.5,0.5");
-    let e = err(&d);
-    assert!(matches!(e, ReadError::FieldCount { line: 10, .. }), "{e}");
-    msg_has(&e, "imu_frame.csv", 10);
-    let d = copy("notnumber");
-    replace_line(&frame(&d), 11, "0.0833,abc,0.1,0.1,0.1");
-    assert!(matches!(err(&d), ReadError::NotANumber { line: 11, .. }));
-    // NaN.
-    let d = copy("nan");
-    replace_line(&frame(&d), 12, "0.0917,NaN,0.1,0.1,0.1");
-    let e = err(&d);
-    assert!(matches!(e, ReadError::NotFinite { line: 12, .. }), "{e}");
-    msg_has(&e, "imu_frame.csv", 12);
-    // Non-monotonic and duplicated time stamps.
-    let d = copy("backwards");
-    let r = row(&d, 20);
-    replace_line(&frame(&d), 21, &r.replacen(r.split(',').next().unwrap(), "0.0100", 1));
-    assert!(matches!(err(&d), ReadError::NonMonotonicTime { line: 21, .. }));
-    let d = copy("duplicate");
-    let r = row(&d, 30);
-    replace_line(&frame(&d), 31, &r);
-    let e = err(&d);
-    assert!(
-        matches!(
-            e,
-            ReadError::DuplicateTime {
-                line: 31,
-                previous_line: 30,
-                ..
-            }
-        ),
-        "{e}"
-    );
-    // Quaternion far from unit norm; near it, normalised and counted.
-    let d = copy("quatnorm");
-    let t = row(&d, 40).split(',').next().unwrap().to_string();
-    replace_line(&frame(&d), 40, &format!("{t},0.9,0.9,0.1,0.1"));
-    let e = err(&d);
-    assert!(matches!(e, ReadError::QuaternionNorm { line: 40, .. }), "{e}");
-    let d = copy("quatnear");
-    let f: Vec<f64> = row(&d, 41).split(',').map(|x| x.parse().unwrap()).collect();
-    replace_line(
-        &frame(&d),
-        41,
-        &format!(
-            "{},{},{},{},{}",
-            f[0],
-            f[1] * 1.01,
-            f[2] * 1.01,
-            f[3] * 1.01,
-            f[4] * 1.01
-        ),
-    );
-    let run = read::read_run(&d).unwrap();
-    assert_eq!(run.frame.renormalised, 1);
-    assert!((run.frame.q[39].norm() - 1.0).abs() < 1e-12);
-    // Gaps: reported, not an error; the windows never span them.
-    let d = copy("gap");
-    let s = std::fs::read_to_string(frame(&d)).unwrap();
-    let kept: Vec<&str> = s
-        .lines()
-        .enumerate()
-        .filter(|(i, _)| !(100..110).contains(i))
-        .map(|(_, l)| l)
-        .collect();
-    std::fs::write(frame(&d), kept.join("\n") + "\n").unwrap();
-    let s = std::fs::read_to_string(d.join("imu_handlebar.csv")).unwrap();
-    let kept: Vec<&str> = s
-        .lines()
-        .enumerate()
-        .filter(|(i, _)| !(100..110).contains(i))
-        .map(|(_, l)| l)
-        .collect();
-    std::fs::write(d.join("imu_handlebar.csv"), kept.join("\n") + "\n").unwrap();
-    let run = read::read_run(&d).unwrap();
-    assert_eq!(run.frame.gaps.len(), 1);
-    assert_eq!(run.frame.gaps[0].line, 101);
-    // Truncated file (cut in the middle of the last row, no line end).
-    let d = copy("truncated");
-    let s = std::fs::read_to_string(frame(&d)).unwrap();
-    std::fs::write(frame(&d), &s[..s.len() - 20]).unwrap();
-    let e = err(&d);
-    assert!(matches!(e, ReadError::Truncated { .. }), "{e}");
-    assert!(e.to_string().contains("imu_frame.csv"));
-    // Tolerated: CRLF, comments, blank lines, header variant, BOM.
-    let d = copy("variants");
-    let s = std::fs::read_to_string(frame(&d)).unwrap();
-    let body: String = s.lines().skip(1).map(|l| format!("{l}\r\n")).collect();
-    std::fs::write(
-        frame(&d),
-        format!("\u{feff}# exported by the logger\r\nTime, qw, qx, qy, qz\r\n\r\n{body}"),
-    )
-    .unwrap();
-    let run = read::read_run(&d).unwrap();
-    assert_eq!(run.frame.t.len(), read::read_run(&good).unwrap().frame.t.len());
-
-    // A corrupt run in a set is reported; the others are processed.
-    let set = tmp("set");
-    write_run(
-        &set.join("calibration"),
-        "calibration",
-        RunKind::Calibration,
-        &rest_trajectory(8.0, ResponseSpec::default().frame_pitch, 0.2),
-        &SensorModel::default(),
-        5,
-    )
-    .unwrap();
-    write_good_run(&set.join("run01"), 6);
-    write_good_run(&set.join("run02"), 7);
-    replace_line(&set.join("run02/imu_handlebar.csv"), 50, "nan,nan");
-    let inputs = experiment::classify(&set).unwrap();
-    let experiment::Input::Set { runs, calibration } = &inputs[0] else {
-        panic!("a set")
-    };
-    let (_, out) =
-        experiment::process_set(runs, calibration.as_ref().unwrap(), &PipelineOptions::default(), &noop).unwrap();
-    assert!(out[0].is_ok());
-    let e = out[1].as_ref().unwrap_err().to_string();
-    assert!(e.contains("run02") && e.contains("imu_handlebar.csv:50:"), "{e}");
-}
-
 /// Issue 8, point 8: every kick of the TU Delft logs is found without row
 /// ranges, and each is fitted with its r^2. The kicks are lateral pushes
 /// every few seconds; the detector must find them all and nothing in the
@@ -488,7 +303,7 @@ fn tudelft_logs_every_kick_found_and_fitted() {
     logs.sort();
     assert_eq!(logs.len(), 4);
     for path in logs {
-        let log = read::read_tudelft(&path).unwrap();
+        let log = runs::read_tudelft(&path).unwrap();
         let rep = experiment::process_tudelft(&log, &PipelineOptions::default());
         let n = rep.kicks.len();
         let fitted: Vec<_> = rep
@@ -520,57 +335,6 @@ fn tudelft_logs_every_kick_found_and_fitted() {
         assert!(fitted.len() * 10 >= n * 7, "{}: most kicks fitted", path.display());
         assert!(fitted.iter().all(|(_, f)| f.r2.is_finite() && f.eigenvalue[1] > 0.0));
     }
-}
-
-/// Counts, rates and file names read from `run.toml` are bounded and kept
-/// inside the run folder; oversized inputs are refused before memory grows.
-#[test]
-fn run_metadata_is_bounded_and_kept_inside_the_run() {
-    use bikedyn_runtime::experiment::read::{read_capped, read_meta};
-    let good = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/data/hidden_steer_damping/run01/run.toml"),
-    )
-    .unwrap();
-    let dir = tmp("bounded_meta");
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("run.toml");
-    std::fs::write(&path, &good).unwrap();
-    assert!(read_meta(&path).is_ok());
-    for (from, to, says) in [
-        ("magnets = 9", "magnets = 1e9", "from 1 to 1000"),
-        ("magnets = 9", "magnets = 2.5", "whole number"),
-        ("rate_hz = 120", "rate_hz = 1e300", "sample rate"),
-        (
-            "files = [\"imu_frame.csv\", \"imu_handlebar.csv\"]",
-            "files = [\"/etc/passwd\", \"imu_handlebar.csv\"]",
-            "inside the run folder",
-        ),
-        (
-            "file = \"speed_switch.csv\"",
-            "file = \"../run02/speed_switch.csv\"",
-            "inside the run folder",
-        ),
-        (
-            "wheel_circumference_m = 2.0",
-            "wheel_circumference_m = 2000.0",
-            "circumference",
-        ),
-    ] {
-        assert!(good.contains(from), "{from}");
-        std::fs::write(&path, good.replacen(from, to, 1)).unwrap();
-        let err = read_meta(&path).unwrap_err().to_string();
-        assert!(err.contains("run.toml") && err.contains(says), "{to}: {err}");
-    }
-    // An endless device is refused as no file, not read whole; a file above
-    // the cap is refused from its size (sparse: no data in it).
-    if cfg!(unix) {
-        let err = read_capped(Path::new("/dev/zero"), 1 << 20).unwrap_err();
-        assert!(err.to_string().contains("device"), "{err}");
-    }
-    let big = dir.join("big.csv");
-    std::fs::File::create(&big).unwrap().set_len(3 << 20).unwrap();
-    let err = read_capped(&big, 1 << 20).unwrap_err();
-    assert!(err.to_string().contains("more than the 1 MiB"), "{err}");
 }
 
 /// The curve `fit --plot` draws is the fitted curve: evaluated over the
@@ -618,10 +382,9 @@ fn drawn_fit_reproduces_r2(reports: &[experiment::RunReport]) -> usize {
 #[test]
 fn the_drawn_fit_is_the_fitted_curve() {
     // The committed synthetic set (speed decays during its responses).
-    let set = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/data/hidden_steer_damping");
+    let set = example_set();
     let runs: Vec<PathBuf> = (1..=6).map(|i| set.join(format!("run{i:02}"))).collect();
-    let (_, reports) =
-        experiment::process_set(&runs, &set.join("calibration"), &PipelineOptions::default(), &noop).unwrap();
+    let (_, reports) = runs::process_set(&runs, &set.join("calibration"), &PipelineOptions::default(), &noop).unwrap();
     let reports: Vec<_> = reports.into_iter().map(Result::unwrap).collect();
     assert!(drawn_fit_reproduces_r2(&reports) >= 6);
     // The dev runs whose plots were flat (run01, run05, run08 were fitted
@@ -629,7 +392,7 @@ fn the_drawn_fit_is_the_fitted_curve() {
     if let Some(dev) = shared("data/dev") {
         let runs: Vec<PathBuf> = ["run01", "run05", "run08"].iter().map(|r| dev.join(r)).collect();
         let (_, reports) =
-            experiment::process_set(&runs, &dev.join("calibration"), &PipelineOptions::default(), &noop).unwrap();
+            runs::process_set(&runs, &dev.join("calibration"), &PipelineOptions::default(), &noop).unwrap();
         let reports: Vec<_> = reports.into_iter().map(Result::unwrap).collect();
         let varying = reports
             .iter()

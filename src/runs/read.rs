@@ -1,5 +1,6 @@
 //! Reading measured runs: the thesis-style run folders of
-//! `shared/data/FORMAT.md` and the TU Delft steer-by-wire kick logs.
+//! `shared/data/FORMAT.md` and the TU Delft steer-by-wire kick logs, into
+//! the runtime's records (`bikedyn_runtime::experiment::records`).
 //!
 //! The reader tolerates a byte-order mark, CRLF line ends, `#` comment lines,
 //! blank lines, surrounding spaces and header variants (`time_s`, `time`, `t`;
@@ -7,13 +8,13 @@
 //! is wrong is an error naming the file and the line: a run with one is
 //! reported and skipped by the pipeline; the other runs still go through.
 
+use crate::capped::{read_capped, MAX_DATA_FILE_BYTES, MAX_LOG_FILE_BYTES};
+use bikedyn_runtime::experiment::records::{Gap, ImuRecord, RunMeta, SwitchRecord, ThesisRun, TudelftLog};
 use nalgebra::{Quaternion, UnitQuaternion};
 use std::path::{Path, PathBuf};
 
-mod capped;
 mod meta;
-pub use capped::{read_capped, read_text_capped, MAX_DATA_FILE_BYTES, MAX_LOG_FILE_BYTES, MAX_TEXT_FILE_BYTES};
-pub use meta::{read_meta, RunKind, RunMeta};
+pub use meta::{read_meta, MAX_MAGNETS, MAX_RATE_HZ};
 
 /// Quaternion norms within this distance of 1 are taken as they are (the
 /// files print 7 decimals, so rounding alone gives ~1e-7).
@@ -211,17 +212,6 @@ pub enum ReadError {
     },
 }
 
-/// A stretch where samples are missing: never interpolated across.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Gap {
-    /// Last time stamp before the gap (s).
-    pub start: f64,
-    /// First time stamp after the gap (s).
-    pub end: f64,
-    /// Line of the first row after the gap.
-    pub line: usize,
-}
-
 /// One numeric table: columns in the order asked for, with each row's line.
 struct Table {
     cols: Vec<Vec<f64>>,
@@ -385,24 +375,6 @@ fn check_time(path: &Path, t: &[f64], lines: &[usize], period: f64) -> Result<Ve
     Ok(gaps)
 }
 
-/// Orientation record of one IMU.
-#[derive(Clone, Debug)]
-pub struct ImuRecord {
-    /// Source file.
-    pub path: PathBuf,
-    /// Time stamps on the IMU clock (s).
-    pub t: Vec<f64>,
-    /// Sensor orientation, `v_global = R(q) v_sensor`, global Z up.
-    pub q: Vec<UnitQuaternion<f64>>,
-    /// Rows whose quaternion was normalised (norm off by more than rounding,
-    /// within [`QUAT_NORMALISE_TOL`]).
-    pub renormalised: usize,
-    /// Missing stretches.
-    pub gaps: Vec<Gap>,
-    /// Line of each row.
-    pub lines: Vec<usize>,
-}
-
 /// Read `imu_frame.csv` / `imu_handlebar.csv`. `rate_hz` is the nominal rate
 /// (for gap detection).
 pub fn read_imu(path: &Path, rate_hz: f64) -> Result<ImuRecord, ReadError> {
@@ -446,19 +418,6 @@ pub fn read_imu(path: &Path, rate_hz: f64) -> Result<ImuRecord, ReadError> {
         gaps,
         lines: tab.lines,
     })
-}
-
-/// Voltage record of the reed switch.
-#[derive(Clone, Debug)]
-pub struct SwitchRecord {
-    /// Source file.
-    pub path: PathBuf,
-    /// Time stamps on the DAQ clock (s).
-    pub t: Vec<f64>,
-    /// Switch output (V).
-    pub volts: Vec<f64>,
-    /// Missing stretches.
-    pub gaps: Vec<Gap>,
 }
 
 /// Read `speed_switch.csv`.
@@ -505,21 +464,6 @@ pub fn clip_lines(text: &str, max: usize) -> String {
         })
         .collect::<Vec<_>>()
         .join("\n")
-}
-
-/// A thesis-style run folder, read and checked.
-#[derive(Clone, Debug)]
-pub struct ThesisRun {
-    /// The folder.
-    pub dir: PathBuf,
-    /// `run.toml`.
-    pub meta: RunMeta,
-    /// Frame (body 3) IMU.
-    pub frame: ImuRecord,
-    /// Handlebar (body 4) IMU.
-    pub handlebar: ImuRecord,
-    /// Reed switch.
-    pub switch: SwitchRecord,
 }
 
 /// Read a run folder (or the calibration folder).
@@ -590,27 +534,6 @@ pub const MIN_LOG_SPEED_M_S: f64 = -0.1;
 
 /// Sample period of the TU Delft logs (s): they have no time column.
 pub const TUDELFT_PERIOD_S: f64 = 0.01;
-
-/// A TU Delft steer-by-wire kick log.
-#[derive(Clone, Debug)]
-pub struct TudelftLog {
-    /// Source file.
-    pub path: PathBuf,
-    /// Data-row index times 0.01 s (first data row at 0).
-    pub t: Vec<f64>,
-    /// Forward speed (m/s).
-    pub speed: Vec<f64>,
-    /// Roll (lean) angle (rad).
-    pub roll: Vec<f64>,
-    /// Roll rate from the IMU gyro (rad/s).
-    pub roll_rate: Vec<f64>,
-    /// Handlebar angle (rad).
-    pub steer: Vec<f64>,
-    /// Fork angle (rad).
-    pub fork: Vec<f64>,
-    /// Line of each row.
-    pub lines: Vec<usize>,
-}
 
 /// Read a TU Delft log (13-column CSV with header; columns found by name).
 pub fn read_tudelft(path: &Path) -> Result<TudelftLog, ReadError> {

@@ -1,42 +1,10 @@
 //! A run folder's `run.toml`: which run it is, its sensors' files, rates
-//! and clock offset, and the wheel's magnets and circumference.
+//! and clock offset, and the wheel's magnets and circumference, read into
+//! the runtime's [`RunMeta`].
 
 use super::*;
-
-/// Whether a folder is a run or the calibration.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum RunKind {
-    /// Launch and kick.
-    Run,
-    /// Bicycle held upright at rest, handlebar straight.
-    Calibration,
-}
-
-/// The parts of `run.toml` the pipeline uses.
-#[derive(Clone, Debug)]
-pub struct RunMeta {
-    /// Run name.
-    pub name: String,
-    /// Run or calibration.
-    pub kind: RunKind,
-    /// Nominal `t_imu - t_daq` (s).
-    pub nominal_offset_s: f64,
-    /// IMU rate (Hz).
-    pub imu_rate_hz: f64,
-    /// IMU files (frame first, handlebar second).
-    pub imu_files: [String; 2],
-    /// DAQ rate (Hz).
-    pub switch_rate_hz: f64,
-    /// Reed-switch file.
-    pub switch_file: String,
-    /// Magnets on the wheel.
-    pub magnets: usize,
-    /// Circumference of the wheel carrying the magnets (m).
-    pub wheel_circumference_m: f64,
-    /// Supply (and closed-switch) voltage (V), if given.
-    pub supply_v: Option<f64>,
-}
+use crate::capped::{read_text_capped, MAX_TEXT_FILE_BYTES};
+use bikedyn_runtime::experiment::records::RunKind;
 
 /// Most magnets a wheel carries (real set-ups use 1 to a few dozen).
 pub const MAX_MAGNETS: usize = 1000;
