@@ -345,6 +345,10 @@ pub struct MemberCheck {
     pub cv_without: Option<f64>,
     pub outcome: Verdict,
     pub verdict: String,
+    /// Kept because the model without it puts a correction beyond the
+    /// plausible prior deviations: which (symbol, value, prior standard
+    /// deviations from the measured value).
+    pub without_implausible: Option<(String, f64, f64)>,
 }
 
 impl From<&bikedyn_runtime::identify::MemberCheck> for MemberCheck {
@@ -358,7 +362,13 @@ impl From<&bikedyn_runtime::identify::MemberCheck> for MemberCheck {
             cv_with: finite(c.cv_with),
             cv_without: finite(c.cv_without),
             outcome: c.verdict.clone(),
-            verdict: verdict_text(&c.verdict),
+            verdict: match &c.without_implausible {
+                Some((symbol, value, sds)) => format!(
+                    "kept: without it {symbol} would fit at {value:.4} ({sds:.1} prior standard deviations from its measured value), no plausible rival"
+                ),
+                None => verdict_text(&c.verdict),
+            },
+            without_implausible: c.without_implausible.clone(),
         }
     }
 }

@@ -235,14 +235,25 @@ pub fn sentence(o: &TimeSeriesOutcome, unit: &str, scale: f64) -> String {
             } else {
                 format!("discovered in the time series: {}", f.readings.join("; "))
             };
-            let found = if f.search.removed.is_empty() {
-                found
-            } else {
-                format!(
-                    "{found}\nwith the terms, the backward check removed from the library's selection: {} (the terms explain the data better without it)",
-                    f.search.removed.join(", ")
-                )
-            };
+            // What the backward check removed: the library's members, and
+            // terms that entered before the last and stood in for it.
+            let dictionary: Vec<String> = Term::time_series_dictionary().iter().map(Term::name).collect();
+            let (terms, members): (Vec<&String>, Vec<&String>) =
+                f.search.removed.iter().partition(|r| dictionary.contains(r));
+            let list = |names: &[&String]| names.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ");
+            let mut found = found;
+            if !members.is_empty() {
+                found.push_str(&format!(
+                    "\nwith the terms, the backward check removed from the library's selection: {} (the terms explain the data better without it, or as well within one standard error of the held-out error)",
+                    list(&members)
+                ));
+            }
+            if !terms.is_empty() {
+                found.push_str(&format!(
+                    "\nthe backward check removed terms that entered before the last: {} (the model explains the data better without them, or as well within one standard error of the held-out error)",
+                    list(&terms)
+                ));
+            }
             format!(
                 "{found}\nroll RMS: base model {:.3}, with the library {:.3}, with the discovered terms {:.3} {unit}; held out: {:.3} -> {:.3} -> {:.3} {unit}",
                 f.base.roll_rms * scale,

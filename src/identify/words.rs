@@ -73,6 +73,9 @@ pub fn verdict_text(v: &Verdict) -> String {
         Verdict::HeldOutNotLower { cv, base_cv } => {
             format!("rejected: held-out error {cv:.4} not below {base_cv:.4} (does not generalise)")
         }
+        Verdict::WithinOneStandardError { cv, base_cv, stderr } => format!(
+            "removed: without it the held-out error is {base_cv:.4} against {cv:.4}, within one standard error ({stderr:.4}); the simpler model is kept"
+        ),
         Verdict::HeldOutGainNotConsistent { gain, stderr, sigmas } => format!(
             "rejected: mean held-out gain per run (per row or kick in the dictionary's search) {gain:.4}, within {} standard errors of zero (standard error {stderr:.4}; not a consistent improvement)",
             if (*sigmas - 2.0).abs() < 1e-9 { "two".to_string() } else { format!("{sigmas:.2}") }

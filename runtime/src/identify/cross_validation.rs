@@ -90,6 +90,33 @@ pub fn folds_by_run(segments: &[Segment], folds: usize) -> (usize, Vec<usize>) {
     (folds, fold_of)
 }
 
+/// Standard error of a fit's held-out error `cv` (the pooled mean square
+/// of the weighted held-out residuals), with the segments (kicks) as the
+/// units: the ratio estimator's `sqrt(m / (m - 1) sum (ss_i - cv n_i)^2) / N`
+/// over `m` segments of `n_i` samples and weighted sum of squares `ss_i`
+/// (`N` samples in all). `None` with fewer than two segments.
+pub fn held_out_standard_error(fit: &CandidateFit, w: &[Weights]) -> Option<f64> {
+    let parts: Vec<(f64, f64)> = fit
+        .held_out
+        .iter()
+        .zip(w)
+        .map(|(e, w)| {
+            let ss = e.channel_ss[0] / (w.roll * w.roll)
+                + e.channel_ss[1] / (w.steer * w.steer)
+                + e.channel_ss[2] / (w.speed * w.speed);
+            (ss, e.channel_n.iter().sum::<usize>() as f64)
+        })
+        .collect();
+    let m = parts.len() as f64;
+    let total: f64 = parts.iter().map(|p| p.1).sum();
+    if m < 2.0 || !(total > 0.0) {
+        return None;
+    }
+    let cv = parts.iter().map(|p| p.0).sum::<f64>() / total;
+    let spread: f64 = parts.iter().map(|(ss, n)| (ss - cv * n).powi(2)).sum();
+    Some((m / (m - 1.0) * spread).sqrt() / total)
+}
+
 /// Paired comparison of the held-out errors of two models, run by run:
 /// mean gain (weighted mean square, `base - candidate`) and its standard
 /// error. Selection asks the gain to exceed two standard errors, so an

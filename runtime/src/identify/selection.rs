@@ -240,7 +240,7 @@ pub fn identify<M: MultibodyModel>(
                 current = fit;
             }
         }
-        let checks = search.eliminate(&mut current, &mut selected, &mut simulations)?;
+        let checks = search.eliminate(&mut current, &mut selected, &mut simulations, false)?;
         let gone: Vec<String> = checks.iter().filter(|c| c.removed).map(|c| c.name.clone()).collect();
         final_check.extend(checks);
         if gone.is_empty() {

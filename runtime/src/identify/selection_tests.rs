@@ -193,3 +193,62 @@ fn the_consistent_gain_bar_of_many_alike_candidates_keeps_the_family_wise_rate()
     // More candidates ask more.
     assert!(family_wise_sigmas(56) > z && family_wise_sigmas(2) < z);
 }
+
+/// A fit whose held-out error of each kick is `(weighted sum of squares of
+/// the roll channel, samples)`, under roll weight `w`.
+fn held_out_fit(kicks: &[(f64, usize)], w: f64) -> (CandidateFit, Vec<crate::identify::Weights>) {
+    let held_out = kicks
+        .iter()
+        .map(|&(ss, n)| crate::identify::SegmentError {
+            // The error stores the scaled sum; the weight takes it back.
+            channel_ss: [ss * w * w, 0.0, 0.0],
+            channel_n: [n, 0, 0],
+            ..Default::default()
+        })
+        .collect::<Vec<_>>();
+    let total: f64 = kicks.iter().map(|k| k.0).sum();
+    let n: usize = kicks.iter().map(|k| k.1).sum();
+    let fit = CandidateFit {
+        effects: Vec::new(),
+        parameters: Vec::new(),
+        values: Vec::new(),
+        stderr: Vec::new(),
+        nuisance: Vec::new(),
+        errors: held_out.clone(),
+        held_out,
+        fold_values: Vec::new(),
+        bic: 0.0,
+        cv: total / n as f64,
+        chi2: total,
+        simulations: 0,
+        physical: true,
+    };
+    let weights = vec![
+        crate::identify::Weights {
+            roll: w,
+            steer: 1.0,
+            speed: 1.0
+        };
+        kicks.len()
+    ];
+    (fit, weights)
+}
+
+/// The one-standard-error rule's scale: the standard error of the pooled
+/// held-out mean square with the kicks as units (a ratio estimator), by
+/// hand for two kicks of ten samples with sums 1 and 3: mean square 0.2,
+/// deviations -1 and +1, `sqrt(2 / 1 * 2) / 20 = 0.1`; nothing to spread
+/// when every kick fits alike, and no estimate from one kick.
+#[test]
+fn the_held_out_errors_standard_error_takes_the_kicks_as_units() {
+    use crate::identify::cross_validation::held_out_standard_error;
+    for w in [1.0, 0.02] {
+        let (fit, weights) = held_out_fit(&[(1.0, 10), (3.0, 10)], w);
+        let se = held_out_standard_error(&fit, &weights).unwrap();
+        assert!((se - 0.1).abs() < 1e-12, "{se} at weight {w}");
+        let (alike, weights) = held_out_fit(&[(2.0, 10), (4.0, 20)], w);
+        assert!(held_out_standard_error(&alike, &weights).unwrap() < 1e-12);
+        let (one, weights) = held_out_fit(&[(2.0, 10)], w);
+        assert_eq!(held_out_standard_error(&one, &weights), None);
+    }
+}

@@ -53,6 +53,11 @@ pub enum Verdict {
     NoCriterionGain { bic_change: f64 },
     /// The held-out error does not fall: it does not generalise.
     HeldOutNotLower { cv: f64, base_cv: f64 },
+    /// A member of the final model whose removal raises the held-out error
+    /// (`cv` with it, `base_cv` without) by no more than one standard error
+    /// of it (`stderr`): the data do not tell the simpler model apart, and
+    /// the simpler is kept (the one-standard-error rule).
+    WithinOneStandardError { cv: f64, base_cv: f64, stderr: f64 },
     /// The held-out gain per run is within two standard errors of zero:
     /// not a consistent improvement.
     HeldOutGainNotConsistent {

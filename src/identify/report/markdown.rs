@@ -104,7 +104,11 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
                 Some(_) => format!("{:+.1}, -", -c.bic_change),
                 None => "fit failed".into(),
             };
-            let outcome = if c.verdict.added() {
+            let outcome = if let Some((symbol, value, sds)) = &c.without_implausible {
+                format!(
+                    "keeps its place: without it `{symbol}` fits at {value:.4} ({sds:.1} prior standard deviations from its measured value), no plausible rival"
+                )
+            } else if c.verdict.added() {
                 format!("keeps its place ({})", verdict_text(&c.verdict))
             } else if c.removed {
                 format!("removed: {}", verdict_text(&c.verdict))

@@ -111,9 +111,10 @@ pub fn discover_in_time_series<M: MultibodyModel>(
     let mut simulations = 0;
     // Forward, then the backward check of every member (the library's
     // included: a correction the library took for want of the missing
-    // force, far beyond its prior, gives way when a term explains the
-    // data better without it); after a removal the forward search resumes
-    // once, as the library's does.
+    // force gives way when a term explains the data better without it, or
+    // when beside the term its gain is within the held-out error's scatter);
+    // after a removal the forward search resumes once, as the library's
+    // does.
     for _round in 0..2 {
         while added.len() < max_terms {
             let remaining: Vec<&Candidate> = scaled
@@ -143,7 +144,11 @@ pub fn discover_in_time_series<M: MultibodyModel>(
         if added.is_empty() {
             break;
         }
-        let checks = search.eliminate(&mut current, &mut selected, &mut simulations)?;
+        // Every member entered a model without the term added last; beside
+        // it, of the models the held-out error does not tell apart (within
+        // one standard error) the simplest is kept (the one-standard-error
+        // rule, see `eliminate`).
+        let checks = search.eliminate(&mut current, &mut selected, &mut simulations, true)?;
         let gone: Vec<String> = checks.iter().filter(|c| c.removed).map(|c| c.name.clone()).collect();
         final_check.extend(checks);
         if gone.is_empty() {

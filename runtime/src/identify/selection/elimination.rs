@@ -14,9 +14,28 @@
 //! lowers the criterion most is removed, the model refitted without it,
 //! and the others tested again. (The last one added was tested against
 //! exactly the model without it when it entered.)
+//!
+//! Two rules more. A model without the member that puts a correction
+//! beyond [`PLAUSIBLE_PRIOR_SDS`] of its stated uncertainty (and further
+//! than with the member) is no rival (the entry test refuses such a fit
+//! too): the member keeps its place,
+//! since what it explains would otherwise be pushed into a measured
+//! parameter. And a caller may ask for the one-standard-error rule of
+//! cross-validation (Breiman et al. 1984, *Classification and Regression
+//! Trees*, sec. 3.4.3; Hastie, Tibshirani & Friedman 2009, *The Elements
+//! of Statistical Learning*, sec. 7.10): a member stays only if the model
+//! without it predicts the held-out data worse by more than one standard
+//! error of the held-out error. The search in the time series asks for
+//! it: its members entered a model without the term added last, and a
+//! correction or term that stood in for that force keeps, beside it, a
+//! gain that may be consistent over the runs (a calibration's residue is
+//! the same in every run) yet is far inside the scatter of the held-out
+//! error; of the models the data do not tell apart, the simplest is
+//! kept.
 
 use super::{Search, Verdict};
-use crate::identify::criterion::bic;
+use crate::identify::criterion::{bic, farthest_from_prior, PLAUSIBLE_PRIOR_SDS};
+use crate::identify::cross_validation::held_out_standard_error;
 use crate::identify::{cross_validate, fit_candidate, Candidate, CandidateFit, IdentifyError};
 use serde::Serialize;
 
@@ -43,18 +62,26 @@ pub struct MemberCheck {
     pub verdict: Verdict,
     /// Whether it was removed.
     pub removed: bool,
+    /// Why a member kept its place although the criterion or the held-out
+    /// error alone would remove it: the fit without it puts this correction
+    /// (symbol, value, distance in stated prior standard deviations)
+    /// beyond [`PLAUSIBLE_PRIOR_SDS`].
+    pub without_implausible: Option<(String, f64, f64)>,
 }
 
 impl<'s> Search<'s> {
     /// Test every selected candidate followed by a later addition (speed
     /// decay apart: every run slows, and its law is chosen in a phase of its
     /// own) against `current` without it; remove those that fail, one at a
-    /// time. Returns the checks in the order made.
+    /// time. With `one_standard_error`, a member must also lower the
+    /// held-out error by more than one standard error of it. Returns the
+    /// checks in the order made.
     pub(in crate::identify) fn eliminate(
         &self,
         current: &mut CandidateFit,
         selected: &mut Vec<&Candidate>,
         simulations: &mut usize,
+        one_standard_error: bool,
     ) -> Result<Vec<MemberCheck>, IdentifyError> {
         let mut checks = Vec::new();
         // Each round tests every candidate followed by a later lateral
@@ -75,7 +102,7 @@ impl<'s> Search<'s> {
             let mut failing: Vec<(usize, f64, usize)> = Vec::new();
             let start = checks.len();
             for &j in &testable {
-                let (check, fit) = self.without(current, selected, j, simulations)?;
+                let (check, fit) = self.without(current, selected, j, one_standard_error, simulations)?;
                 if check.removed {
                     let change = fit.as_ref().map_or(f64::INFINITY, |f| f.bic - current.bic);
                     failing.push((j, change, checks.len()));
@@ -106,12 +133,15 @@ impl<'s> Search<'s> {
 
     /// The entry test of `selected[j]` against the model `current` without
     /// it: the check, and the fit without it (cross-validated when the
-    /// criterion alone does not decide).
+    /// criterion alone does not decide). With `one_standard_error`, the
+    /// held-out error without it must exceed the current one by more than
+    /// one standard error of the current one.
     fn without(
         &self,
         current: &CandidateFit,
         selected: &[&Candidate],
         j: usize,
+        one_standard_error: bool,
         simulations: &mut usize,
     ) -> Result<(MemberCheck, Option<CandidateFit>), IdentifyError> {
         let model: Vec<String> = selected.iter().map(|c| c.name.clone()).collect();
@@ -160,6 +190,7 @@ impl<'s> Search<'s> {
                         cv_without: f64::NAN,
                         verdict: keep,
                         removed: false,
+                        without_implausible: None,
                     },
                     None,
                 ));
@@ -176,7 +207,21 @@ impl<'s> Search<'s> {
         // the spread over runs wide.) A model kept by this test is
         // cross-validated either way: it may become the final one.
         cross_validate(&setup, &mut fit, self.fold_of, self.opts);
-        let verdict = if !(with_bic < fit.bic) {
+        // Only a removal that pushes a correction beyond the plausible range
+        // (further than it lies with the member) makes the rival
+        // implausible; a correction already beyond it says nothing of this
+        // member.
+        let with_farthest = farthest_from_prior(self.stated, selected, &current.values).map_or(0.0, |f| f.2);
+        let implausible = farthest_from_prior(self.stated, &active, &fit.values)
+            .filter(|(_, _, sds)| *sds > PLAUSIBLE_PRIOR_SDS && *sds > with_farthest);
+        let kept = Verdict::Added {
+            bic_change: with_bic - fit.bic,
+            cv: current.cv,
+            base_cv: fit.cv,
+        };
+        let verdict = if implausible.is_some() {
+            kept
+        } else if !(with_bic < fit.bic) {
             Verdict::NoCriterionGain {
                 bic_change: with_bic - fit.bic,
             }
@@ -185,12 +230,18 @@ impl<'s> Search<'s> {
                 cv: current.cv,
                 base_cv: fit.cv,
             }
-        } else {
-            Verdict::Added {
-                bic_change: with_bic - fit.bic,
+        } else if let Some(stderr) = one_standard_error
+            .then(|| held_out_standard_error(current, self.weights))
+            .flatten()
+            .filter(|se| !(fit.cv - current.cv > *se))
+        {
+            Verdict::WithinOneStandardError {
                 cv: current.cv,
                 base_cv: fit.cv,
+                stderr,
             }
+        } else {
+            kept
         };
         fit.simulations = setup.simulations.load(std::sync::atomic::Ordering::Relaxed);
         *simulations += fit.simulations;
@@ -205,6 +256,7 @@ impl<'s> Search<'s> {
                 without: Some(fit.clone()),
                 verdict,
                 removed,
+                without_implausible: implausible,
             },
             Some(fit),
         ))
