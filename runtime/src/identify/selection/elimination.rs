@@ -16,9 +16,9 @@
 //! exactly the model without it when it entered.)
 //!
 //! Two rules more. A model without the member that puts a correction
-//! beyond [`PLAUSIBLE_PRIOR_SDS`] of its stated uncertainty (and further
-//! than with the member) is no rival (the entry test refuses such a fit
-//! too): the member keeps its place,
+//! beyond [`PLAUSIBLE_PRIOR_SDS`] of its stated uncertainty, where every
+//! correction is plausible with the member, is no rival (the entry test
+//! refuses such a fit too): the member keeps its place,
 //! since what it explains would otherwise be pushed into a measured
 //! parameter. And a caller may ask for the one-standard-error rule of
 //! cross-validation (Breiman et al. 1984, *Classification and Regression
@@ -207,13 +207,15 @@ impl<'s> Search<'s> {
         // the spread over runs wide.) A model kept by this test is
         // cross-validated either way: it may become the final one.
         cross_validate(&setup, &mut fit, self.fold_of, self.opts);
-        // Only a removal that pushes a correction beyond the plausible range
-        // (further than it lies with the member) makes the rival
-        // implausible; a correction already beyond it says nothing of this
-        // member.
-        let with_farthest = farthest_from_prior(self.stated, selected, &current.values).map_or(0.0, |f| f.2);
+        // Only a removal that takes a model whose corrections are all
+        // plausible to one with a correction beyond the plausible range
+        // makes the rival implausible; where a correction already lies
+        // beyond it with the member, both models are implausible, and the
+        // usual criteria decide.
+        let with_plausible = farthest_from_prior(self.stated, selected, &current.values)
+            .is_none_or(|(_, _, sds)| sds <= PLAUSIBLE_PRIOR_SDS);
         let implausible = farthest_from_prior(self.stated, &active, &fit.values)
-            .filter(|(_, _, sds)| *sds > PLAUSIBLE_PRIOR_SDS && *sds > with_farthest);
+            .filter(|(_, _, sds)| with_plausible && *sds > PLAUSIBLE_PRIOR_SDS);
         let kept = Verdict::Added {
             bic_change: with_bic - fit.bic,
             cv: current.cv,
