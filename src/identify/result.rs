@@ -363,9 +363,7 @@ impl From<&bikedyn_runtime::identify::MemberCheck> for MemberCheck {
             cv_without: finite(c.cv_without),
             outcome: c.verdict.clone(),
             verdict: match &c.without_implausible {
-                Some((symbol, value, sds)) => format!(
-                    "kept: without it {symbol} would fit at {value:.4} ({sds:.1} prior standard deviations from its measured value), no plausible rival"
-                ),
+                Some((symbol, value, sds)) => super::words::kept_as_no_plausible_rival(symbol, *value, *sds),
                 None => verdict_text(&c.verdict),
             },
             without_implausible: c.without_implausible.clone(),

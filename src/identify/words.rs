@@ -24,6 +24,16 @@ pub(crate) fn fmt_c(z: Option<[f64; 2]>) -> String {
     z.map_or("-".into(), |z| format!("{:.3}{:+.3}i", z[0], z[1]))
 }
 
+/// Why a member of the final model kept its place although the criterion
+/// or the held-out error alone would remove it: without it, correction
+/// `symbol` fits at `value`, `sds` prior standard deviations from its
+/// measured value.
+pub fn kept_as_no_plausible_rival(symbol: &str, value: f64, sds: f64) -> String {
+    format!(
+        "keeps its place: without it {symbol} fits at {value:.4} ({sds:.1} prior standard deviations from its measured value), no plausible rival"
+    )
+}
+
 /// A candidate's verdict in words, with its numbers (changes of the
 /// criterion against the step's base; negative is better).
 pub fn verdict_text(v: &Verdict) -> String {

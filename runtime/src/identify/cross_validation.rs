@@ -90,23 +90,23 @@ pub fn folds_by_run(segments: &[Segment], folds: usize) -> (usize, Vec<usize>) {
     (folds, fold_of)
 }
 
+/// A segment's weighted sum of squares over its channels (the residuals
+/// divided by the channel scales `w`, as the fit weighs them) and its
+/// number of samples.
+fn weighted_ss(e: &SegmentError, w: &Weights) -> (f64, f64) {
+    let ss = e.channel_ss[0] / (w.roll * w.roll)
+        + e.channel_ss[1] / (w.steer * w.steer)
+        + e.channel_ss[2] / (w.speed * w.speed);
+    (ss, e.channel_n.iter().sum::<usize>() as f64)
+}
+
 /// Standard error of a fit's held-out error `cv` (the pooled mean square
 /// of the weighted held-out residuals), with the segments (kicks) as the
 /// units: the ratio estimator's `sqrt(m / (m - 1) sum (ss_i - cv n_i)^2) / N`
 /// over `m` segments of `n_i` samples and weighted sum of squares `ss_i`
 /// (`N` samples in all). `None` with fewer than two segments.
 pub fn held_out_standard_error(fit: &CandidateFit, w: &[Weights]) -> Option<f64> {
-    let parts: Vec<(f64, f64)> = fit
-        .held_out
-        .iter()
-        .zip(w)
-        .map(|(e, w)| {
-            let ss = e.channel_ss[0] / (w.roll * w.roll)
-                + e.channel_ss[1] / (w.steer * w.steer)
-                + e.channel_ss[2] / (w.speed * w.speed);
-            (ss, e.channel_n.iter().sum::<usize>() as f64)
-        })
-        .collect();
+    let parts: Vec<(f64, f64)> = fit.held_out.iter().zip(w).map(|(e, w)| weighted_ss(e, w)).collect();
     let m = parts.len() as f64;
     let total: f64 = parts.iter().map(|p| p.1).sum();
     if m < 2.0 || !(total > 0.0) {
@@ -124,10 +124,8 @@ pub fn held_out_standard_error(fit: &CandidateFit, w: &[Weights]) -> Option<f64>
 /// (an artefact of one run, noise) is not added.
 pub fn paired_gain(base: &CandidateFit, cand: &CandidateFit, w: &[Weights]) -> Option<(f64, f64)> {
     let mse = |e: &SegmentError, w: &Weights| {
-        let ss = e.channel_ss[0] / (w.roll * w.roll)
-            + e.channel_ss[1] / (w.steer * w.steer)
-            + e.channel_ss[2] / (w.speed * w.speed);
-        ss / (e.channel_n.iter().sum::<usize>().max(1) as f64)
+        let (ss, n) = weighted_ss(e, w);
+        ss / n.max(1.0)
     };
     let d: Vec<f64> = base
         .held_out

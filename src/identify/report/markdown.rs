@@ -105,9 +105,7 @@ pub(super) fn report_markdown<R: ModelRegistry>(o: &Outcome<R>, a: &IdentifyRequ
                 None => "fit failed".into(),
             };
             let outcome = if let Some((symbol, value, sds)) = &c.without_implausible {
-                format!(
-                    "keeps its place: without it `{symbol}` fits at {value:.4} ({sds:.1} prior standard deviations from its measured value), no plausible rival"
-                )
+                crate::identify::words::kept_as_no_plausible_rival(symbol, *value, *sds)
             } else if c.verdict.added() {
                 format!("keeps its place ({})", verdict_text(&c.verdict))
             } else if c.removed {
