@@ -34,7 +34,7 @@
 //! kept.
 
 use super::{Search, Verdict};
-use crate::identify::criterion::{bic, farthest_from_prior, PLAUSIBLE_PRIOR_SDS};
+use crate::identify::criterion::{bic, PLAUSIBLE_PRIOR_SDS};
 use crate::identify::cross_validation::held_out_standard_error;
 use crate::identify::{cross_validate, fit_candidate, Candidate, CandidateFit, IdentifyError};
 use serde::Serialize;
@@ -212,9 +212,11 @@ impl<'s> Search<'s> {
         // makes the rival implausible; where a correction already lies
         // beyond it with the member, both models are implausible, and the
         // usual criteria decide.
-        let with_plausible = farthest_from_prior(self.stated, selected, &current.values)
+        let with_plausible = self
+            .farthest_from_prior(selected, &current.values)
             .is_none_or(|(_, _, sds)| sds <= PLAUSIBLE_PRIOR_SDS);
-        let implausible = farthest_from_prior(self.stated, &active, &fit.values)
+        let implausible = self
+            .farthest_from_prior(&active, &fit.values)
             .filter(|(_, _, sds)| with_plausible && *sds > PLAUSIBLE_PRIOR_SDS);
         let kept = Verdict::Added {
             bic_change: with_bic - fit.bic,
