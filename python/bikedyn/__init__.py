@@ -230,8 +230,9 @@ class SweepResult(NamedTuple):
 
 # The generated models' axes are the thesis's (Martin Recuero 2009): roll
 # positive leaning right, as the benchmark's, and steer positive turning
-# left, minus the benchmark's (runtime/src/linearize.rs: `steer_sign: -1.0`
-# for every generated model; runtime/src/simulate/inputs.rs). The benchmark
+# left, minus the benchmark's (runtime/src/linearize/linear_model.rs:
+# `steer_sign: -1.0` for every generated model;
+# runtime/src/simulate/inputs.rs). The benchmark
 # convention (Meijaard et al. 2007) has both positive to the right: the
 # signs of `eig`'s eigenvectors, `state_space`, `canonical` and `bode`.
 _BENCHMARK_SIGN = {"roll": 1.0, "steer": -1.0}
