@@ -10,7 +10,9 @@
 use super::discovery::{effect_file, reading};
 use super::IdentifyError;
 use crate::bicycle::Bicycle;
-use bikedyn_runtime::identify::discovery::time_series::{discover_in_time_series, NotSearched, TimeSeriesDiscovery};
+use bikedyn_runtime::identify::discovery::time_series::{
+    discover_in_time_series, NotSearched, SecondStart, TimeSeriesDiscovery,
+};
 use bikedyn_runtime::identify::discovery::{FoundTerm, Signal, Term, ALIKE_BIC};
 use bikedyn_runtime::identify::{pooled_rms, Candidate, EffectParameter, Identification, IdentifyOptions, Segment};
 use bikedyn_runtime::linearize::parameter_vector;
@@ -238,10 +240,25 @@ pub fn sentence(o: &TimeSeriesOutcome, unit: &str, scale: f64) -> String {
             // What the backward check removed: the library's members, and
             // terms that entered before the last and stood in for it.
             let dictionary: Vec<String> = Term::time_series_dictionary().iter().map(Term::name).collect();
-            let (terms, members): (Vec<&String>, Vec<&String>) =
-                f.search.removed.iter().partition(|r| dictionary.contains(r));
+            // (The corrections a kept second start left out are said with it.)
+            let left_out = |r: &String| {
+                f.search
+                    .second_start
+                    .as_ref()
+                    .is_some_and(|s| s.kept_second && s.left_out.iter().any(|l| &l.candidate == r))
+            };
+            let (terms, members): (Vec<&String>, Vec<&String>) = f
+                .search
+                .removed
+                .iter()
+                .filter(|r| !left_out(r))
+                .partition(|r| dictionary.contains(r));
             let list = |names: &[&String]| names.iter().map(|n| n.as_str()).collect::<Vec<_>>().join(", ");
             let mut found = found;
+            if let Some(second) = &f.search.second_start {
+                found.push('\n');
+                found.push_str(&second_start_sentence(second));
+            }
             if !members.is_empty() {
                 found.push_str(&format!(
                     "\nwith the terms, the backward check removed from the library's selection: {} (the terms explain the data better without it, or as well within one standard error of the held-out error)",
@@ -267,6 +284,45 @@ pub fn sentence(o: &TimeSeriesOutcome, unit: &str, scale: f64) -> String {
     }
 }
 
+/// Why the search started twice, and which start's model was kept.
+fn second_start_sentence(s: &SecondStart) -> String {
+    let left: Vec<String> = s
+        .left_out
+        .iter()
+        .map(|l| {
+            format!(
+                "`{}` ({} = {:.4}, {:.1} prior sd from the measured value)",
+                l.candidate, l.symbol, l.value, l.prior_sds
+            )
+        })
+        .collect();
+    let terms = if s.other_selected.is_empty() {
+        "no term".to_string()
+    } else {
+        format!("terms {}", s.other_selected.join(", "))
+    };
+    let (kept, verdict, other) = if s.kept_second {
+        (
+            "kept",
+            "lower",
+            format!("the first start (the library's whole selection, {terms})"),
+        )
+    } else {
+        (
+            "not kept",
+            "not lower",
+            format!("the first start; the second found {terms}"),
+        )
+    };
+    format!(
+        "second start of the search without the library's corrections beyond their plausible range, {}: {kept}, its held-out error {:.4} against {:.4} of {other}: {verdict} by more than one standard error ({:.4})",
+        left.join(", "),
+        s.cv_second,
+        s.cv_first,
+        s.standard_error
+    )
+}
+
 /// The effect file of the found terms (`None` when none was found).
 pub fn effect_file_of(o: &TimeSeriesOutcome) -> Option<Result<String, String>> {
     match o {
@@ -284,6 +340,14 @@ pub fn markdown(f: &TimeSeriesFound) -> String {
         s,
         "\n## Discovery in the time series: terms of the dictionary\n\nGeneralized forces on the roll and steer equations that the model carries (`{DICTIONARY_EFFECT}`, every coefficient zero by default, in the model's signs: steer positive to the left), each tried as a candidate of its own after the library's search, with the library's selection refitted beside it and the same tests (criterion, held-out error of the same folds of runs, a gain consistent run by run). At most {MAX_TERMS} terms are added.\n"
     );
+    if let Some(second) = &f.search.second_start {
+        let _ = writeln!(
+            s,
+            "The library took corrections beyond their plausible range ({PLAUSIBLE} prior standard deviations), so the search started twice: from the library's whole selection, and from it without those corrections. The model of the second start is kept only if it predicts the held-out runs better than the first's by more than one standard error. {}.\n\nThe steps of the start kept:\n",
+            second_start_sentence(second).replacen("second start", "Second start", 1),
+            PLAUSIBLE = bikedyn_runtime::identify::PLAUSIBLE_PRIOR_SDS
+        );
+    }
     super::words::steps_markdown(&mut s, &f.search.steps, 1);
     let _ = writeln!(
         s,

@@ -338,17 +338,20 @@ fn in_the_time_series_a_steer_damper_the_library_lacks_is_found_and_halves_the_r
 /// identification model's dictionary parameter, eight runs at 5.5-7 m/s,
 /// sensor errors included) with every declared correction a candidate of
 /// the library. The library takes corrections beyond their priors for want
-/// of the force (on this seed, the front frame's yaw inertia and the rear frame's
-/// mass-centre height). The search in the time series must end with the
-/// force alone: a correction whose removal would push another correction
-/// beyond its plausible range keeps the force in, and the corrections and
-/// terms that stood in for it leave once the held-out error no longer
-/// tells them apart from the simpler model (within one standard error).
-/// Once, a stand-in pair (the mass-centre height 9 prior standard
-/// deviations away and a steer stiffness growing with speed squared)
-/// removed the force itself and left the roll error three times as large.
+/// of the force (on this seed, the front frame's product of inertia 9 and
+/// the rear frame's mass-centre height 3.5 prior standard deviations away,
+/// with the front frame's mass-centre x). The search in the time series
+/// must end with the force alone. Started from the library's whole
+/// selection it adds a steer stiffness growing with v^2, which drives the
+/// mass-centre height further (9 prior standard deviations), and the score
+/// test then sees no gain left for the force: the roll error stays at
+/// 0.43 deg. The second start, without the corrections beyond their
+/// plausible range, finds the force, and its model predicts the held-out
+/// runs better by more than one standard error, so it is kept. (Seed 11,
+/// the example's in `examples/discovered_force`, takes the other path: the
+/// force enters beside the stand-ins, and the backward check removes them.)
 #[test]
-fn in_runs_the_corrections_taken_for_want_of_a_force_give_way_to_the_force_found_in_the_time_series() {
+fn in_runs_a_second_start_without_the_implausible_corrections_finds_the_force_they_stood_in_for() {
     let dir = scratch("identify").join("steer_torque_roll_runs");
     let _ = std::fs::remove_dir_all(&dir);
     let out = bikedyn(&[
@@ -362,12 +365,14 @@ fn in_runs_the_corrections_taken_for_want_of_a_force_give_way_to_the_force_found
         "--runs",
         "8",
         "--seed",
-        "11",
+        "2",
         "--out",
         dir.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "synth: {}", text(&out.stderr));
     let v = ok_json(&["identify", dir.to_str().unwrap(), "--bike", "thesis", "--json"]);
+    let second = &v["time_series_discovery"]["second_start"];
+    assert_eq!(second["kept_second"], Value::from(true), "{second:#}");
     let terms = time_series_terms(&v);
     assert_eq!(terms.len(), 1, "{:#}", v["time_series_discovery"]);
     let t = &terms[0]["term"];

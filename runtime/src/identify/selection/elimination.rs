@@ -145,57 +145,35 @@ impl<'s> Search<'s> {
         simulations: &mut usize,
     ) -> Result<(MemberCheck, Option<CandidateFit>), IdentifyError> {
         let model: Vec<String> = selected.iter().map(|c| c.name.clone()).collect();
+        let name = selected[j].name.clone();
+        (self.progress)(&format!("testing {name} against the model without it"), None);
+        let Some(fit) = self.fit_without(current, selected, j)? else {
+            let keep = Verdict::Added {
+                bic_change: f64::NAN,
+                cv: current.cv,
+                base_cv: f64::NAN,
+            };
+            return Ok((
+                MemberCheck {
+                    name,
+                    model,
+                    without: None,
+                    bic_change: f64::NAN,
+                    cv_with: current.cv,
+                    cv_without: f64::NAN,
+                    verdict: keep,
+                    removed: false,
+                    without_implausible: None,
+                },
+                None,
+            ));
+        };
         let active: Vec<&Candidate> = selected
             .iter()
             .enumerate()
             .filter(|&(i, _)| i != j)
             .map(|(_, c)| *c)
             .collect();
-        // The member's parameters in the current values: after those of
-        // the candidates before it.
-        let offset: usize = selected[..j].iter().map(|c| c.parameters.len()).sum();
-        let width = selected[j].parameters.len();
-        let mut g0 = current.values.clone();
-        g0.drain(offset..offset + width);
-        let setup = match self.alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
-            Some(f) => f.setup(self.segments, self.weights, &active)?,
-            None => self.main.setup(self.segments, self.weights, &active)?,
-        };
-        let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
-        let name = selected[j].name.clone();
-        (self.progress)(&format!("testing {name} against the model without it"), None);
-        let mut fit = match fit_candidate(
-            &setup,
-            effects,
-            &g0,
-            &current.nuisance,
-            self.fold_of,
-            self.opts,
-            Some(self.reference),
-        ) {
-            Ok(f) => f,
-            Err(_) => {
-                let keep = Verdict::Added {
-                    bic_change: f64::NAN,
-                    cv: current.cv,
-                    base_cv: f64::NAN,
-                };
-                return Ok((
-                    MemberCheck {
-                        name,
-                        model,
-                        without: None,
-                        bic_change: f64::NAN,
-                        cv_with: current.cv,
-                        cv_without: f64::NAN,
-                        verdict: keep,
-                        removed: false,
-                        without_implausible: None,
-                    },
-                    None,
-                ));
-            }
-        };
         let with_bic = bic(current, self.reference);
         // The exit test is the entry test's criteria without its bar of
         // consistency: a candidate stays while the criterion and the
@@ -206,7 +184,6 @@ impl<'s> Search<'s> {
         // criterion and the held-out error, whenever one run's gain makes
         // the spread over runs wide.) A model kept by this test is
         // cross-validated either way: it may become the final one.
-        cross_validate(&setup, &mut fit, self.fold_of, self.opts);
         // Only a removal that takes a model whose corrections are all
         // plausible to one with a correction beyond the plausible range
         // makes the rival implausible; where a correction already lies
@@ -247,7 +224,6 @@ impl<'s> Search<'s> {
         } else {
             kept
         };
-        fit.simulations = setup.simulations.load(std::sync::atomic::Ordering::Relaxed);
         *simulations += fit.simulations;
         let removed = !verdict.added();
         Ok((
@@ -264,5 +240,48 @@ impl<'s> Search<'s> {
             },
             Some(fit),
         ))
+    }
+
+    /// The model `current` refitted without `selected[j]`, from the
+    /// values of the others, and cross-validated by the same folds
+    /// (`None`: the fit failed). Its `simulations` count those of the fit
+    /// and of the cross-validation.
+    pub(in crate::identify) fn fit_without(
+        &self,
+        current: &CandidateFit,
+        selected: &[&Candidate],
+        j: usize,
+    ) -> Result<Option<CandidateFit>, IdentifyError> {
+        let active: Vec<&Candidate> = selected
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i != j)
+            .map(|(_, c)| *c)
+            .collect();
+        // The member's parameters in the current values: after those of
+        // the candidates before it.
+        let offset: usize = selected[..j].iter().map(|c| c.parameters.len()).sum();
+        let width = selected[j].parameters.len();
+        let mut g0 = current.values.clone();
+        g0.drain(offset..offset + width);
+        let setup = match self.alternative.filter(|_| active.iter().any(|a| a.alternative_model)) {
+            Some(f) => f.setup(self.segments, self.weights, &active)?,
+            None => self.main.setup(self.segments, self.weights, &active)?,
+        };
+        let effects: Vec<String> = active.iter().flat_map(|a| a.effects.clone()).collect();
+        let Ok(mut fit) = fit_candidate(
+            &setup,
+            effects,
+            &g0,
+            &current.nuisance,
+            self.fold_of,
+            self.opts,
+            Some(self.reference),
+        ) else {
+            return Ok(None);
+        };
+        cross_validate(&setup, &mut fit, self.fold_of, self.opts);
+        fit.simulations = setup.simulations.load(std::sync::atomic::Ordering::Relaxed);
+        Ok(Some(fit))
     }
 }
