@@ -25,7 +25,7 @@
       check(S.encode(app.state) === S.encode(given), `the state ${S.encode(app.state)} is not the link's ${S.encode(given)}`);
       check($("bike").value === given.bike, `bicycle ${$("bike").value}, the link says ${given.bike}`);
       check($("error").hidden, `the link's bicycle: ${$("error").textContent}`);
-      check(app.eig && app.eig.points.length === S.speedRange(given).count, "the link's eigenvalues are not drawn");
+      check(app.eig && app.eig.count === S.speedRange(given).count, "the link's eigenvalues are not drawn");
       for (const [k, v] of Object.entries(given.edits)) {
         const input = document.querySelector(`input[data-symbol="${k}"]`);
         check(input && Number(input.value) === v && input.closest("tr").classList.contains("edited"), `the link's ${k} = ${v} is not in the table`);
