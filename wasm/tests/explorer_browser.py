@@ -524,6 +524,17 @@ def step_redraw_time(p):
        f"(fastest {times[0]:.1f}, slowest {times[-1]:.1f}) [issue 34's target: < 5 ms]")
 
 
+def step_map_time(p):
+    """11. A 100 x 100 stability map's time in the page (issue 34's figure: printed, not checked)."""
+    type_into(p, "#map-nx", "100")
+    type_into(p, "#map-ny", "100")
+    p.el("#map-run").click()
+    p.wait(lambda: " points in " in (p.text("map-status") or ""), "the 100 x 100 map", timeout=120)
+    status = p.text("map-status")
+    check(status.startswith("100 \u00d7 100 points"), f"the map is not 100 x 100: {status!r}")
+    ok(f"stability map in the page, rows computed and drawn as they come: {status} [issue 34's target: < 2 s]")
+
+
 def step_console(p):
     """No script errors in the browser's console."""
     try:
@@ -620,6 +631,7 @@ def main():
             ("8 a bad file", lambda: step_bad_file(p, tmp, state["file_ref"])),
             ("9 the browser's console", lambda: step_console(p)),
             ("10 the redraw's time", lambda: step_redraw_time(p)),
+            ("11 the map's time", lambda: step_map_time(p)),
         ]
         for step, run in steps:
             t0 = time.monotonic()
