@@ -315,16 +315,63 @@ impl EigenJob {
 
     fn at_speed(&self, p: EigenPoint) -> EigenAtSpeed {
         let idx = ordered_indices(&p);
-        let eigenvalues = idx.map(|k| [p.eigenvalues[k].re, p.eigenvalues[k].im]);
+        let EigenvaluesAtSpeed {
+            v,
+            eigenvalues,
+            modes,
+            extra_eigenvalues,
+        } = EigenvaluesAtSpeed::of(&p, &idx);
         let standard_deviations = self.spread.as_ref().map(|s| s.of_eigenvalues(p.v, &eigenvalues));
         EigenAtSpeed {
             eigenvalues,
-            extra_eigenvalues: p.extra_eigenvalues.iter().map(|z| [z.re, z.im]).collect(),
+            extra_eigenvalues,
             mode_shapes: idx.map(|k| mode_shape(&p.eigenvectors[k])),
-            modes: idx.map(|k| p.modes[k].name()),
+            modes,
             standard_deviations,
-            v: p.v,
+            v,
             point: p,
+        }
+    }
+
+    /// Every speed's eigenvalues and modes alone, in the order and with the
+    /// values of [`EigenJob::points`], without mode shapes or standard
+    /// deviations: a diagram over speed draws no more (the browser's, where
+    /// the mode shapes were a sixth of its time, 2026-11-29).
+    pub fn eigenvalues_and_modes(&self) -> Result<Vec<EigenvaluesAtSpeed>, EigenSweepError> {
+        let n = self.speeds.len();
+        let mut out = Vec::with_capacity(n);
+        for start in (0..n).step_by(BLOCK) {
+            let speeds: Vec<f64> = (start..(start + BLOCK).min(n)).map(|k| self.speeds.at(k)).collect();
+            for p in eigen_sweep_of(&self.lin, &speeds)?.points {
+                out.push(EigenvaluesAtSpeed::of(&p, &ordered_indices(&p)));
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// A speed's eigenvalues and modes, as in [`EigenAtSpeed`] (the same order).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EigenvaluesAtSpeed {
+    /// Forward speed (m/s).
+    pub v: f64,
+    /// The four roll-steer eigenvalues `[re, im]` (1/s).
+    pub eigenvalues: [[f64; 2]; 4],
+    /// Each eigenvalue's mode.
+    pub modes: [&'static str; 4],
+    /// The eigenvalues `[re, im]` (1/s) of a model's extra first-order
+    /// states; empty for others.
+    pub extra_eigenvalues: Vec<[f64; 2]>,
+}
+
+impl EigenvaluesAtSpeed {
+    /// Point `p`'s, in the output order `idx` ([`ordered_indices`]).
+    fn of(p: &EigenPoint, idx: &[usize; 4]) -> Self {
+        EigenvaluesAtSpeed {
+            v: p.v,
+            eigenvalues: idx.map(|k| [p.eigenvalues[k].re, p.eigenvalues[k].im]),
+            modes: idx.map(|k| p.modes[k].name()),
+            extra_eigenvalues: p.extra_eigenvalues.iter().map(|z| [z.re, z.im]).collect(),
         }
     }
 }

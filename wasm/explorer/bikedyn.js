@@ -98,6 +98,15 @@
       if (status !== 0) {
         throw new BikedynError(answer.kind, answer.message);
       }
+      // Numbers sent as bytes (`eig` with `arrays`): each `[offset, length]`
+      // of `arrays` becomes its Float64Array, copied out of the module's
+      // memory (the next call reuses it).
+      if (answer.arrays && typeof answer.arrays === "object") {
+        const base = x.bikedyn_arrays_ptr();
+        for (const [name, [offset, length]] of Object.entries(answer.arrays)) {
+          answer.arrays[name] = new Float64Array(x.memory.buffer, base + 8 * offset, length).slice();
+        }
+      }
       return answer;
     }
   }

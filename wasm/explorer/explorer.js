@@ -197,6 +197,10 @@
   }
 
   function update() {
+    // The redraw's time (the module's answers and the figures' SVG put in
+    // the page; not the browser's layout and paint after it), for the
+    // status line and the browser test's figure.
+    const started = performance.now();
     writeHash();
     const spec = bicycleSpec();
     const b = call(withModel({ job: "bicycle", bicycle: spec }));
@@ -208,9 +212,10 @@
     }
     app.current = b.ok;
     const speeds = S.speedRange(app.state);
-    // The diagram draws eigenvalues and modes; the slider asks for its
-    // speed's mode shapes itself.
-    const e = call(withModel({ job: "eig", bicycle: spec, speeds, critical_speeds: true, mode_shapes: false }));
+    // The diagram draws eigenvalues and modes, which come as arrays of
+    // numbers (panel-eigen.js); the slider asks for its speed's mode shapes
+    // itself.
+    const e = call(withModel({ job: "eig", bicycle: spec, speeds, critical_speeds: true, arrays: true }));
     if (e.error) {
       showError(e.error);
       status("error");
@@ -226,7 +231,8 @@
     app.renderBicycle();
     app.renderCritical();
     app.updateSpeed();
-    status(`${app.current.name} \u00b7 model ${app.eig.model} \u00b7 ${app.eig.points.length} speeds`);
+    app.redrawMs = performance.now() - started;
+    status(`${app.current.name} \u00b7 model ${app.eig.model} \u00b7 ${app.eig.count} speeds \u00b7 ${fmt(app.redrawMs, 1)} ms`);
   }
 
   function markStale(stale) {

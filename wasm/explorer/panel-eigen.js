@@ -14,22 +14,34 @@
 
   // ---- eigenvalues over speed ------------------------------------------------
 
+  // The diagram's points come as columns of numbers (`eig` with `arrays`,
+  // wasm/README.md), not one object per speed: text for 1,000 speeds took
+  // longer to write, decode and parse than the eigenvalues to compute.
+  // Speed i is v[i]; its four eigenvalues are eigenvalues[8i .. 8i + 8]
+  // (re, im in turn), with modes mode_names[modes[4i + k]]; a model's tyre
+  // states add extra_per_speed more from extra_eigenvalues.
+
+  /** Calls f(re, im, mode) for each eigenvalue at speed i of the diagram `eig` ("extra": a tyre state's). */
+  function eigenvaluesAt(eig, i, f) {
+    const { eigenvalues: z, modes, extra_eigenvalues: x } = eig.arrays;
+    for (let k = 0; k < 4; k++) f(z[8 * i + 2 * k], z[8 * i + 2 * k + 1], eig.mode_names[modes[4 * i + k]]);
+    const e = eig.extra_per_speed;
+    for (let k = e * i; k < e * (i + 1); k++) f(x[2 * k], x[2 * k + 1], "extra");
+  }
+
   /** The series of the eig plot: per mode and rank, real and imaginary parts over speed. */
-  function eigSeries(points) {
+  function eigSeries(eig) {
     const series = new Map(); // key -> {mode, re: [[v, re]], im: [[v, im]]}
     const get = (key, mode) => {
       if (!series.has(key)) series.set(key, { mode, re: [], im: [] });
       return series.get(key);
     };
-    points.forEach((p, i) => {
+    const v = eig.arrays.v;
+    for (let i = 0; i < eig.count; i++) {
       const groups = {};
-      p.eigenvalues.forEach(([re, im], k) => {
+      eigenvaluesAt(eig, i, (re, im, mode) => {
         if (im < 0) return; // a conjugate pair is drawn once
-        (groups[p.modes[k]] ||= []).push([re, im]);
-      });
-      (p.extra_eigenvalues || []).forEach(([re, im]) => {
-        if (im < 0) return;
-        (groups.extra ||= []).push([re, im]);
+        (groups[mode] ||= []).push([re, im]);
       });
       for (const [mode, list] of Object.entries(groups)) {
         list.sort((a, b) => b[0] - a[0]);
@@ -40,26 +52,26 @@
             s.re.push([NaN, NaN]);
             s.im.push([NaN, NaN]);
           }
-          s.re.push([p.v, re]);
-          s.im.push([p.v, im > 1e-9 ? im : NaN]);
+          s.re.push([v[i], re]);
+          s.im.push([v[i], im > 1e-9 ? im : NaN]);
           s.last = i;
         });
       }
-    });
+    }
     return [...series.values()];
   }
 
-  function eigLimits(points, clip = 10) {
+  function eigLimits(eig, clip = 10) {
     let lo = Infinity;
     let hi = -Infinity;
-    for (const p of points) {
-      for (const [re, im] of p.eigenvalues.concat(p.extra_eigenvalues || [])) {
+    for (let i = 0; i < eig.count; i++) {
+      eigenvaluesAt(eig, i, (re, im) => {
         for (const x of [re, Math.abs(im)]) {
           if (!Number.isFinite(x)) continue;
           lo = Math.min(lo, x);
           hi = Math.max(hi, x);
         }
-      }
+      });
     }
     lo = Math.max(lo, -clip);
     hi = Math.min(hi, clip);
@@ -68,9 +80,8 @@
   }
 
   function eigFigureSvg(width = 760, height = 440) {
-    const pts = app.eig.points;
     const xlim = [app.state.vmin, app.state.vmax];
-    const ylim = eigLimits(pts);
+    const ylim = eigLimits(app.eig);
     const fig = P.figure({ width, height, xlim, ylim, xlabel: "forward speed v (m/s)", ylabel: "eigenvalue (1/s)", margin: { top: 36 } });
     // The self-stable band(s).
     const band = app.stab ? app.stab.stable_intervals : [];
@@ -79,7 +90,7 @@
       const x1 = fig.x(b === null || b === undefined ? xlim[1] : Math.min(b, xlim[1]));
       fig.add(`<rect data-band="1" x="${P.n(x0)}" y="${P.n(fig.margin.top)}" width="${P.n(Math.max(0, x1 - x0))}" height="${P.n(fig.ph)}" fill="#d9f0d3" stroke="none"/>`);
     }
-    const series = eigSeries(pts);
+    const series = eigSeries(app.eig);
     for (const s of series) fig.add(P.line(fig, s.im, { stroke: modeColour(s.mode), "stroke-dasharray": "6 4", "stroke-width": 1.6 }));
     for (const s of series) fig.add(P.line(fig, s.re, { stroke: modeColour(s.mode), "stroke-width": 2 }));
     // Critical speeds.
@@ -202,28 +213,36 @@
     return g.join("\n");
   }
 
+  const LOCUS_COLOURS = 48; // the colour bar's steps (plot.js)
+
   function locusSvg(width = 760, height = 420) {
-    const pts = app.eig.points;
+    const eig = app.eig;
     let xlo = Infinity, xhi = -Infinity, yhi = 0;
-    for (const p of pts) {
-      for (const [re, im] of p.eigenvalues.concat(p.extra_eigenvalues || [])) {
+    for (let i = 0; i < eig.count; i++) {
+      eigenvaluesAt(eig, i, (re, im) => {
         xlo = Math.min(xlo, re);
         xhi = Math.max(xhi, re);
         yhi = Math.max(yhi, Math.abs(im));
-      }
+      });
     }
     const clip = 12;
     const xlim = P.niceLimits(Math.max(xlo, -clip), Math.min(xhi, clip), 8);
     const ym = P.niceLimits(0, Math.max(1, Math.min(yhi, clip)), 4)[1];
     const fig = P.figure({ width, height, xlim, ylim: [-ym, ym], xlabel: "real part (1/s)", ylabel: "imaginary part (1/s)", zeroX: true, margin: { right: 90 } });
     const [v0, v1] = [app.state.vmin, app.state.vmax];
-    const colour = (v) => P.viridis((v - v0) / (v1 - v0 || 1));
-    for (const p of pts) {
-      const c = colour(p.v);
-      for (const [re, im] of p.eigenvalues.concat(p.extra_eigenvalues || [])) {
-        fig.add(`<circle cx="${P.n(fig.x(re))}" cy="${P.n(fig.y(im))}" r="2.1" fill="${c}"/>`);
-      }
+    // The points as dots (zero-length strokes with round caps), one path
+    // per colour, the colour bar's 48 steps: 4,000 circle elements took
+    // the browser 36 ms to parse and lay out at every redraw (1,000 speeds,
+    // 2026-11-29), more than all else of it.
+    const dots = Array.from({ length: LOCUS_COLOURS }, () => []);
+    for (let i = 0; i < eig.count; i++) {
+      const t = (eig.arrays.v[i] - v0) / (v1 - v0 || 1);
+      const k = Math.max(0, Math.min(LOCUS_COLOURS - 1, Math.floor(t * LOCUS_COLOURS)));
+      eigenvaluesAt(eig, i, (re, im) => dots[k].push(`M${P.n(fig.x(re))} ${P.n(fig.y(im))}h0`));
     }
+    dots.forEach((d, k) => {
+      if (d.length) fig.add(`<path data-locus="${d.length}" d="${d.join("")}" fill="none" stroke="${P.viridis((k + 0.5) / LOCUS_COLOURS)}" stroke-width="4.2" stroke-linecap="round"/>`);
+    });
     if (app.atSpeed) {
       for (const [re, im] of app.atSpeed.eigenvalues.concat(app.atSpeed.extra_eigenvalues || [])) {
         fig.add(`<circle cx="${P.n(fig.x(re))}" cy="${P.n(fig.y(im))}" r="5.5" fill="none" stroke="#d00" stroke-width="1.6"/>`);

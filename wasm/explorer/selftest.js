@@ -25,7 +25,7 @@
       check(S.encode(app.state) === S.encode(given), `the state ${S.encode(app.state)} is not the link's ${S.encode(given)}`);
       check($("bike").value === given.bike, `bicycle ${$("bike").value}, the link says ${given.bike}`);
       check($("error").hidden, `the link's bicycle: ${$("error").textContent}`);
-      check(app.eig && app.eig.points.length === S.speedRange(given).count, "the link's eigenvalues are not drawn");
+      check(app.eig && app.eig.count === S.speedRange(given).count, "the link's eigenvalues are not drawn");
       for (const [k, v] of Object.entries(given.edits)) {
         const input = document.querySelector(`input[data-symbol="${k}"]`);
         check(input && Number(input.value) === v && input.closest("tr").classList.contains("edited"), `the link's ${k} = ${v} is not in the table`);
@@ -56,7 +56,7 @@
       check(before === "v_w = 4.292", `the plot's weave label is "${before}"`);
       check($("eig-plot").querySelectorAll("polyline").length >= 4, "the eigenvalue plot has no lines");
       check($("eig-plot").querySelector("rect[data-band]"), "the eigenvalue plot has no self-stable band");
-      check($("locus-plot").querySelectorAll("circle").length > 100, "the root locus has no points");
+      check([...$("locus-plot").querySelectorAll("path[data-locus]")].reduce((n, p) => n + Number(p.dataset.locus), 0) > 100, "the root locus has no points");
       check($("eig-table").tBodies[0].rows.length === 4, "the eigenvalue table has not 4 rows");
       check($("derived").textContent.includes("kAll"), "no radius of gyration of the front assembly");
       // 2. Trail c edited in the table: the weave speed changes, the link says so.

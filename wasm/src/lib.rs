@@ -15,15 +15,19 @@
 //! - `bikedyn_call(ptr, len) -> status` runs the request (0: the answer is
 //!   the result, 1: the answer is an error `{"kind", "message"}`);
 //! - `bikedyn_answer_ptr()`, `bikedyn_answer_len()`: the answer's UTF-8
-//!   bytes, valid until the next call.
+//!   bytes, valid until the next call;
+//! - `bikedyn_arrays_ptr()`, `bikedyn_arrays_len()`: the `f64` buffer that
+//!   an answer's `arrays` field points into (`eig` with `arrays`), valid
+//!   until the next call.
 //!
 //! A panic (a defect: the library returns typed errors) traps the call; its
 //! message is kept for `bikedyn_panic_ptr()`/`bikedyn_panic_len()`, and the
 //! page loads a fresh module.
 
+mod arrays;
 mod request;
 
-pub use request::{answer, Answer};
+pub use request::{answer, reply, Answer, Reply};
 
 #[cfg(target_arch = "wasm32")]
 mod abi {
@@ -32,6 +36,7 @@ mod abi {
     thread_local! {
         static ANSWER: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
         static PANIC: RefCell<Vec<u8>> = const { RefCell::new(Vec::new()) };
+        static ARRAYS: RefCell<Vec<f64>> = const { RefCell::new(Vec::new()) };
     }
 
     /// A buffer of `len` bytes in the module's memory, for the caller to
@@ -69,11 +74,13 @@ mod abi {
             }))
         });
         let bytes = std::slice::from_raw_parts(ptr, len);
-        let (status, text) = match super::answer(bytes) {
+        let reply = super::reply(bytes);
+        let (status, text) = match reply.answer {
             super::Answer::Result(t) => (0, t),
             super::Answer::Error(t) => (1, t),
         };
         ANSWER.with(|a| *a.borrow_mut() = text.into_bytes());
+        ARRAYS.with(|a| *a.borrow_mut() = reply.arrays);
         status
     }
 
@@ -87,6 +94,19 @@ mod abi {
     #[no_mangle]
     pub extern "C" fn bikedyn_answer_len() -> usize {
         ANSWER.with(|a| a.borrow().len())
+    }
+
+    /// The last answer's arrays: the `f64` buffer that its `arrays` field
+    /// points into (8-byte aligned).
+    #[no_mangle]
+    pub extern "C" fn bikedyn_arrays_ptr() -> *const f64 {
+        ARRAYS.with(|a| a.borrow().as_ptr())
+    }
+
+    /// Its length in `f64` elements.
+    #[no_mangle]
+    pub extern "C" fn bikedyn_arrays_len() -> usize {
+        ARRAYS.with(|a| a.borrow().len())
     }
 
     /// The message of the panic that trapped the last call.

@@ -5,7 +5,7 @@
 use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::bicycle::{Bicycle, BicycleError};
 use bikedyn::canonical::{canonical, CanonicalOptions};
-use bikedyn::eigen::{eigen_sweep, EigenOptions, Speeds};
+use bikedyn::eigen::{eigen_sweep, EigenJob, EigenOptions, Speeds};
 use bikedyn::runtime::parameters::{BenchmarkParameters, ThesisParameters};
 use bikedyn::runtime::simulate::{InitialConditions, Inputs, SimOptions};
 use bikedyn::simulate::{simulate, SimulateRequest};
@@ -100,6 +100,11 @@ enum Request {
         /// JSON (the speed slider asks for its one speed with them).
         #[serde(default = "yes")]
         mode_shapes: bool,
+        /// Give the eigenvalues and modes as columns of `f64` (no mode
+        /// shapes or standard deviations; see `arrays.rs`): the explorer's
+        /// diagram over speed.
+        #[serde(default)]
+        arrays: bool,
     },
     /// `bikedyn stability --json`.
     Stability {
@@ -308,8 +313,29 @@ fn bicycle_answer(b: &Bicycle, model: Option<&str>) -> Result<BicycleAnswer, Bic
     })
 }
 
-/// The answer to the UTF-8 JSON request `bytes`.
+/// The answer to the UTF-8 JSON request `bytes` (an answer's arrays, if it
+/// has any, are left out: see [`reply`]).
 pub fn answer(bytes: &[u8]) -> Answer {
+    reply(bytes).answer
+}
+
+/// The answer to a request, with the `f64` buffer that its `arrays` field
+/// points into (empty unless the request asks for arrays).
+pub struct Reply {
+    /// The answer's JSON.
+    pub answer: Answer,
+    /// The numbers of its arrays.
+    pub arrays: Vec<f64>,
+}
+
+/// The answer to the UTF-8 JSON request `bytes`, with its arrays.
+pub fn reply(bytes: &[u8]) -> Reply {
+    let mut arrays = Vec::new();
+    let answer = answer_into(bytes, &mut arrays);
+    Reply { answer, arrays }
+}
+
+fn answer_into(bytes: &[u8], arrays: &mut Vec<f64>) -> Answer {
     let request: Request = match serde_json::from_slice(bytes) {
         Ok(r) => r,
         Err(e) => return error("request", format!("the request is not one this module answers: {e}")),
@@ -331,6 +357,7 @@ pub fn answer(bytes: &[u8]) -> Answer {
             standard_deviations,
             csv,
             mode_shapes,
+            arrays: as_arrays,
         } => {
             let speeds = match speeds {
                 SpeedsSpec::List(v) => Speeds::List(v),
@@ -342,6 +369,22 @@ pub fn answer(bytes: &[u8]) -> Answer {
                 standard_deviations,
                 critical_speeds,
             };
+            if as_arrays {
+                if csv {
+                    return error(
+                        "request",
+                        "`arrays` gives the eigenvalues and modes only: ask for `csv` without it",
+                    );
+                }
+                // Neither standard deviations nor mode shapes go in arrays.
+                let opts = EigenOptions {
+                    standard_deviations: false,
+                    ..opts
+                };
+                return on(&bicycle, "job", |b| {
+                    EigenJob::new(b, &opts).and_then(|job| crate::arrays::eig_arrays(&job, arrays))
+                });
+            }
             on(&bicycle, "job", |b| {
                 eigen_sweep(b, &opts).map(|r| EigAnswer {
                     model: r.model.clone(),

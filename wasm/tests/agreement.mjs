@@ -160,6 +160,41 @@ for (const [bike, spec] of [bicycles[0], bicycles[2], bicycles[bicycles.length -
     (n) => ({ job: "eig", bicycle: spec, speeds: n.ok ? speedsOf(n.ok) : [0], mode_shapes: false }), withoutModeShapes, (w) => w.points);
 }
 
+// The explorer's diagram asks for its eigenvalues and modes as arrays of
+// numbers (`eig` with `arrays`; no mode shapes or standard deviations):
+// the same points, as columns, bit for bit those of the module's JSON (so
+// to the command line's as the JSON is).
+const pair = (a, k) => [a[2 * k], a[2 * k + 1]];
+const eigenvaluesAndModes = (points) => points.map(({ mode_shapes, standard_deviations, ...rest }) => rest);
+const fromArrays = (w) =>
+  Array.from({ length: w.count }, (_, i) => {
+    const a = w.arrays;
+    const p = {
+      eigenvalues: [0, 1, 2, 3].map((k) => pair(a.eigenvalues, 4 * i + k)),
+      modes: [0, 1, 2, 3].map((k) => w.mode_names[a.modes[4 * i + k]]),
+      v: a.v[i],
+    };
+    const e = w.extra_per_speed;
+    if (e) p.extra_eigenvalues = Array.from({ length: e }, (_, k) => pair(a.extra_eigenvalues, e * i + k));
+    return p;
+  });
+const arraysCheck = (name, args, request) => {
+  check(name, args, (n) => ({ ...request(n), arrays: true, critical_speeds: true }), (t) => eigenvaluesAndModes(JSON.parse(t)), (w) => {
+    // The critical speeds beside the arrays are those of the JSON answer.
+    const j = wasm({ ...request({}), critical_speeds: true, mode_shapes: false }).ok;
+    for (const k of ["weave_speed", "capsize_speed", "weave_real_pair_merge_speed", "model"]) {
+      if (!Object.is(j[k], w[k])) throw new Error(`${k}: ${j[k]} (JSON) against ${w[k]} (arrays)`);
+    }
+    const points = fromArrays(w);
+    compare(eigenvaluesAndModes(j.points), points, `${name} (JSON against arrays)`);
+    return points;
+  });
+};
+for (const [bike, spec] of [bicycles[0], bicycles[2], bicycles[bicycles.length - 1]]) {
+  arraysCheck(`eig arrays ${bike}`, ["eig", "--bike", bike, "--speeds", "0:10:0.25", "--format", "json"],
+    () => ({ job: "eig", bicycle: spec, speeds: { start: 0, step: 0.25, count: 41 } }));
+}
+
 // The eigenvalue table as `eig --format csv` writes it (the explorer's
 // download): the same header, and each cell the same text or number.
 const table = (t) => t.trim().split("\n").map((r) => r.split(",").map((c) => (c === "" || isNaN(Number(c)) ? c : Number(c))));
@@ -176,6 +211,9 @@ for (const model of models) {
     ["eig", "--bike", "thesis", "--model", model, "--speeds", "0.5:9.5:1", "--format", "json"],
     (n) => ({ job: "eig", bicycle: { builtin: "thesis" }, model, speeds: n.ok ? speedsOf(n.ok) : [0.5] }),
     JSON.parse, (w) => w.points);
+  arraysCheck(`eig arrays thesis --model ${model}`,
+    ["eig", "--bike", "thesis", "--model", model, "--speeds", "0.5:9.5:1", "--format", "json"],
+    () => ({ job: "eig", bicycle: { builtin: "thesis" }, model, speeds: { start: 0.5, step: 1, count: 10 } }));
   check(`stability thesis --model ${model}`, ["stability", "--bike", "thesis", "--model", model, "--json"],
     () => ({ job: "stability", bicycle: { builtin: "thesis" }, model }));
 }

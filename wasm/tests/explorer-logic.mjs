@@ -125,6 +125,15 @@ if (fs.existsSync(wasm)) {
     assert.equal(e.points.length, 201);
     assert.equal(e.weave_speed.toFixed(4), "4.2924");
     assert.equal(e.capsize_speed.toFixed(4), "6.0243");
+    // The diagram's request: the same eigenvalues and modes as arrays.
+    const a = bd.call({ job: "eig", bicycle: S.bicycleSpec(s, order), speeds: S.speedRange(s), critical_speeds: true, arrays: true });
+    assert.equal(a.count, 201);
+    assert.ok(a.arrays.eigenvalues instanceof Float64Array && a.arrays.eigenvalues.length === 8 * 201);
+    assert.equal(a.weave_speed, e.weave_speed);
+    const i = 120;
+    assert.deepEqual([...a.arrays.eigenvalues.slice(8 * i, 8 * i + 8)], e.points[i].eigenvalues.flat());
+    assert.deepEqual([...a.arrays.modes.slice(4 * i, 4 * i + 4)].map((k) => a.mode_names[k]), e.points[i].modes);
+    assert.equal(a.arrays.v[i], e.points[i].v);
   });
 } else {
   console.log(`  skipped the module's requests: ${wasm} is not built`);

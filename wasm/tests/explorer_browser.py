@@ -505,6 +505,36 @@ def step_bad_file(p, tmp, file_ref):
     p.screenshot("07-after-reset")
 
 
+def step_redraw_time(p):
+    """10. The redraw's time after a parameter change on 1,001 speeds (issue 34's figure: printed, not checked)."""
+    type_into(p, "#vstep", "0.01")
+    p.wait(lambda: "1001 speeds" in (p.text("status") or "") and p.settled(), "the page to redraw on 1,001 speeds")
+    field = p.el('input[data-symbol="c"]')
+    times = []
+    for k in range(11):
+        old = p.el("#v-weave")
+        field.click()
+        field.send_keys(Keys.CONTROL, "a")
+        field.send_keys(f"0.{k + 70}")
+        p.wait_redraw(old, f"typing c = 0.{k + 70}")
+        times.append(p.js("return window.Explorer.redrawMs;"))
+    times.sort()
+    ok(f"redraw after a parameter change, 1,001 speeds (the module's answers and the figures put in the page, "
+       f"before layout and paint): {times[len(times) // 2]:.1f} ms median of {len(times)} "
+       f"(fastest {times[0]:.1f}, slowest {times[-1]:.1f}) [issue 34's target: < 5 ms]")
+
+
+def step_map_time(p):
+    """11. A 100 x 100 stability map's time in the page (issue 34's figure: printed, not checked)."""
+    type_into(p, "#map-nx", "100")
+    type_into(p, "#map-ny", "100")
+    p.el("#map-run").click()
+    p.wait(lambda: " points in " in (p.text("map-status") or ""), "the 100 x 100 map", timeout=120)
+    status = p.text("map-status")
+    check(status.startswith("100 \u00d7 100 points"), f"the map is not 100 x 100: {status!r}")
+    ok(f"stability map in the page, rows computed and drawn as they come: {status} [issue 34's target: < 2 s]")
+
+
 def step_console(p):
     """No script errors in the browser's console."""
     try:
@@ -600,6 +630,8 @@ def main():
             ("7 download the eigenvalue CSV", lambda: step_csv(p, edited, downloads)),
             ("8 a bad file", lambda: step_bad_file(p, tmp, state["file_ref"])),
             ("9 the browser's console", lambda: step_console(p)),
+            ("10 the redraw's time", lambda: step_redraw_time(p)),
+            ("11 the map's time", lambda: step_map_time(p)),
         ]
         for step, run in steps:
             t0 = time.monotonic()

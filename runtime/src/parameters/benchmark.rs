@@ -127,6 +127,39 @@ impl BenchmarkParameters {
             _ => return None,
         })
     }
+
+    /// The field of `symbol`, to set it (`None` for an unknown symbol).
+    pub fn get_mut(&mut self, symbol: &str) -> Option<&mut f64> {
+        Some(match symbol {
+            "w" => &mut self.wheelbase,
+            "c" => &mut self.trail,
+            "lam" => &mut self.steer_axis_tilt,
+            "g" => &mut self.g,
+            "rR" => &mut self.rear_wheel_radius,
+            "mR" => &mut self.rear_wheel_mass,
+            "IRxx" => &mut self.rear_wheel_ixx,
+            "IRyy" => &mut self.rear_wheel_iyy,
+            "xB" => &mut self.rear_frame_com_x,
+            "zB" => &mut self.rear_frame_com_z,
+            "mB" => &mut self.rear_frame_mass,
+            "IBxx" => &mut self.rear_frame_ixx,
+            "IByy" => &mut self.rear_frame_iyy,
+            "IBzz" => &mut self.rear_frame_izz,
+            "IBxz" => &mut self.rear_frame_ixz,
+            "xH" => &mut self.front_frame_com_x,
+            "zH" => &mut self.front_frame_com_z,
+            "mH" => &mut self.front_frame_mass,
+            "IHxx" => &mut self.front_frame_ixx,
+            "IHyy" => &mut self.front_frame_iyy,
+            "IHzz" => &mut self.front_frame_izz,
+            "IHxz" => &mut self.front_frame_ixz,
+            "rF" => &mut self.front_wheel_radius,
+            "mF" => &mut self.front_wheel_mass,
+            "IFxx" => &mut self.front_wheel_ixx,
+            "IFyy" => &mut self.front_wheel_iyy,
+            _ => return None,
+        })
+    }
 }
 
 /// The Meijaard et al. (2007) benchmark bicycle as TOML

@@ -164,6 +164,39 @@ impl ThesisParameters {
             _ => return None,
         })
     }
+
+    /// The field of `symbol`, to set it (`None` for an unknown symbol).
+    pub fn get_mut(&mut self, symbol: &str) -> Option<&mut f64> {
+        Some(match symbol {
+            "Rt" => &mut self.rear_wheel_radius,
+            "Rd" => &mut self.front_wheel_radius,
+            "x3" => &mut self.frame_com_x,
+            "z3" => &mut self.frame_com_z,
+            "x4" => &mut self.steer_point_x,
+            "z4" => &mut self.steer_point_z,
+            "x5" => &mut self.front_wheel_x,
+            "z5" => &mut self.front_wheel_z,
+            "d4" => &mut self.fork_com_offset,
+            "m2" => &mut self.rear_wheel_mass,
+            "m3" => &mut self.frame_mass,
+            "m4" => &mut self.fork_mass,
+            "m5" => &mut self.front_wheel_mass,
+            "I2x" => &mut self.rear_wheel_i_diametral,
+            "I2y" => &mut self.rear_wheel_i_axial,
+            "I3x" => &mut self.frame_ixx,
+            "I3y" => &mut self.frame_iyy,
+            "I3z" => &mut self.frame_izz,
+            "I3zx" => &mut self.frame_ixz,
+            "I4x" => &mut self.fork_ixx,
+            "I4y" => &mut self.fork_iyy,
+            "I4z" => &mut self.fork_izz,
+            "I4xz" => &mut self.fork_ixz,
+            "I5x" => &mut self.front_wheel_i_diametral,
+            "I5y" => &mut self.front_wheel_i_axial,
+            "g" => &mut self.g,
+            _ => return None,
+        })
+    }
 }
 
 /// The thesis bicycle as TOML (`runtime/data/thesis_bicycle.toml`), embedded.
