@@ -22,9 +22,12 @@ pub const DERIVE_COMMAND: &str = "cargo run --release -p bikedyn-modeler --featu
 
 /// The code that turns a model into its emitted file, besides the model
 /// itself: a change to any of it changes every inputs hash.
-const DERIVATION_CODE: [(&str, &str); 3] = [
+const DERIVATION_CODE: [(&str, &str); 6] = [
     ("modeler/src/derive.rs", include_str!("derive.rs")),
     ("modeler/src/emit.rs", include_str!("emit.rs")),
+    ("modeler/src/emit/dag.rs", include_str!("emit/dag.rs")),
+    ("modeler/src/emit/function.rs", include_str!("emit/function.rs")),
+    ("modeler/src/emit/names.rs", include_str!("emit/names.rs")),
     ("modeler/src/snapshot.rs", include_str!("snapshot.rs")),
 ];
 
