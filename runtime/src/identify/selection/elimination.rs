@@ -168,12 +168,7 @@ impl<'s> Search<'s> {
                 None,
             ));
         };
-        let active: Vec<&Candidate> = selected
-            .iter()
-            .enumerate()
-            .filter(|&(i, _)| i != j)
-            .map(|(_, c)| *c)
-            .collect();
+        let active = without_member(selected, j);
         let with_bic = bic(current, self.reference);
         // The exit test is the entry test's criteria without its bar of
         // consistency: a candidate stays while the criterion and the
@@ -252,12 +247,7 @@ impl<'s> Search<'s> {
         selected: &[&Candidate],
         j: usize,
     ) -> Result<Option<CandidateFit>, IdentifyError> {
-        let active: Vec<&Candidate> = selected
-            .iter()
-            .enumerate()
-            .filter(|&(i, _)| i != j)
-            .map(|(_, c)| *c)
-            .collect();
+        let active = without_member(selected, j);
         // The member's parameters in the current values: after those of
         // the candidates before it.
         let offset: usize = selected[..j].iter().map(|c| c.parameters.len()).sum();
@@ -284,4 +274,11 @@ impl<'s> Search<'s> {
         fit.simulations = setup.simulations.load(std::sync::atomic::Ordering::Relaxed);
         Ok(Some(fit))
     }
+}
+
+/// The members of `selected` but the `j`-th, in order.
+fn without_member<'c>(selected: &[&'c Candidate], j: usize) -> Vec<&'c Candidate> {
+    let mut active = selected.to_vec();
+    active.remove(j);
+    active
 }
