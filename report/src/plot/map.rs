@@ -20,6 +20,20 @@ use bikedyn_runtime::sweep::{MapQuantity, StabilityMap};
 const MISSING: RGBColor = RGBColor(200, 200, 200);
 const FAILED: RGBColor = RGBColor(120, 120, 120);
 
+/// The colour at `t` in `[0, 1]` of a map given by evenly spaced stops,
+/// each channel interpolated linearly between the two stops around it.
+fn interpolate(stops: &[(u8, u8, u8)], t: f64) -> RGBColor {
+    let s = t * (stops.len() - 1) as f64;
+    let k = (s.floor() as usize).min(stops.len() - 2);
+    let f = s - k as f64;
+    let lerp = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
+    RGBColor(
+        lerp(stops[k].0, stops[k + 1].0),
+        lerp(stops[k].1, stops[k + 1].1),
+        lerp(stops[k].2, stops[k + 1].2),
+    )
+}
+
 /// Viridis colour map (matplotlib), `t` in `[0, 1]`.
 pub(crate) fn viridis(t: f64) -> RGBColor {
     const C: [(u8, u8, u8); 9] = [
@@ -34,15 +48,7 @@ pub(crate) fn viridis(t: f64) -> RGBColor {
         (253, 231, 37),
     ];
     let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
-    let s = t * (C.len() - 1) as f64;
-    let k = (s.floor() as usize).min(C.len() - 2);
-    let f = s - k as f64;
-    let lerp = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
-    RGBColor(
-        lerp(C[k].0, C[k + 1].0),
-        lerp(C[k].1, C[k + 1].1),
-        lerp(C[k].2, C[k + 1].2),
-    )
+    interpolate(&C, t)
 }
 
 /// Cell edges of a (sorted or unsorted) axis: midpoints between neighbours.
@@ -102,15 +108,7 @@ pub(crate) fn diverging(t: f64) -> RGBColor {
         (178, 24, 43),
     ];
     let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.5 };
-    let s = t * (C.len() - 1) as f64;
-    let k = (s.floor() as usize).min(C.len() - 2);
-    let f = s - k as f64;
-    let lerp = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
-    RGBColor(
-        lerp(C[k].0, C[k + 1].0),
-        lerp(C[k].1, C[k + 1].1),
-        lerp(C[k].2, C[k + 1].2),
-    )
+    interpolate(&C, t)
 }
 
 /// The zero contour of `f` over a grid (marching squares on the cell

@@ -47,12 +47,7 @@ fn canonical_matrices_by<M: MultibodyModel>(
 ) -> Result<CanonicalMatrices, LinearizeError> {
     // At speed 1 directly (a driven model's speed parameter).
     let mut param = parameter_vector::<M>(&lookup, 1.0)?;
-    let g = M::GRAVITY_PARAMETER
-        .map(|k| param[k])
-        .ok_or(LinearizeError::MissingParameter {
-            model: M::NAME,
-            name: "gravity".into(),
-        })?;
+    let g = gravity::<M>(&param)?;
     if !M::STATES.is_empty() {
         return Err(LinearizeError::HasStates { model: M::NAME });
     }
@@ -110,12 +105,7 @@ pub fn canonical_matrices_two_speeds<M: MultibodyModel>(
     lookup: impl Fn(&str) -> Option<f64>,
 ) -> Result<CanonicalMatrices, LinearizeError> {
     let param = parameter_vector::<M>(&lookup, 0.0)?;
-    let g = M::GRAVITY_PARAMETER
-        .map(|k| param[k])
-        .ok_or(LinearizeError::MissingParameter {
-            model: M::NAME,
-            name: "gravity".into(),
-        })?;
+    let g = gravity::<M>(&param)?;
     let l0 = lateral_block::<M>(&linearize_at_speed::<M>(&param, 0.0)?);
     let l1 = lateral_block::<M>(&linearize_at_speed::<M>(&param, 1.0)?);
     let flip = |m: &DMatrix<f64>| Matrix2::new(m[(0, 0)], -m[(0, 1)], -m[(1, 0)], m[(1, 1)]);
@@ -126,4 +116,15 @@ pub fn canonical_matrices_two_speeds<M: MultibodyModel>(
         k2: flip(&(&l1.stiffness - &l0.stiffness)),
         g,
     })
+}
+
+/// The model's gravity from its parameter vector (an error naming the
+/// model when it declares none: the canonical form separates the terms in g).
+fn gravity<M: MultibodyModel>(param: &[f64]) -> Result<f64, LinearizeError> {
+    M::GRAVITY_PARAMETER
+        .map(|k| param[k])
+        .ok_or(LinearizeError::MissingParameter {
+            model: M::NAME,
+            name: "gravity".into(),
+        })
 }
