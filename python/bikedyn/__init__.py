@@ -782,6 +782,7 @@ def identify(
     calibration: Optional[PathLike] = None,
     progress: Optional[ProgressCallback] = None,
     discover: bool = True,
+    max_fits_per_step: Optional[int] = None,
 ) -> IdentifyResult:
     """Close the loop (``bikedyn identify``): fit the base model to measured
     runs, diagnose the residual, select effects and parameter corrections
@@ -798,7 +799,11 @@ def identify(
     does not report). ``discover``: after the library, search a dictionary
     of generalized forces on the roll and steer equations, on the table or
     on the kicks' weave eigenvalues (``result.discovery``; the command
-    line's ``--no-discover`` is ``discover=False``). Returns an
+    line's ``--no-discover`` is ``discover=False``).
+    ``max_fits_per_step``: at most this many candidate fits per step of
+    the library's search beyond its contenders (a compute budget for large
+    sets of runs; default: none, a step that adds nothing has fitted every
+    candidate predicted to gain). Returns an
     :class:`IdentifyResult`: ``selected``, ``parameters`` (each an
     :class:`Estimate` with its 95 % interval), ``error_before`` and
     ``error_after`` (fitted and held out), ``discovery``; ``summary()``,
@@ -807,9 +812,14 @@ def identify(
     # (an int beyond the machine's would be an OverflowError naming nothing).
     folds = _count("folds", folds, 2, 1000)
     corrections = None if corrections is None else _count("corrections", corrections, 0, 1_000_000)
+    max_fits_per_step = (
+        None if max_fits_per_step is None else _count("max_fits_per_step", max_fits_per_step, 1, 1_000_000)
+    )
     stack: List[Any] = []
     spec = None if bike is None else _bicycle(bike)._as_spec(stack)
     if isinstance(paths_or_eigen_table, (str, os.PathLike)) and os.fspath(paths_or_eigen_table).lower().endswith(".csv"):
+        if max_fits_per_step is not None:
+            raise InvalidArgumentError("max_fits_per_step applies to runs and logs, not to an eigenvalue table")
         table = _paths(paths_or_eigen_table, "identify")[0]
         return IdentifyResult._from_json(
             _bikedyn.identify_eigenvalues(table, spec, list(effects), corrections, bool(discover))
@@ -825,6 +835,7 @@ def identify(
             corrections,
             progress,
             bool(discover),
+            max_fits_per_step,
         )
     )
 

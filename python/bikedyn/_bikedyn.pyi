@@ -102,6 +102,7 @@ def identify(
     corrections: Optional[int] = None,
     progress: Optional[Callable[[str, int, Optional[int]], None]] = None,
     discover: bool = True,
+    max_fits_per_step: Optional[int] = None,
 ) -> _IdentifyResult: ...
 def identify_eigenvalues(
     table: str,

@@ -108,9 +108,18 @@ def test_with_parameters_checks_values_as_a_file_would():
 def test_identify_counts_are_checked_and_named():
     # Issue 35, reproducer 26: folds=2**70 and corrections=-1 were an
     # OverflowError that named no argument.
-    for kwargs, name in [({"folds": 2**70}, "folds"), ({"folds": 1}, "folds"), ({"corrections": -1}, "corrections")]:
+    for kwargs, name in [
+        ({"folds": 2**70}, "folds"),
+        ({"folds": 1}, "folds"),
+        ({"corrections": -1}, "corrections"),
+        ({"max_fits_per_step": 0}, "max_fits_per_step"),
+    ]:
         with pytest.raises(bikedyn.InvalidArgumentError, match=name):
             bikedyn.identify("no-such-folder", **kwargs)
+    # A table's search fits every candidate: a budget there is refused by
+    # name, not ignored.
+    with pytest.raises(bikedyn.InvalidArgumentError, match="max_fits_per_step"):
+        bikedyn.identify("table.csv", bike="thesis", max_fits_per_step=4)
 
 
 def test_a_rust_panic_is_an_exception_with_its_message():

@@ -392,6 +392,12 @@ pub struct IdentifyArgs {
     /// names), on the table or on the kicks' weave eigenvalues.
     #[arg(long)]
     pub no_discover: bool,
+    /// Most candidates one step of the library's search fits beyond its
+    /// contenders, best predicted first (a compute budget for large sets;
+    /// the report lists what a step left unfitted). Default: no budget, a
+    /// step that adds nothing has fitted every candidate predicted to gain.
+    #[arg(long, conflicts_with = "eigenvalues", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
+    pub max_fits_per_step: Option<usize>,
     /// Size and resolution of the report's plots; the limits apply to the
     /// continuation diagram.
     #[command(flatten)]

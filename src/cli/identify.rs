@@ -17,6 +17,7 @@ pub fn request(a: &IdentifyArgs) -> IdentifyRequest {
         folds: a.folds,
         corrections: a.corrections,
         discover: !a.no_discover,
+        max_fits_per_step: a.max_fits_per_step,
     }
 }
 

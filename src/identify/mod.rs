@@ -73,6 +73,13 @@ pub struct IdentifyRequest {
     /// After the library, search the dictionary of generalized forces on
     /// the kicks' measured weave eigenvalues ([`discovery`]; default true).
     pub discover: bool,
+    /// Most candidates one step of the library's search fits beyond its
+    /// contenders, best predicted first: a compute budget for large sets
+    /// (a fit of a hundred TU Delft kicks takes tens of seconds), whose
+    /// report lists what a step left unfitted. `None`, the default: a step
+    /// that adds nothing has fitted every candidate the score test
+    /// predicted to gain.
+    pub max_fits_per_step: Option<usize>,
 }
 
 impl Default for IdentifyRequest {
@@ -85,6 +92,7 @@ impl Default for IdentifyRequest {
             folds: 4,
             corrections: None,
             discover: true,
+            max_fits_per_step: None,
         }
     }
 }
@@ -310,6 +318,7 @@ pub fn run_plan<R: ModelRegistry>(
     let cands = &cands;
     let opts = FitSettings {
         folds: request.folds,
+        max_fits_per_step: request.max_fits_per_step,
         ..FitSettings::default()
     };
     // The runtime reports each stage by name, from the fitting threads, with

@@ -351,6 +351,16 @@ fn example_set_report_folder() {
     let set = example_set();
     let j = identify(&set, Some(&dir));
     assert_eq!(j["selected_effects"][0], "steer_damping");
+    // Issue 33, item 1: with no compute budget (the default) the search
+    // ends only when every candidate predicted to gain has been fitted
+    // and failed; none is left unfitted for want of budget.
+    let unfitted: Vec<&Value> = j["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["outcome"]["kind"] == "beyond_budget")
+        .collect();
+    assert!(unfitted.is_empty(), "{unfitted:#?}");
     for f in [
         "report.md",
         "report.json",
@@ -391,6 +401,22 @@ fn bad_inputs_are_clear_errors() {
     assert!(!out.status.success());
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("flux_capacitor") && e.contains("steer_damping"), "{e}");
+    // A compute budget of no fit, or one on a table (whose search fits
+    // every candidate), is refused by name before any work.
+    for (bad, named) in [
+        (vec!["--max-fits-per-step", "0"], "--max-fits-per-step"),
+        (
+            vec!["--max-fits-per-step", "4", "--eigenvalues", "t.csv", "--bike", "thesis"],
+            "--eigenvalues",
+        ),
+    ] {
+        let mut args = vec!["identify", set.to_str().unwrap()];
+        args.extend(bad.iter().copied());
+        let out = bikedyn(&args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(e.contains(named), "{args:?}: {e}");
+    }
 }
 
 /// `identify --eigenvalues`: effects fitted to a table of measured weave

@@ -390,9 +390,12 @@ impl<'s> Search<'s> {
             })
             .collect();
         let mut plan = SearchOrder::of(&predicted);
-        // The compute budget: the contenders, then at most
-        // `max_fits_per_step` more, in the order of the search.
-        let budget = plan.contenders.max(self.opts.max_fits_per_step);
+        // The compute budget, if one is set: the contenders, or
+        // `max_fits_per_step` in the order of the search if more.
+        let budget = self
+            .opts
+            .max_fits_per_step
+            .map_or(plan.order.len(), |most| plan.contenders.max(most));
         for &i in plan.order.iter().skip(budget) {
             pending[i].verdict = Some(Verdict::BeyondBudget {
                 predicted_bic_change: pending[i].predicted.unwrap_or(f64::NAN),

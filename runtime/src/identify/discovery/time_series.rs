@@ -94,6 +94,9 @@ pub enum NotSearched {
     NoTerms,
 }
 
+/// The time series' budget of term fits per step beyond the contenders.
+pub const TERM_FITS_PER_STEP: usize = 8;
+
 /// Search the dictionary's `terms` (candidates of one parameter each, no
 /// prior) in the time series, after the library's identification
 /// `library` of model `M` with base parameters `base` and candidates
@@ -129,6 +132,15 @@ pub fn discover_in_time_series<M: MultibodyModel>(
         selected.push(c);
     }
     let main = Factory::<M>::new(base.to_vec());
+    // Each term's fit is a fit of every kick's whole response, and the
+    // dictionary offers some fifty: a step fits at most
+    // TERM_FITS_PER_STEP beyond its contenders unless the caller set its
+    // own budget (the library's search has none). What a step left unfitted
+    // is in its record.
+    let opts = &IdentifyOptions {
+        max_fits_per_step: Some(opts.max_fits_per_step.unwrap_or(TERM_FITS_PER_STEP)),
+        ..opts.clone()
+    };
     let search = Search {
         main: &main,
         alternative: None,
