@@ -25,6 +25,7 @@
 //! page loads a fresh module.
 
 mod arrays;
+mod explore;
 mod request;
 
 pub use request::{answer, reply, Answer, Reply};
