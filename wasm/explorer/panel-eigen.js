@@ -36,7 +36,9 @@
   /**
    * The series of the diagram: per mode and rank (by real part, the largest
    * first), the real and imaginary parts over speed as flat lists
-   * (`[v, re, v, re, ...]`; a NaN pair breaks the line).
+   * (`[v, re, v, re, ...]`, the first `n` numbers of `re` and `im`; a NaN
+   * pair breaks the line). A series has a point and at most one break per
+   * speed: its lists are made that long at once.
    */
   function eigSeries(eig) {
     const { v, eigenvalues: z, extra_eigenvalues: x } = eig.arrays;
@@ -71,16 +73,18 @@
         if (!byMode.has(mode[j])) byMode.set(mode[j], []);
         const ranks = byMode.get(mode[j]);
         for (let r = 0; r < g; r++) {
-          if (!ranks[r]) series.push((ranks[r] = { mode: mode[j], re: [], im: [], last: -1 }));
+          if (!ranks[r]) series.push((ranks[r] = { mode: mode[j], re: new Float64Array(4 * eig.count), im: new Float64Array(4 * eig.count), n: 0, last: -1 }));
           const s = ranks[r];
           // Pad the gap since the series' last point (a pair that merged or split).
-          if (s.re.length && s.last !== i - 1) {
-            s.re.push(NaN, NaN);
-            s.im.push(NaN, NaN);
+          if (s.n && s.last !== i - 1) {
+            s.re[s.n] = s.im[s.n] = s.re[s.n + 1] = s.im[s.n + 1] = NaN;
+            s.n += 2;
           }
           const l = group[r];
-          s.re.push(v[i], re[l]);
-          s.im.push(v[i], im[l] > 1e-9 ? im[l] : NaN);
+          s.re[s.n] = s.im[s.n] = v[i];
+          s.re[s.n + 1] = re[l];
+          s.im[s.n + 1] = im[l] > 1e-9 ? im[l] : NaN;
+          s.n += 2;
           s.last = i;
         }
       }
@@ -121,8 +125,8 @@
       fig.add(P.shape("rect", { "data-band": 1, x: x0, y: top, width: Math.max(0, x1 - x0), height: fig.ph, fill: "#d9f0d3", stroke: "none" }));
     }
     const series = eigSeries(app.eig);
-    for (const s of series) fig.add(P.line(fig, s.im, { stroke: modeColour(s.mode), "stroke-dasharray": "6 4", "stroke-width": 1.6 }));
-    for (const s of series) fig.add(P.line(fig, s.re, { stroke: modeColour(s.mode), "stroke-width": 2 }));
+    for (const s of series) fig.add(P.line(fig, s.im, { stroke: modeColour(s.mode), "stroke-dasharray": "6 4", "stroke-width": 1.6 }, s.n));
+    for (const s of series) fig.add(P.line(fig, s.re, { stroke: modeColour(s.mode), "stroke-width": 2 }, s.n));
     // Critical speeds.
     const marks = [
       ["v_w", app.eig.weave_speed, "weave"],

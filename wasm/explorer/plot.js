@@ -300,25 +300,35 @@
     return fig;
   }
 
-  /** Polylines through the points [x0, y0, x1, y1, ...] in data coordinates (a list of shapes); breaks at non-finite points. */
-  function line(fig, pts, attrs = {}) {
+  /**
+   * Polylines through the points [x0, y0, x1, y1, ...] in data coordinates
+   * (the first `n` numbers of `pts`), a list of shapes; breaks at
+   * non-finite points. The pixels go to one typed array that the shapes
+   * share: a diagram's lines have thousands of points, redrawn after every
+   * change, and growing lists of them kept the garbage collector busy.
+   */
+  function line(fig, pts, attrs = {}, n = pts.length) {
     const a = Object.assign({ fill: "none", stroke: "#000", "stroke-width": 1.8, "stroke-linejoin": "round", "stroke-linecap": "round" }, attrs);
     const out = [];
-    let cur = [];
+    const px = new Float64Array(n);
+    let start = 0;
+    let k = 0;
     const end = () => {
-      if (cur.length > 2) out.push(shape("polyline", a, { pts: cur }));
-      cur = [];
+      if (k - start > 2) out.push(shape("polyline", a, { pts: px.subarray(start, k) }));
+      start = k;
     };
-    // fig.x and fig.y written out: a diagram's line has a thousand points.
+    // fig.x and fig.y written out.
     const [x0, x1] = fig.xlim;
     const [y0, y1] = fig.ylim;
     const { left, top } = fig.margin;
     const { pw, ph } = fig;
-    for (let i = 0; i < pts.length; i += 2) {
+    for (let i = 0; i < n; i += 2) {
       const u = pts[i];
       const v = pts[i + 1];
-      if (Number.isFinite(u) && Number.isFinite(v)) cur.push(left + ((u - x0) / (x1 - x0)) * pw, top + ph - ((v - y0) / (y1 - y0)) * ph);
-      else end();
+      if (Number.isFinite(u) && Number.isFinite(v)) {
+        px[k++] = left + ((u - x0) / (x1 - x0)) * pw;
+        px[k++] = top + ph - ((v - y0) / (y1 - y0)) * ph;
+      } else end();
     }
     end();
     return out;
