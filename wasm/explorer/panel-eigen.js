@@ -125,8 +125,9 @@
       fig.add(P.shape("rect", { "data-band": 1, x: x0, y: top, width: Math.max(0, x1 - x0), height: fig.ph, fill: "#d9f0d3", stroke: "none" }));
     }
     const series = eigSeries(app.eig);
-    for (const s of series) fig.add(P.line(fig, s.im, { stroke: modeColour(s.mode), "stroke-dasharray": "6 4", "stroke-width": 1.6 }, s.n));
-    for (const s of series) fig.add(P.line(fig, s.re, { stroke: modeColour(s.mode), "stroke-width": 2 }, s.n));
+    // Each series' lists become its lines' pixels (they are the figure's own).
+    for (const s of series) fig.add(P.line(fig, s.im, { stroke: modeColour(s.mode), "stroke-dasharray": "6 4", "stroke-width": 1.6 }, s.n, s.im));
+    for (const s of series) fig.add(P.line(fig, s.re, { stroke: modeColour(s.mode), "stroke-width": 2 }, s.n, s.re));
     // Critical speeds.
     const marks = [
       ["v_w", app.eig.weave_speed, "weave"],
@@ -311,21 +312,30 @@
     const [v0, v1] = [app.state.vmin, app.state.vmax];
     // The points as dots, one shape per colour, the colour bar's 48 steps
     // (in SVG one path each: 4,000 circle elements took the browser 36 ms
-    // to parse and lay out, 2026-11-29).
-    const dots = Array.from({ length: LOCUS_COLOURS }, () => []);
+    // to parse and lay out, 2026-11-29); the colours' points in one typed
+    // array, counted first.
+    const colour = new Int32Array(eig.count);
+    const start = new Int32Array(LOCUS_COLOURS + 1);
     for (let i = 0; i < eig.count; i++) {
       const t = (eig.arrays.v[i] - v0) / (v1 - v0 || 1);
-      const k = Math.max(0, Math.min(LOCUS_COLOURS - 1, Math.floor(t * LOCUS_COLOURS)));
-      const d = dots[k];
+      colour[i] = Math.max(0, Math.min(LOCUS_COLOURS - 1, Math.floor(t * LOCUS_COLOURS)));
+      start[colour[i] + 1] += 2 * (4 + e);
+    }
+    for (let k = 0; k < LOCUS_COLOURS; k++) start[k + 1] += start[k];
+    const pts = new Float64Array(start[LOCUS_COLOURS]);
+    const end = start.slice(0, LOCUS_COLOURS);
+    for (let i = 0; i < eig.count; i++) {
       for (let m = 0; m < 4 + e; m++) {
         const w = m < 4 ? z : x;
         const j = at(e, i, m);
-        d.push(fig.x(w[j]), fig.y(w[j + 1]));
+        pts[end[colour[i]]++] = fig.x(w[j]);
+        pts[end[colour[i]]++] = fig.y(w[j + 1]);
       }
     }
-    dots.forEach((d, k) => {
-      if (d.length) fig.add(P.shape("dots", { "data-locus": d.length / 2, stroke: P.viridis((k + 0.5) / LOCUS_COLOURS), "stroke-width": 4.2 }, { pts: d }));
-    });
+    for (let k = 0; k < LOCUS_COLOURS; k++) {
+      const n = end[k] - start[k];
+      if (n) fig.add(P.shape("dots", { "data-locus": n / 2, stroke: P.viridis((k + 0.5) / LOCUS_COLOURS), "stroke-width": 4.2 }, { pts: pts.subarray(start[k], end[k]) }));
+    }
     if (app.atSpeed) {
       for (const [re, im] of app.atSpeed.eigenvalues.concat(app.atSpeed.extra_eigenvalues || [])) {
         fig.add(P.shape("circle", { cx: fig.x(re), cy: fig.y(im), r: 5.5, fill: "none", stroke: "#d00", "stroke-width": 1.6 }));

@@ -304,13 +304,13 @@
    * Polylines through the points [x0, y0, x1, y1, ...] in data coordinates
    * (the first `n` numbers of `pts`), a list of shapes; breaks at
    * non-finite points. The pixels go to one typed array that the shapes
-   * share: a diagram's lines have thousands of points, redrawn after every
-   * change, and growing lists of them kept the garbage collector busy.
+   * share, `px`, which may be `pts` itself (a point is read before it is
+   * overwritten): a diagram's lines have thousands of points, redrawn after
+   * every change, and making lists of them kept the garbage collector busy.
    */
-  function line(fig, pts, attrs = {}, n = pts.length) {
+  function line(fig, pts, attrs = {}, n = pts.length, px = new Float64Array(n)) {
     const a = Object.assign({ fill: "none", stroke: "#000", "stroke-width": 1.8, "stroke-linejoin": "round", "stroke-linecap": "round" }, attrs);
     const out = [];
-    const px = new Float64Array(n);
     let start = 0;
     let k = 0;
     const end = () => {
