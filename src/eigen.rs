@@ -12,10 +12,10 @@
 use crate::bicycle::{Bicycle, BicycleError, Linear};
 use crate::registry::ModelRegistry;
 use crate::sensitivity::EigenvalueSpread;
-use bikedyn_report::output::{mode_shape, ordered_indices, ModeShape};
+use bikedyn_report::output::{mode_shape, ordered_indices, output_order, ModeShape};
 use bikedyn_runtime::eigen::{
-    critical_speeds_of, eigen_sweep_of, eigenvalues_of, CriticalSpeeds, EigenError, EigenPoint, EigenSweep,
-    LinearBicycle,
+    critical_speeds_of, eigen_sweep_of, eigenvalue_sweep_of, eigenvalues_of, CriticalSpeeds, EigenError, EigenPoint,
+    EigenSweep, LinearBicycle, Mode,
 };
 use nalgebra::Complex;
 use rayon::prelude::*;
@@ -320,7 +320,7 @@ impl EigenJob {
             eigenvalues,
             modes,
             extra_eigenvalues,
-        } = EigenvaluesAtSpeed::of(&p, &idx);
+        } = EigenvaluesAtSpeed::of(p.v, &p.eigenvalues, &p.modes, &p.extra_eigenvalues, &idx);
         let standard_deviations = self.spread.as_ref().map(|s| s.of_eigenvalues(p.v, &eigenvalues));
         EigenAtSpeed {
             eigenvalues,
@@ -336,14 +336,22 @@ impl EigenJob {
     /// Every speed's eigenvalues and modes alone, in the order and with the
     /// values of [`EigenJob::points`], without mode shapes or standard
     /// deviations: a diagram over speed draws no more (the browser's, where
-    /// the mode shapes were a sixth of its time, 2026-11-29).
+    /// the mode shapes were a sixth of its time, 2026-11-29, and the
+    /// eigenvectors they come from a tenth of what was left, 2026-11-30).
     pub fn eigenvalues_and_modes(&self) -> Result<Vec<EigenvaluesAtSpeed>, EigenSweepError> {
         let n = self.speeds.len();
         let mut out = Vec::with_capacity(n);
         for start in (0..n).step_by(BLOCK) {
             let speeds: Vec<f64> = (start..(start + BLOCK).min(n)).map(|k| self.speeds.at(k)).collect();
-            for p in eigen_sweep_of(&self.lin, &speeds)?.points {
-                out.push(EigenvaluesAtSpeed::of(&p, &ordered_indices(&p)));
+            for p in eigenvalue_sweep_of(&self.lin, &speeds)? {
+                let idx = output_order(&p.modes, &p.eigenvalues);
+                out.push(EigenvaluesAtSpeed::of(
+                    p.v,
+                    &p.eigenvalues,
+                    &p.modes,
+                    &p.extra_eigenvalues,
+                    &idx,
+                ));
             }
         }
         Ok(out)
@@ -365,13 +373,19 @@ pub struct EigenvaluesAtSpeed {
 }
 
 impl EigenvaluesAtSpeed {
-    /// Point `p`'s, in the output order `idx` ([`ordered_indices`]).
-    fn of(p: &EigenPoint, idx: &[usize; 4]) -> Self {
+    /// A speed's, in the output order `idx` ([`output_order`]).
+    fn of(
+        v: f64,
+        eigenvalues: &[Complex<f64>; 4],
+        modes: &[Mode; 4],
+        extra: &[Complex<f64>],
+        idx: &[usize; 4],
+    ) -> Self {
         EigenvaluesAtSpeed {
-            v: p.v,
-            eigenvalues: idx.map(|k| [p.eigenvalues[k].re, p.eigenvalues[k].im]),
-            modes: idx.map(|k| p.modes[k].name()),
-            extra_eigenvalues: p.extra_eigenvalues.iter().map(|z| [z.re, z.im]).collect(),
+            v,
+            eigenvalues: idx.map(|k| [eigenvalues[k].re, eigenvalues[k].im]),
+            modes: idx.map(|k| modes[k].name()),
+            extra_eigenvalues: extra.iter().map(|z| [z.re, z.im]).collect(),
         }
     }
 }

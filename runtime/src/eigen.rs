@@ -65,7 +65,10 @@ mod states;
 mod tracking;
 
 pub use critical::critical_speeds;
-pub use general::{critical_speeds_of, eigen_sweep_of, eigenvalues_of, LinearBicycle, SpeedMatrices};
+pub use general::{
+    critical_speeds_of, eigen_sweep_of, eigenvalue_sweep_of, eigenvalues_of, LabelledEigenvalues, LinearBicycle,
+    SpeedMatrices,
+};
 use quartic::{quartic_roots, sort_desc, C64};
 pub use states::{LateralStates, StateSpaceBicycle};
 use tracking::*;

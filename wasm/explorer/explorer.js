@@ -31,9 +31,9 @@
     state: S.decode(location.hash),
     base: null, // the `bicycle` answer of the bicycle before edits
     current: null, // ... after edits and effects
-    eig: null, // the `eig` answer over the speed range
-    stab: null, // the `stability` answer (self-stable band)
-    atSpeed: null, // the `eig` answer at the slider's speed
+    eig: null, // the `explore` answer: the eigenvalues over the speed range (arrays)
+    stableIntervals: null, // the self-stable speeds [[from, to]] in the range
+    atSpeed: null, // the eigenvalues and mode shapes at the slider's speed
     effectParams: [], // [{name, default, doc, effect}], the models' effect parameters
     units: {}, // benchmark symbol -> {unit, what}, from the TOML's comments
     mapResult: null,
@@ -196,43 +196,48 @@
     if (location.hash !== h) history.replaceState(null, "", h);
   }
 
+  // The times of the last update, for the status line and the browser
+  // test: `redrawMs` from the request to the diagram painted (the module's
+  // one answer, which also brings the bicycle, the self-stable band and
+  // the slider's speed, and the eigenvalue diagram drawn on its canvas),
+  // `updateMs` to everything the change updates on the page (also the
+  // parameter and derived tables, the critical speeds' text, the slider's
+  // table and mode shapes, the root locus and the link). Both stop before
+  // the browser lays out and paints the page.
   function update() {
-    // The redraw's time (the module's answers and the figures' SVG put in
-    // the page; not the browser's layout and paint after it), for the
-    // status line and the browser test's figure.
     const started = performance.now();
-    writeHash();
     const spec = bicycleSpec();
-    const b = call(withModel({ job: "bicycle", bicycle: spec }));
-    if (b.error) {
-      showError(b.error);
+    const range = S.speedRange(app.state);
+    const r = call(withModel({ job: "explore", bicycle: spec, speeds: range, speed_min: app.state.vmin, speed_max: app.state.vmax, speed: app.state.speed }));
+    if (r.error) {
+      // The bicycle is shown as long as it can be made: the module's
+      // message is that of the first job that failed.
+      const b = r.kind === "job" ? call(withModel({ job: "bicycle", bicycle: spec })) : null;
+      showError(r.error);
       status("error");
+      if (b && b.ok) {
+        app.current = b.ok;
+        app.renderBicycle();
+      }
       markStale(true);
-      return;
-    }
-    app.current = b.ok;
-    const speeds = S.speedRange(app.state);
-    // The diagram draws eigenvalues and modes, which come as arrays of
-    // numbers (panel-eigen.js); the slider asks for its speed's mode shapes
-    // itself.
-    const e = call(withModel({ job: "eig", bicycle: spec, speeds, critical_speeds: true, arrays: true }));
-    if (e.error) {
-      showError(e.error);
-      status("error");
-      app.renderBicycle();
-      markStale(true);
+      writeHash();
       return;
     }
     showError("");
-    app.eig = e.ok;
-    const s = call(withModel({ job: "stability", bicycle: spec, speed_min: app.state.vmin, speed_max: app.state.vmax }));
-    app.stab = s.ok || null;
+    const answer = r.ok;
+    app.eig = answer;
+    app.current = answer.bicycle;
+    app.stableIntervals = answer.stable_intervals;
+    app.atSpeed = answer.at_speed;
+    app.drawDiagram();
+    app.redrawMs = performance.now() - started;
     markStale(false);
     app.renderBicycle();
     app.renderCritical();
-    app.updateSpeed();
-    app.redrawMs = performance.now() - started;
-    status(`${app.current.name} \u00b7 model ${app.eig.model} \u00b7 ${app.eig.count} speeds \u00b7 ${fmt(app.redrawMs, 1)} ms`);
+    app.showSpeed();
+    writeHash();
+    app.updateMs = performance.now() - started;
+    status(`${app.current.name} \u00b7 model ${app.eig.model} \u00b7 ${app.eig.count} speeds \u00b7 diagram ${fmt(app.redrawMs, 1)} ms, whole update ${fmt(app.updateMs, 1)} ms`);
   }
 
   function markStale(stale) {

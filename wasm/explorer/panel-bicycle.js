@@ -28,6 +28,10 @@
     const f = app.current && app.current.feedback;
     $("feedback").hidden = !f;
     const table = $("feedback-table");
+    // A parameter edit leaves the file's controller as it is.
+    const key = f ? JSON.stringify(f) : "";
+    if (table.dataset.shown === key) return;
+    table.dataset.shown = key;
     table.tHead.innerHTML = "";
     table.tBodies[0].innerHTML = "";
     if (!f) return;
@@ -85,8 +89,12 @@
       const input = tr.querySelector("input");
       const sym = input.dataset.symbol;
       tr.classList.toggle("edited", sym in app.state.edits);
-      // The bicycle's value where not typed in (and not being typed).
-      if (!(sym in app.state.edits) && document.activeElement !== input && sym in values) input.value = String(values[sym]);
+      // The bicycle's value where not typed in (and not being typed); a
+      // row whose value is the same is left alone.
+      if (!(sym in app.state.edits) && document.activeElement !== input && sym in values) {
+        const v = String(values[sym]);
+        if (input.value !== v) input.value = v;
+      }
     }
   }
 
@@ -111,18 +119,15 @@
 
   function renderDerived() {
     const tbody = $("derived").tBodies[0];
-    tbody.innerHTML = "";
-    if (!app.current) return;
-    const row = (sym, v, unit, what, computed) => {
-      const tr = document.createElement("tr");
-      tr.innerHTML = "<td class=sym></td><td class=num></td><td class=unit></td><td class=what></td>";
-      tr.cells[0].textContent = sym;
-      tr.cells[1].textContent = sig(v, 6);
-      tr.cells[2].textContent = unit;
-      tr.cells[3].textContent = what + (computed ? " (computed on this page)" : "");
-      if (computed) tr.classList.add("computed");
-      tbody.appendChild(tr);
-    };
+    if (!app.current) {
+      tbody.innerHTML = "";
+      delete tbody.dataset.symbols;
+      return;
+    }
+    // The rows are those of the last bicycle but for their values (a
+    // parameter edit): only the values are written then.
+    const rows = [];
+    const row = (sym, v, unit, what, computed) => rows.push([sym, sig(v, 6), unit, what, computed]);
     const d = Object.fromEntries(app.current.derived_geometry.map((r) => [r.symbol, r.value]));
     for (const r of app.current.derived_geometry) row(r.symbol, r.value, r.unit, r.what, false);
     // Radii of gyration, k = sqrt(I / m): the definition (e.g. Moore 2012,
@@ -139,6 +144,26 @@
         if (I === undefined) continue;
         row(`k${body}${ax}`, k(I, b[`m${body}`]), "m", `${name} radius of gyration about ${ax[0]}, sqrt(I${body}${ax}/m${body})`, true);
       }
+    }
+    const symbols = rows.map((r) => r[0]).join(" ");
+    if (tbody.dataset.symbols === symbols) {
+      rows.forEach((r, i) => {
+        const cell = tbody.rows[i].cells[1];
+        if (cell.textContent !== r[1]) cell.textContent = r[1];
+      });
+      return;
+    }
+    tbody.dataset.symbols = symbols;
+    tbody.innerHTML = "";
+    for (const [sym, value, unit, what, computed] of rows) {
+      const tr = document.createElement("tr");
+      tr.innerHTML = "<td class=sym></td><td class=num></td><td class=unit></td><td class=what></td>";
+      tr.cells[0].textContent = sym;
+      tr.cells[1].textContent = value;
+      tr.cells[2].textContent = unit;
+      tr.cells[3].textContent = what + (computed ? " (computed on this page)" : "");
+      if (computed) tr.classList.add("computed");
+      tbody.appendChild(tr);
     }
   }
 

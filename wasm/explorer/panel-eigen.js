@@ -14,64 +14,95 @@
 
   // ---- eigenvalues over speed ------------------------------------------------
 
-  // The diagram's points come as columns of numbers (`eig` with `arrays`,
-  // wasm/README.md), not one object per speed: text for 1,000 speeds took
-  // longer to write, decode and parse than the eigenvalues to compute.
+  // The diagram's points come as columns of numbers (`explore`, as `eig`
+  // with `arrays`, wasm/README.md), not one object per speed: text for
+  // 1,000 speeds took longer to write, decode and parse than the
+  // eigenvalues to compute.
   // Speed i is v[i]; its four eigenvalues are eigenvalues[8i .. 8i + 8]
   // (re, im in turn), with modes mode_names[modes[4i + k]]; a model's tyre
   // states add extra_per_speed more from extra_eigenvalues.
 
-  /** Calls f(re, im, mode) for each eigenvalue at speed i of the diagram `eig` ("extra": a tyre state's). */
-  function eigenvaluesAt(eig, i, f) {
-    const { eigenvalues: z, modes, extra_eigenvalues: x } = eig.arrays;
-    for (let k = 0; k < 4; k++) f(z[8 * i + 2 * k], z[8 * i + 2 * k + 1], eig.mode_names[modes[4 * i + k]]);
-    const e = eig.extra_per_speed;
-    for (let k = e * i; k < e * (i + 1); k++) f(x[2 * k], x[2 * k + 1], "extra");
-  }
+  // The figures read the eigenvalues straight from these arrays, without
+  // an object or a callback per eigenvalue: the diagram is redrawn after
+  // every change, and its 1,000 speeds were drawn in more time than the
+  // module took to compute them otherwise (2026-11-30).
 
-  /** The series of the eig plot: per mode and rank, real and imaginary parts over speed. */
+  /** Eigenvalue k of speed i in the arrays of `eig` (its four, then its tyre states'): the index of its real part in `z` or `x`. */
+  const at = (e, i, k) => (k < 4 ? 8 * i + 2 * k : 2 * (e * i + k - 4));
+
+  /** The mode of eigenvalue k at speed i ("extra": a tyre state's). */
+  const modeOf = (eig, i, k) => (k < 4 ? eig.mode_names[eig.arrays.modes[4 * i + k]] : "extra");
+
+  /**
+   * The series of the diagram: per mode and rank (by real part, the largest
+   * first), the real and imaginary parts over speed as flat lists
+   * (`[v, re, v, re, ...]`, the first `n` numbers of `re` and `im`; a NaN
+   * pair breaks the line). A series has a point and at most one break per
+   * speed: its lists are made that long at once.
+   */
   function eigSeries(eig) {
-    const series = new Map(); // key -> {mode, re: [[v, re]], im: [[v, im]]}
-    const get = (key, mode) => {
-      if (!series.has(key)) series.set(key, { mode, re: [], im: [] });
-      return series.get(key);
-    };
-    const v = eig.arrays.v;
+    const { v, eigenvalues: z, extra_eigenvalues: x } = eig.arrays;
+    const e = eig.extra_per_speed;
+    const series = []; // in the order first met
+    const byMode = new Map(); // mode -> its series by rank
+    // One speed's eigenvalues in the upper half plane (a conjugate pair is drawn once).
+    const re = [], im = [], mode = [], done = [], group = [];
     for (let i = 0; i < eig.count; i++) {
-      const groups = {};
-      eigenvaluesAt(eig, i, (re, im, mode) => {
-        if (im < 0) return; // a conjugate pair is drawn once
-        (groups[mode] ||= []).push([re, im]);
-      });
-      for (const [mode, list] of Object.entries(groups)) {
-        list.sort((a, b) => b[0] - a[0]);
-        list.forEach(([re, im], k) => {
-          const s = get(`${mode}#${k}`, mode);
+      let n = 0;
+      for (let k = 0; k < 4 + e; k++) {
+        const w = k < 4 ? z : x;
+        const j = at(e, i, k);
+        if (w[j + 1] < 0) continue;
+        re[n] = w[j];
+        im[n] = w[j + 1];
+        mode[n] = modeOf(eig, i, k);
+        done[n] = false;
+        n += 1;
+      }
+      for (let j = 0; j < n; j++) {
+        if (done[j]) continue;
+        // This mode's eigenvalues, the largest real part first (on a tie, in their order).
+        let g = 0;
+        for (let l = j; l < n; l++) {
+          if (mode[l] !== mode[j]) continue;
+          done[l] = true;
+          let q = g++;
+          for (; q > 0 && re[group[q - 1]] < re[l]; q--) group[q] = group[q - 1];
+          group[q] = l;
+        }
+        if (!byMode.has(mode[j])) byMode.set(mode[j], []);
+        const ranks = byMode.get(mode[j]);
+        for (let r = 0; r < g; r++) {
+          if (!ranks[r]) series.push((ranks[r] = { mode: mode[j], re: new Float64Array(4 * eig.count), im: new Float64Array(4 * eig.count), n: 0, last: -1 }));
+          const s = ranks[r];
           // Pad the gap since the series' last point (a pair that merged or split).
-          if (s.re.length && s.last !== i - 1) {
-            s.re.push([NaN, NaN]);
-            s.im.push([NaN, NaN]);
+          if (s.n && s.last !== i - 1) {
+            s.re[s.n] = s.im[s.n] = s.re[s.n + 1] = s.im[s.n + 1] = NaN;
+            s.n += 2;
           }
-          s.re.push([v[i], re]);
-          s.im.push([v[i], im > 1e-9 ? im : NaN]);
+          const l = group[r];
+          s.re[s.n] = s.im[s.n] = v[i];
+          s.re[s.n + 1] = re[l];
+          s.im[s.n + 1] = im[l] > 1e-9 ? im[l] : NaN;
+          s.n += 2;
           s.last = i;
-        });
+        }
       }
     }
-    return [...series.values()];
+    return series;
   }
 
   function eigLimits(eig, clip = 10) {
     let lo = Infinity;
     let hi = -Infinity;
-    for (let i = 0; i < eig.count; i++) {
-      eigenvaluesAt(eig, i, (re, im) => {
-        for (const x of [re, Math.abs(im)]) {
-          if (!Number.isFinite(x)) continue;
-          lo = Math.min(lo, x);
-          hi = Math.max(hi, x);
-        }
-      });
+    // Every real part and every imaginary part's size, finite.
+    for (const w of [eig.arrays.eigenvalues, eig.arrays.extra_eigenvalues]) {
+      for (let j = 0; j < w.length; j++) {
+        const x = j % 2 ? Math.abs(w[j]) : w[j];
+        if (!Number.isFinite(x)) continue;
+        lo = Math.min(lo, x);
+        hi = Math.max(hi, x);
+      }
     }
     lo = Math.max(lo, -clip);
     hi = Math.min(hi, clip);
@@ -79,20 +110,24 @@
     return P.niceLimits(lo, hi, 8);
   }
 
-  function eigFigureSvg(width = 760, height = 440) {
+  /** The eigenvalue diagram's figure (plot.js): painted on the page, written as SVG for its download. */
+  function eigFigure(width = 760, height = 440) {
     const xlim = [app.state.vmin, app.state.vmax];
     const ylim = eigLimits(app.eig);
     const fig = P.figure({ width, height, xlim, ylim, xlabel: "forward speed v (m/s)", ylabel: "eigenvalue (1/s)", margin: { top: 36 } });
+    const top = fig.margin.top;
+    const bottom = top + fig.ph;
     // The self-stable band(s).
-    const band = app.stab ? app.stab.stable_intervals : [];
+    const band = app.stableIntervals || [];
     for (const [a, b] of band) {
       const x0 = fig.x(Math.max(a, xlim[0]));
       const x1 = fig.x(b === null || b === undefined ? xlim[1] : Math.min(b, xlim[1]));
-      fig.add(`<rect data-band="1" x="${P.n(x0)}" y="${P.n(fig.margin.top)}" width="${P.n(Math.max(0, x1 - x0))}" height="${P.n(fig.ph)}" fill="#d9f0d3" stroke="none"/>`);
+      fig.add(P.shape("rect", { "data-band": 1, x: x0, y: top, width: Math.max(0, x1 - x0), height: fig.ph, fill: "#d9f0d3", stroke: "none" }));
     }
     const series = eigSeries(app.eig);
-    for (const s of series) fig.add(P.line(fig, s.im, { stroke: modeColour(s.mode), "stroke-dasharray": "6 4", "stroke-width": 1.6 }));
-    for (const s of series) fig.add(P.line(fig, s.re, { stroke: modeColour(s.mode), "stroke-width": 2 }));
+    // Each series' lists become its lines' pixels (they are the figure's own).
+    for (const s of series) fig.add(P.line(fig, s.im, { stroke: modeColour(s.mode), "stroke-dasharray": "6 4", "stroke-width": 1.6 }, s.n, s.im));
+    for (const s of series) fig.add(P.line(fig, s.re, { stroke: modeColour(s.mode), "stroke-width": 2 }, s.n, s.re));
     // Critical speeds.
     const marks = [
       ["v_w", app.eig.weave_speed, "weave"],
@@ -104,33 +139,71 @@
     shownMarks.sort((a, b) => a[1] - b[1]);
     for (const [label, v, what] of shownMarks) {
       const x = fig.x(v);
-      fig.add(`<line x1="${P.n(x)}" y1="${P.n(fig.margin.top)}" x2="${P.n(x)}" y2="${P.n(fig.margin.top + fig.ph)}" stroke="#333" stroke-width="0.9" stroke-dasharray="2 3"/>`);
+      fig.add(P.shape("line", { x1: x, y1: top, x2: x, y2: bottom, stroke: "#333", "stroke-width": 0.9, "stroke-dasharray": "2 3" }));
       const text = `${label} = ${fmt(v, 3)}`;
       const w = text.length * 6;
       // Inside the plot's width: anchored at the start near the left edge, at the end near the right.
       const left = Math.min(Math.max(x - w / 2, fig.margin.left), fig.margin.left + fig.pw - w);
       const row = left < lastRight + 4 ? 1 : 0;
       lastRight = row ? lastRight : left + w;
-      fig.over(`<text data-critical="${what}" x="${P.n(left)}" y="${P.n(fig.margin.top - 6 - row * 12)}" font-size="11">${text}</text>`);
+      fig.over(P.text(left, top - 6 - row * 12, text, { "data-critical": what, "font-size": 11 }));
     }
     // The slider's speed.
     if (app.state.speed >= xlim[0] && app.state.speed <= xlim[1]) {
       const x = fig.x(app.state.speed);
-      fig.add(`<line x1="${P.n(x)}" y1="${P.n(fig.margin.top)}" x2="${P.n(x)}" y2="${P.n(fig.margin.top + fig.ph)}" stroke="#888" stroke-width="1.2"/>`);
+      fig.add(P.shape("line", { x1: x, y1: top, x2: x, y2: bottom, stroke: "#888", "stroke-width": 1.2 }));
     }
     const modes = [...new Set(series.map((s) => s.mode))];
     const items = modes.map((m) => ({ label: m === "extra" ? "tyre states" : m, color: modeColour(m) }));
     items.push({ label: "real part", color: "#000" }, { label: "imaginary part", color: "#000", dash: "6 4" });
     if (band.length) items.push({ label: "self-stable", fill: "#d9f0d3" });
     fig.over(P.legend(fig, items, "bottom-right"));
-    return fig.svg();
+    return fig;
+  }
+
+  const eigFigureSvg = () => eigFigure().svg();
+
+  /** The canvas of figure `id`'s element (made on first use). */
+  function canvasOf(id) {
+    const host = $(id);
+    let c = host.firstElementChild;
+    if (!c || c.tagName !== "CANVAS") {
+      host.textContent = "";
+      c = host.appendChild(document.createElement("canvas"));
+    }
+    return c;
+  }
+
+  /**
+   * Paints the eigenvalue diagram. What it shows is also written on its
+   * canvas as data attributes (the number of lines and bands, the critical
+   * speeds' labels), for the page's tests: a canvas keeps no elements.
+   */
+  function drawDiagram() {
+    const fig = eigFigure();
+    const c = canvasOf("eig-plot");
+    fig.paint(c);
+    let lines = 0;
+    let bands = 0;
+    const labels = {};
+    for (const s of fig.shapes()) {
+      if (s.tag === "polyline") lines += 1;
+      else if (s.a["data-band"]) bands += 1;
+      else if (s.a["data-critical"]) labels[s.a["data-critical"]] = s.text;
+    }
+    c.dataset.lines = String(lines);
+    c.dataset.bands = String(bands);
+    for (const what of ["weave", "capsize", "merge"]) {
+      if (what in labels) c.dataset[what] = labels[what];
+      else delete c.dataset[what];
+    }
   }
 
   function renderCritical() {
     const c = $("critical");
     const v = (x) => fmt(x, 4);
-    const bands = app.stab && app.stab.stable_intervals.length
-      ? app.stab.stable_intervals.map(([a, b]) => `${fmt(a, 3)}\u2013${b === null || b === undefined ? "\u221e" : fmt(b, 3)}`).join(", ") + " m/s"
+    const bands = app.stableIntervals && app.stableIntervals.length
+      ? app.stableIntervals.map(([a, b]) => `${fmt(a, 3)}\u2013${b === null || b === undefined ? "\u221e" : fmt(b, 3)}`).join(", ") + " m/s"
       : "none in the range";
     c.innerHTML = `<span>weave speed v<sub>w</sub> = <b id="v-weave"></b> m/s</span>
       <span>capsize speed v<sub>c</sub> = <b id="v-capsize"></b> m/s</span>
@@ -144,14 +217,18 @@
 
   // ---- the slider's speed: table, mode shapes, root locus ------------------
 
+  /** The slider's speed: its eigenvalues and mode shapes asked for, then shown. */
   function updateSpeed() {
-    $("speed-out").textContent = `${fmt(app.state.speed, 2)} m/s`;
-    const r = call(withModel({ job: "eig", bicycle: bicycleSpec(), speeds: [app.state.speed] }));
+    const r = call(withModel({ job: "eig", bicycle: bicycleSpec(), speeds: [app.state.speed], standard_deviations: false }));
     app.atSpeed = r.ok ? r.ok.points[0] : null;
-    if (app.eig) {
-      $("eig-plot").innerHTML = eigFigureSvg();
-      $("locus-plot").innerHTML = locusSvg();
-    }
+    if (app.eig) drawDiagram();
+    showSpeed();
+  }
+
+  /** The panels of the slider's speed (`app.atSpeed`): its text, table, mode shapes and the root locus. */
+  function showSpeed() {
+    $("speed-out").textContent = `${fmt(app.state.speed, 2)} m/s`;
+    if (app.eig) drawLocus();
     renderEigTable();
     $("modes").innerHTML = app.atSpeed ? modesSvg() : "";
   }
@@ -215,42 +292,68 @@
 
   const LOCUS_COLOURS = 48; // the colour bar's steps (plot.js)
 
-  function locusSvg(width = 760, height = 420) {
+  /** The root locus's figure (plot.js): painted on the page, written as SVG for its download. */
+  function locusFigure(width = 760, height = 420) {
     const eig = app.eig;
+    const { eigenvalues: z, extra_eigenvalues: x } = eig.arrays;
+    const e = eig.extra_per_speed;
     let xlo = Infinity, xhi = -Infinity, yhi = 0;
-    for (let i = 0; i < eig.count; i++) {
-      eigenvaluesAt(eig, i, (re, im) => {
-        xlo = Math.min(xlo, re);
-        xhi = Math.max(xhi, re);
-        yhi = Math.max(yhi, Math.abs(im));
-      });
+    for (const w of [z, x]) {
+      for (let j = 0; j < w.length; j += 2) {
+        xlo = Math.min(xlo, w[j]);
+        xhi = Math.max(xhi, w[j]);
+        yhi = Math.max(yhi, Math.abs(w[j + 1]));
+      }
     }
     const clip = 12;
     const xlim = P.niceLimits(Math.max(xlo, -clip), Math.min(xhi, clip), 8);
     const ym = P.niceLimits(0, Math.max(1, Math.min(yhi, clip)), 4)[1];
     const fig = P.figure({ width, height, xlim, ylim: [-ym, ym], xlabel: "real part (1/s)", ylabel: "imaginary part (1/s)", zeroX: true, margin: { right: 90 } });
     const [v0, v1] = [app.state.vmin, app.state.vmax];
-    // The points as dots (zero-length strokes with round caps), one path
-    // per colour, the colour bar's 48 steps: 4,000 circle elements took
-    // the browser 36 ms to parse and lay out at every redraw (1,000 speeds,
-    // 2026-11-29), more than all else of it.
-    const dots = Array.from({ length: LOCUS_COLOURS }, () => []);
+    // The points as dots, one shape per colour, the colour bar's 48 steps
+    // (in SVG one path each: 4,000 circle elements took the browser 36 ms
+    // to parse and lay out, 2026-11-29); the colours' points in one typed
+    // array, counted first.
+    const colour = new Int32Array(eig.count);
+    const start = new Int32Array(LOCUS_COLOURS + 1);
     for (let i = 0; i < eig.count; i++) {
       const t = (eig.arrays.v[i] - v0) / (v1 - v0 || 1);
-      const k = Math.max(0, Math.min(LOCUS_COLOURS - 1, Math.floor(t * LOCUS_COLOURS)));
-      eigenvaluesAt(eig, i, (re, im) => dots[k].push(`M${P.n(fig.x(re))} ${P.n(fig.y(im))}h0`));
+      colour[i] = Math.max(0, Math.min(LOCUS_COLOURS - 1, Math.floor(t * LOCUS_COLOURS)));
+      start[colour[i] + 1] += 2 * (4 + e);
     }
-    dots.forEach((d, k) => {
-      if (d.length) fig.add(`<path data-locus="${d.length}" d="${d.join("")}" fill="none" stroke="${P.viridis((k + 0.5) / LOCUS_COLOURS)}" stroke-width="4.2" stroke-linecap="round"/>`);
-    });
+    for (let k = 0; k < LOCUS_COLOURS; k++) start[k + 1] += start[k];
+    const pts = new Float64Array(start[LOCUS_COLOURS]);
+    const end = start.slice(0, LOCUS_COLOURS);
+    for (let i = 0; i < eig.count; i++) {
+      for (let m = 0; m < 4 + e; m++) {
+        const w = m < 4 ? z : x;
+        const j = at(e, i, m);
+        pts[end[colour[i]]++] = fig.x(w[j]);
+        pts[end[colour[i]]++] = fig.y(w[j + 1]);
+      }
+    }
+    for (let k = 0; k < LOCUS_COLOURS; k++) {
+      const n = end[k] - start[k];
+      if (n) fig.add(P.shape("dots", { "data-locus": n / 2, stroke: P.viridis((k + 0.5) / LOCUS_COLOURS), "stroke-width": 4.2 }, { pts: pts.subarray(start[k], end[k]) }));
+    }
     if (app.atSpeed) {
       for (const [re, im] of app.atSpeed.eigenvalues.concat(app.atSpeed.extra_eigenvalues || [])) {
-        fig.add(`<circle cx="${P.n(fig.x(re))}" cy="${P.n(fig.y(im))}" r="5.5" fill="none" stroke="#d00" stroke-width="1.6"/>`);
+        fig.add(P.shape("circle", { cx: fig.x(re), cy: fig.y(im), r: 5.5, fill: "none", stroke: "#d00", "stroke-width": 1.6 }));
       }
-      fig.over(`<text x="${P.n(fig.margin.left + 6)}" y="${P.n(fig.margin.top + 14)}" font-size="11" fill="#d00">\u25cb v = ${fmt(app.state.speed, 2)} m/s</text>`);
+      fig.over(P.text(fig.margin.left + 6, fig.margin.top + 14, `\u25cb v = ${fmt(app.state.speed, 2)} m/s`, { "font-size": 11, fill: "#d00" }));
     }
     fig.over(P.colorbar(fig, v0, v1, P.viridis, "speed v (m/s)"));
-    return fig.svg();
+    return fig;
+  }
+
+  const locusSvg = () => locusFigure().svg();
+
+  /** Paints the root locus; its number of points is written on its canvas (as the diagram's, for the tests). */
+  function drawLocus() {
+    const fig = locusFigure();
+    const c = canvasOf("locus-plot");
+    fig.paint(c);
+    c.dataset.points = String(fig.shapes().reduce((n, s) => n + (s.tag === "dots" ? s.a["data-locus"] : 0), 0));
   }
 
   // ---- the speed range and the slider ------------------------------------------
@@ -285,5 +388,5 @@
   }
 
   // Used by the other files.
-  Object.assign(app, { eigFigureSvg, renderCritical, updateSpeed, modesSvg, locusSvg, readSpeedInputs, syncSlider, setSpeed });
+  Object.assign(app, { eigFigureSvg, drawDiagram, renderCritical, showSpeed, modesSvg, locusSvg, readSpeedInputs, syncSlider, setSpeed });
 })(window.Explorer);

@@ -74,8 +74,8 @@
       fig.add(`<line x1="${P.n(fig.x(s.time))}" y1="${P.n(fig.margin.top)}" x2="${P.n(fig.x(s.time))}" y2="${P.n(fig.margin.top + fig.ph)}" stroke="#999" stroke-dasharray="2 3"/>`);
       fig.over(`<text x="${P.n(fig.x(s.time) + 4)}" y="${P.n(fig.margin.top + fig.ph - 6)}" font-size="11" fill="#666">kick ${sig(s.impulse, 3)} N s</text>`);
     }
-    fig.add(P.line(fig, t.map((x, i) => [x, roll[i]]), { stroke: "#0072B2" }));
-    fig.add(P.line(fig, t.map((x, i) => [x, steer[i]]), { stroke: "#D55E00" }));
+    fig.add(P.line(fig, t.flatMap((x, i) => [x, roll[i]]), { stroke: "#0072B2" }));
+    fig.add(P.line(fig, t.flatMap((x, i) => [x, steer[i]]), { stroke: "#D55E00" }));
     fig.add(`<line data-cursor="1" x1="0" y1="${P.n(fig.margin.top)}" x2="0" y2="${P.n(fig.margin.top + fig.ph)}" stroke="#000" stroke-width="1" stroke-opacity="0.5"/>`);
     fig.over(P.legend(fig, [{ label: "roll \u03c6 (right +)", color: "#0072B2" }, { label: "steer \u03b4 (right +)", color: "#D55E00" }]));
     simFig = fig;
@@ -135,7 +135,7 @@
 
   function viewSvg(g, project, xlim, ylim, extra, width = 370, height = 300) {
     const fig = P.figure({ width, height, xlim, ylim, grid: true, zeroY: false, margin: { left: 44, bottom: 34, top: 10, right: 10 }, xtickCount: 4, ytickCount: 4 });
-    const pl = (pts, a) => P.line(fig, pts.map(project), a);
+    const pl = (pts, a) => P.line(fig, pts.flatMap(project), a);
     fig.add(extra(fig));
     fig.add(pl(g.rear, { stroke: "#333", "stroke-width": 2 }));
     fig.add(pl(g.front, { stroke: "#333", "stroke-width": 2 }));
@@ -172,7 +172,7 @@
     const xs = roleSeries("rear_contact_X");
     const ys = roleSeries("rear_contact_Y");
     $("sim-top").innerHTML = viewSvg(g, (p) => [p[0], p[1]], [cx - w / 2, cx + w / 2], [cy - h / 2, cy + h / 2],
-      (fig) => P.line(fig, xs.map((x, k) => [x, ys[k]]), { stroke: "#aaa", "stroke-width": 1.2, "stroke-dasharray": "4 3" }));
+      (fig) => P.line(fig, xs.flatMap((x, k) => [x, ys[k]]), { stroke: "#aaa", "stroke-width": 1.2, "stroke-dasharray": "4 3" }));
     if (simFig) {
       const cur = $("sim-plot").querySelector("line[data-cursor]");
       if (cur) {

@@ -1,7 +1,8 @@
-// A small SVG plotting library for the stability explorer: axes with nice
-// ticks, lines, markers, shaded bands, colour maps. Figures are SVG text
-// with inline attributes only (no CSS), so that a downloaded figure looks
-// as it does on the page and goes into a paper as it is.
+// A small plotting library for the stability explorer: axes with nice
+// ticks, lines, markers, shaded bands, colour maps. A figure is drawn as
+// SVG text with inline attributes only (no CSS), so that a downloaded
+// figure looks as it does on the page and goes into a paper as it is, or
+// painted on a canvas from the same shapes.
 //
 // A classic script: in a page it defines the global `BikedynPlot`; in
 // Node.js it is a CommonJS module (the tests import it).
@@ -62,11 +63,142 @@
     return Number(s) === 0 ? (0).toFixed(decimals) : s.replace(/^-/, "\u2212");
   }
 
+  // ---- shapes: one description, drawn as SVG text or on a canvas ----------
+  //
+  // A figure is a list of shapes in pixels: `{tag, a, pts, text, rotate}`,
+  // with `tag` an SVG element's name, `a` its SVG attributes (numbers or
+  // strings), `pts` a polyline's or dots' coordinates (x, y in turn) and
+  // `text` a text's. The same list is written as SVG (a download, the
+  // figures of other panels) or painted on a canvas (the diagrams redrawn
+  // after every change: writing, parsing and laying out the SVG of a
+  // 1,000-speed diagram took the browser longer than the module took to
+  // compute it, 2026-11-29). A figure may also take SVG text (`add` of a
+  // string): such a figure is SVG only.
+
+  const shape = (tag, a, more) => Object.assign({ tag, a }, more);
+  /** A text shape at (x, y) (its baseline; `text-anchor` as in SVG). */
+  const text = (x, y, s, a = {}) => shape("text", Object.assign({ x, y }, a), { text: String(s) });
+
+  function attrText(a) {
+    let out = "";
+    for (const k in a) out += ` ${k}="${typeof a[k] === "number" ? n(a[k]) : esc(a[k])}"`;
+    return out;
+  }
+
+  /** A shape (or SVG text) as SVG text. */
+  function shapeSvg(s) {
+    if (typeof s === "string") return s;
+    const p = s.pts;
+    switch (s.tag) {
+      case "polyline": {
+        const xy = [];
+        for (let i = 0; i < p.length; i += 2) xy.push(`${n(p[i])},${n(p[i + 1])}`);
+        return `<polyline points="${xy.join(" ")}"${attrText(s.a)}/>`;
+      }
+      case "dots": {
+        // Zero-length strokes with round caps: one path for many dots.
+        let d = "";
+        for (let i = 0; i < p.length; i += 2) d += `M${n(p[i])} ${n(p[i + 1])}h0`;
+        return `<path d="${d}" fill="none" stroke-linecap="round"${attrText(s.a)}/>`;
+      }
+      case "text": {
+        if (!s.rotate) return `<text${attrText(s.a)}>${esc(s.text)}</text>`;
+        const { x, y, ...rest } = s.a;
+        return `<text transform="translate(${n(x)} ${n(y)}) rotate(${s.rotate})"${attrText(rest)}>${esc(s.text)}</text>`;
+      }
+      default:
+        return `<${s.tag}${attrText(s.a)}/>`;
+    }
+  }
+
+  const ALIGN = { start: "left", middle: "center", end: "right" };
+
+  /**
+   * Paints a shape as the browser draws its SVG (the attributes the figures
+   * use). `pass` is what the painting of one figure keeps between shapes:
+   * the font last set (setting a canvas's font parses it, every time).
+   */
+  function paintShape(ctx, s, pass) {
+    if (typeof s === "string") throw new Error("plot.js: a figure with SVG text is drawn as SVG only");
+    const a = s.a;
+    const p = s.pts;
+    ctx.lineWidth = a["stroke-width"] ?? 1;
+    ctx.setLineDash(a["stroke-dasharray"] ? String(a["stroke-dasharray"]).split(/[ ,]+/).map(Number) : []);
+    ctx.lineCap = a["stroke-linecap"] || "butt";
+    ctx.lineJoin = a["stroke-linejoin"] || "miter";
+    const fill = a.fill ?? "#000"; // SVG's default fill
+    const stroke = a.stroke ?? "none";
+    const paint = () => {
+      if (fill !== "none") {
+        ctx.globalAlpha = a["fill-opacity"] ?? 1;
+        ctx.fillStyle = fill;
+        ctx.fill();
+        ctx.globalAlpha = 1;
+      }
+      if (stroke !== "none") {
+        ctx.strokeStyle = stroke;
+        ctx.stroke();
+      }
+    };
+    ctx.beginPath();
+    switch (s.tag) {
+      case "line":
+        ctx.moveTo(a.x1, a.y1);
+        ctx.lineTo(a.x2, a.y2);
+        if (stroke !== "none") {
+          ctx.strokeStyle = stroke;
+          ctx.stroke();
+        }
+        return;
+      case "polyline":
+        ctx.moveTo(p[0], p[1]);
+        for (let i = 2; i < p.length; i += 2) ctx.lineTo(p[i], p[i + 1]);
+        return paint();
+      case "dots":
+        // As in the SVG, zero-length strokes with round caps: Chromium's
+        // canvas draws their caps, discs as wide as the stroke, in a
+        // quarter of the time of as many arcs (2026-11-30).
+        for (let i = 0; i < p.length; i += 2) {
+          ctx.moveTo(p[i], p[i + 1]);
+          ctx.lineTo(p[i], p[i + 1]);
+        }
+        ctx.lineCap = "round";
+        ctx.strokeStyle = stroke;
+        ctx.stroke();
+        return;
+      case "rect":
+        ctx.rect(a.x, a.y, a.width, a.height);
+        return paint();
+      case "circle":
+        ctx.arc(a.cx, a.cy, a.r, 0, 2 * Math.PI);
+        return paint();
+      case "text": {
+        const font = `${a["font-weight"] || "normal"} ${a["font-size"] ?? 12}px ${FONT}`;
+        if (pass.font !== font) ctx.font = pass.font = font;
+        ctx.textAlign = ALIGN[a["text-anchor"] || "start"];
+        ctx.fillStyle = fill;
+        if (!s.rotate) {
+          ctx.fillText(s.text, a.x, a.y);
+          return;
+        }
+        ctx.save();
+        ctx.translate(a.x, a.y);
+        ctx.rotate((s.rotate * Math.PI) / 180);
+        ctx.fillText(s.text, 0, 0);
+        ctx.restore();
+        return;
+      }
+      default:
+        throw new Error(`plot.js: no painting for <${s.tag}>`);
+    }
+  }
+
   /**
    * A figure: `figure({width, height, xlim, ylim, xlabel, ylabel, title})`
-   * returns an object with `x(v)`, `y(v)` (data to pixels), `add(svgText)`
-   * to draw in the plotting area (clipped), `over(svgText)` to draw above
-   * the axes, and `svg()` for the finished SVG text.
+   * returns an object with `x(v)`, `y(v)` (data to pixels), `add(shapes)`
+   * to draw in the plotting area (clipped), `over(shapes)` to draw above
+   * the axes (each a shape, a list of them, or SVG text), `svg()` for the
+   * finished SVG text and `paint(canvas)` to draw the same on a canvas.
    */
   function figure(o) {
     const width = o.width ?? 640;
@@ -78,72 +210,131 @@
     const ph = height - m.top - m.bottom;
     const x = (v) => m.left + ((v - x0) / (x1 - x0)) * pw;
     const y = (v) => m.top + ph - ((v - y0) / (y1 - y0)) * ph;
-    const clip = `clip${Math.random().toString(36).slice(2, 9)}`;
     const body = [];
     const above = [];
+    const push = (list, s) => {
+      if (Array.isArray(s)) for (const t of s) list.push(t);
+      else list.push(s);
+    };
+
+    /** The grid (under the data) and the axes (over it). */
+    function axes() {
+      const xt = o.xticks ?? niceTicks(x0, x1, o.xtickCount ?? Math.max(3, Math.round(pw / 80)));
+      const yt = o.yticks ?? niceTicks(y0, y1, o.ytickCount ?? Math.max(3, Math.round(ph / 50)));
+      const xs = xt.length > 1 ? xt[1] - xt[0] : 1;
+      const ys = yt.length > 1 ? yt[1] - yt[0] : 1;
+      const grid = [];
+      const over = [];
+      const seg = (x1_, y1_, x2_, y2_, stroke, w) => shape("line", Object.assign({ x1: x1_, y1: y1_, x2: x2_, y2: y2_, stroke }, w === undefined ? {} : { "stroke-width": w }));
+      if (o.grid !== false) {
+        for (const t of xt) if (t >= x0 && t <= x1) grid.push(seg(x(t), m.top, x(t), m.top + ph, "#e6e6e6", 1));
+        for (const t of yt) if (t >= y0 && t <= y1) grid.push(seg(m.left, y(t), m.left + pw, y(t), "#e6e6e6", 1));
+      }
+      if (o.zeroY !== false && y0 < 0 && y1 > 0) over.push(seg(m.left, y(0), m.left + pw, y(0), "#000", 0.8));
+      if (o.zeroX && x0 < 0 && x1 > 0) over.push(seg(x(0), m.top, x(0), m.top + ph, "#000", 0.8));
+      over.push(shape("rect", { x: m.left, y: m.top, width: pw, height: ph, fill: "none", stroke: "#000", "stroke-width": 1 }));
+      for (const t of xt) {
+        if (t < x0 || t > x1) continue;
+        over.push(seg(x(t), m.top + ph, x(t), m.top + ph + 5, "#000"));
+        over.push(text(x(t), m.top + ph + 18, tickLabel(t, xs), { "text-anchor": "middle" }));
+      }
+      for (const t of yt) {
+        if (t < y0 || t > y1) continue;
+        over.push(seg(m.left - 5, y(t), m.left, y(t), "#000"));
+        over.push(text(m.left - 8, y(t) + 4, tickLabel(t, ys), { "text-anchor": "end" }));
+      }
+      if (o.xlabel) over.push(text(m.left + pw / 2, height - 10, o.xlabel, { "text-anchor": "middle", "font-size": 13 }));
+      if (o.ylabel) over.push(Object.assign(text(15, m.top + ph / 2, o.ylabel, { "text-anchor": "middle", "font-size": 13 }), { rotate: -90 }));
+      if (o.title) over.push(text(m.left, 19, o.title, { "font-size": 13, "font-weight": "bold" }));
+      return { grid, over };
+    }
+
     const fig = {
       x, y, width, height, margin: m, pw, ph, xlim: o.xlim, ylim: o.ylim,
-      add(s) { body.push(s); return fig; },
-      over(s) { above.push(s); return fig; },
+      add(s) { push(body, s); return fig; },
+      over(s) { push(above, s); return fig; },
+      /** The shapes added (not the axes'). */
+      shapes() { return body.concat(above); },
       svg() {
-        const xt = o.xticks ?? niceTicks(x0, x1, o.xtickCount ?? Math.max(3, Math.round(pw / 80)));
-        const yt = o.yticks ?? niceTicks(y0, y1, o.ytickCount ?? Math.max(3, Math.round(ph / 50)));
-        const xs = xt.length > 1 ? xt[1] - xt[0] : 1;
-        const ys = yt.length > 1 ? yt[1] - yt[0] : 1;
+        const clip = `clip${Math.random().toString(36).slice(2, 9)}`;
+        const { grid, over } = axes();
         const g = [];
         g.push(`<svg xmlns="http://www.w3.org/2000/svg" width="${width}" height="${height}" viewBox="0 0 ${width} ${height}" font-family="${FONT}" font-size="12">`);
         g.push(`<rect x="0" y="0" width="${width}" height="${height}" fill="#ffffff"/>`);
         g.push(`<defs><clipPath id="${clip}"><rect x="${n(m.left)}" y="${n(m.top)}" width="${n(pw)}" height="${n(ph)}"/></clipPath></defs>`);
-        // Grid.
-        if (o.grid !== false) {
-          for (const t of xt) if (t >= x0 && t <= x1) g.push(`<line x1="${n(x(t))}" y1="${n(m.top)}" x2="${n(x(t))}" y2="${n(m.top + ph)}" stroke="#e6e6e6" stroke-width="1"/>`);
-          for (const t of yt) if (t >= y0 && t <= y1) g.push(`<line x1="${n(m.left)}" y1="${n(y(t))}" x2="${n(m.left + pw)}" y2="${n(y(t))}" stroke="#e6e6e6" stroke-width="1"/>`);
-        }
-        g.push(`<g clip-path="url(#${clip})">`, ...body, `</g>`);
-        // Zero lines.
-        if (o.zeroY !== false && y0 < 0 && y1 > 0) g.push(`<line x1="${n(m.left)}" y1="${n(y(0))}" x2="${n(m.left + pw)}" y2="${n(y(0))}" stroke="#000" stroke-width="0.8"/>`);
-        if (o.zeroX && x0 < 0 && x1 > 0) g.push(`<line x1="${n(x(0))}" y1="${n(m.top)}" x2="${n(x(0))}" y2="${n(m.top + ph)}" stroke="#000" stroke-width="0.8"/>`);
-        // Frame, ticks, labels.
-        g.push(`<rect x="${n(m.left)}" y="${n(m.top)}" width="${n(pw)}" height="${n(ph)}" fill="none" stroke="#000" stroke-width="1"/>`);
-        for (const t of xt) {
-          if (t < x0 || t > x1) continue;
-          g.push(`<line x1="${n(x(t))}" y1="${n(m.top + ph)}" x2="${n(x(t))}" y2="${n(m.top + ph + 5)}" stroke="#000"/>`);
-          g.push(`<text x="${n(x(t))}" y="${n(m.top + ph + 18)}" text-anchor="middle">${tickLabel(t, xs)}</text>`);
-        }
-        for (const t of yt) {
-          if (t < y0 || t > y1) continue;
-          g.push(`<line x1="${n(m.left - 5)}" y1="${n(y(t))}" x2="${n(m.left)}" y2="${n(y(t))}" stroke="#000"/>`);
-          g.push(`<text x="${n(m.left - 8)}" y="${n(y(t) + 4)}" text-anchor="end">${tickLabel(t, ys)}</text>`);
-        }
-        if (o.xlabel) g.push(`<text x="${n(m.left + pw / 2)}" y="${n(height - 10)}" text-anchor="middle" font-size="13">${esc(o.xlabel)}</text>`);
-        if (o.ylabel) g.push(`<text transform="translate(15 ${n(m.top + ph / 2)}) rotate(-90)" text-anchor="middle" font-size="13">${esc(o.ylabel)}</text>`);
-        if (o.title) g.push(`<text x="${n(m.left)}" y="19" font-size="13" font-weight="bold">${esc(o.title)}</text>`);
-        g.push(...above, `</svg>`);
+        for (const s of grid) g.push(shapeSvg(s));
+        g.push(`<g clip-path="url(#${clip})">`);
+        for (const s of body) g.push(shapeSvg(s));
+        g.push(`</g>`);
+        for (const s of over.concat(above)) g.push(shapeSvg(s));
+        g.push(`</svg>`);
         return g.join("\n");
+      },
+      /** Draws the figure on `canvas` (sized to the figure; sharp on a high-density screen). */
+      paint(canvas) {
+        const dpr = (typeof window !== "undefined" && window.devicePixelRatio) || 1;
+        if (canvas.width !== Math.round(width * dpr) || canvas.height !== Math.round(height * dpr)) {
+          canvas.width = Math.round(width * dpr);
+          canvas.height = Math.round(height * dpr);
+          canvas.style.width = `${width}px`; // the height follows (CSS: auto)
+        }
+        const ctx = canvas.getContext("2d");
+        ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+        ctx.fillStyle = "#ffffff";
+        ctx.fillRect(0, 0, width, height);
+        const { grid, over } = axes();
+        const pass = { font: "" };
+        for (const s of grid) paintShape(ctx, s, pass);
+        ctx.save();
+        ctx.beginPath();
+        ctx.rect(m.left, m.top, pw, ph);
+        ctx.clip();
+        for (const s of body) paintShape(ctx, s, pass);
+        ctx.restore();
+        pass.font = ""; // as it was before the clip
+        for (const s of over) paintShape(ctx, s, pass);
+        for (const s of above) paintShape(ctx, s, pass);
+        return fig;
       },
     };
     return fig;
   }
 
-  /** A polyline through [[x, y], ...] in data coordinates; breaks at non-finite points. */
-  function line(fig, pts, attrs = {}) {
-    const parts = [];
-    let cur = [];
-    for (const [a, b] of pts) {
-      if (Number.isFinite(a) && Number.isFinite(b)) cur.push(`${n(fig.x(a))},${n(fig.y(b))}`);
-      else if (cur.length) { parts.push(cur); cur = []; }
+  /**
+   * Polylines through the points [x0, y0, x1, y1, ...] in data coordinates
+   * (the first `n` numbers of `pts`), a list of shapes; breaks at
+   * non-finite points. The pixels go to one typed array that the shapes
+   * share, `px`, which may be `pts` itself (a point is read before it is
+   * overwritten): a diagram's lines have thousands of points, redrawn after
+   * every change, and making lists of them kept the garbage collector busy.
+   */
+  function line(fig, pts, attrs = {}, n = pts.length, px = new Float64Array(n)) {
+    const a = Object.assign({ fill: "none", stroke: "#000", "stroke-width": 1.8, "stroke-linejoin": "round", "stroke-linecap": "round" }, attrs);
+    const out = [];
+    let start = 0;
+    let k = 0;
+    const end = () => {
+      if (k - start > 2) out.push(shape("polyline", a, { pts: px.subarray(start, k) }));
+      start = k;
+    };
+    // fig.x and fig.y written out.
+    const [x0, x1] = fig.xlim;
+    const [y0, y1] = fig.ylim;
+    const { left, top } = fig.margin;
+    const { pw, ph } = fig;
+    for (let i = 0; i < n; i += 2) {
+      const u = pts[i];
+      const v = pts[i + 1];
+      if (Number.isFinite(u) && Number.isFinite(v)) {
+        px[k++] = left + ((u - x0) / (x1 - x0)) * pw;
+        px[k++] = top + ph - ((v - y0) / (y1 - y0)) * ph;
+      } else end();
     }
-    if (cur.length) parts.push(cur);
-    const at = Object.entries(Object.assign({ fill: "none", stroke: "#000", "stroke-width": 1.8, "stroke-linejoin": "round", "stroke-linecap": "round" }, attrs))
-      .map(([k, v]) => `${k}="${esc(v)}"`).join(" ");
-    return parts.filter((p) => p.length > 1).map((p) => `<polyline points="${p.join(" ")}" ${at}/>`).join("\n");
+    end();
+    return out;
   }
 
-  function attrs(a) {
-    return Object.entries(a).map(([k, v]) => `${k}="${esc(v)}"`).join(" ");
-  }
-
-  /** A legend box: items [{label, color, dash, marker, fill}] at the top right (or `where`). */
+  /** A legend box (a list of shapes): items [{label, color, dash, marker, fill}] at the top right (or `where`). */
   function legend(fig, items, where = "right") {
     const lh = 17;
     const w = Math.max(...items.map((i) => i.label.length)) * 6.6 + 40;
@@ -151,15 +342,15 @@
     // `where`: "right" (top right), "left" (top left), "bottom-right", "bottom-left".
     const x0 = /left/.test(where) ? fig.margin.left + 8 : fig.margin.left + fig.pw - w - 8;
     const y0 = /bottom/.test(where) ? fig.margin.top + fig.ph - h - 8 : fig.margin.top + 8;
-    const g = [`<rect x="${n(x0)}" y="${n(y0)}" width="${n(w)}" height="${n(h)}" fill="#ffffff" fill-opacity="0.9" stroke="#999" stroke-width="0.6"/>`];
+    const g = [shape("rect", { x: x0, y: y0, width: w, height: h, fill: "#ffffff", "fill-opacity": 0.9, stroke: "#999", "stroke-width": 0.6 })];
     items.forEach((it, k) => {
       const yy = y0 + 4 + lh * k + lh / 2;
-      if (it.marker) g.push(`<circle cx="${n(x0 + 17)}" cy="${n(yy)}" r="3.5" fill="${esc(it.color)}"/>`);
-      else if (it.fill) g.push(`<rect x="${n(x0 + 7)}" y="${n(yy - 5)}" width="20" height="10" fill="${esc(it.fill)}" stroke="none"/>`);
-      else g.push(`<line x1="${n(x0 + 7)}" y1="${n(yy)}" x2="${n(x0 + 27)}" y2="${n(yy)}" stroke="${esc(it.color)}" stroke-width="2" ${it.dash ? `stroke-dasharray="${esc(it.dash)}"` : ""}/>`);
-      g.push(`<text x="${n(x0 + 33)}" y="${n(yy + 4)}" font-size="11.5">${esc(it.label)}</text>`);
+      if (it.marker) g.push(shape("circle", { cx: x0 + 17, cy: yy, r: 3.5, fill: it.color }));
+      else if (it.fill) g.push(shape("rect", { x: x0 + 7, y: yy - 5, width: 20, height: 10, fill: it.fill, stroke: "none" }));
+      else g.push(shape("line", Object.assign({ x1: x0 + 7, y1: yy, x2: x0 + 27, y2: yy, stroke: it.color, "stroke-width": 2 }, it.dash ? { "stroke-dasharray": it.dash } : {})));
+      g.push(text(x0 + 33, yy + 4, it.label, { "font-size": 11.5 }));
     });
-    return g.join("\n");
+    return g;
   }
 
   // Colour maps: viridis (sequential) and a blue-white-red diverging map,
@@ -182,7 +373,7 @@
   const viridis = (t) => colormap(VIRIDIS, t);
   const diverging = (t) => colormap(DIVERGING, t);
 
-  /** A vertical colour bar at the right of `fig` for values [lo, hi]. */
+  /** A vertical colour bar (a list of shapes) at the right of `fig` for values [lo, hi]. */
   function colorbar(fig, lo, hi, map, label) {
     const x0 = fig.margin.left + fig.pw + 14;
     const w = 14;
@@ -191,20 +382,20 @@
     for (let k = 0; k < steps; k += 1) {
       const t0 = k / steps;
       const yy = fig.margin.top + fig.ph * (1 - (k + 1) / steps);
-      g.push(`<rect x="${n(x0)}" y="${n(yy)}" width="${w}" height="${n(fig.ph / steps + 0.6)}" fill="${map(t0 + 0.5 / steps)}"/>`);
+      g.push(shape("rect", { x: x0, y: yy, width: w, height: fig.ph / steps + 0.6, fill: map(t0 + 0.5 / steps) }));
     }
-    g.push(`<rect x="${n(x0)}" y="${n(fig.margin.top)}" width="${w}" height="${n(fig.ph)}" fill="none" stroke="#000" stroke-width="0.8"/>`);
+    g.push(shape("rect", { x: x0, y: fig.margin.top, width: w, height: fig.ph, fill: "none", stroke: "#000", "stroke-width": 0.8 }));
     const ticks = niceTicks(lo, hi, 5);
     const step = ticks.length > 1 ? ticks[1] - ticks[0] : 1;
     for (const t of ticks) {
       if (t < lo || t > hi) continue;
       const yy = fig.margin.top + fig.ph * (1 - (t - lo) / (hi - lo || 1));
-      g.push(`<line x1="${n(x0 + w)}" y1="${n(yy)}" x2="${n(x0 + w + 4)}" y2="${n(yy)}" stroke="#000"/>`);
-      g.push(`<text x="${n(x0 + w + 7)}" y="${n(yy + 4)}" font-size="11">${tickLabel(t, step)}</text>`);
+      g.push(shape("line", { x1: x0 + w, y1: yy, x2: x0 + w + 4, y2: yy, stroke: "#000" }));
+      g.push(text(x0 + w + 7, yy + 4, tickLabel(t, step), { "font-size": 11 }));
     }
-    if (label) g.push(`<text transform="translate(${n(x0 + w + 52)} ${n(fig.margin.top + fig.ph / 2)}) rotate(-90)" text-anchor="middle" font-size="12">${esc(label)}</text>`);
-    return g.join("\n");
+    if (label) g.push(Object.assign(text(x0 + w + 52, fig.margin.top + fig.ph / 2, label, { "text-anchor": "middle", "font-size": 12 }), { rotate: -90 }));
+    return g;
   }
 
-  return { esc, n, niceTicks, niceLimits, tickLabel, figure, line, attrs, legend, viridis, diverging, colorbar };
+  return { esc, n, niceTicks, niceLimits, tickLabel, shape, text, figure, line, legend, viridis, diverging, colorbar };
 });

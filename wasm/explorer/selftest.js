@@ -48,15 +48,22 @@
       await applyState();
       check($("v-weave").textContent === "4.2924", `weave speed shown ${$("v-weave").textContent}, expected 4.2924`);
       check($("v-capsize").textContent === "6.0243", `capsize speed shown ${$("v-capsize").textContent}, expected 6.0243`);
-      const label = () => {
-        const t = $("eig-plot").querySelector('text[data-critical="weave"]');
-        return t ? t.textContent : "";
-      };
+      // The figures are painted on canvases, which say what they show in
+      // data attributes; their SVG downloads must show the same.
+      const diagram = () => $("eig-plot").querySelector("canvas").dataset;
+      const label = () => diagram().weave || "";
       const before = label();
       check(before === "v_w = 4.292", `the plot's weave label is "${before}"`);
-      check($("eig-plot").querySelectorAll("polyline").length >= 4, "the eigenvalue plot has no lines");
-      check($("eig-plot").querySelector("rect[data-band]"), "the eigenvalue plot has no self-stable band");
-      check([...$("locus-plot").querySelectorAll("path[data-locus]")].reduce((n, p) => n + Number(p.dataset.locus), 0) > 100, "the root locus has no points");
+      check(Number(diagram().lines) >= 4, "the eigenvalue plot has no lines");
+      check(Number(diagram().bands) >= 1, "the eigenvalue plot has no self-stable band");
+      const svg = new DOMParser().parseFromString(app.eigFigureSvg(), "image/svg+xml");
+      const svgLabel = svg.querySelector('text[data-critical="weave"]');
+      check(svg.querySelectorAll("polyline").length === Number(diagram().lines) && svg.querySelectorAll("rect[data-band]").length === Number(diagram().bands) && svgLabel && svgLabel.textContent === before,
+        "the diagram's SVG download is not the diagram shown");
+      const points = Number($("locus-plot").querySelector("canvas").dataset.points);
+      check(points > 100, "the root locus has no points");
+      const locus = new DOMParser().parseFromString(app.locusSvg(), "image/svg+xml");
+      check([...locus.querySelectorAll("path[data-locus]")].reduce((n, p) => n + Number(p.dataset.locus), 0) === points, "the root locus's SVG download is not the root locus shown");
       check($("eig-table").tBodies[0].rows.length === 4, "the eigenvalue table has not 4 rows");
       check($("derived").textContent.includes("kAll"), "no radius of gyration of the front assembly");
       // 2. Trail c edited in the table: the weave speed changes, the link says so.

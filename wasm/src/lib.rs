@@ -5,7 +5,8 @@
 //! job's typed result serialized as the command line serializes it
 //! (`eig --format json`, `stability --json`, `canonical --json`, `sweep
 //! --format json`, `models --json`), so a page and a script read the same
-//! fields. Nothing is computed here: each job is one call of the library.
+//! fields. Nothing is computed here: each job is one call of the library
+//! (`explore`, the explorer's answer after a change, a few on one bicycle).
 //!
 //! The module exports a plain C interface (no JavaScript glue to generate),
 //! which `wasm/explorer/bikedyn.js` wraps:
@@ -25,6 +26,7 @@
 //! page loads a fresh module.
 
 mod arrays;
+mod explore;
 mod request;
 
 pub use request::{answer, reply, Answer, Reply};

@@ -2,6 +2,7 @@
 //! as JSON fields (SI units, the command line's defaults), each result the
 //! library's typed result serialized.
 
+use crate::explore::{explore, ExploreError};
 use bikedyn::bicycle::files::ParameterFile;
 use bikedyn::bicycle::{Bicycle, BicycleError};
 use bikedyn::canonical::{canonical, CanonicalOptions};
@@ -62,6 +63,15 @@ enum SpeedsSpec {
     Range { start: f64, step: f64, count: usize },
 }
 
+impl From<SpeedsSpec> for Speeds {
+    fn from(s: SpeedsSpec) -> Speeds {
+        match s {
+            SpeedsSpec::List(v) => Speeds::List(v),
+            SpeedsSpec::Range { start, step, count } => Speeds::Range { start, step, count },
+        }
+    }
+}
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct Swept {
@@ -105,6 +115,19 @@ enum Request {
         /// diagram over speed.
         #[serde(default)]
         arrays: bool,
+    },
+    /// Everything the explorer's page shows of one bicycle, in one answer
+    /// (`explore.rs`): the bicycle, its eigenvalues and modes over `speeds`
+    /// as arrays, its self-stable speeds between `speed_min` and
+    /// `speed_max`, and its eigenvalues and mode shapes at `speed`.
+    Explore {
+        bicycle: BicycleSpec,
+        #[serde(default)]
+        model: Option<String>,
+        speeds: SpeedsSpec,
+        speed_min: f64,
+        speed_max: f64,
+        speed: f64,
     },
     /// `bikedyn stability --json`.
     Stability {
@@ -175,7 +198,7 @@ fn yes() -> bool {
 /// forms, derived geometry, uncertainties, effects, warnings, the model the
 /// bicycle gets, and its TOML (benchmark form, effects after).
 #[derive(Serialize)]
-struct BicycleAnswer {
+pub(crate) struct BicycleAnswer {
     name: String,
     form: &'static str,
     model: String,
@@ -263,7 +286,7 @@ fn bicycle(spec: &BicycleSpec) -> Result<Bicycle, BicycleError> {
     Ok(b)
 }
 
-fn bicycle_answer(b: &Bicycle, model: Option<&str>) -> Result<BicycleAnswer, BicycleError> {
+pub(crate) fn bicycle_answer(b: &Bicycle, model: Option<&str>) -> Result<BicycleAnswer, BicycleError> {
     let benchmark = b.parameters.to_benchmark()?;
     let thesis = b.thesis()?;
     let mut toml = benchmark.to_toml_string();
@@ -359,13 +382,9 @@ fn answer_into(bytes: &[u8], arrays: &mut Vec<f64>) -> Answer {
             mode_shapes,
             arrays: as_arrays,
         } => {
-            let speeds = match speeds {
-                SpeedsSpec::List(v) => Speeds::List(v),
-                SpeedsSpec::Range { start, step, count } => Speeds::Range { start, step, count },
-            };
             let opts = EigenOptions {
                 model,
-                speeds,
+                speeds: speeds.into(),
                 standard_deviations,
                 critical_speeds,
             };
@@ -400,6 +419,21 @@ fn answer_into(bytes: &[u8], arrays: &mut Vec<f64>) -> Answer {
                 })
             })
         }
+        Request::Explore {
+            bicycle: spec,
+            model,
+            speeds,
+            speed_min,
+            speed_max,
+            speed,
+        } => match bicycle(&spec) {
+            Err(e) => error("bicycle", e),
+            Ok(b) => match explore(&b, model, speeds.into(), (speed_min, speed_max), speed, arrays) {
+                Ok(r) => result(&r),
+                Err(ExploreError::Bicycle(e)) => error("bicycle", e),
+                Err(ExploreError::Eig(e)) => error("job", e),
+            },
+        },
         Request::Stability {
             bicycle,
             model,

@@ -195,6 +195,36 @@ for (const [bike, spec] of [bicycles[0], bicycles[2], bicycles[bicycles.length -
     () => ({ job: "eig", bicycle: spec, speeds: { start: 0, step: 0.25, count: 41 } }));
 }
 
+// The explorer's one request after a change (`explore`): the bicycle, the
+// diagram's arrays, the self-stable speeds and the slider's speed, each
+// the numbers of the job that gave it alone (the command line's, and for
+// the bicycle and the critical speeds the module's own `bicycle` and `eig`).
+const exploreRequest = (spec, model) => ({
+  job: "explore", bicycle: spec, ...(model ? { model } : {}),
+  speeds: { start: 0, step: 0.25, count: 41 }, speed_min: 0, speed_max: 10, speed: 5,
+});
+const withoutDeviations = (t) => JSON.parse(t).map(({ standard_deviations, ...rest }) => rest);
+for (const [bike, spec] of [bicycles[0], bicycles[2], bicycles[bicycles.length - 1]]) {
+  check(`explore ${bike}: diagram`, ["eig", "--bike", bike, "--speeds", "0:10:0.25", "--format", "json"],
+    () => exploreRequest(spec), (t) => eigenvaluesAndModes(JSON.parse(t)), fromArrays);
+  check(`explore ${bike}: self-stable speeds`, ["stability", "--bike", bike, "--json"],
+    () => exploreRequest(spec), (t) => JSON.parse(t).stable_intervals, (w) => w.stable_intervals);
+  check(`explore ${bike}: at 5 m/s`, ["eig", "--bike", bike, "--speeds", "5:5:1", "--format", "json"],
+    () => exploreRequest(spec), withoutDeviations, (w) => [w.at_speed]);
+  tally.cases += 1;
+  try {
+    const w = wasm(exploreRequest(spec)).ok;
+    compare(wasm({ job: "bicycle", bicycle: spec }).ok, w.bicycle, `explore ${bike}: bicycle`);
+    const j = wasm({ job: "eig", bicycle: spec, speeds: exploreRequest(spec).speeds, critical_speeds: true, arrays: true }).ok;
+    for (const k of ["weave_speed", "capsize_speed", "weave_real_pair_merge_speed", "model"]) {
+      if (!Object.is(j[k], w[k])) throw new Error(`${k}: ${j[k]} (eig) against ${w[k]} (explore)`);
+    }
+    console.log(`  explore ${bike}: the bicycle and critical speeds of \`bicycle\` and \`eig\``);
+  } catch (e) {
+    tally.failures.push(`explore ${bike}: ${e.message}`);
+  }
+}
+
 // The eigenvalue table as `eig --format csv` writes it (the explorer's
 // download): the same header, and each cell the same text or number.
 const table = (t) => t.trim().split("\n").map((r) => r.split(",").map((c) => (c === "" || isNaN(Number(c)) ? c : Number(c))));

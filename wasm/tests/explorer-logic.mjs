@@ -106,7 +106,7 @@ test("colour maps and SVG text", () => {
   assert.equal(P.diverging(0.5), "#f7f7f7");
   assert.equal(P.viridis(NaN), "#bbbbbb");
   const fig = P.figure({ width: 300, height: 200, xlim: [0, 10], ylim: [-1, 1], xlabel: "v (m/s)", ylabel: "a < b" });
-  fig.add(P.line(fig, [[0, 0], [5, 1], [NaN, NaN], [6, 0], [10, -1]]));
+  fig.add(P.line(fig, [0, 0, 5, 1, NaN, NaN, 6, 0, 10, -1]));
   const svg = fig.svg();
   assert.match(svg, /^<svg xmlns="http:\/\/www.w3.org\/2000\/svg"/);
   assert.equal((svg.match(/<polyline/g) || []).length, 2);

@@ -19,12 +19,17 @@ fn mode_rank(m: Mode) -> u32 {
 /// (weave, capsize, castering, merged pairs, other), then descending imaginary
 /// part, then descending real part.
 pub fn ordered_indices(p: &EigenPoint) -> [usize; 4] {
+    output_order(&p.modes, &p.eigenvalues)
+}
+
+/// [`ordered_indices`] of eigenvalues and their modes.
+pub fn output_order(modes: &[Mode; 4], eigenvalues: &[Complex<f64>; 4]) -> [usize; 4] {
     let mut idx = [0usize, 1, 2, 3];
     idx.sort_by(|&a, &b| {
-        mode_rank(p.modes[a])
-            .cmp(&mode_rank(p.modes[b]))
-            .then(p.eigenvalues[b].im.total_cmp(&p.eigenvalues[a].im))
-            .then(p.eigenvalues[b].re.total_cmp(&p.eigenvalues[a].re))
+        mode_rank(modes[a])
+            .cmp(&mode_rank(modes[b]))
+            .then(eigenvalues[b].im.total_cmp(&eigenvalues[a].im))
+            .then(eigenvalues[b].re.total_cmp(&eigenvalues[a].re))
     });
     idx
 }

@@ -219,6 +219,55 @@ pub fn eigen_sweep_of(bike: &dyn LinearBicycle, speeds: &[f64]) -> Result<EigenS
     Ok(EigenSweep { points })
 }
 
+/// A speed's eigenvalues and their mode labels, as an [`EigenPoint`] has
+/// them, without the eigenvectors.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LabelledEigenvalues {
+    /// Forward speed (m/s).
+    pub v: f64,
+    /// The four eigenvalues (1/s).
+    pub eigenvalues: [Complex<f64>; 4],
+    /// Mode label of each eigenvalue.
+    pub modes: [Mode; 4],
+    /// The extra eigenvalues of a first-order model (see [`EigenPoint`]).
+    pub extra_eigenvalues: Vec<Complex<f64>>,
+}
+
+/// [`eigen_sweep_of`] without the eigenvectors: the same eigenvalues and
+/// labels (the labels come from tracking the roots over speed, not from
+/// the vectors). A diagram over speed draws no more, and the vectors were
+/// about a tenth of computing one in the browser (2026-11-30).
+pub fn eigenvalue_sweep_of(bike: &dyn LinearBicycle, speeds: &[f64]) -> Result<Vec<LabelledEigenvalues>, EigenError> {
+    if let Some(s) = bike.first_order() {
+        // Its extra eigenvalues come from the split that gives the vectors.
+        let points = states::eigen_sweep_of_states(s, speeds)?.points;
+        return Ok(points
+            .into_iter()
+            .map(|p| LabelledEigenvalues {
+                v: p.v,
+                eigenvalues: p.eigenvalues,
+                modes: p.modes,
+                extra_eigenvalues: p.extra_eigenvalues,
+            })
+            .collect());
+    }
+    // As `eigen_sweep` (closed forms) and `eigen_sweep_of` track them.
+    let tracked = match bike.canonical() {
+        Some(c) => track(&CharPoly::new(c)?, speeds)?,
+        None => track(&General::new(bike)?, speeds)?,
+    };
+    Ok(speeds
+        .iter()
+        .zip(tracked)
+        .map(|(&v, l)| LabelledEigenvalues {
+            v,
+            eigenvalues: l.roots,
+            modes: l.labels,
+            extra_eigenvalues: Vec::new(),
+        })
+        .collect())
+}
+
 /// [`critical_speeds`] for any [`LinearBicycle`] over `[v_min, v_max]`.
 pub fn critical_speeds_of(bike: &dyn LinearBicycle, v_min: f64, v_max: f64) -> Result<CriticalSpeeds, EigenError> {
     if let Some(s) = bike.first_order() {
@@ -338,6 +387,29 @@ mod tests {
             let mut m = self.canonical.at_speed(v)?;
             m.damping[(1, 1)] += self.c_steer;
             Ok(m)
+        }
+    }
+
+    /// Without the eigenvectors, a sweep has the eigenvalues and labels of
+    /// the whole one, bit for bit, on the closed-form path and the general.
+    #[test]
+    fn eigenvalue_sweep_is_the_eigen_sweep_without_its_vectors() {
+        let speeds: Vec<f64> = (0..=200).map(|k| 0.05 * k as f64).collect();
+        let canonical = meijaard_canonical(&BenchmarkParameters::benchmark_bicycle());
+        let damped = Damped {
+            canonical,
+            c_steer: 0.3,
+        };
+        for bike in [&canonical as &dyn LinearBicycle, &damped] {
+            let whole = eigen_sweep_of(bike, &speeds).expect("a sweep");
+            let values = eigenvalue_sweep_of(bike, &speeds).expect("a sweep");
+            assert_eq!(whole.points.len(), values.len());
+            for (p, q) in whole.points.iter().zip(&values) {
+                assert_eq!(
+                    (p.v, p.eigenvalues, p.modes, &p.extra_eigenvalues),
+                    (q.v, q.eigenvalues, q.modes, &q.extra_eigenvalues)
+                );
+            }
         }
     }
 
