@@ -12,7 +12,7 @@
 //! the same library calls on the same bicycle.
 
 use crate::arrays::{eig_arrays, EigArrays};
-use crate::request::{bicycle_answer, BicycleAnswer};
+use crate::bicycle_answer::{bicycle_answer, BicycleAnswer};
 use bikedyn::bicycle::{Bicycle, BicycleError};
 use bikedyn::eigen::{eigen_sweep, EigenAtSpeed, EigenJob, EigenOptions, EigenSweepError, Speeds};
 use bikedyn::runtime::eigen::critical_speeds_of;

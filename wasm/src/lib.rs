@@ -26,6 +26,7 @@
 //! page loads a fresh module.
 
 mod arrays;
+mod bicycle_answer;
 mod explore;
 mod request;
 
