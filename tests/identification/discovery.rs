@@ -370,21 +370,7 @@ fn in_runs_a_second_start_without_the_implausible_corrections_finds_the_force_th
         dir.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "synth: {}", text(&out.stderr));
-    // The force leaves a structured residual, so the library's last step
-    // ends with many candidates the score test predicts to gain; without a
-    // budget it fits every one, and this test took 1,329 s on a loaded
-    // machine, the longest of the suite, for the same verdict (2026-11-30).
-    // Its subject is the time series' second start, so the library gets
-    // the budget it had.
-    let v = ok_json(&[
-        "identify",
-        dir.to_str().unwrap(),
-        "--bike",
-        "thesis",
-        "--max-fits-per-step",
-        "8",
-        "--json",
-    ]);
+    let v = ok_json(&["identify", dir.to_str().unwrap(), "--bike", "thesis", "--json"]);
     let second = &v["time_series_discovery"]["second_start"];
     assert_eq!(second["kept_second"], Value::from(true), "{second:#}");
     let terms = time_series_terms(&v);

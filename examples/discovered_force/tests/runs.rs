@@ -111,13 +111,6 @@ fn in_runs_the_force_found_in_the_time_series_is_written_derived_and_refitted() 
         &IdentifyRequest {
             inputs: vec![set.clone()],
             bike: Some("thesis".into()),
-            // The force leaves a structured residual, so the library's last
-            // step ends with many candidates predicted to gain, and with no
-            // budget it fits every one (this test: 851 s on a loaded machine,
-            // 455 s with the budget the stop before).
-            // The subject here is the force found in the time series, so
-            // the library keeps the budget it had when this was written.
-            max_fits_per_step: Some(8),
             ..IdentifyRequest::default()
         },
         &|_| {},
