@@ -68,7 +68,7 @@ pub const EXTRA_TEXT_FIELDS: [(&str, &str); 26] = [
 /// [`ParameterError::UnknownField`] with its line.
 ///
 /// ```
-/// use bikedyn_runtime::parameters::MeasuredBenchmark;
+/// use bikedyn::bicycle::files::MeasuredBenchmark;
 /// let text = "w = 1.02+/-0.002\nc=0.08\nlam=pi/10\ng=9.81\nv=5\nrR=0.3\nmR=2\nIRxx=0.0603\n\
 ///             IRyy=0.12\nxB=0.3\nzB=-0.9\nmB=85\nIBxx=9.2\nIByy=11\nIBzz=2.8\nIBxz=2.4\n\
 ///             xH=0.9\nzH=-0.7\nmH=4\nIHxx=0.05892\nIHyy=0.06\nIHzz=0.00708\nIHxz=-0.00756\n\
