@@ -34,43 +34,10 @@ fn linear_weave(speed: f64) -> (f64, f64) {
     (w.re, w.im)
 }
 
-/// Kick at the saddle scaled so that the first roll peak is `peak` (rad);
-/// returns the run.
+/// Kick at the saddle of the thesis bicycle scaled so that the first roll
+/// peak is `peak` (rad); returns the run.
 fn kick_to_peak(speed: f64, peak: f64) -> bikedyn_runtime::simulate::Simulation {
-    let run = |j: f64| {
-        let inputs = Inputs {
-            kicks: vec![Kick::at_saddle(0.0, j)],
-            pulses: vec![],
-        };
-        let o = SimOptions {
-            output_interval: 0.002,
-            ..Default::default()
-        };
-        simulate::<M>(
-            &thesis_at(speed),
-            &InitialConditions {
-                speed,
-                ..Default::default()
-            },
-            &inputs,
-            4.0,
-            &o,
-        )
-        .unwrap()
-    };
-    let first_peak = |s: &bikedyn_runtime::simulate::Simulation| {
-        let r = s.coordinate("theta").unwrap();
-        let i = (1..r.len() - 1)
-            .find(|&i| r[i] >= r[i - 1] && r[i] > r[i + 1] && r[i] > 0.0)
-            .unwrap();
-        r[i]
-    };
-    let mut j = 1.0;
-    for _ in 0..6 {
-        let p = first_peak(&run(j));
-        j *= peak / p;
-    }
-    run(j)
+    kick_to_peak_of::<M>(&thesis_at(speed), speed, peak)
 }
 
 /// Issue 7, point 5: the weave eigenvalue fitted to a simulated kick at small
