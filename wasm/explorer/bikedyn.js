@@ -5,19 +5,25 @@
 //
 // A classic script, not an ES module, so that a page opened as a file
 // (file://, where Chromium refuses module imports and fetch) can load it:
-// in a page it defines the globals `Bikedyn`, `BikedynError` and
+// in a page it defines the globals `Bikedyn`, `BikedynError`,
+// `BikedynWorkers` (the module in Web Workers, for the stability map) and
 // `bikedynBytesFromBase64`; in Node.js they are the exports of a CommonJS
 // module, which `import { Bikedyn, BikedynError } from ".../bikedyn.js"`
 // also reads.
 (function (root, factory) {
   const api = factory();
+  // A worker runs this same code: its script is the factory's own text
+  // (a page opened as a file may not fetch this file to hand it over).
+  api.Bikedyn.workerFactory = factory.toString();
   if (typeof module === "object" && module && module.exports) {
     module.exports.Bikedyn = api.Bikedyn;
     module.exports.BikedynError = api.BikedynError;
+    module.exports.BikedynWorkers = api.BikedynWorkers;
     module.exports.bikedynBytesFromBase64 = api.bikedynBytesFromBase64;
   } else {
     root.Bikedyn = api.Bikedyn;
     root.BikedynError = api.BikedynError;
+    root.BikedynWorkers = api.BikedynWorkers;
     root.bikedynBytesFromBase64 = api.bikedynBytesFromBase64;
   }
 })(typeof globalThis !== "undefined" ? globalThis : this, function () {
@@ -111,6 +117,123 @@
     }
   }
 
+  // What a worker runs: the factory (bikedyn.js's text, `Bikedyn.workerFactory`)
+  // and a loop that answers one request at a time. The first message
+  // brings the compiled module, which a worker instantiates with its own
+  // memory; a job's error is sent back as its kind and message.
+  const WORKER_LOOP = `
+    let bikedyn = null;
+    self.onmessage = async (event) => {
+      const { id, module, request } = event.data;
+      try {
+        if (module) {
+          bikedyn = await api.Bikedyn.load(module);
+          self.postMessage({ id, ok: true });
+        } else {
+          self.postMessage({ id, ok: bikedyn.call(request) });
+        }
+      } catch (e) {
+        self.postMessage({ id, error: { kind: e.kind, message: e.message } });
+      }
+    };`;
+
+  /**
+   * The module in dedicated workers, for long jobs of independent parts
+   * (the stability map's rows): `await BikedynWorkers.start(module, count)`,
+   * then `call(request)` resolves with the answer or rejects with the
+   * BikedynError, each request going to the next idle worker. Rejects if
+   * the environment gives no workers (the caller then works in the page).
+   */
+  class BikedynWorkers {
+    static async start(module, count) {
+      if (typeof Worker === "undefined" || typeof Blob === "undefined") throw new Error("no Web Workers here");
+      const text = `"use strict";\nconst api = (${Bikedyn.workerFactory})();\n${WORKER_LOOP}`;
+      const url = URL.createObjectURL(new Blob([text], { type: "text/javascript" }));
+      const pool = new BikedynWorkers();
+      try {
+        for (let k = 0; k < count; k += 1) pool.workers.push(new Worker(url));
+        await Promise.all(pool.workers.map((w) => pool.send(w, { module })));
+      } catch (e) {
+        pool.terminate();
+        throw e;
+      } finally {
+        URL.revokeObjectURL(url);
+      }
+      pool.idle = pool.workers.slice();
+      return pool;
+    }
+
+    constructor() {
+      this.workers = [];
+      this.idle = [];
+      this.queue = []; // [request, resolve, reject, group] waiting for a worker
+      this.nextId = 1;
+    }
+
+    get size() {
+      return this.workers.length;
+    }
+
+    /** One message to one worker, answered by its reply (or its failure to load). */
+    send(worker, message) {
+      const id = this.nextId++;
+      return new Promise((resolve, reject) => {
+        const done = () => {
+          worker.removeEventListener("message", onMessage);
+          worker.removeEventListener("error", onError);
+        };
+        const onMessage = (event) => {
+          if (event.data.id !== id) return;
+          done();
+          const { ok, error } = event.data;
+          if (error) reject(new BikedynError(error.kind, error.message));
+          else resolve(ok);
+        };
+        const onError = (event) => {
+          done();
+          event.preventDefault();
+          reject(new Error(`bikedyn worker: ${event.message || "failed to start"}`));
+        };
+        worker.addEventListener("message", onMessage);
+        worker.addEventListener("error", onError);
+        worker.postMessage(Object.assign({ id }, message));
+      });
+    }
+
+    /** The answer to `request`, from the next idle worker; `group` names it for `drop`. */
+    call(request, group = null) {
+      return new Promise((resolve, reject) => {
+        this.queue.push([request, resolve, reject, group]);
+        this.dispatch();
+      });
+    }
+
+    dispatch() {
+      while (this.idle.length && this.queue.length) {
+        const worker = this.idle.pop();
+        const [request, resolve, reject] = this.queue.shift();
+        this.send(worker, { request })
+          .then(resolve, reject)
+          .finally(() => {
+            this.idle.push(worker);
+            this.dispatch();
+          });
+      }
+    }
+
+    /** The requests of `group` not yet sent to a worker are dropped (their promises never settle). */
+    drop(group) {
+      this.queue = this.queue.filter((q) => q[3] !== group);
+    }
+
+    terminate() {
+      for (const w of this.workers) w.terminate();
+      this.workers = [];
+      this.idle = [];
+      this.queue = [];
+    }
+  }
+
   /** The module's bytes from base64 (build.sh's `bikedyn-wasm.js`). */
   function bikedynBytesFromBase64(text) {
     if (typeof Buffer !== "undefined") return new Uint8Array(Buffer.from(text, "base64"));
@@ -120,5 +243,5 @@
     return bytes;
   }
 
-  return { Bikedyn, BikedynError, bikedynBytesFromBase64 };
+  return { Bikedyn, BikedynError, BikedynWorkers, bikedynBytesFromBase64 };
 });

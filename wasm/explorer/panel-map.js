@@ -1,7 +1,7 @@
 // The stability map panel: a metric (least-stable real part at a speed,
 // width of the self-stable range, weave or capsize speed) over any two
-// parameters, benchmark or effect, computed row by row (`map_row`) with
-// progress, cancellable.
+// parameters, benchmark or effect, computed row by row (`map_row`) in Web
+// Workers, with progress, cancellable.
 // Shares the page's state through `Explorer` (explorer.js).
 (function (app) {
   "use strict";
@@ -51,9 +51,34 @@
     }
   }
 
-  /** Computes the map row by row, yielding to the page between rows; resolves with the cells (or null, cancelled). */
-  async function runMap() {
-    if (mapRun) mapRun.cancelled = true;
+  // The map's rows are computed in Web Workers, one per core (at most
+  // eight), each with its own instance of the page's compiled module: on
+  // two cores a 100 x 100 map takes about half as long, and the page stays
+  // free to draw. Where no worker starts (an engine without them, or one
+  // that refuses a worker's script in a page opened as a file), the rows
+  // are computed in the page, which is given back its turn every 50 ms.
+  let workers = null; // a promise of the BikedynWorkers, or of null (in the page)
+  function mapWorkers() {
+    if (!workers) {
+      const count = Math.max(1, Math.min(8, navigator.hardwareConcurrency || 2));
+      workers = BikedynWorkers.start(app.bd.module, count).then(
+        (pool) => pool,
+        (e) => {
+          app.mapWorkersError = e.message;
+          return null;
+        },
+      );
+    }
+    return workers;
+  }
+
+  /**
+   * Computes the map row by row; resolves with the cells (or null, cancelled
+   * or failed). `inPage`: compute in the page even where workers start (the
+   * self-test's, whose virtual time does not wait for a worker).
+   */
+  async function runMap({ inPage = false } = {}) {
+    cancelMap();
     readMapInputs();
     const m = app.state.map;
     const xs = S.linspace(m.x0, m.x1, m.nx);
@@ -64,20 +89,20 @@
       row: 0, speed_max: app.state.vmax,
     });
     if (m.metric === "least_stable_real_part") req.at_speed = m.at;
-    const cells = [];
     $("map-cancel").disabled = false;
     $("map-run").disabled = true;
     $("map-progress").value = 0;
     wireHover();
     const t0 = performance.now();
+    const pool = inPage ? null : await mapWorkers();
+    app.mapWorkerCount = pool ? pool.size : 0;
+    const rows = new Array(xs.length);
+    let done = 0;
     // The plot is redrawn as rows come, but not after every row: a 100 x
     // 100 map's 10,000 cells drawn again after each of its rows took
     // Chromium 12 of the map's 15 s (2026-11-29). At most a tenth of the
-    // time goes to drawing (and at most one drawing a second). Likewise the
-    // page is given back its turn after 50 ms of rows, not after each row
-    // (a browser waits at least 4 ms before a timer nested that deep).
+    // time goes to drawing (and at most one drawing a second).
     let drawnAt = performance.now();
-    let yieldedAt = drawnAt;
     let drawing = 0;
     const draw = () => {
       const s = performance.now();
@@ -85,42 +110,72 @@
       drawnAt = performance.now();
       drawing = drawnAt - s;
     };
+    const rowDone = (i, cells) => {
+      rows[i] = cells.map((c) => Object.assign(c, { i }));
+      done += 1;
+      $("map-progress").value = done / xs.length;
+      $("map-status").textContent = `row ${done} of ${xs.length}`;
+      app.mapResult = { xs, ys, cells: rows.flat(), map: Object.assign({}, m), done: false };
+      if (done < xs.length && performance.now() - drawnAt >= Math.max(1000, 10 * drawing)) draw();
+    };
+    const fail = (message) => {
+      showError(message);
+      $("map-status").textContent = "error";
+      return null;
+    };
+    const cancelled = () => {
+      $("map-status").textContent = `cancelled after ${done} of ${xs.length} rows`;
+      return null;
+    };
     try {
-      for (let i = 0; i < xs.length; i += 1) {
-        if (run.cancelled) {
-          $("map-status").textContent = `cancelled after ${i} of ${xs.length} rows`;
-          return null;
-        }
-        req.row = i;
-        const r = call(req);
-        if (r.error) {
-          showError(r.error);
-          $("map-status").textContent = "error";
-          return null;
-        }
-        cells.push(...r.ok.cells.map((c) => Object.assign(c, { i })));
-        $("map-progress").value = (i + 1) / xs.length;
-        $("map-status").textContent = `row ${i + 1} of ${xs.length}`;
-        app.mapResult = { xs, ys, cells, map: Object.assign({}, m), done: false };
-        if (i === xs.length - 1 || performance.now() - drawnAt >= Math.max(1000, 10 * drawing)) draw();
-        if (performance.now() - yieldedAt >= 50) {
-          await new Promise((resolve) => setTimeout(resolve, 0));
-          yieldedAt = performance.now();
+      if (run.cancelled) return cancelled();
+      if (pool) {
+        // Every row is queued at once; a cancel drops those not yet sent.
+        const answers = xs.map((_, i) =>
+          pool.call(Object.assign({}, req, { row: i }), run).then((ok) => {
+            if (!run.cancelled) rowDone(i, ok.cells);
+          }),
+        );
+        const stop = new Promise((resolve) => (run.stop = resolve));
+        const outcome = await Promise.race([Promise.all(answers).then(() => "done", (e) => e), stop]);
+        if (outcome !== "done") pool.drop(run);
+        if (outcome === "cancelled" || run.cancelled) return cancelled();
+        if (outcome !== "done") return fail(outcome.message);
+      } else {
+        // In the page: the page is given back its turn after 50 ms of rows,
+        // not after each row (a browser waits at least 4 ms before a timer
+        // nested that deep).
+        let yieldedAt = performance.now();
+        for (let i = 0; i < xs.length; i += 1) {
+          if (run.cancelled) return cancelled();
+          const r = call(Object.assign({}, req, { row: i }));
+          if (r.error) return fail(r.error);
+          rowDone(i, r.ok.cells);
+          if (performance.now() - yieldedAt >= 50) {
+            await new Promise((resolve) => setTimeout(resolve, 0));
+            yieldedAt = performance.now();
+          }
         }
       }
+      draw();
       app.mapResult.done = true;
       $("map-status").textContent = `${xs.length} \u00d7 ${ys.length} points in ${((performance.now() - t0) / 1000).toFixed(1)} s`;
-      return cells;
+      return app.mapResult.cells;
     } finally {
-      if (mapRun === run) mapRun = null;
-      $("map-cancel").disabled = true;
-      $("map-run").disabled = false;
+      if (mapRun === run) {
+        mapRun = null;
+        $("map-cancel").disabled = true;
+        $("map-run").disabled = false;
+      }
     }
   }
 
-  /** Stops the map being computed, after its current row. */
+  /** Stops the map being computed: the rows being computed finish, no more start. */
   function cancelMap() {
-    if (mapRun) mapRun.cancelled = true;
+    if (mapRun) {
+      mapRun.cancelled = true;
+      if (mapRun.stop) mapRun.stop("cancelled");
+    }
   }
 
   const METRIC_LABELS = {

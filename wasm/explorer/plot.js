@@ -155,12 +155,15 @@
         for (let i = 2; i < p.length; i += 2) ctx.lineTo(p[i], p[i + 1]);
         return paint();
       case "dots":
-        // As in the SVG, zero-length strokes with round caps: Chromium's
-        // canvas draws their caps, discs as wide as the stroke, in a
-        // quarter of the time of as many arcs (2026-11-30).
+        // Strokes with round caps, discs as wide as the stroke: in
+        // Chromium a quarter of the time of as many arcs (2026-11-30).
+        // Unlike SVG, the canvas standard prunes zero-length segments
+        // before stroking ("Zero-length line segments must be pruned"),
+        // so each is a hundredth of a pixel long, which every engine
+        // strokes, rather than relying on one that draws caps anyway.
         for (let i = 0; i < p.length; i += 2) {
           ctx.moveTo(p[i], p[i + 1]);
-          ctx.lineTo(p[i], p[i + 1]);
+          ctx.lineTo(p[i] + 0.01, p[i + 1]);
         }
         ctx.lineCap = "round";
         ctx.strokeStyle = stroke;
@@ -278,6 +281,8 @@
           canvas.height = Math.round(height * dpr);
           canvas.style.width = `${width}px`; // the height follows (CSS: auto)
         }
+        // The plot area, in CSS pixels, for a test reading the canvas.
+        canvas.dataset.plotArea = [m.left, m.top, pw, ph].map(n).join(",");
         const ctx = canvas.getContext("2d");
         ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
         ctx.fillStyle = "#ffffff";

@@ -119,7 +119,11 @@
       // 5. A small stability map.
       app.state.map = { x: "c", x0: 0.04, x1: 0.12, nx: 3, y: "lam", y0: 0.2, y1: 0.4, ny: 3, metric: "least_stable_real_part", at: 5 };
       app.writeMapInputs();
-      const cells = await app.runMap();
+      // In the page: Chromium's virtual time, which runs this test's timers
+      // at once, does not wait for a worker's answer. The workers' map is
+      // checked against the page's module in real time
+      // (wasm/tests/explorer_browser.py, step 11).
+      const cells = await app.runMap({ inPage: true });
       check(cells && cells.length === 9, `the map has ${cells ? cells.length : 0} cells, expected 9`);
       check($("map-plot").querySelectorAll("rect[data-cell]").length === 9, "the map's cells are not drawn");
       // 6. A kick simulation.
