@@ -15,7 +15,7 @@ use crate::sensitivity::EigenvalueSpread;
 use bikedyn_report::output::{mode_shape, ordered_indices, output_order, ModeShape};
 use bikedyn_runtime::eigen::{
     critical_speeds_of, eigen_sweep_of, eigenvalue_sweep_of, eigenvalues_of, CriticalSpeeds, EigenError, EigenPoint,
-    EigenSweep, LinearBicycle, Mode,
+    EigenSweep, LabelledEigenvalues, LinearBicycle,
 };
 use nalgebra::Complex;
 use rayon::prelude::*;
@@ -320,7 +320,7 @@ impl EigenJob {
             eigenvalues,
             modes,
             extra_eigenvalues,
-        } = EigenvaluesAtSpeed::of(p.v, &p.eigenvalues, &p.modes, &p.extra_eigenvalues, &idx);
+        } = EigenvaluesAtSpeed::of(&LabelledEigenvalues::from(&p), &idx);
         let standard_deviations = self.spread.as_ref().map(|s| s.of_eigenvalues(p.v, &eigenvalues));
         EigenAtSpeed {
             eigenvalues,
@@ -345,13 +345,7 @@ impl EigenJob {
             let speeds: Vec<f64> = (start..(start + BLOCK).min(n)).map(|k| self.speeds.at(k)).collect();
             for p in eigenvalue_sweep_of(&self.lin, &speeds)? {
                 let idx = output_order(&p.modes, &p.eigenvalues);
-                out.push(EigenvaluesAtSpeed::of(
-                    p.v,
-                    &p.eigenvalues,
-                    &p.modes,
-                    &p.extra_eigenvalues,
-                    &idx,
-                ));
+                out.push(EigenvaluesAtSpeed::of(&p, &idx));
             }
         }
         Ok(out)
@@ -374,18 +368,12 @@ pub struct EigenvaluesAtSpeed {
 
 impl EigenvaluesAtSpeed {
     /// A speed's, in the output order `idx` ([`output_order`]).
-    fn of(
-        v: f64,
-        eigenvalues: &[Complex<f64>; 4],
-        modes: &[Mode; 4],
-        extra: &[Complex<f64>],
-        idx: &[usize; 4],
-    ) -> Self {
+    fn of(p: &LabelledEigenvalues, idx: &[usize; 4]) -> Self {
         EigenvaluesAtSpeed {
-            v,
-            eigenvalues: idx.map(|k| [eigenvalues[k].re, eigenvalues[k].im]),
-            modes: idx.map(|k| modes[k].name()),
-            extra_eigenvalues: extra.iter().map(|z| [z.re, z.im]).collect(),
+            v: p.v,
+            eigenvalues: idx.map(|k| [p.eigenvalues[k].re, p.eigenvalues[k].im]),
+            modes: idx.map(|k| p.modes[k].name()),
+            extra_eigenvalues: p.extra_eigenvalues.iter().map(|z| [z.re, z.im]).collect(),
         }
     }
 }

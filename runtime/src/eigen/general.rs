@@ -233,6 +233,18 @@ pub struct LabelledEigenvalues {
     pub extra_eigenvalues: Vec<Complex<f64>>,
 }
 
+impl From<&EigenPoint> for LabelledEigenvalues {
+    /// The point's eigenvalues and labels, without its eigenvectors.
+    fn from(p: &EigenPoint) -> Self {
+        LabelledEigenvalues {
+            v: p.v,
+            eigenvalues: p.eigenvalues,
+            modes: p.modes,
+            extra_eigenvalues: p.extra_eigenvalues.clone(),
+        }
+    }
+}
+
 /// [`eigen_sweep_of`] without the eigenvectors: the same eigenvalues and
 /// labels (the labels come from tracking the roots over speed, not from
 /// the vectors). A diagram over speed draws no more, and the vectors were
