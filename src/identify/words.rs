@@ -38,8 +38,21 @@ pub fn kept_as_no_plausible_rival(symbol: &str, value: f64, sds: f64) -> String 
 /// criterion against the step's base; negative is better).
 pub fn verdict_text(v: &Verdict) -> String {
     match v {
-        Verdict::Added { bic_change, cv, base_cv } => {
-            format!("warranted: BIC {bic_change:+.1}, held-out error {cv:.4} (was {base_cv:.4})")
+        Verdict::Added {
+            bic_change,
+            cv,
+            base_cv,
+            held_out_gain,
+        } => {
+            let consistent = held_out_gain.map_or(String::new(), |g| {
+                format!(
+                    "; held-out gain per run {:.4} +- {:.4} (1 SE, {:.1} SE)",
+                    g.gain,
+                    g.stderr,
+                    g.gain / g.stderr
+                )
+            });
+            format!("warranted: BIC {bic_change:+.1}, held-out error {cv:.4} (was {base_cv:.4}){consistent}")
         }
         Verdict::NoPredictedGain { predicted_bic_change } => format!(
             "not fitted: linearised at the current fit (score test), its best BIC change is {predicted_bic_change:+.1}, no gain"

@@ -361,6 +361,22 @@ fn example_set_report_folder() {
         .filter(|c| c["outcome"]["kind"] == "beyond_budget")
         .collect();
     assert!(unfitted.is_empty(), "{unfitted:#?}");
+    // Issue 33, item 4: an added candidate's claim says how consistent its
+    // held-out gain was (the bar it passed: two standard errors), in the
+    // JSON and in the report's words.
+    let added: Vec<&Value> = j["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["outcome"]["kind"] == "added")
+        .collect();
+    assert!(!added.is_empty());
+    for c in &added {
+        let g = &c["outcome"]["held_out_gain"];
+        let (gain, stderr) = (g["gain"].as_f64().unwrap(), g["stderr"].as_f64().unwrap());
+        assert!(gain > 2.0 * stderr, "{c:#}");
+        assert!(c["verdict"].as_str().unwrap().contains("(1 SE, "), "{c:#}");
+    }
     for f in [
         "report.md",
         "report.json",

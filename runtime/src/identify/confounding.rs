@@ -52,7 +52,7 @@ pub struct Confounding {
 
 /// A paired held-out gain and its standard error (weighted mean square of
 /// the held-out residuals, dimensionless).
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct HeldOutGain {
     pub gain: f64,
     pub stderr: f64,

@@ -36,7 +36,7 @@
 
 mod elimination;
 
-use super::confounding::Confounding;
+use super::confounding::{Confounding, HeldOutGain};
 pub use super::criterion::{bic, PLAUSIBLE_PRIOR_SDS};
 use super::criterion::{farthest_from_prior, with_priors_on_the_data_scale};
 pub use super::cross_validation::{folds_by_run, paired_gain};
@@ -723,20 +723,20 @@ impl<'s> Search<'s> {
         };
         let (fit, setup) = p.fit.as_mut()?;
         cross_validate(setup, fit, self.fold_of, self.opts);
+        let held_out_gain = paired_gain(current, fit, self.weights);
         Some(if !(fit.cv < current.cv) {
             Verdict::HeldOutNotLower {
                 cv: fit.cv,
                 base_cv: current.cv,
             }
-        } else if let Some((gain, stderr)) =
-            paired_gain(current, fit, self.weights).filter(|(d, se)| !(*d > sigmas * se))
-        {
+        } else if let Some((gain, stderr)) = held_out_gain.filter(|(d, se)| !(*d > sigmas * se)) {
             Verdict::HeldOutGainNotConsistent { gain, stderr, sigmas }
         } else {
             Verdict::Added {
                 bic_change: fit.bic - bic(current, self.reference),
                 cv: fit.cv,
                 base_cv: current.cv,
+                held_out_gain: held_out_gain.map(|(gain, stderr)| HeldOutGain { gain, stderr }),
             }
         })
     }

@@ -2,6 +2,7 @@
 //! not added, with the numbers behind it. The report formats these; the
 //! selection decides them.
 
+use super::confounding::HeldOutGain;
 use serde::Serialize;
 
 /// Why a candidate of a step was or was not added, with the numbers behind
@@ -11,8 +12,18 @@ use serde::Serialize;
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Verdict {
     /// Added: it lowers the criterion and the held-out error, consistently
-    /// over the runs.
-    Added { bic_change: f64, cv: f64, base_cv: f64 },
+    /// over the runs. `held_out_gain`: the mean gain in held-out error per
+    /// run (or row, or kick) over the step's base model and its standard
+    /// error, where the entry test measured it (the bar it passed is that of
+    /// [`Verdict::HeldOutGainNotConsistent`]); `None` for a member kept by
+    /// the backward check.
+    Added {
+        bic_change: f64,
+        cv: f64,
+        base_cv: f64,
+        #[serde(skip_serializing_if = "Option::is_none")]
+        held_out_gain: Option<HeldOutGain>,
+    },
     /// The score test's linearised fit does not lower the criterion: it
     /// cannot win this step (not fitted).
     NoPredictedGain { predicted_bic_change: f64 },

@@ -357,6 +357,7 @@ pub fn identify_table_in<R: bikedyn_runtime::registry::ModelRegistry>(
                     bic_change: db,
                     cv,
                     base_cv: current_cv,
+                    held_out_gain: None,
                 }
             };
             let names = set.iter().flat_map(|c| c.parameters.iter().map(|p| p.symbol.clone()));
@@ -403,6 +404,7 @@ pub fn identify_table_in<R: bikedyn_runtime::registry::ModelRegistry>(
                     bic_change: db,
                     cv,
                     base_cv: current_cv,
+                    held_out_gain: None,
                 };
             }
         }

@@ -41,7 +41,7 @@
 //! table fits take them.
 
 use super::least_squares::levenberg_marquardt;
-use super::Verdict;
+use super::{HeldOutGain, Verdict};
 use nalgebra::Complex;
 use rayon::prelude::*;
 use serde::Serialize;
@@ -531,6 +531,7 @@ pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
                         bic_change: db,
                         cv,
                         base_cv: current_cv,
+                        held_out_gain: Some(HeldOutGain { gain, stderr }),
                     }
                 };
                 let added = verdict.added();

@@ -152,6 +152,7 @@ impl<'s> Search<'s> {
                 bic_change: f64::NAN,
                 cv: current.cv,
                 base_cv: f64::NAN,
+                held_out_gain: None,
             };
             return Ok((
                 MemberCheck {
@@ -194,6 +195,7 @@ impl<'s> Search<'s> {
             bic_change: with_bic - fit.bic,
             cv: current.cv,
             base_cv: fit.cv,
+            held_out_gain: None,
         };
         let verdict = if implausible.is_some() {
             kept
