@@ -62,10 +62,15 @@ fn serve(dir: &std::path::Path) -> Serving {
 
 /// Status, headers (lower case) and body of one request.
 fn request(port: u16, method: &str, path: &str) -> (u16, String, Vec<u8>) {
+    request_with(port, method, path, "")
+}
+
+/// [`request`] with more header lines (each ending in `\r\n`).
+fn request_with(port: u16, method: &str, path: &str, headers: &str) -> (u16, String, Vec<u8>) {
     let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
     write!(
         s,
-        "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n"
+        "{method} {path} HTTP/1.1\r\nHost: 127.0.0.1\r\n{headers}Connection: close\r\n\r\n"
     )
     .unwrap();
     let mut raw = Vec::new();
@@ -73,7 +78,27 @@ fn request(port: u16, method: &str, path: &str) -> (u16, String, Vec<u8>) {
     let split = raw.windows(4).position(|w| w == b"\r\n\r\n").expect("a header");
     let head = String::from_utf8_lossy(&raw[..split]).to_lowercase();
     let status = head.split_whitespace().nth(1).and_then(|c| c.parse().ok()).unwrap();
-    (status, head, raw[split + 4..].to_vec())
+    let body = &raw[split + 4..];
+    let body = if head.contains("transfer-encoding: chunked") {
+        dechunk(body)
+    } else {
+        body.to_vec()
+    };
+    (status, head, body)
+}
+
+/// A chunked HTTP/1.1 body's bytes (a large file comes so).
+fn dechunk(mut raw: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    loop {
+        let line = raw.windows(2).position(|w| w == b"\r\n").expect("a chunk size");
+        let size = usize::from_str_radix(text(&raw[..line]).split(';').next().unwrap().trim(), 16).unwrap();
+        if size == 0 {
+            return out;
+        }
+        out.extend_from_slice(&raw[line + 2..line + 2 + size]);
+        raw = &raw[line + 2 + size + 2..];
+    }
 }
 
 #[test]
@@ -111,6 +136,58 @@ fn serve_gives_the_explorer_files_with_their_types_and_nothing_else() {
     }
     let (status, _, _) = request(server.port, "POST", "/index.html");
     assert_eq!(status, 405);
+}
+
+#[test]
+fn serve_compresses_for_a_browser_that_accepts_gzip() {
+    let dir = explorer("gzip", true);
+    // A module of a realistic size and make (repetitive, like code).
+    let module: Vec<u8> = (0..400_000u32).flat_map(|k| (k % 251).to_le_bytes()).collect();
+    std::fs::write(dir.join("bikedyn.wasm"), &module).unwrap();
+    let server = serve(&dir);
+    let gunzip = |z: &[u8]| {
+        let mut out = Vec::new();
+        flate2::read::GzDecoder::new(z).read_to_end(&mut out).unwrap();
+        out
+    };
+    // Twice: compressed, then from the cache, the same bytes.
+    let mut first = None;
+    for _ in 0..2 {
+        let (status, head, body) = request_with(
+            server.port,
+            "GET",
+            "/bikedyn.wasm",
+            "Accept-Encoding: gzip, deflate, br\r\n",
+        );
+        assert_eq!(status, 200, "{head}");
+        assert!(
+            head.contains("content-encoding: gzip") && head.contains("content-type: application/wasm"),
+            "{head}"
+        );
+        assert!(
+            body.len() < module.len() / 4,
+            "{} bytes for {}",
+            body.len(),
+            module.len()
+        );
+        assert_eq!(gunzip(&body), module);
+        assert!(first.as_ref().is_none_or(|f| *f == body));
+        first = Some(body);
+    }
+    // A changed file is compressed again.
+    std::fs::write(dir.join("plot.js"), "var y = 2;\n").unwrap();
+    let (_, head, body) = request_with(server.port, "GET", "/plot.js", "Accept-Encoding: gzip\r\n");
+    assert!(head.contains("content-encoding: gzip"), "{head}");
+    assert_eq!(gunzip(&body), b"var y = 2;\n");
+    // Not to a client that does not ask, or refuses it.
+    for headers in ["", "Accept-Encoding: identity\r\n", "Accept-Encoding: gzip;q=0\r\n"] {
+        let (status, head, body) = request_with(server.port, "GET", "/bikedyn.wasm", headers);
+        assert!(
+            status == 200 && !head.contains("content-encoding"),
+            "{headers:?}: {head}"
+        );
+        assert_eq!(body, module, "{headers:?}");
+    }
 }
 
 #[test]
