@@ -159,13 +159,13 @@
       } finally {
         URL.revokeObjectURL(url);
       }
-      pool.idle = pool.workers.slice();
+      for (const w of pool.workers) pool.busy.set(w, 0);
       return pool;
     }
 
     constructor() {
       this.workers = [];
-      this.idle = [];
+      this.busy = new Map(); // worker -> requests sent and not yet answered
       this.queue = []; // [request, resolve, reject, group] waiting for a worker
       this.nextId = 1;
     }
@@ -208,14 +208,23 @@
       });
     }
 
+    // Each worker holds up to four requests: the one it computes and the
+    // next ones, so that it does not wait for the page (busy drawing, say)
+    // to hear its answer before it gets more work. With one at a time the
+    // two workers of a 100 x 100 map took 1.7-1.8 s in Chromium, with four
+    // 1.2-1.6 s, against 0.8-1.0 s for the same rows asked of a pool with
+    // nothing else to do (2026-11-30).
     dispatch() {
-      while (this.idle.length && this.queue.length) {
-        const worker = this.idle.pop();
+      while (this.queue.length) {
+        let worker = null;
+        for (const [w, n] of this.busy) if (n < 4 && (!worker || n < this.busy.get(worker))) worker = w;
+        if (!worker) return;
         const [request, resolve, reject] = this.queue.shift();
+        this.busy.set(worker, this.busy.get(worker) + 1);
         this.send(worker, { request })
           .then(resolve, reject)
           .finally(() => {
-            this.idle.push(worker);
+            if (this.busy.has(worker)) this.busy.set(worker, this.busy.get(worker) - 1);
             this.dispatch();
           });
       }
@@ -229,7 +238,7 @@
     terminate() {
       for (const w of this.workers) w.terminate();
       this.workers = [];
-      this.idle = [];
+      this.busy.clear();
       this.queue = [];
     }
   }

@@ -104,8 +104,11 @@
     // time goes to drawing (and at most one drawing a second).
     let drawnAt = performance.now();
     let drawing = 0;
+    // The cells so far are gathered for a drawing (and at the end), not
+    // after every row.
     const draw = () => {
       const s = performance.now();
+      app.mapResult = { xs, ys, cells: rows.flat(), map: Object.assign({}, m), done: false };
       $("map-plot").innerHTML = mapSvg(760, 460, false);
       drawnAt = performance.now();
       drawing = drawnAt - s;
@@ -115,7 +118,6 @@
       done += 1;
       $("map-progress").value = done / xs.length;
       $("map-status").textContent = `row ${done} of ${xs.length}`;
-      app.mapResult = { xs, ys, cells: rows.flat(), map: Object.assign({}, m), done: false };
       if (done < xs.length && performance.now() - drawnAt >= Math.max(1000, 10 * drawing)) draw();
     };
     const fail = (message) => {
@@ -157,8 +159,11 @@
           }
         }
       }
+      const computed = performance.now();
       draw();
       app.mapResult.done = true;
+      // What the map's time went to (ms): its rows, and its last drawing.
+      app.mapTiming = { rows: computed - t0, lastDrawing: drawing, workers: pool ? pool.size : 0 };
       $("map-status").textContent = `${xs.length} \u00d7 ${ys.length} points in ${((performance.now() - t0) / 1000).toFixed(1)} s`;
       return app.mapResult.cells;
     } finally {
