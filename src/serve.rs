@@ -127,14 +127,14 @@ impl Server {
             let (status, body, kind, path) = respond(&self.root, &method, &url);
             let gzip = status == 200 && accepts_gzip(request.headers()) && compressible(kind);
             let body = match (&path, gzip) {
-                (Some(path), true) => self.gzipped(path, body),
-                _ => Arc::new(body),
+                (Some(path), true) => self.gzipped(path, body).to_vec(),
+                _ => body,
             };
             log(&format!("{method} {url} {status}{}", if gzip { " (gzip)" } else { "" }));
             let head = method == tiny_http::Method::Head;
             let length = body.len();
-            let data = if head { Vec::new() } else { body.to_vec() };
-            let mut response = tiny_http::Response::from_data(data).with_status_code(status);
+            let mut response =
+                tiny_http::Response::from_data(if head { Vec::new() } else { body }).with_status_code(status);
             for (name, value) in [
                 ("Content-Type", kind),
                 // A rebuilt module shows on the next reload.
