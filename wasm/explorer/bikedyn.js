@@ -141,7 +141,7 @@
    * The module in dedicated workers, for long jobs of independent parts
    * (the stability map's rows): `await BikedynWorkers.start(module, count)`,
    * then `call(request)` resolves with the answer or rejects with the
-   * BikedynError, each request going to the next idle worker. Rejects if
+   * BikedynError, each request going to the least busy worker. Rejects if
    * the environment gives no workers (the caller then works in the page).
    */
   class BikedynWorkers {
@@ -200,7 +200,7 @@
       });
     }
 
-    /** The answer to `request`, from the next idle worker; `group` names it for `drop`. */
+    /** The answer to `request`, from the least busy worker; `group` names it for `drop`. */
     call(request, group = null) {
       return new Promise((resolve, reject) => {
         this.queue.push([request, resolve, reject, group]);

@@ -53,8 +53,9 @@
 
   // The map's rows are computed in Web Workers, one per core (at most
   // eight), each with its own instance of the page's compiled module: on
-  // two cores a 100 x 100 map takes about half as long, and the page stays
-  // free to draw. Where no worker starts (an engine without them, or one
+  // two cores a 100 x 100 map took 1.2-1.6 s against 1.8-2.0 s in the page
+  // (2026-11-30; the page's own rendering shares the cores), and the page
+  // stays free to draw. Where no worker starts (an engine without them, or one
   // that refuses a worker's script in a page opened as a file), the rows
   // are computed in the page, which is given back its turn every 50 ms.
   let workers = null; // a promise of the BikedynWorkers, or of null (in the page)
@@ -163,7 +164,7 @@
       draw();
       app.mapResult.done = true;
       // What the map's time went to (ms): its rows, and its last drawing.
-      app.mapTiming = { rows: computed - t0, lastDrawing: drawing, workers: pool ? pool.size : 0 };
+      app.mapTiming = { rows: computed - t0, lastDrawing: drawing };
       $("map-status").textContent = `${xs.length} \u00d7 ${ys.length} points in ${((performance.now() - t0) / 1000).toFixed(1)} s`;
       return app.mapResult.cells;
     } finally {
