@@ -783,6 +783,7 @@ def identify(
     progress: Optional[ProgressCallback] = None,
     discover: bool = True,
     max_fits_per_step: Optional[int] = None,
+    family_wise_bar: bool = False,
 ) -> IdentifyResult:
     """Close the loop (``bikedyn identify``): fit the base model to measured
     runs, diagnose the residual, select effects and parameter corrections
@@ -803,7 +804,10 @@ def identify(
     ``max_fits_per_step``: at most this many candidate fits per step of
     the library's search beyond its contenders (a compute budget for large
     sets of runs; default: none, a step that adds nothing has fitted every
-    candidate predicted to gain). Returns an
+    candidate predicted to gain). ``family_wise_bar``: raise each step's
+    bar of a consistent held-out gain with the candidates it has fitted (a
+    Bonferroni bar; the command line's ``--family-wise-bar``; default: two
+    standard errors for each). Returns an
     :class:`IdentifyResult`: ``selected``, ``parameters`` (each an
     :class:`Estimate` with its 95 % interval), ``error_before`` and
     ``error_after`` (fitted and held out), ``discovery``; ``summary()``,
@@ -820,6 +824,8 @@ def identify(
     if isinstance(paths_or_eigen_table, (str, os.PathLike)) and os.fspath(paths_or_eigen_table).lower().endswith(".csv"):
         if max_fits_per_step is not None:
             raise InvalidArgumentError("max_fits_per_step applies to runs and logs, not to an eigenvalue table")
+        if family_wise_bar:
+            raise InvalidArgumentError("family_wise_bar applies to runs and logs, not to an eigenvalue table")
         table = _paths(paths_or_eigen_table, "identify")[0]
         return IdentifyResult._from_json(
             _bikedyn.identify_eigenvalues(table, spec, list(effects), corrections, bool(discover))
@@ -836,6 +842,7 @@ def identify(
             progress,
             bool(discover),
             max_fits_per_step,
+            bool(family_wise_bar),
         )
     )
 

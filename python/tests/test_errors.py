@@ -120,6 +120,9 @@ def test_identify_counts_are_checked_and_named():
     # name, not ignored.
     with pytest.raises(bikedyn.InvalidArgumentError, match="max_fits_per_step"):
         bikedyn.identify("table.csv", bike="thesis", max_fits_per_step=4)
+    # So is the family-wise bar (the table's search has its own bars).
+    with pytest.raises(bikedyn.InvalidArgumentError, match="family_wise_bar"):
+        bikedyn.identify("table.csv", bike="thesis", family_wise_bar=True)
 
 
 def test_a_rust_panic_is_an_exception_with_its_message():

@@ -398,6 +398,12 @@ pub struct IdentifyArgs {
     /// step that adds nothing has fitted every candidate predicted to gain.
     #[arg(long, conflicts_with = "eigenvalues", value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
     pub max_fits_per_step: Option<usize>,
+    /// Raise each step's bar of a consistent held-out gain with the
+    /// candidates the step has fitted (a Bonferroni bar over them; the
+    /// speed-decay laws keep two standard errors), against chance entries
+    /// among many tries. Default: two standard errors for every candidate.
+    #[arg(long, conflicts_with = "eigenvalues")]
+    pub family_wise_bar: bool,
     /// Size and resolution of the report's plots; the limits apply to the
     /// continuation diagram.
     #[command(flatten)]

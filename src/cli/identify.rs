@@ -18,6 +18,7 @@ pub fn request(a: &IdentifyArgs) -> IdentifyRequest {
         corrections: a.corrections,
         discover: !a.no_discover,
         max_fits_per_step: a.max_fits_per_step,
+        family_wise_bar: a.family_wise_bar,
     }
 }
 

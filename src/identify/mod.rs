@@ -80,6 +80,11 @@ pub struct IdentifyRequest {
     /// that adds nothing has fitted every candidate the score test
     /// predicted to gain.
     pub max_fits_per_step: Option<usize>,
+    /// Raise each step's bar of a consistent held-out gain with the
+    /// candidates it has fitted (a family-wise bar; default false, two
+    /// standard errors for each: see
+    /// [`bikedyn_runtime::identify::IdentifyOptions::family_wise_bar`]).
+    pub family_wise_bar: bool,
 }
 
 impl Default for IdentifyRequest {
@@ -93,6 +98,7 @@ impl Default for IdentifyRequest {
             corrections: None,
             discover: true,
             max_fits_per_step: None,
+            family_wise_bar: false,
         }
     }
 }
@@ -319,6 +325,7 @@ pub fn run_plan<R: ModelRegistry>(
     let opts = FitSettings {
         folds: request.folds,
         max_fits_per_step: request.max_fits_per_step,
+        family_wise_bar: request.family_wise_bar,
         ..FitSettings::default()
     };
     // The runtime reports each stage by name, from the fitting threads, with

@@ -99,9 +99,20 @@ pub fn verdict_text(v: &Verdict) -> String {
         Verdict::WithinOneStandardError { cv, base_cv, stderr } => format!(
             "removed: without it the held-out error is {base_cv:.4} against {cv:.4}, within one standard error ({stderr:.4}); the simpler model is kept"
         ),
-        Verdict::HeldOutGainNotConsistent { gain, stderr, sigmas } => format!(
-            "rejected: mean held-out gain per run (per row or kick in the dictionary's search) {gain:.4}, within {} standard errors of zero (standard error {stderr:.4}; not a consistent improvement)",
-            if (*sigmas - 2.0).abs() < 1e-9 { "two".to_string() } else { format!("{sigmas:.2}") }
+        Verdict::HeldOutGainNotConsistent {
+            gain,
+            stderr,
+            sigmas,
+            family,
+        } => format!(
+            "rejected: mean held-out gain per run (per row or kick in the dictionary's search) {gain:.4}, within {} standard errors of zero (standard error {stderr:.4}, {:.1} SE{}; not a consistent improvement)",
+            if (*sigmas - 2.0).abs() < 1e-9 { "two".to_string() } else { format!("{sigmas:.2}") },
+            gain / stderr,
+            if *family > 1 {
+                format!("; the bar of one of the {family} candidates this step fitted")
+            } else {
+                String::new()
+            }
         ),
         Verdict::Encompassed { by, t, remains } => format!(
             "replaced by {by}: fitted together with it, its parameters keep {:.0} % of their shift alone ({t:.1} standard errors from their absence) while {by} stays significant; it stood in for {by}",

@@ -111,7 +111,8 @@ impl<'s> Search<'s> {
         let Some((t_winner, remains)) = swap else {
             return Ok(None);
         };
-        let Some(verdict) = self.validate_one(&mut pending[x], current) else {
+        let family = self.family(pending);
+        let Some(verdict) = self.validate_one(&mut pending[x], current, family) else {
             return Ok(None);
         };
         if !verdict.added() {

@@ -106,6 +106,15 @@ pub struct IdentifyOptions {
     /// scorecard sets of seed base 2 ended with 1 to 11 such candidates
     /// never fitted.
     pub max_fits_per_step: Option<usize>,
+    /// Whether a step's bar of a consistent held-out gain rises with the
+    /// candidates it has fitted (a Bonferroni bar over them,
+    /// [`super::selection::family_wise_sigmas`]; the speed-decay laws keep
+    /// two standard errors), against chance entries among many tries.
+    /// Default `false`: two standard errors for every candidate. Scored on
+    /// the oracle's draw of seed base 4 (docs/identification.md): it stops
+    /// corrections that clear two standard errors by a hair, and with them
+    /// weak right ones.
+    pub family_wise_bar: bool,
 }
 
 impl Default for IdentifyOptions {
@@ -115,6 +124,7 @@ impl Default for IdentifyOptions {
             max_effects: 3,
             patience: 4,
             max_fits_per_step: None,
+            family_wise_bar: false,
         }
     }
 }

@@ -5,7 +5,9 @@
 //! Each step extends the current model by the candidate that (a) lowers the
 //! information criterion ([`bic`]), (b) lowers the held-out error of the
 //! cross-validation by run, by more than two standard errors of the
-//! run-by-run gain ([`paired_gain`]), and (c) keeps its dissipative
+//! run-by-run gain ([`paired_gain`]; more when the step has fitted several
+//! candidates: the family-wise bar of [`entry_bar`], so that one of many
+//! tries does not enter on the scatter of the runs), and (c) keeps its dissipative
 //! parameters positive. The score test ([`super::screen`]) orders the
 //! candidates and skips those whose linearised fit cannot lower the
 //! criterion, but it never discards one because of another: the
@@ -196,6 +198,7 @@ pub fn identify<M: MultibodyModel>(
         progress,
         gain_sigmas: 2.0,
         pair_gain_sigmas: Some(2.0),
+        family_wise: opts.family_wise_bar,
     };
 
     let mut current = before.clone();
@@ -282,6 +285,13 @@ pub(super) struct Search<'s> {
     /// left). A pair is one of many more hypotheses than a single
     /// candidate; the library keeps its two standard errors for both.
     pub(super) pair_gain_sigmas: Option<f64>,
+    /// Whether the bar of a step rises with the candidates it has fitted
+    /// ([`family_wise_sigmas`] of them, at least `gain_sigmas`): a step that
+    /// fits nine candidates gives chance nine tries at the bar of a single
+    /// test. The speed-decay laws keep the single bar: every measured run
+    /// slows, so they are expected rather than one hypothesis of many. The
+    /// dictionary's search sets its bars for the whole dictionary instead.
+    pub(super) family_wise: bool,
 }
 
 /// The bar of a consistent held-out gain, in standard errors, when one of
@@ -298,6 +308,15 @@ pub fn family_wise_sigmas(candidates: usize) -> f64 {
     let alpha = 1.0 - Normal::standard().cdf(2.0);
     let k = candidates.max(1) as f64;
     Normal::standard().inverse_cdf(1.0 - alpha / k).max(2.0)
+}
+
+/// The bar of a consistent held-out gain a trial must clear, in standard
+/// errors, and the family it is counted in: `single_bar` for a single test,
+/// raised to [`family_wise_sigmas`] of the `family` fitted so far when the
+/// bar is family-wise (never below `single_bar`).
+pub(super) fn entry_bar(single_bar: f64, family_wise: bool, family: usize) -> (f64, usize) {
+    let family = if family_wise { family.max(1) } else { 1 };
+    (single_bar.max(family_wise_sigmas(family)), family)
 }
 
 /// A trial being considered: its members (indices into the step's
@@ -657,7 +676,8 @@ impl<'s> Search<'s> {
         let mut passed: Vec<usize> = Vec::new();
         for (done, i) in order.into_iter().enumerate() {
             let name = pending[i].name();
-            let Some(verdict) = self.validate_one(&mut pending[i], current) else {
+            let family = self.family(pending);
+            let Some(verdict) = self.validate_one(&mut pending[i], current, family) else {
                 continue;
             };
             (self.progress)(&format!("cross-validated {name}"), Some((done + 1, total)));
@@ -713,14 +733,33 @@ impl<'s> Search<'s> {
         Ok(Some(best))
     }
 
-    /// Cross-validate one fitted trial against `current`: its verdict
+    /// The size of the step's family of hypotheses so far: the trials it
+    /// has fitted that add a candidate other than a speed-decay law
+    /// (singles and pairs alike; not the pairs of the encompassing test,
+    /// which are not candidates), or 1 when the bar does not rise
+    /// ([`Search::family_wise`]).
+    pub(super) fn family(&self, pending: &[Pending<'s>]) -> usize {
+        if !self.family_wise {
+            return 1;
+        }
+        pending
+            .iter()
+            .filter(|p| p.fit.is_some() && !matches!(p.verdict, Some(Verdict::NotAdded)))
+            .filter(|p| !p.members.iter().all(|c| c.speed_decay))
+            .count()
+    }
+
+    /// Cross-validate one fitted trial against `current`, one of `family`
+    /// hypotheses its step has fitted ([`Search::family`]): its verdict
     /// (`None`: not fitted).
-    pub(super) fn validate_one(&self, p: &mut Pending<'s>, current: &CandidateFit) -> Option<Verdict> {
-        let sigmas = if p.members.len() > 1 {
+    pub(super) fn validate_one(&self, p: &mut Pending<'s>, current: &CandidateFit, family: usize) -> Option<Verdict> {
+        let single_bar = if p.members.len() > 1 {
             self.pair_gain_sigmas.unwrap_or(f64::INFINITY)
         } else {
             self.gain_sigmas
         };
+        let expected = p.members.iter().all(|c| c.speed_decay);
+        let (sigmas, family) = entry_bar(single_bar, self.family_wise && !expected, family);
         let (fit, setup) = p.fit.as_mut()?;
         cross_validate(setup, fit, self.fold_of, self.opts);
         let held_out_gain = paired_gain(current, fit, self.weights);
@@ -730,7 +769,12 @@ impl<'s> Search<'s> {
                 base_cv: current.cv,
             }
         } else if let Some((gain, stderr)) = held_out_gain.filter(|(d, se)| !(*d > sigmas * se)) {
-            Verdict::HeldOutGainNotConsistent { gain, stderr, sigmas }
+            Verdict::HeldOutGainNotConsistent {
+                gain,
+                stderr,
+                sigmas,
+                family,
+            }
         } else {
             Verdict::Added {
                 bic_change: fit.bic - bic(current, self.reference),

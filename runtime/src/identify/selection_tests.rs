@@ -194,6 +194,26 @@ fn the_consistent_gain_bar_of_many_alike_candidates_keeps_the_family_wise_rate()
     assert!(family_wise_sigmas(56) > z && family_wise_sigmas(2) < z);
 }
 
+#[test]
+fn a_step_that_fitted_many_candidates_asks_more_of_each_and_the_speed_loss_keeps_two() {
+    // The first candidate a step fits is one test: two standard errors.
+    assert_eq!(entry_bar(2.0, true, 1), (2.0, 1));
+    // The ninth: the family-wise bar of nine (2.275e-2 / 9 = 2.53e-3, the
+    // normal quantile 2.80), which a chance entry at 2.0-2.5 SE does not
+    // clear (stop 61's scorecard: z4, z5 and I4x entered at 2.0-2.5 SE at
+    // steps that had fitted 7-9).
+    let (bar, family) = entry_bar(2.0, true, 9);
+    assert_eq!(family, 9);
+    assert!((bar - 2.80).abs() < 0.01, "{bar}");
+    // A speed-decay law (or a search whose bars are set for the whole
+    // dictionary) is one test whatever the step fitted.
+    assert_eq!(entry_bar(2.0, false, 9), (2.0, 1));
+    // A preset bar above the family-wise one is kept.
+    assert_eq!(entry_bar(3.1, true, 4).0, 3.1);
+    // A pair that may not enter stays barred.
+    assert_eq!(entry_bar(f64::INFINITY, true, 4).0, f64::INFINITY);
+}
+
 /// A fit whose held-out error of each kick is `(weighted sum of squares of
 /// the roll channel, samples)`, under roll weight `w`.
 fn held_out_fit(kicks: &[(f64, usize)], w: f64) -> (CandidateFit, Vec<crate::identify::Weights>) {

@@ -78,6 +78,10 @@ pub enum Verdict {
         /// library; more for a dictionary of many terms, see
         /// [`super::selection::family_wise_sigmas`]).
         sigmas: f64,
+        /// The hypotheses the bar is family-wise over: the candidates its
+        /// step had fitted (1: the bar of a single test, or one set for a
+        /// whole dictionary).
+        family: usize,
     },
     /// It passed, but fitted together with a correction beyond its prior
     /// that fits better, its parameters fall within two standard errors of

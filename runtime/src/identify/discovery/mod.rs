@@ -519,6 +519,7 @@ pub fn discover(p: &Problem) -> Result<Discovery, DiscoveryError> {
                         gain,
                         stderr,
                         sigmas: gain_sigmas,
+                        family: 1,
                     }
                 } else if let Some((gain, stderr)) = reference_held
                     .zip(held.as_ref())

@@ -155,6 +155,7 @@ pub fn discover_in_time_series<M: MultibodyModel>(
         // is one of n (n - 1) / 2.
         gain_sigmas: family_wise_sigmas(terms.len()),
         pair_gain_sigmas: Some(family_wise_sigmas(terms.len() * terms.len().saturating_sub(1) / 2)),
+        family_wise: false,
     };
     let first = search_from(
         &search,
