@@ -36,6 +36,7 @@
 //! the whole search), so the steps' figures add up: a step's base is the
 //! previous step's base plus the change it selected.
 
+mod bar;
 mod elimination;
 
 use super::confounding::{Confounding, HeldOutGain};
@@ -50,6 +51,8 @@ use super::{
     ModelFactory, RollChannel, Segment, SegmentError, Setup, Weights, NUISANCE,
 };
 use crate::model::MultibodyModel;
+pub(super) use bar::entry_bar;
+pub use bar::family_wise_sigmas;
 pub use elimination::MemberCheck;
 use serde::Serialize;
 use std::sync::atomic::Ordering;
@@ -292,31 +295,6 @@ pub(super) struct Search<'s> {
     /// slows, so they are expected rather than one hypothesis of many. The
     /// dictionary's search sets its bars for the whole dictionary instead.
     pub(super) family_wise: bool,
-}
-
-/// The bar of a consistent held-out gain, in standard errors, when one of
-/// `candidates` alike candidates may enter: the library's two standard
-/// errors are a one-sided test at about 2.3 %; for a dictionary of many
-/// terms the same family-wise rate (Bonferroni) keeps a term from entering
-/// because one of many fitted the scatter best by chance (1: 2.0; 28 terms:
-/// about 3.1).
-pub fn family_wise_sigmas(candidates: usize) -> f64 {
-    use statrs::distribution::{ContinuousCDF, Normal};
-    if candidates <= 1 {
-        return 2.0;
-    }
-    let alpha = 1.0 - Normal::standard().cdf(2.0);
-    let k = candidates.max(1) as f64;
-    Normal::standard().inverse_cdf(1.0 - alpha / k).max(2.0)
-}
-
-/// The bar of a consistent held-out gain a trial must clear, in standard
-/// errors, and the family it is counted in: `single_bar` for a single test,
-/// raised to [`family_wise_sigmas`] of the `family` fitted so far when the
-/// bar is family-wise (never below `single_bar`).
-pub(super) fn entry_bar(single_bar: f64, family_wise: bool, family: usize) -> (f64, usize) {
-    let family = if family_wise { family.max(1) } else { 1 };
-    (single_bar.max(family_wise_sigmas(family)), family)
 }
 
 /// A trial being considered: its members (indices into the step's
