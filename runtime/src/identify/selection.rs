@@ -652,9 +652,10 @@ impl<'s> Search<'s> {
         });
         let total = order.len();
         let mut passed: Vec<usize> = Vec::new();
+        // Every trial waiting here is fitted already: one family for all.
+        let family = self.family(pending);
         for (done, i) in order.into_iter().enumerate() {
             let name = pending[i].name();
-            let family = self.family(pending);
             let Some(verdict) = self.validate_one(&mut pending[i], current, family) else {
                 continue;
             };
@@ -714,12 +715,9 @@ impl<'s> Search<'s> {
     /// The size of the step's family of hypotheses so far: the trials it
     /// has fitted that add a candidate other than a speed-decay law
     /// (singles and pairs alike; not the pairs of the encompassing test,
-    /// which are not candidates), or 1 when the bar does not rise
-    /// ([`Search::family_wise`]).
+    /// which are not candidates). Whether it raises the bar is
+    /// [`entry_bar`]'s to decide ([`Search::family_wise`]).
     pub(super) fn family(&self, pending: &[Pending<'s>]) -> usize {
-        if !self.family_wise {
-            return 1;
-        }
         pending
             .iter()
             .filter(|p| p.fit.is_some() && !matches!(p.verdict, Some(Verdict::NotAdded)))
