@@ -10,9 +10,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use plotters::prelude::*;
-
-use super::{PlotError, PlotOptions, FAMILY};
+use super::{PlotError, PlotOptions};
 
 /// Environment variable naming a TTF/OTF font file for plot text.
 pub const FONT_ENV: &str = "BIKEDYN_FONT";
@@ -182,9 +180,11 @@ fn register_file(path: &Path) -> Result<(), PlotError> {
             b
         }
     };
-    plotters::style::register_font(FAMILY, FontStyle::Normal, bytes).map_err(|_| PlotError::Font {
-        path: path.to_path_buf(),
-        message: "not a valid TrueType/OpenType font".into(),
+    plotters::style::register_font(super::FAMILY, plotters::style::FontStyle::Normal, bytes).map_err(|_| {
+        PlotError::Font {
+            path: path.to_path_buf(),
+            message: "not a valid TrueType/OpenType font".into(),
+        }
     })
 }
 
