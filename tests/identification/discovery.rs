@@ -351,11 +351,6 @@ fn in_the_time_series_a_steer_damper_the_library_lacks_is_found_and_halves_the_r
 /// runs better by more than one standard error, so it is kept. (Seed 11,
 /// the example's in `examples/discovered_force`, takes the other path: the
 /// force enters beside the stand-ins, and the backward check removes them.)
-///
-/// It takes about 15 minutes (the library's whole search, then the time
-/// series searched from two starts), more than the rest of this module
-/// together, so `cargo test` leaves it out and `.ci/run` runs it last,
-/// when the run has the time left for it (`--ignored`).
 #[test]
 #[ignore = "about 15 minutes: .ci/run runs it last when its time allows; `cargo test --release -- --ignored` runs it"]
 fn in_runs_a_second_start_without_the_implausible_corrections_finds_the_force_they_stood_in_for() {

@@ -113,10 +113,6 @@ fn a_frame_inertia_error_is_corrected_beside_steer_damping() {
 /// encompassing test) or removed by the final check, so the correction is
 /// what remains, near the hidden value, with its distance from the prior
 /// reported.
-///
-/// Twelve runs through the library's whole search and the time series take
-/// about 14 minutes on 2 cores, so `cargo test` leaves it out and
-/// `.ci/run` runs it last when its time allows (`--ignored`).
 #[test]
 #[ignore = "about 14 minutes: .ci/run runs it last when its time allows; `cargo test --release -- --ignored` runs it"]
 fn a_steer_inertia_beyond_its_prior_is_not_left_to_a_proxy() {
