@@ -348,7 +348,7 @@ def main():
     results = []
     failed = False
     began = time.time()
-    longest_set = args.set_seconds
+    longest_set = None  # seconds of the longest set so far (make and identify)
     not_scored = []
     for i, row in enumerate(rows, 1):
         seed = seed_of(row["name"], args.seed_base)
@@ -357,9 +357,11 @@ def main():
         # short by the budget's end would take the whole run with it.
         if args.time_left is not None:
             left = args.time_left - (time.time() - began)
-            if 1.5 * longest_set > left:
-                print(f"[{i}/{len(rows)}] {row['name']}: not scored for want of time ({left:.0f} s left; a set "
-                      f"takes up to {longest_set:.0f} s)", file=sys.stderr, flush=True)
+            expected = args.set_seconds if longest_set is None else longest_set
+            if 1.5 * expected > left:
+                print(f"[{i}/{len(rows)}] {row['name']}: not scored for want of time ({left:.0f} s left; "
+                      f"{'a set is expected to take' if longest_set is None else 'the longest set so far took'} "
+                      f"{expected:.0f} s)", file=sys.stderr, flush=True)
                 not_scored.append(row["name"])
                 continue
         set_began = time.time()
@@ -395,7 +397,7 @@ def main():
             r["own_shift"] = own_shifts(row, args)
             print(f"    selected {', '.join(r['selected']) or 'nothing'}; right {r['right']}; false {r['false']}; "
                   f"{seconds:.0f} s", file=sys.stderr, flush=True)
-            longest_set = max(longest_set, time.time() - set_began)
+            longest_set = max(longest_set or 0.0, time.time() - set_began)
         except (subprocess.CalledProcessError, RuntimeError, OSError, KeyError) as e:
             failed = True
             results.append({"set": row["name"], "error": str(e), "has_cause": has_cause})
