@@ -58,7 +58,7 @@ pub fn verdict_text(v: &Verdict) -> String {
             "not fitted: linearised at the current fit (score test), its best BIC change is {predicted_bic_change:+.1}, no gain"
         ),
         Verdict::BehindAdded { predicted_bic_change, added } => format!(
-            "not fitted: predicted BIC change {predicted_bic_change:+.1}; the step added {added} before reaching it (tried again in the next step)"
+            "not fitted: predicted BIC change {predicted_bic_change:+.1}, under half of what the passing fit gained (it could not beat it); the step added {added} (tried again in the next step)"
         ),
         Verdict::BeyondBudget { predicted_bic_change, budget } => format!(
             "not fitted: predicted BIC change {predicted_bic_change:+.1}; the step had fitted its budget of {budget} candidates before reaching it (a compute limit, not a verdict)"

@@ -14,7 +14,10 @@
 //! candidates it ranks close to the best are fitted together (they are the
 //! rivals the report compares), and when none of them passes, the next
 //! ones are fitted in the order of their predicted gain until one passes
-//! or none is left. When no single candidate passes, pairs whose joint
+//! or none is left. Before one that passes is added, every candidate
+//! predicted to gain at least half of what it gained once fitted is
+//! fitted too (it could beat it), and the best of those that pass is
+//! added. When no single candidate passes, pairs whose joint
 //! linearised fit beats each member's alone are fitted and validated the
 //! same way (a damper and an inertia error may each explain only part of
 //! a misfit). The search ends when a step adds nothing, or after
@@ -400,6 +403,7 @@ impl<'s> Search<'s> {
             });
         }
         plan.order.truncate(budget);
+        plan.gains.truncate(budget);
         let mut fitted = 0;
         let mut winner = first_passing(
             &mut pending,
@@ -414,6 +418,7 @@ impl<'s> Search<'s> {
                 Ok(())
             },
             |pending| self.validate(pending, current),
+            |pending, w| pending[w].fit.as_ref().map_or(f64::NAN, |(f, _)| base_bic - f.bic),
         )?;
         // No single candidate passed: pairs whose joint linearised fit
         // beats each member's alone, best predicted first.
@@ -643,8 +648,13 @@ impl<'s> Search<'s> {
     /// Cross-validate the fitted trials without a verdict, in the order of
     /// the criterion: the index of the one added, if any passes.
     fn validate(&self, pending: &mut [Pending<'s>], current: &CandidateFit) -> Result<Option<usize>, IdentifyError> {
+        // The fitted trials waiting, and those that passed an earlier call
+        // of the same step (a passing candidate waits while the candidates
+        // that could beat it are fitted: [`first_passing`]); those are
+        // judged again among all, without a second cross-validation.
+        let passed_before = |p: &Pending<'s>| p.verdict.as_ref().is_some_and(Verdict::passed);
         let mut order: Vec<usize> = (0..pending.len())
-            .filter(|&i| pending[i].verdict.is_none() && pending[i].fit.is_some())
+            .filter(|&i| (pending[i].verdict.is_none() || passed_before(&pending[i])) && pending[i].fit.is_some())
             .collect();
         order.sort_by(|&a, &b| {
             let bic = |i: usize| pending[i].fit.as_ref().map_or(f64::INFINITY, |f| f.0.bic);
@@ -656,10 +666,16 @@ impl<'s> Search<'s> {
         let family = self.family(pending);
         for (done, i) in order.into_iter().enumerate() {
             let name = pending[i].name();
-            let Some(verdict) = self.validate_one(&mut pending[i], current, family) else {
+            let verdict = if passed_before(&pending[i]) {
+                self.judge(&pending[i], current, family)
+            } else {
+                let verdict = self.validate_one(&mut pending[i], current, family);
+                (self.progress)(&format!("cross-validated {name}"), Some((done + 1, total)));
+                verdict
+            };
+            let Some(verdict) = verdict else {
                 continue;
             };
-            (self.progress)(&format!("cross-validated {name}"), Some((done + 1, total)));
             if verdict.added() {
                 passed.push(i);
             }
@@ -729,6 +745,14 @@ impl<'s> Search<'s> {
     /// hypotheses its step has fitted ([`Search::family`]): its verdict
     /// (`None`: not fitted).
     pub(super) fn validate_one(&self, p: &mut Pending<'s>, current: &CandidateFit, family: usize) -> Option<Verdict> {
+        let (fit, setup) = p.fit.as_mut()?;
+        cross_validate(setup, fit, self.fold_of, self.opts);
+        self.judge(p, current, family)
+    }
+
+    /// The verdict of a cross-validated trial against `current`, one of
+    /// `family` hypotheses its step has fitted (`None`: not fitted).
+    fn judge(&self, p: &Pending<'s>, current: &CandidateFit, family: usize) -> Option<Verdict> {
         let single_bar = if p.members.len() > 1 {
             self.pair_gain_sigmas.unwrap_or(f64::INFINITY)
         } else {
@@ -736,8 +760,7 @@ impl<'s> Search<'s> {
         };
         let expected = p.members.iter().all(|c| c.speed_decay);
         let (sigmas, family) = entry_bar(single_bar, self.family_wise && !expected, family);
-        let (fit, setup) = p.fit.as_mut()?;
-        cross_validate(setup, fit, self.fold_of, self.opts);
+        let (fit, _) = p.fit.as_ref()?;
         let held_out_gain = paired_gain(current, fit, self.weights);
         Some(if !(fit.cv < current.cv) {
             Verdict::HeldOutNotLower {

@@ -64,10 +64,13 @@ fn candidates_are_fitted_best_predicted_first_and_none_that_cannot_gain() {
 }
 
 /// A mock step: which candidates pass cross-validation, their held-out
-/// errors, and the log of what was fitted and validated.
+/// errors and fitted gains of the criterion, and the log of what was
+/// fitted and validated.
 struct Mock {
     passes: Vec<bool>,
     held_out: Vec<f64>,
+    /// What each candidate gains of the criterion once fitted.
+    gains: Vec<f64>,
     /// Pairs (a, b) where b's held-out gain over a is consistent run by run.
     consistent: Vec<(usize, usize)>,
     fitted: Vec<usize>,
@@ -76,18 +79,16 @@ struct Mock {
 
 impl Mock {
     fn validate(&mut self) -> Result<Option<usize>, ()> {
-        // Cross-validate every fitted one not yet validated; of those that
-        // pass, the one `added_of` chooses (as `Selection::validate`).
-        let mut passed = Vec::new();
+        // Cross-validate every fitted one not yet validated; of all that
+        // passed in the step, in the order of the criterion, the one
+        // `added_of` chooses (as `Search::validate`).
         for &i in &self.fitted.clone() {
-            if self.validated.contains(&i) {
-                continue;
-            }
-            self.validated.push(i);
-            if self.passes[i] {
-                passed.push(i);
+            if !self.validated.contains(&i) {
+                self.validated.push(i);
             }
         }
+        let mut passed: Vec<usize> = self.validated.iter().copied().filter(|&i| self.passes[i]).collect();
+        passed.sort_by(|&a, &b| self.gains[b].total_cmp(&self.gains[a]));
         let consistent = &self.consistent;
         Ok(added_of(&passed, &self.held_out, |a, b| consistent.contains(&(a, b))))
     }
@@ -104,9 +105,22 @@ fn run_with(
     held_out: Vec<f64>,
     consistent: Vec<(usize, usize)>,
 ) -> (Option<usize>, Mock) {
+    // Each fitted as predicted.
+    let gains = predicted.iter().map(|p| p.map_or(f64::INFINITY, |d| -d)).collect();
+    run_fitted(predicted, gains, passes, held_out, consistent)
+}
+
+fn run_fitted(
+    predicted: &[Option<f64>],
+    gains: Vec<f64>,
+    passes: Vec<bool>,
+    held_out: Vec<f64>,
+    consistent: Vec<(usize, usize)>,
+) -> (Option<usize>, Mock) {
     let mut m = Mock {
         passes,
         held_out,
+        gains,
         consistent,
         fitted: Vec::new(),
         validated: Vec::new(),
@@ -120,6 +134,7 @@ fn run_with(
             Ok(())
         },
         Mock::validate,
+        |m, w| m.gains[w],
     )
     .unwrap();
     (w, m)
@@ -133,6 +148,60 @@ fn a_candidate_far_behind_the_best_is_tried_when_the_best_fails() {
     let (w, m) = run(&[Some(-450.0), Some(-130.0), Some(-20.0)], vec![false, true, true]);
     assert_eq!(w, Some(1));
     assert_eq!(m.fitted, vec![0, 1], "the third is not fitted once the second passed");
+}
+
+#[test]
+fn a_candidate_that_could_beat_the_passing_one_once_fitted_is_fitted_before_it_is_added() {
+    // The first three fail; the fourth passes, but gains once fitted a
+    // quarter of its prediction (97 of 400). The fifth, predicted at 78
+    // (more than half of 97), could beat it: it is fitted, passes, and
+    // predicts the held-out runs consistently better, so it is added. The
+    // sixth, predicted at 20, could not: it is not fitted.
+    let predicted = [
+        Some(-1200.0),
+        Some(-900.0),
+        Some(-700.0),
+        Some(-400.0),
+        Some(-78.0),
+        Some(-20.0),
+    ];
+    let gains = vec![1225.0, 320.0, 119.0, 97.0, 90.0, 20.0];
+    let (w, m) = run_fitted(
+        &predicted,
+        gains.clone(),
+        vec![false, false, false, true, true, true],
+        vec![0.50, 0.50, 0.50, 0.4629, 0.4600, 0.45],
+        vec![(3, 4)],
+    );
+    assert_eq!(w, Some(4));
+    assert_eq!(m.fitted, vec![0, 1, 2, 3, 4]);
+    // Without the consistent held-out gain, the criterion's first stands,
+    // but the rival was fitted and cross-validated all the same.
+    let (w, m) = run_fitted(
+        &predicted,
+        gains,
+        vec![false, false, false, true, true, true],
+        vec![0.50, 0.50, 0.50, 0.4629, 0.4600, 0.45],
+        vec![],
+    );
+    assert_eq!(w, Some(3));
+    assert_eq!(m.validated, vec![0, 1, 2, 3, 4]);
+    // A rival that fails leaves the passing one, and the search stops
+    // there: nothing else could beat it.
+    let (w, m) = run_fitted(
+        &predicted,
+        vec![1225.0, 320.0, 119.0, 97.0, 90.0, 20.0],
+        vec![false, false, false, true, false, true],
+        vec![0.5; 6],
+        vec![],
+    );
+    assert_eq!(w, Some(3));
+    assert_eq!(m.fitted, vec![0, 1, 2, 3, 4]);
+    // A rival fitted beside a contender that gained far more than the
+    // others were predicted to (its gain raises the mark): none.
+    let (w, m) = run(&[Some(-450.0), Some(-130.0), Some(-20.0)], vec![true, true, true]);
+    assert_eq!(w, Some(0));
+    assert_eq!(m.fitted, vec![0]);
 }
 
 #[test]

@@ -27,8 +27,9 @@ pub enum Verdict {
     /// The score test's linearised fit does not lower the criterion: it
     /// cannot win this step (not fitted).
     NoPredictedGain { predicted_bic_change: f64 },
-    /// Not fitted: the step added another candidate before reaching it in
-    /// the order of the search (a contender, or one predicted to gain more).
+    /// Not fitted: the step added another candidate, and this one was
+    /// predicted to gain less than half of what a passing fit gained (it
+    /// could not beat it once fitted).
     BehindAdded { predicted_bic_change: f64, added: String },
     /// Not fitted: the step had fitted its budget of candidates
     /// ([`super::IdentifyOptions::max_fits_per_step`]) before reaching it.
@@ -116,5 +117,14 @@ impl Verdict {
     /// The candidate was added.
     pub fn added(&self) -> bool {
         matches!(self, Verdict::Added { .. })
+    }
+
+    /// The candidate passed every test of its step: added, or passed
+    /// behind the one added.
+    pub fn passed(&self) -> bool {
+        matches!(
+            self,
+            Verdict::Added { .. } | Verdict::PassedHeldOutBelow { .. } | Verdict::PassedCriterionAbove { .. }
+        )
     }
 }
