@@ -8,7 +8,9 @@ kept under --work), `bikedyn identify` runs on its data folder, and the
 outcome is scored against the truth the oracle wrote apart:
 
 * right cause: every cause in the set is selected, or reported as not
-  separable from a selected candidate (the report's `confounded` list);
+  separable from a selected candidate that is plausible under its prior
+  (the report's `confounded` list; a correction within three prior
+  standard deviations of its measured value, or an effect);
 * false causes: selected candidates that are neither a cause nor speed decay
   (rolling resistance and drag are in every set), and every term the
   search in the time series discovers beyond the library (the oracle's
@@ -78,6 +80,11 @@ EFFECT_CAUSES = {
 SPEED_DECAY = {"rolling_resistance", "aero_drag"}
 TARGET_RIGHT = 0.90
 TARGET_PARAMETER = 0.25
+# bikedyn's mark of a plausible correction (PLAUSIBLE_PRIOR_SDS): a cause
+# named as not separable from a selected correction beyond it is not found
+# (issue 33: "not separable from a selected one that is plausible under its
+# prior").
+PLAUSIBLE_PRIOR_SDS = 3.0
 
 
 def pairs(text: str) -> dict[str, float]:
@@ -195,7 +202,14 @@ def score(row, truth, report, seconds):
     # so every such term is a false cause.
     ts = report.get("time_series_discovery") or {}
     discovered = [f"discovered {t}" for t in ts.get("selected", [])] if ts.get("status") == "ran" else []
-    confounded = [(c["chosen"], c["rival"]) for c in report.get("confounded", []) if c.get("confounded")]
+    def plausible(candidate):
+        if not candidate.startswith("correct "):
+            return True
+        p = report["parameters"].get(candidate[len("correct "):]) or {}
+        return p.get("prior_sds") is None or abs(p["prior_sds"]) <= PLAUSIBLE_PRIOR_SDS
+
+    confounded = [(c["chosen"], c["rival"]) for c in report.get("confounded", [])
+                  if c.get("confounded") and plausible(c["chosen"])]
     cause_names = {c[0] for c in causes}
     found = []
     found_via = []  # (cause, selected candidate it is reported not separable from)
