@@ -8,8 +8,9 @@ use super::super::{cross_validate, CandidateFit, IdentifyError};
 use super::{added_of, bic, entry_bar, paired_gain, Pending, Search, Verdict};
 
 impl<'s> Search<'s> {
-    /// Cross-validate the fitted trials without a verdict, in the order of
-    /// the criterion: the index of the one added, if any passes.
+    /// Cross-validate the fitted trials without a verdict, and judge again
+    /// those that passed an earlier call of the step, in the order of the
+    /// criterion: the index of the one added, if any passes.
     pub(super) fn validate(
         &self,
         pending: &mut [Pending<'s>],
