@@ -472,10 +472,17 @@ def main():
     # alone do not tell that cause from the other (the time series and the
     # priors of measured parameters may still).
     hidden = [(r, c, v) for r in results for c, v in (r.get("own_signal") or {}).items() if v is not None and v < 2.0]
+
+    def found(r, c):
+        if c in [base_name(x) for x in r["selected"]]:
+            return "found"
+        via = next((v["not_separable_from"] for v in r.get("right_via", []) if v["cause"] == c), None)
+        return f"not separable from {via}" if via else "not found"
+
     if hidden:
         print("own signal of a cause beside another (what the other cause, refitted, leaves of its weave shift, in "
               "kick scatters; below 2 the weaves alone do not tell it from the other): below 2 for " + ", ".join(
-                  f"{c} in {r['set']} ({fmt(v, 1)}; {'found' if c in [base_name(x) for x in r['selected']] else 'not found'})"
+                  f"{c} in {r['set']} ({fmt(v, 1)}; {found(r, c)})"
                   for r, c, v in hidden))
         s["causes_below_own_signal_2"] = [{"set": r["set"], "cause": c, "own_signal": v} for r, c, v in hidden]
     print(f"identify time: {s['seconds']:.0f} s in all")
