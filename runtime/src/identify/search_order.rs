@@ -59,6 +59,12 @@ impl SearchOrder {
             gains,
         }
     }
+
+    /// Keep the first `most` candidates of the order (a compute budget).
+    pub(super) fn truncate(&mut self, most: usize) {
+        self.order.truncate(most);
+        self.gains.truncate(most);
+    }
 }
 
 /// The search of one step: fit the contenders, cross-validate, and while
@@ -90,10 +96,7 @@ pub(super) fn first_passing<S, E>(
             None => 1,
             Some(w) => {
                 let near = CONTENDER_SHARE * fitted_gain(state, w);
-                plan.gains[next..plan.order.len()]
-                    .iter()
-                    .take_while(|&&g| g >= near)
-                    .count()
+                plan.gains[next..].iter().take_while(|&&g| g >= near).count()
             }
         };
         if batch == 0 {

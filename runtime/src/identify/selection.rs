@@ -403,8 +403,7 @@ impl<'s> Search<'s> {
                 budget,
             });
         }
-        plan.order.truncate(budget);
-        plan.gains.truncate(budget);
+        plan.truncate(budget);
         let mut fitted = 0;
         let mut winner = first_passing(
             &mut pending,
