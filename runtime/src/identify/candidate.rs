@@ -49,13 +49,15 @@ pub struct EffectParameter {
     /// corrected by identification moves only as far as the data demand
     /// (the fit adds `((value - mean) / sd)^2` to its weighted sum).
     pub prior: Option<(f64, f64)>,
-    /// Where the prior's tail turns from Gaussian to exponential, in its
-    /// standard deviations (Huber): within it the fit adds
-    /// `((value - mean) / sd)^2`, beyond it a penalty growing linearly. A
+    /// Where the prior's tail turns from Gaussian to heavy, in its standard
+    /// deviations: within it the fit adds `((value - mean) / sd)^2`, beyond
+    /// it a penalty growing with the log of the distance, whose pull falls
+    /// as the distance grows (`heavy_tailed` in `problem.rs`). A
     /// measurement can be grossly wrong (a lamp or a bag on the handlebar
-    /// that the file forgot); a Gaussian tail would then pull the corrected
-    /// value back and spread the rest of the error over other parameters.
-    /// (Scaled with the prior when the prior is put on the data's scale.)
+    /// that the file forgot); a Gaussian tail, or a linear one, would then
+    /// pull the corrected value back and spread the rest of the error over
+    /// other parameters. (Scaled with the prior when the prior is put on
+    /// the data's scale.)
     pub gross_beyond: f64,
 }
 
