@@ -290,10 +290,10 @@ impl Problem<'_, '_> {
 /// measured value falls as `2 c^2 / |r|`: a Cauchy-like tail, which lets
 /// data that contradict a measurement by far overrule it (O'Hagan and
 /// Pericchi 2012, "Bayesian heavy-tailed models and conflict resolution:
-/// a review", Brazilian Journal of Probability and Statistics 26(4)), where
-/// Huber's linear tail kept a constant pull.
-/// That pull held a grossly wrong measurement short of its true value and
-/// left the rest of the error to another parameter: on the oracle's
+/// a review", Brazilian Journal of Probability and Statistics 26(4)).
+/// Huber's linear tail, used before, kept a constant pull, which held a
+/// grossly wrong measurement short of its true value and left the rest of
+/// the error to another parameter: on the oracle's
 /// front_steer_inertia_higher (the front assembly's inertia about the
 /// steer axis doubled, ten of its standard deviations), `I4z` stopped at
 /// 0.069 of the true 0.077 kg m^2, its data fit then lost to the front
