@@ -362,6 +362,19 @@ fn example_set_report_folder() {
         .filter(|c| c["outcome"]["kind"] == "beyond_budget")
         .collect();
     assert!(unfitted.is_empty(), "{unfitted:#?}");
+    // Each trial is fitted once a step and listed once: the speed loss's
+    // pair, fitted as one trial, is not fitted again by the search over
+    // pairs when no single candidate passes.
+    let mut trials: Vec<(i64, &str)> = j["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| (c["step"].as_i64().unwrap(), c["name"].as_str().unwrap()))
+        .collect();
+    let listed = trials.len();
+    trials.sort();
+    trials.dedup();
+    assert_eq!(trials.len(), listed, "a trial listed twice in a step");
     // Issue 33, item 4: an added candidate's claim says how consistent its
     // held-out gain was (the bar it passed: two standard errors), in the
     // JSON and in the report's words.

@@ -425,7 +425,17 @@ impl<'s> Search<'s> {
         if winner.is_none() && self.pair_gain_sigmas.is_some() {
             let mut pairs = screened.pairs.clone();
             pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
-            pairs.retain(|(_, p)| *p < reference_bic);
+            // A pair this step has already fitted as one trial (the speed
+            // loss's two laws) is not fitted again: the same fit, listed
+            // twice in the report.
+            let fitted_together = |a: usize, b: usize| {
+                pending.iter().any(|p| {
+                    p.members.len() == 2
+                        && p.members.iter().any(|c| std::ptr::eq(*c, remaining[a]))
+                        && p.members.iter().any(|c| std::ptr::eq(*c, remaining[b]))
+                })
+            };
+            pairs.retain(|((a, b), p)| *p < reference_bic && !fitted_together(*a, *b));
             pairs.truncate(MAX_PAIRS);
             let count = pairs.len();
             for (n, ((a, b), p)) in pairs.into_iter().enumerate() {
