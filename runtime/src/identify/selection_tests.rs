@@ -283,6 +283,27 @@ fn a_step_that_fitted_many_candidates_asks_more_of_each_and_the_speed_loss_keeps
     assert_eq!(entry_bar(f64::INFINITY, true, 4).0, f64::INFINITY);
 }
 
+#[test]
+fn a_pair_of_candidates_clears_the_bar_of_every_pair_they_form_and_the_speed_loss_pair_one_test() {
+    // The library's 36 candidates form 630 pairs: 2.275e-2 / 630 =
+    // 3.6e-5, the normal quantile 3.97.
+    let pairs = pair_sigmas(36);
+    assert!((pairs - 3.97).abs() < 0.01, "{pairs}");
+    // Oracle-sim seed base 5's `steer_friction_small`: a roll-rate
+    // controller with `I5y` at 2.65 standard errors, which the single
+    // test's bar let in, does not clear it.
+    assert!(2.65 < trial_bar(2, false, 2.0, Some(pairs)));
+    // A single candidate, and rolling resistance with drag (expected
+    // together: every run slows), are one test each.
+    assert_eq!(trial_bar(1, false, 2.0, Some(pairs)), 2.0);
+    assert_eq!(trial_bar(2, true, 2.0, Some(pairs)), 2.0);
+    // No pair where none may enter (one place left).
+    assert_eq!(trial_bar(2, false, 2.0, None), f64::INFINITY);
+    // One or two candidates form at most one pair: the single bar.
+    assert_eq!(pair_sigmas(2), 2.0);
+    assert_eq!(pair_sigmas(1), 2.0);
+}
+
 /// A fit whose held-out error of each kick is `(weighted sum of squares of
 /// the roll channel, samples)`, under roll weight `w`.
 fn held_out_fit(kicks: &[(f64, usize)], w: f64) -> (CandidateFit, Vec<crate::identify::Weights>) {

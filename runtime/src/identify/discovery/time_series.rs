@@ -17,7 +17,7 @@
 
 use super::super::criterion::{farthest_from_prior, with_priors_on_the_data_scale, PLAUSIBLE_PRIOR_SDS};
 use super::super::cross_validation::held_out_standard_error;
-use super::super::selection::{family_wise_sigmas, Identification, MemberCheck, Search, Step};
+use super::super::selection::{family_wise_sigmas, pair_sigmas, Identification, MemberCheck, Search, Step};
 use super::super::{Candidate, CandidateFit, Factory, IdentifyError, IdentifyOptions, Segment};
 use crate::model::MultibodyModel;
 use serde::Serialize;
@@ -154,7 +154,7 @@ pub fn discover_in_time_series<M: MultibodyModel>(
         // One of many terms entering by chance is guarded against; a pair
         // is one of n (n - 1) / 2.
         gain_sigmas: family_wise_sigmas(terms.len()),
-        pair_gain_sigmas: Some(family_wise_sigmas(terms.len() * terms.len().saturating_sub(1) / 2)),
+        pair_gain_sigmas: Some(pair_sigmas(terms.len())),
         family_wise: false,
     };
     let first = search_from(

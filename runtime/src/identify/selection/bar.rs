@@ -26,3 +26,28 @@ pub(in crate::identify) fn entry_bar(single_bar: f64, family_wise: bool, family:
     let family = if family_wise { family.max(1) } else { 1 };
     (single_bar.max(family_wise_sigmas(family)), family)
 }
+
+/// The bar of a pair of `candidates` alike candidates: one of every pair
+/// they can form, since the search over pairs ranges over all of them
+/// (the screen ranks them by their joint linearised fit, and the best are
+/// fitted).
+pub fn pair_sigmas(candidates: usize) -> f64 {
+    family_wise_sigmas(candidates * candidates.saturating_sub(1) / 2)
+}
+
+/// The bar of a trial before any family-wise raise: `gain_sigmas` for a
+/// single candidate and for the speed loss's laws together (an expected
+/// trial: every run slows), `pair_gain_sigmas` for any other pair (`None`:
+/// no pair may enter).
+pub(in crate::identify) fn trial_bar(
+    members: usize,
+    all_speed_decay: bool,
+    gain_sigmas: f64,
+    pair_gain_sigmas: Option<f64>,
+) -> f64 {
+    if members > 1 && !all_speed_decay {
+        pair_gain_sigmas.unwrap_or(f64::INFINITY)
+    } else {
+        gain_sigmas
+    }
+}

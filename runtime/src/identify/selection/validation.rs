@@ -5,7 +5,7 @@
 
 use super::super::confounding::HeldOutGain;
 use super::super::{cross_validate, CandidateFit, IdentifyError};
-use super::{added_of, bic, entry_bar, paired_gain, Pending, Search, Verdict};
+use super::{added_of, bic, entry_bar, paired_gain, trial_bar, Pending, Search, Verdict};
 
 impl<'s> Search<'s> {
     /// Cross-validate the fitted trials without a verdict, and judge again
@@ -126,12 +126,8 @@ impl<'s> Search<'s> {
     /// The verdict of a cross-validated trial against `current`, one of
     /// `family` hypotheses its step has fitted (`None`: not fitted).
     fn judge(&self, p: &Pending<'s>, current: &CandidateFit, family: usize) -> Option<Verdict> {
-        let single_bar = if p.members.len() > 1 {
-            self.pair_gain_sigmas.unwrap_or(f64::INFINITY)
-        } else {
-            self.gain_sigmas
-        };
         let expected = p.members.iter().all(|c| c.speed_decay);
+        let single_bar = trial_bar(p.members.len(), expected, self.gain_sigmas, self.pair_gain_sigmas);
         let (sigmas, family) = entry_bar(single_bar, self.family_wise && !expected, family);
         let (fit, _) = p.fit.as_ref()?;
         let held_out_gain = paired_gain(current, fit, self.weights);
