@@ -143,7 +143,7 @@ pub(crate) fn steps_markdown(s: &mut String, steps: &[bikedyn_runtime::identify:
         };
         let _ = writeln!(
             s,
-            "Step {}: each candidate tried on top of {base} (its BIC {:.1}, held-out error {:.4}).\n",
+            "Step {}: candidates tried on top of {base} (whose BIC is {:.1}, held-out error {:.4}).\n",
             first + k,
             step.base_bic,
             step.base_cv
