@@ -362,3 +362,59 @@ fn the_held_out_errors_standard_error_takes_the_kicks_as_units() {
         assert_eq!(held_out_standard_error(&one, &weights), None);
     }
 }
+
+fn speed_law(name: &str, symbol: &str) -> Candidate {
+    Candidate {
+        speed_decay: true,
+        ..candidate(name, symbol, None)
+    }
+}
+
+#[test]
+fn the_speed_loss_laws_are_always_fitted_and_tried_together_while_neither_is_in_the_model() {
+    let rolling = speed_law("rolling_resistance", "Crr_rear");
+    let drag = speed_law("aero_drag", "CdA");
+    let friction = candidate("steer_friction", "T_steer", None);
+    let damper = candidate("steer_damping", "c_steer", None);
+    // A lateral step after a speed phase that added nothing (its pair fitted
+    // drag below zero beside the missing friction): the screen predicts no
+    // gain for drag, yet every law is fitted, and the two together too.
+    let remaining = [&rolling, &drag, &friction, &damper];
+    let (trials, single) = trials_of(
+        &remaining,
+        &[&friction],
+        &[Some(-40.0), Some(65.0), Some(-500.0), Some(3.0)],
+    );
+    assert_eq!(single, 4);
+    let names: Vec<String> = trials.iter().map(|p| p.name()).collect();
+    assert_eq!(
+        names,
+        [
+            "rolling_resistance",
+            "aero_drag",
+            "steer_friction",
+            "steer_damping",
+            "rolling_resistance + aero_drag"
+        ]
+    );
+    let predicted: Vec<Option<f64>> = trials.iter().map(|p| p.predicted).collect();
+    assert_eq!(
+        predicted,
+        [None, None, Some(-500.0), Some(3.0), None],
+        "speed laws are not screened"
+    );
+    let plan = SearchOrder::of(&predicted);
+    for law in [0, 1, 4] {
+        assert!(plan.order[..plan.contenders].contains(&law), "{:?}", plan);
+    }
+    assert!(
+        !plan.order.contains(&3),
+        "a lateral candidate predicted to lose stays unfitted"
+    );
+
+    // Once one law is in the model, the other is tried alone, never as a pair.
+    let remaining = [&drag, &damper];
+    let (trials, single) = trials_of(&remaining, &[&rolling, &friction], &[Some(65.0), Some(-20.0)]);
+    assert_eq!((trials.len(), single), (2, 2));
+    assert_eq!(trials[0].predicted, None);
+}
