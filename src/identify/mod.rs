@@ -197,6 +197,17 @@ pub struct Outcome<R: ModelRegistry = BuiltIn> {
 }
 
 impl<R: ModelRegistry> Outcome<R> {
+    /// The stated prior `(measured value, standard deviation)` of a
+    /// corrected parameter (the bicycle file's `+/-`, or the model's default
+    /// for its kind), as the plan's candidates declare it.
+    pub fn stated_prior(&self, symbol: &str) -> Option<(f64, f64)> {
+        self.candidates
+            .iter()
+            .flat_map(|c| &c.parameters)
+            .find(|p| p.symbol == symbol)
+            .and_then(|p| p.prior)
+    }
+
     /// What the segments' roll channel measures (angle or rate).
     pub fn roll_channel(&self) -> RollChannel {
         self.segments.first().map_or(RollChannel::Angle, |s| s.roll_channel)

@@ -100,7 +100,7 @@ pub fn result<R: ModelRegistry>(o: &Outcome<R>) -> IdentifyResult {
         .zip(id.after.values.iter().zip(&id.after.stderr))
         .map(|(p, (&v, &se))| {
             let mut e = Estimate::of(p, v, se);
-            let prior = stated_prior(o, &p.symbol);
+            let prior = o.stated_prior(&p.symbol);
             e.prior = prior.map(|(mean, sd)| Prior { mean, sd });
             e.prior_sds = prior.map(|(mean, sd)| (v - mean) / sd);
             (p.symbol.clone(), e)
@@ -238,7 +238,8 @@ pub fn summary<R: ModelRegistry>(o: &Outcome<R>) -> String {
         .iter()
         .zip(id.after.values.iter().zip(&id.after.stderr))
         .map(|(p, (v, se))| {
-            let prior = stated_prior(o, &p.symbol)
+            let prior = o
+                .stated_prior(&p.symbol)
                 .map(|(mean, sd)| format!(" ({:+.1} prior sd from the measured {mean:.4})", (v - mean) / sd))
                 .unwrap_or_default();
             match p.on_bound(*v) {
@@ -513,15 +514,4 @@ pub fn write_report<R: ModelRegistry>(
     write_string_atomic(out.join("report.md"), &md)?;
     staged.commit()?;
     Ok(())
-}
-
-/// The stated prior `(measured value, standard deviation)` of a corrected
-/// parameter (the bicycle file's `+/-`, or the model's default for its
-/// kind), as the plan's candidates declare it.
-pub fn stated_prior<R: ModelRegistry>(o: &Outcome<R>, symbol: &str) -> Option<(f64, f64)> {
-    o.candidates
-        .iter()
-        .flat_map(|c| &c.parameters)
-        .find(|p| p.symbol == symbol)
-        .and_then(|p| p.prior)
 }

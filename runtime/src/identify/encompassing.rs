@@ -10,6 +10,7 @@
 //! so: the plausible winner keeps less than half of its shift, or falls
 //! within two standard errors of its absence, beside the correction.
 
+use super::cross_validation::cross_validate;
 use super::selection::{Pending, Search, Verdict};
 use super::{Candidate, CandidateFit, IdentifyError};
 
@@ -119,6 +120,22 @@ impl<'s> Search<'s> {
             return Ok(None);
         }
         pending[x].verdict = Some(verdict);
+        // The other corrections beyond their priors that also fitted better
+        // than the stand-in are cross-validated too, their verdicts kept:
+        // the criterion counts no prior, and two such corrections of one
+        // assembly can trade places by less than the runs' scatter (on an
+        // independent set the front wheel's diametral inertia fitted best
+        // where the fork's steer-axis inertia was wrong, and predicted the
+        // held-out runs no better). The rivals of the one added then show
+        // whether the runs tell them apart.
+        for y in (0..single).filter(|&y| y != x) {
+            let far = matches!(pending[y].verdict, Some(Verdict::ImplausibleUnderPrior { .. }));
+            if far && bic_of(&pending[y]) < wbic {
+                if let Some((fit, setup)) = pending[y].fit.as_mut() {
+                    cross_validate(setup, fit, self.fold_of, self.opts);
+                }
+            }
+        }
         pending[w].verdict = Some(Verdict::Encompassed {
             by: pending[x].name(),
             t: t_winner,

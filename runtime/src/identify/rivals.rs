@@ -1,5 +1,7 @@
 //! The rivals of a step's added candidate: every other fitted candidate
-//! that also lowered the criterion and is plausible under its prior, with
+//! that also lowered the criterion and is plausible under its prior (or,
+//! beside a chosen correction beyond its prior, was cross-validated as
+//! well), with
 //! how far the data tell the two apart ([`super::confounding`]) and, for a
 //! rival that passed cross-validation too, its paired held-out gain.
 
@@ -39,6 +41,10 @@ impl<'s> Search<'s> {
         };
         let ks: usize = selected.iter().map(|c| c.parameters.len()).sum();
         let kc = chosen.parameters.len();
+        // A chosen correction beyond its prior (the encompassing test's):
+        // its rivals beyond theirs that were cross-validated beside it are
+        // as plausible as it is, and are weighed as well.
+        let chosen_far = !self.plausible(chosen, &fit.values[ks.min(fit.values.len())..]);
         let mut out = Vec::new();
         for (i, p) in pending.iter().enumerate() {
             let Some((rival_fit, _)) = &p.fit else { continue };
@@ -46,7 +52,9 @@ impl<'s> Search<'s> {
                 continue;
             }
             let rival = p.members[0];
-            if !self.plausible(rival, &rival_fit.values[ks..]) {
+            let plausible = self.plausible(rival, &rival_fit.values[ks..]);
+            let far_rival = chosen_far && !plausible && rival_fit.cv.is_finite();
+            if !plausible && !far_rival {
                 continue;
             }
             let mut active: Vec<&Candidate> = selected.to_vec();
@@ -61,7 +69,16 @@ impl<'s> Search<'s> {
                 continue;
             };
             let mut g = fit.values.clone();
-            g.extend(rival_fit.values.iter().skip(ks));
+            if far_rival {
+                // Two corrections beyond their priors, each fitted for the
+                // same misfit: both at their fitted values would count the
+                // shift twice (a model the runs are far from, whose kicks
+                // may not simulate). The information is taken at the
+                // chosen one's fit with the rival at its measured value.
+                g.extend(rival.parameters.iter().map(|q| q.prior.map_or(0.0, |p| p.0)));
+            } else {
+                g.extend(rival_fit.values.iter().skip(ks));
+            }
             if g.len() != setup.k() {
                 continue;
             }
@@ -69,10 +86,11 @@ impl<'s> Search<'s> {
             let b: Vec<usize> = (ks + kc..setup.k()).collect();
             // A rival that passed cross-validation too: how much better or
             // worse it predicts the held-out runs, run by run.
-            let passed = matches!(
-                p.verdict,
-                Some(Verdict::PassedCriterionAbove { .. } | Verdict::PassedHeldOutBelow { .. })
-            );
+            let passed = far_rival
+                || matches!(
+                    p.verdict,
+                    Some(Verdict::PassedCriterionAbove { .. } | Verdict::PassedHeldOutBelow { .. })
+                );
             let held_out_gain = passed
                 .then(|| paired_gain(fit, rival_fit, self.weights))
                 .flatten()
