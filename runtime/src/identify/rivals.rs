@@ -1,9 +1,9 @@
 //! The rivals of a step's added candidate: every other fitted candidate
 //! that also lowered the criterion and is plausible under its prior (or,
-//! beside a chosen correction beyond its prior, was cross-validated as
-//! well), with
-//! how far the data tell the two apart ([`super::confounding`]) and, for a
-//! rival that passed cross-validation too, its paired held-out gain.
+//! beside a chosen correction beyond its prior, is a correction beyond its
+//! own that was cross-validated too), with how far the data tell the two
+//! apart ([`super::confounding`]) and, for a rival that passed
+//! cross-validation too, its paired held-out gain.
 
 use super::confounding::{self, Confounding, HeldOutGain};
 use super::cross_validation::paired_gain;
