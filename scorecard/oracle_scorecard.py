@@ -230,8 +230,10 @@ def score(row, truth, report, seconds):
             else:
                 err = abs(p["value"] - true) / abs(true)
             param_errors.append((symbol, p["value"], true, err))
+    # A candidate named as not separable from a cause stands in for it,
+    # unless the cause is selected too: then it is one more term.
     false = [s for s in selected if s not in cause_names and s not in SPEED_DECAY
-             and not any(rv in cause_names for ch, rv in confounded if ch == s)] + discovered
+             and not any(rv in cause_names and rv not in selected for ch, rv in confounded if ch == s)] + discovered
     before, after = report["error_before"], report["error_after"]
     ho_b, ho_a = before["held_out"], after["held_out"]
 
