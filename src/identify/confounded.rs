@@ -13,16 +13,15 @@ pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
     let mut out = Vec::new();
     for step in &id.steps {
         for c in step.confounded.iter().filter(|c| c.not_separated()) {
-            // The trial's own parameters (those beyond the step's base):
-            // symbol, value, standard error, unit, distance from the
-            // measured value in prior standard deviations.
-            let own = |name: &str| -> Vec<(String, f64, f64, String, Option<f64>)> {
+            // The trial's own parameters (those beyond the step's base),
+            // each correction with its distance from its measured value.
+            let values = |name: &str| {
                 step.trials
                     .iter()
                     .find(|t| t.name == name)
                     .and_then(|t| t.fit.as_ref())
                     .map(|f| {
-                        let skip = f.parameters.len().saturating_sub(
+                        let own = f.parameters.len().saturating_sub(
                             o.candidates
                                 .iter()
                                 .find(|x| x.name == name)
@@ -31,33 +30,19 @@ pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
                         f.parameters
                             .iter()
                             .zip(f.values.iter().zip(&f.stderr))
-                            .skip(skip)
-                            .map(|(p, (&v, &se))| {
-                                let sds = o.stated_prior(&p.symbol).map(|(mean, sd)| (v - mean) / sd);
-                                (p.symbol.clone(), v, se, p.unit.clone(), sds)
+                            .skip(own)
+                            .map(|(p, (v, se))| {
+                                let prior = o
+                                    .stated_prior(&p.symbol)
+                                    .map(|(mean, sd)| format!(", {:+.1} prior sd", (v - mean) / sd))
+                                    .unwrap_or_default();
+                                format!("{} = {:.4} +- {:.4} {} (95 %{prior})", p.symbol, v, 1.96 * se, p.unit)
                             })
-                            .collect()
+                            .collect::<Vec<_>>()
+                            .join(", ")
                     })
                     .unwrap_or_default()
             };
-            let values = |name: &str| {
-                own(name)
-                    .iter()
-                    .map(|(symbol, v, se, unit, sds)| {
-                        let prior = sds.map(|d| format!(", {d:+.1} prior sd")).unwrap_or_default();
-                        format!("{symbol} = {v:.4} +- {:.4} {unit} (95 %{prior})", 1.96 * se)
-                    })
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            };
-            // Beyond the mark of a plausible correction: the encompassing
-            // test's choice and a rival of the same kind.
-            let far = |name: &str| {
-                own(name)
-                    .iter()
-                    .any(|(.., sds)| sds.is_some_and(|d| d.abs() > PLAUSIBLE_PRIOR_SDS))
-            };
-            let both_far = far(&c.chosen) && far(&c.rival);
             let better: Vec<String> = c
                 .designs
                 .iter()
@@ -81,7 +66,7 @@ pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
                 ));
             }
             if let Some(h) = c.held_out_gain.filter(|h| h.within_scatter()) {
-                let both = if both_far {
+                let both = if c.beyond_priors {
                     format!(
                         "both lie beyond {PLAUSIBLE_PRIOR_SDS} prior standard deviations of their measured values, both were cross-validated,"
                     )
@@ -92,7 +77,7 @@ pub fn confounding_lines<R: ModelRegistry>(o: &Outcome<R>) -> Vec<String> {
                     "{both} and neither predicts the held-out runs consistently better (the rival's paired gain {:+.4} +- {:.4}, 1 SE; correlation {:.3})",
                     h.gain, h.stderr, c.correlation
                 ));
-                if both_far {
+                if c.beyond_priors {
                     why.push(
                         "so these runs call for a correction beyond its measurement without telling which (weigh or swing the parts again)"
                             .to_string(),

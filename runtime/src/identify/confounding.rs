@@ -45,6 +45,10 @@ pub struct Confounding {
     /// the held-out residuals, chosen minus rival: positive when the rival
     /// predicts better), and that gain's standard error.
     pub held_out_gain: Option<HeldOutGain>,
+    /// Both lie beyond their priors (the encompassing test's choice and a
+    /// rival correction of the same kind, cross-validated beside it): the
+    /// runs call for one such correction without telling which.
+    pub beyond_priors: bool,
     /// Designs of further kicks and the correlation each would give on its
     /// own, best separating first.
     pub designs: Vec<Design>,
@@ -219,6 +223,7 @@ mod tests {
             rival: "correct x3".into(),
             correlation,
             held_out_gain,
+            beyond_priors: false,
             designs: Vec::new(),
         };
         let gain = |gain: f64, stderr: f64| Some(HeldOutGain { gain, stderr });

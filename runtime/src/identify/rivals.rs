@@ -104,6 +104,7 @@ impl<'s> Search<'s> {
                     rival: rival.name.clone(),
                     correlation,
                     held_out_gain,
+                    beyond_priors: far_rival,
                     designs,
                 });
             }
