@@ -200,14 +200,19 @@ pub fn run<R: ModelRegistry>(
     duration: f64,
     options: &SimOptions,
 ) -> Result<Simulation, SimulationError> {
-    bike.refuse_feedback("simulate")?;
     let lookup = bike.lookup()?;
+    // The bicycle's controller acts through the whole run, whatever the
+    // request's perturbations.
+    let closed_loop = Inputs {
+        feedback: bike.feedback.clone(),
+        ..inputs.clone()
+    };
     R::with_model(
         model.name,
         RunSimulation {
             lookup: &lookup,
             ic: initial,
-            inputs,
+            inputs: &closed_loop,
             duration,
             opts: options,
         },

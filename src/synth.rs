@@ -23,6 +23,7 @@ use bikedyn_report::output::{save_json, write_atomic, OutputError};
 use bikedyn_report::staged::{FolderKind, StagedDir};
 use bikedyn_runtime::eigen::{eigenvalues_of, EigenError};
 use bikedyn_runtime::experiment::synth::{rest_trajectory, RunKind, SensorModel, SynthTruth};
+use bikedyn_runtime::feedback::GainSchedule;
 use bikedyn_runtime::linearize::{parameter_vector, LinearizeError};
 use bikedyn_runtime::model::CoordinateRole;
 use bikedyn_runtime::parameters::ThesisParameters;
@@ -265,21 +266,24 @@ fn write_physical_run(dir: &Path, name: &str, tr: &Trajectory, truth: &RunTruth)
 fn one_run<M: MultibodyModel>(
     lookup: &dyn Fn(&str) -> Option<f64>,
     plan: &RunPlan,
+    feedback: Option<&GainSchedule>,
 ) -> Result<(Trajectory, Simulation, Vec<f64>), SynthError> {
     let param = parameter_vector::<M>(lookup, plan.speed)?;
-    let (tr, sim) = trajectory_for_run::<M>(&param, plan, &SimOptions::default())?;
+    let (tr, sim) = trajectory_for_run::<M>(&param, plan, feedback, &SimOptions::default())?;
     Ok((tr, sim, param))
 }
 
 struct OneRun<'a, F: Fn(&str) -> Option<f64>> {
     lookup: &'a F,
     plan: &'a RunPlan,
+    /// The bicycle file's controller, acting from the release on.
+    feedback: Option<&'a GainSchedule>,
 }
 impl<F: Fn(&str) -> Option<f64>> ModelVisitor for OneRun<'_, F> {
     #[allow(clippy::type_complexity)]
     type Output = Result<(Trajectory, Simulation, Vec<f64>, &'static [&'static str]), SynthError>;
     fn visit<M: MultibodyModel>(self) -> Self::Output {
-        let (t, s, pv) = one_run::<M>(self.lookup, self.plan)?;
+        let (t, s, pv) = one_run::<M>(self.lookup, self.plan, self.feedback)?;
         Ok((t, s, pv, M::PARAMETERS))
     }
 }
@@ -299,7 +303,6 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
         return Err(SynthError::RunCount { runs: a.runs });
     }
     let mut bike = Bicycle::<R>::resolve_in(&a.bike)?;
-    bike.refuse_feedback("synth")?;
     for (sym, val) in &a.effects {
         bike = bike.with_parameter(sym, *val)?;
     }
@@ -359,6 +362,7 @@ pub fn synth_in<R: ModelRegistry>(a: &SynthOptions, on_run: &mut dyn FnMut(&Synt
             OneRun {
                 lookup: &lookup,
                 plan: &plan,
+                feedback: bike.feedback.as_ref(),
             },
         )
         .expect("registered model")?;

@@ -137,6 +137,7 @@ pub(crate) fn simulate<'py>(
             inputs: Inputs {
                 kicks: kick_list,
                 pulses: pulse_list,
+                feedback: None,
             },
             duration,
             options: opts,

@@ -225,7 +225,7 @@ def test_eigenvalue_standard_deviations_are_the_first_order_propagation():
     assert bikedyn.Bicycle("benchmark").eigenvalue_standard_deviations([4.0]) is None
 
 
-def test_a_files_feedback_closes_the_loop_and_simulate_refuses_to_ignore_it():
+def test_a_files_feedback_closes_the_loop_in_the_linear_analyses_and_the_simulation():
     import pathlib
     src = pathlib.Path(__file__).resolve().parents[2] / "tests" / "data" / "balance_assist_gain_8.toml"
     b = bikedyn.Bicycle(str(src))
@@ -237,8 +237,15 @@ def test_a_files_feedback_closes_the_loop_and_simulate_refuses_to_ignore_it():
     assert 1.0 < lo < 1.1 and 4.3 < hi < 4.4
     weave = max(b.eig([1.66]).eigenvalues[0], key=lambda z: z.imag)
     assert abs(weave - complex(-1.5025818770340327, 8.47937107316705)) < 1e-9
-    with pytest.raises(bikedyn.Error, match=r"\[feedback\]"):
-        bikedyn.simulate(b, duration=0.5, speed=3.0)
+    # The nonlinear simulation closes the same loop: a small roll rate at
+    # 3 m/s follows the closed-loop exp(A t) x0 (A - B K in state space).
+    sim = bikedyn.simulate(b, duration=2.0, speed=3.0, roll_rate=1e-4, dt=0.05)
+    A, _ = b.state_space([3.0])
+    w, V = np.linalg.eig(A[0])
+    c = np.linalg.solve(V, np.array([0, 0, 1e-4, 0]))
+    lin = np.array([(V @ (c * np.exp(w * t))).real for t in sim["t"]])
+    err = np.abs(sim.coordinate("roll") - lin[:, 0]).max()
+    assert err < 1e-3 * np.abs(lin[:, 0]).max(), err
 
 
 def test_a_leaning_rider_stiffly_held_is_the_rigid_rider_bicycle():

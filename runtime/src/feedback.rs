@@ -14,6 +14,7 @@
 //! knots 0, 1.5 and 4.7 m/s).
 
 use crate::eigen::{EigenError, LinearBicycle, SpeedMatrices};
+use crate::scalar::Scalar;
 use nalgebra::{Matrix2, Matrix2x4};
 
 /// The gain names, row by row of `K` (bicycleparameters' names): the roll
@@ -110,6 +111,38 @@ impl GainSchedule {
         )
     }
 
+    /// The torques `u = [T_phi, T_delta] = -K(v) x` (N m, benchmark signs)
+    /// for the state `x = [phi, delta, phi', delta']` (rad, rad/s) at the
+    /// forward speed `v` (m/s), in any scalar: what the nonlinear
+    /// simulation applies. `K` is taken at `v`'s value and carried to first
+    /// order along `v`'s derivatives (the schedule's slope there), so the
+    /// forward sensitivities of a simulation are exact wherever the
+    /// schedule is smooth (not at a knot, where it has a kink).
+    pub fn torques<T: Scalar>(&self, v: T, x: [T; 4]) -> [T; 2] {
+        let v0 = v.re();
+        let (k, slope) = (self.at(v0), self.slope(v0));
+        let dv = v - T::cst(v0);
+        let mut u = [T::zero(); 2];
+        for (i, ui) in u.iter_mut().enumerate() {
+            for (j, &xj) in x.iter().enumerate() {
+                *ui -= (T::cst(k[(i, j)]) + T::cst(slope[(i, j)]) * dv) * xj;
+            }
+        }
+        u
+    }
+
+    /// `dK/dv` at `v` ((N m per rad or rad/s) per m/s): the slope of the
+    /// knot interval that holds `v` (the one to the right at a knot, as
+    /// [`GainSchedule::at`] interpolates there), zero beyond the ends.
+    fn slope(&self, v: f64) -> Matrix2x4<f64> {
+        let n = self.speeds.len();
+        if n < 2 || !(v >= self.speeds[0] && v < self.speeds[n - 1]) {
+            return Matrix2x4::zeros();
+        }
+        let i = self.speeds.partition_point(|&s| s <= v) - 1;
+        (self.gains[i + 1] - self.gains[i]) / (self.speeds[i + 1] - self.speeds[i])
+    }
+
     /// `K(v)`: linear between the knots, held beyond the ends.
     pub fn at(&self, v: f64) -> Matrix2x4<f64> {
         let n = self.speeds.len();
@@ -166,6 +199,26 @@ mod tests {
         assert_eq!(s.at(4.7)[(1, 2)], 0.0);
         assert_eq!(s.at(9.0)[(1, 2)], 0.0);
         assert_eq!(GainSchedule::constant(k(2.0)).unwrap().at(123.0)[(1, 2)], 2.0);
+    }
+
+    /// The torques are `-K(v) x` at the speed's value, and a dual
+    /// number's derivative along the speed is the schedule's slope times
+    /// the state (between knots; zero beyond the ends).
+    #[test]
+    fn the_torques_are_minus_k_x_with_the_schedules_slope_along_the_speed() {
+        use crate::scalar::Dual;
+        let s = GainSchedule::new(vec![0.0, 1.5, 4.7], vec![k(0.0), k(-12.48), k(0.0)]).unwrap();
+        let x = [0.1, -0.2, 0.3, 0.4];
+        for (v, slope) in [(1.0, -12.48 / 1.5), (3.0, 12.48 / 3.2), (6.0, 0.0)] {
+            let u = s.torques(v, x);
+            assert_eq!(u[0], 0.0);
+            assert!((u[1] + s.at(v)[(1, 2)] * 0.3).abs() < 1e-15, "v = {v}: {u:?}");
+            let vd = Dual::<1> { re: v, eps: [1.0] };
+            let xd = x.map(|c| Dual::<1> { re: c, eps: [0.0] });
+            let ud = s.torques(vd, xd);
+            assert!((ud[1].re - u[1]).abs() < 1e-15);
+            assert!((ud[1].eps[0] + slope * 0.3).abs() < 1e-12, "v = {v}: {:?}", ud[1]);
+        }
     }
 
     #[test]

@@ -81,6 +81,7 @@ fn time_run<M: MultibodyModel>(
     let inputs = Inputs {
         kicks: vec![Kick::at_saddle(0.0, 3.0)],
         pulses: vec![],
+        feedback: None,
     };
     let opts = SimOptions {
         rtol: 1e-8,

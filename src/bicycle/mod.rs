@@ -78,8 +78,6 @@ pub enum BicycleError {
         model: String,
         states: String,
     },
-    #[error("{bike}: its [feedback] controller is applied by the linear analyses (stability, eig, sweep, bode, identify --eigenvalues); {job} does not apply it yet, so it would ignore the controller. Give {job} a file without [feedback] (the steer_controller effect parameters Kc_* express a steer-torque law linear in speed)")]
-    FeedbackNotApplied { bike: String, job: &'static str },
 }
 
 /// A resolved bicycle, against the models of registry `R` (the built-in
@@ -523,17 +521,6 @@ impl<R: ModelRegistry> Bicycle<R> {
             feedback: self.feedback.clone(),
             registry: PhantomData,
         })
-    }
-
-    /// Refuse a job that would silently ignore the file's `[feedback]`.
-    pub fn refuse_feedback(&self, job: &'static str) -> Result<(), BicycleError> {
-        match self.feedback {
-            Some(_) => Err(BicycleError::FeedbackNotApplied {
-                bike: self.name.clone(),
-                job,
-            }),
-            None => Ok(()),
-        }
     }
 
     /// The effect parameters the file set, as TOML lines that any

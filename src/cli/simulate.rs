@@ -118,6 +118,7 @@ pub fn run(a: SimulateArgs) -> Result<bool> {
     let inputs = Inputs {
         kicks: a.kick.iter().map(|k| parse_kick(k)).collect::<Result<_>>()?,
         pulses: a.pulse.iter().map(|k| parse_pulse(k)).collect::<Result<_>>()?,
+        feedback: None,
     };
     // 0 disables a stop; a negative or non-finite angle is no angle (NaN
     // would silently disable it too).

@@ -25,8 +25,12 @@ pub fn identification_models<R: ModelRegistry>(
     let nonzero = bike.nonzero_parameters()?;
     let (free, driven) = identification_model_pair(bike)?;
     let fitted = if speed_imposed { driven } else { free };
+    // With a `[feedback]` controller, no model with extra states: its
+    // linear equations (the weave predictions) have no `M, C, K` to close
+    // the loop on.
     let alt = R::models()
         .iter()
+        .filter(|_| bike.feedback.is_none())
         .filter(|m| {
             m.free_speed == !speed_imposed
                 && !m.states.is_empty()

@@ -226,7 +226,6 @@ pub fn plan(request: &IdentifyRequest) -> Result<Plan, IdentifyError> {
 pub fn plan_in<R: ModelRegistry>(request: &IdentifyRequest) -> Result<Plan<R>, IdentifyError> {
     let speed_imposed = segments::speed_imposed(&request.inputs)?;
     let bike = Bicycle::<R>::resolve_in(request.bicycle()?)?;
-    bike.refuse_feedback("identify")?;
     let (model, driven_model, alternative_model) = identification_models(&bike, speed_imposed)?;
     let candidates = candidates(model, alternative_model, &bike, &request.effects, speed_imposed)?;
     // A conclusion ("no effect warranted") means something only when
@@ -305,6 +304,12 @@ pub fn run_plan<R: ModelRegistry>(
         rejected,
         mut skipped,
     } = segments(&out);
+    // The experiment's controller acts in every simulation of a kick, as it
+    // did on the road.
+    let segs: Vec<_> = segs
+        .into_iter()
+        .map(|s| s.with_feedback(bike.feedback.clone()))
+        .collect();
     // Runs and logs `fit` skipped (no kick found among them) and folders
     // of a set left out for want of a run.toml.
     skipped.extend(out.errors.iter().cloned());

@@ -543,6 +543,107 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
     }
 }
 
+/// With a controller closed around the equations (a `[feedback]` gain
+/// schedule, every gain non-zero and changing with speed), the forward
+/// sensitivities still match central differences of whole simulations,
+/// along the initial speed too (the gains' slope over speed enters there),
+/// and the lean response is the full simulation's with the same controller.
+#[test]
+fn forward_sensitivities_with_a_controller_match_central_differences() {
+    use bikedyn::generated::ExtendedFree;
+    use bikedyn::runtime::feedback::GainSchedule;
+    use bikedyn::runtime::linearize::parameter_vector;
+    use bikedyn::runtime::parameters::ThesisParameters;
+    use bikedyn::runtime::scalar::Dual;
+    use bikedyn::runtime::simulate::sensitivity::{response_with, Carried, Directions, Response};
+    use bikedyn::runtime::simulate::{simulate, Inputs};
+    use bikedyn::runtime::MultibodyModel;
+    use nalgebra::Matrix2x4;
+    type M = ExtendedFree;
+
+    let schedule = GainSchedule::new(
+        vec![0.0, 10.0],
+        vec![
+            Matrix2x4::new(0.5, 0.2, 0.1, 0.05, -0.3, 0.4, -8.0, 0.1),
+            Matrix2x4::new(1.0, -0.2, 0.3, 0.0, 0.2, 0.8, -2.0, 0.3),
+        ],
+    )
+    .unwrap();
+    let feedback = Some(&schedule);
+    let thesis = ThesisParameters::thesis_bicycle();
+    let mut param = parameter_vector::<M>(|s| thesis.get(s), 5.0).unwrap();
+    param[M::parameter_index("c_steer").unwrap()] = 0.2;
+    let mut dirs = Directions {
+        parameters: vec![(M::parameter_index("c_steer").unwrap(), 0, 1.0)],
+        ..Directions::default()
+    };
+    dirs.initial[2] = Some(1); // roll rate
+    dirs.initial[4] = Some(2); // speed
+    let (ic, opts) = kick_and_tight_options();
+    let duration = 2.0;
+    let speed_at = wheel_sensor_times(duration);
+    let exact: Response<Dual<6>> =
+        response_with::<M, Dual<6>>(&param, &ic, &dirs, duration, &opts, &speed_at, feedback).unwrap();
+    let plain: Response<f64> = response_with::<M, f64>(
+        &param,
+        &ic,
+        &Directions::default(),
+        duration,
+        &opts,
+        &speed_at,
+        feedback,
+    )
+    .unwrap();
+    let inputs = Inputs {
+        feedback: Some(schedule.clone()),
+        ..Inputs::default()
+    };
+    let sim = simulate::<M>(&param, &ic, &inputs, duration, &opts).unwrap();
+    let roll = sim.coordinate("theta").unwrap();
+    let open = simulate::<M>(&param, &ic, &Inputs::default(), duration, &opts).unwrap();
+    let open_roll = open.coordinate("theta").unwrap();
+    let apart = roll
+        .iter()
+        .zip(&open_roll)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(apart > 1e-3, "the controller changes the response ({apart} rad)");
+    for (i, (a, b)) in plain.roll.iter().zip(&roll).enumerate() {
+        assert!((a - b).abs() < 1e-10, "sample {i}: lean roll {a} against simulate {b}");
+        assert!((a - exact.roll[i].re).abs() < 1e-9);
+    }
+    let moved = |d: usize, h: f64| -> Response<f64> {
+        let (mut p, mut c) = (param.clone(), ic);
+        match d {
+            0 => p[M::parameter_index("c_steer").unwrap()] += h,
+            1 => c.roll_rate += h,
+            _ => c.speed += h,
+        }
+        response_with::<M, f64>(&p, &c, &Directions::default(), duration, &opts, &speed_at, feedback).unwrap()
+    };
+    for d in 0..3 {
+        let h = 1e-6;
+        let (a, b) = (moved(d, h), moved(d, -h));
+        for (name, e, a, b) in [
+            ("roll", &exact.roll, &a.roll, &b.roll),
+            ("steer", &exact.steer, &a.steer, &b.steer),
+            ("speed", &exact.speed, &a.speed, &b.speed),
+        ] {
+            let fd: Vec<f64> = a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * h)).collect();
+            let scale = fd.iter().fold(1e-3f64, |m, x| m.max(x.abs()));
+            let worst = e
+                .iter()
+                .zip(&fd)
+                .map(|(x, f)| (x.derivative(d) - f).abs())
+                .fold(0.0f64, f64::max);
+            assert!(
+                worst <= 1e-5 * scale,
+                "d {name} / d direction {d}: exact and central differences differ by {worst:.3e} (scale {scale:.3e})"
+            );
+        }
+    }
+}
+
 /// The state just after a kick at 5 m/s, and integration tolerances far
 /// below the differences' step, for the sensitivity checks.
 /// Times at which the speed is asked for, as a wheel sensor gives them:

@@ -184,6 +184,7 @@ fn kick_at_the_saddle_rolls_the_bicycle_right() {
         let inputs = Inputs {
             kicks: vec![Kick::at_saddle(0.5, j)],
             pulses: vec![],
+            feedback: None,
         };
         simulate::<M>(
             &thesis_at(4.5),
@@ -223,6 +224,7 @@ fn torque_pulses_act_with_the_right_sign() {
             duration: 0.1,
             amplitude: 5.0,
         }],
+        feedback: None,
     };
     let run = |inputs: &Inputs| {
         simulate::<M>(
@@ -337,8 +339,8 @@ fn synthetic_run_trajectory() {
     use bikedyn_runtime::simulate::trajectory::{trajectory_for_run, RunPlan};
     let plan = RunPlan::random(7);
     assert!(plan.speed >= 3.0 && plan.speed <= 7.0 && plan.launch_duration >= 2.0);
-    let (tr, sim) = trajectory_for_run::<M>(&thesis_at(plan.speed), &plan, &SimOptions::default()).unwrap();
-    let (tr2, _) = trajectory_for_run::<M>(&thesis_at(plan.speed), &plan, &SimOptions::default()).unwrap();
+    let (tr, sim) = trajectory_for_run::<M>(&thesis_at(plan.speed), &plan, None, &SimOptions::default()).unwrap();
+    let (tr2, _) = trajectory_for_run::<M>(&thesis_at(plan.speed), &plan, None, &SimOptions::default()).unwrap();
     assert_eq!(tr, tr2);
     assert!(sim.max_constraint_residual() < 1e-9);
     let n = tr.t.len();

@@ -8,6 +8,7 @@ fn free_kick<N: MultibodyModel>(param: &[f64], opts: &SimOptions) -> bikedyn_run
     let inputs = Inputs {
         kicks: vec![Kick::at_saddle(0.0, 3.0)],
         pulses: vec![],
+        feedback: None,
     };
     let ic = InitialConditions {
         speed: 4.5,
@@ -226,6 +227,7 @@ fn stiff_tyres_need_far_fewer_evaluations_with_radau5() {
         let inputs = Inputs {
             kicks: vec![Kick::at_saddle(0.0, 3.0)],
             pulses: vec![],
+            feedback: None,
         };
         let ic = InitialConditions {
             speed: 4.5,

@@ -99,6 +99,7 @@ fn kick_to_peak_of<N: MultibodyModel>(param: &[f64], speed: f64, peak: f64) -> b
         let inputs = Inputs {
             kicks: vec![Kick::at_saddle(0.0, j)],
             pulses: vec![],
+            feedback: None,
         };
         let o = SimOptions {
             output_interval: 0.002,

@@ -12,7 +12,7 @@ use super::{Candidate, EffectParameter, IdentifyError, RollChannel, Segment, Wei
 use super::{EXTRA_STATES, INITIAL_MOTION, NUISANCE, STEER_BIAS};
 use crate::model::MultibodyModel;
 use crate::scalar::Dual;
-use crate::simulate::sensitivity::{interpolate, response, Carried, Directions};
+use crate::simulate::sensitivity::{interpolate, response_with, Carried, Directions};
 use crate::simulate::{simulate, Events, InitialConditions, Inputs, Method, SimOptions};
 use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -129,7 +129,11 @@ fn simulate_segment<M: MultibodyModel>(
     };
     let ic = initial_conditions(x0, M::STATES.len());
     let param = with_extra_states::<M>(param, x0);
-    let sim = simulate::<M>(&param, &ic, &Inputs::default(), seg.duration() + dt, &stiff).map_err(|e| e.to_string())?;
+    let inputs = Inputs {
+        feedback: seg.feedback.clone(),
+        ..Inputs::default()
+    };
+    let sim = simulate::<M>(&param, &ic, &inputs, seg.duration() + dt, &stiff).map_err(|e| e.to_string())?;
     use crate::model::CoordinateRole as R;
     let roll = match seg.roll_channel {
         RollChannel::Angle => sim.require_coordinate(R::Roll, "identification residuals"),
@@ -199,7 +203,16 @@ fn sampled<M: MultibodyModel, T: Carried>(
     };
     let ic = initial_conditions(x0, M::STATES.len());
     let param = &with_extra_states::<M>(param, x0);
-    let r = response::<M, T>(param, &ic, dirs, seg.duration() + dt, &opts, &seg.speed_t).ok()?;
+    let r = response_with::<M, T>(
+        param,
+        &ic,
+        dirs,
+        seg.duration() + dt,
+        &opts,
+        &seg.speed_t,
+        seg.feedback.as_ref(),
+    )
+    .ok()?;
     let roll = match seg.roll_channel {
         RollChannel::Angle => &r.roll,
         RollChannel::Rate => &r.roll_rate,

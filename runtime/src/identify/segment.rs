@@ -5,6 +5,7 @@
 //! its nuisances in a fit.
 
 use super::{at_rest, NUISANCE};
+use crate::feedback::GainSchedule;
 use serde::Serialize;
 
 /// What the roll channel of a segment measures: the roll angle (the
@@ -71,6 +72,10 @@ pub struct Segment {
     /// over the window is a nuisance of the kick ([`super::STEER_BIAS`]).
     /// An encoder's steer (the TU Delft logs) has none.
     pub steer_bias: bool,
+    /// The controller the experiment ran (a bicycle file's `[feedback]`
+    /// table), closed around every simulation of the kick.
+    #[serde(skip)]
+    pub feedback: Option<GainSchedule>,
 }
 
 impl Segment {
@@ -126,6 +131,7 @@ impl Segment {
             weave,
             weave_r2: None,
             steer_bias: false,
+            feedback: None,
         })
     }
 
@@ -160,6 +166,12 @@ impl Segment {
     /// angle from two orientation sensors).
     pub fn with_steer_bias(mut self) -> Segment {
         self.steer_bias = true;
+        self
+    }
+
+    /// The same segment simulated with the experiment's controller.
+    pub fn with_feedback(mut self, feedback: Option<GainSchedule>) -> Segment {
+        self.feedback = feedback;
         self
     }
 

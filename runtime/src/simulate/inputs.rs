@@ -1,6 +1,7 @@
 //! Inputs and perturbations: initial conditions, impulsive kicks, torque
 //! pulses, and the events that stop a run.
 
+use crate::feedback::GainSchedule;
 use serde::{Deserialize, Serialize};
 
 /// Initial conditions in the thesis's conventions (rad, rad/s, m/s): roll
@@ -133,11 +134,18 @@ impl TorquePulse {
     }
 }
 
-/// All perturbations of a run.
+/// All perturbations of a run, and a controller closed around it.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Inputs {
     pub kicks: Vec<Kick>,
     pub pulses: Vec<TorquePulse>,
+    /// Full-state feedback on the roll and steer torques (a bicycle
+    /// file's `[feedback]` table), applied at every evaluation from the
+    /// roll and steer angles and rates and the forward speed
+    /// ([`GainSchedule::torques`], benchmark signs). Not read from a
+    /// request: the application sets it from the bicycle.
+    #[serde(skip)]
+    pub feedback: Option<GainSchedule>,
 }
 
 impl Inputs {

@@ -693,6 +693,18 @@ fn evaluate_dynamics<M: MultibodyModel, T: Scalar>(
     let (tr, ts) = at.inputs.torques(t.max(a + inset).min(b - inset));
     w.qe[at.coords.roll] += T::cst(tr);
     w.qe[at.coords.steer] += T::cst(ts);
+    if let Some(k) = &at.inputs.feedback {
+        // The controller's torques from the state in the benchmark's signs
+        // (the thesis's steer gamma is positive to the left: delta =
+        // -gamma, and a steer torque T_delta is a generalized force
+        // -T_delta on gamma; roll is positive to the right in both).
+        let c = at.coords;
+        let v = forward_speed(c, &w.p, &w.dp);
+        let x = [w.p[c.roll], -w.p[c.steer], w.dp[c.roll], -w.dp[c.steer]];
+        let [t_roll, t_steer] = k.torques(v, x);
+        w.qe[c.roll] += t_roll;
+        w.qe[c.steer] -= t_steer;
+    }
     for r in 0..nq {
         let mut s = w.qv[r] + w.qg[r] + w.qe[r];
         for c in 0..nq {

@@ -37,6 +37,7 @@ use super::{
     imposed_speed_parameter, initial_state, DynSystem, Events, InitialConditions, Inputs, SimOptions, SimulateError,
     MAX_STATE_RATES,
 };
+use crate::feedback::GainSchedule;
 use crate::model::MultibodyModel;
 use crate::scalar::{Dual, Scalar};
 
@@ -194,6 +195,21 @@ pub fn response<M: MultibodyModel, T: Carried>(
     opts: &SimOptions,
     speed_at: &[f64],
 ) -> Result<Response<T>, SimulateError> {
+    response_with::<M, T>(param, ic, directions, duration, opts, speed_at, None)
+}
+
+/// [`response`] with a controller closed around the equations (a bicycle
+/// file's `[feedback]` table, [`Inputs::feedback`]): its torques enter the
+/// right-hand side, and so the derivatives, as every other force does.
+pub fn response_with<M: MultibodyModel, T: Carried>(
+    param: &[f64],
+    ic: &InitialConditions,
+    directions: &Directions,
+    duration: f64,
+    opts: &SimOptions,
+    speed_at: &[f64],
+    feedback: Option<&GainSchedule>,
+) -> Result<Response<T>, SimulateError> {
     let nd = T::DIRECTIONS;
     if !(duration > 0.0 && duration.is_finite()) {
         return Err(SimulateError::InvalidInput(format!(
@@ -272,7 +288,10 @@ pub fn response<M: MultibodyModel, T: Carried>(
         }
     }
 
-    let inputs = Inputs::default();
+    let inputs = Inputs {
+        feedback: feedback.cloned(),
+        ..Inputs::default()
+    };
     let sys = Variational::<M, T> {
         at: At {
             layout: &layout,

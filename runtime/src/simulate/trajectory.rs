@@ -176,10 +176,13 @@ impl Hand {
 /// yaw follows from the steer and roll the hand imposes), the release, the
 /// kick and the free response from the nonlinear equations. Returns the
 /// orientation history (hand-over to the measured-run writer) and the
-/// simulation of the free part (its time starts at the release).
+/// simulation of the free part (its time starts at the release). A
+/// controller (`feedback`, a bicycle file's `[feedback]` table) acts from
+/// the release on: the hand holds the bicycle before.
 pub fn trajectory_for_run<M: crate::model::MultibodyModel>(
     param: &[f64],
     plan: &RunPlan,
+    feedback: Option<&crate::feedback::GainSchedule>,
     opts: &super::SimOptions,
 ) -> Result<(Trajectory, Simulation), SimulateError> {
     use super::{initial_state, simulate, Evaluator, InitialConditions, Inputs, Kick};
@@ -265,6 +268,7 @@ pub fn trajectory_for_run<M: crate::model::MultibodyModel>(
     let inputs = Inputs {
         kicks: vec![Kick::at_saddle(plan.kick_delay, plan.kick_impulse)],
         pulses: vec![],
+        feedback: feedback.cloned(),
     };
     let o = super::SimOptions {
         output_interval: plan.sample_interval,
