@@ -302,3 +302,34 @@ fn identify_simulates_every_kick_with_the_controller_the_experiment_ran() {
         "without the controller: {damper:?}; with it {c}, held out {held_out}"
     );
 }
+
+/// Mode labels stay honest where the controller mixes the modes: from
+/// 1.66 m/s on (the measured table's speeds), the pair labelled weave is
+/// the oscillatory pair of highest frequency that continues the weave
+/// (bicycleparameters' first pair of `A - B K`), and no real root is called
+/// weave, also at 4.44 m/s, where the assist is fading and the capsize
+/// root has crossed to unstable.
+#[test]
+fn with_the_controller_the_weave_label_stays_on_the_pair_that_continues_the_weave() {
+    use bikedyn_runtime::eigen::{eigen_sweep_of, Mode};
+    let bike = Bicycle::resolve(&fixture_arg("balance_assist_gain_8.toml")).unwrap();
+    let lin = bike.linear_with(None).unwrap();
+    let speeds: Vec<f64> = (50..=600).map(|k| k as f64 / 100.0).collect();
+    let sweep = eigen_sweep_of(&lin, &speeds).unwrap();
+    let text = std::fs::read_to_string(fixture("balance_assist_gain_8_bicycleparameters.csv")).unwrap();
+    let mut checked = 0;
+    for line in text.lines().filter(|l| !l.starts_with('#')) {
+        let x: Vec<f64> = line.split(',').map(|s| s.trim().parse().unwrap()).collect();
+        if x[0] < 1.6 {
+            continue;
+        }
+        let p = sweep.points.iter().find(|p| (p.v - x[0]).abs() < 1e-9).unwrap();
+        for (z, mode) in p.eigenvalues.iter().zip(&p.modes) {
+            let is_weave = *mode == Mode::Weave;
+            let reference = (z.re - x[2]).abs() < 1e-8 && (z.im.abs() - x[3]).abs() < 1e-8;
+            assert_eq!(is_weave, reference, "v = {}: {z} labelled {mode:?}", x[0]);
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, 8);
+}
