@@ -8,6 +8,15 @@ use bikedyn::bicycle::Bicycle;
 use bikedyn_runtime::eigen::eigenvalues_of;
 use nalgebra::Complex;
 
+/// The balance-assist bicycle's file without its `[feedback]` table (the
+/// open loop), written as `name` in this group's scratch folder.
+fn open_loop_file(name: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(fixture("balance_assist_gain_8.toml")).unwrap();
+    let path = scratch("feedback").join(name);
+    std::fs::write(&path, text.split("[feedback]").next().unwrap()).unwrap();
+    path
+}
+
 /// The balance-assist bicycle with its gain-8 schedule agrees with
 /// bicycleparameters' `Meijaard2007WithFeedbackModel` (eig(A - B K)) at the
 /// measured table's speeds and beyond, on the ramp, the falling law and
@@ -44,9 +53,7 @@ fn a_scheduled_controller_agrees_with_bicycleparameters_a_minus_bk() {
 #[test]
 fn a_controller_changes_the_eigenvalues_only_where_its_gain_is_not_zero() {
     let path = fixture("balance_assist_gain_8.toml");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let open_path = scratch("feedback").join("open_loop.toml");
-    std::fs::write(&open_path, text.split("[feedback]").next().unwrap()).unwrap();
+    let open_path = open_loop_file("open_loop.toml");
     let closed = Bicycle::resolve(path.to_str().unwrap()).unwrap();
     let open = Bicycle::resolve(open_path.to_str().unwrap()).unwrap();
     assert!(closed.feedback.is_some() && open.feedback.is_none());
@@ -95,9 +102,7 @@ fn linear_and_nonlinear_commands_close_the_loop() {
     let stable = j["stable_intervals"].as_array().unwrap();
     assert!(stable.iter().any(|iv| iv[0].as_f64().unwrap() < 1.66), "{j:#}");
     let dir = scratch("feedback");
-    let open_path = dir.join("open_loop_simulated.toml");
-    let text = std::fs::read_to_string(fixture("balance_assist_gain_8.toml")).unwrap();
-    std::fs::write(&open_path, text.split("[feedback]").next().unwrap()).unwrap();
+    let open_path = open_loop_file("open_loop_simulated.toml");
     let last_roll = |bike: &str, csv: &str| {
         let csv = dir.join(csv);
         let out = bikedyn(&[
@@ -268,9 +273,7 @@ fn identify_simulates_every_kick_with_the_controller_the_experiment_ran() {
         set.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "synth: {}", String::from_utf8_lossy(&out.stderr));
-    let open_path = dir.join("open_loop_identified.toml");
-    let text = std::fs::read_to_string(fixture("balance_assist_gain_8.toml")).unwrap();
-    std::fs::write(&open_path, text.split("[feedback]").next().unwrap()).unwrap();
+    let open_path = open_loop_file("open_loop_identified.toml");
     let identify = |bike: &str| {
         let out = bikedyn(&[
             "identify",
