@@ -357,7 +357,7 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
     use bikedyn::runtime::linearize::parameter_vector;
     use bikedyn::runtime::parameters::ThesisParameters;
     use bikedyn::runtime::scalar::Dual;
-    use bikedyn::runtime::simulate::sensitivity::{response, Carried, Directions, Response};
+    use bikedyn::runtime::simulate::sensitivity::{response, Directions, Response};
     use bikedyn::runtime::simulate::{simulate, Inputs};
     use bikedyn::runtime::MultibodyModel;
 
@@ -459,13 +459,7 @@ fn forward_sensitivities_match_central_differences_of_simulations() {
                 ("speed", &exact.speed, &a.speed, &b.speed),
             ];
             for (name, e, a, b) in channels {
-                let fd: Vec<f64> = a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * h)).collect();
-                let scale = fd.iter().fold(1e-3f64, |m, x| m.max(x.abs()));
-                let worst = e
-                    .iter()
-                    .zip(&fd)
-                    .map(|(x, f)| (x.derivative(d) - f).abs())
-                    .fold(0.0f64, f64::max);
+                let (worst, scale) = misfit_against_central(e, a, b, h, d);
                 println!(
                     "{}: d {name} / d direction {d}: max |exact - central| = {worst:.2e} of {scale:.2e}",
                     M::NAME
@@ -498,7 +492,7 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
     use bikedyn::runtime::linearize::parameter_vector;
     use bikedyn::runtime::parameters::ThesisParameters;
     use bikedyn::runtime::scalar::Dual;
-    use bikedyn::runtime::simulate::sensitivity::{response, Carried, Directions, Response};
+    use bikedyn::runtime::simulate::sensitivity::{response, Directions, Response};
     use bikedyn::runtime::MultibodyModel;
     type M = ExtendedFree;
 
@@ -529,13 +523,7 @@ fn a_weighted_combination_of_parameters_is_one_sensitivity_direction() {
         ("steer", &exact.steer, &a.steer, &b.steer),
         ("speed", &exact.speed, &a.speed, &b.speed),
     ] {
-        let fd: Vec<f64> = a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * h)).collect();
-        let scale = fd.iter().fold(1e-3f64, |m, x| m.max(x.abs()));
-        let worst = e
-            .iter()
-            .zip(&fd)
-            .map(|(x, f)| (x.derivative(0) - f).abs())
-            .fold(0.0f64, f64::max);
+        let (worst, scale) = misfit_against_central(e, a, b, h, 0);
         assert!(
             worst <= 1e-5 * scale,
             "d {name} along the combination: exact and central differences differ by {worst:.3e} (scale {scale:.3e})"
@@ -555,7 +543,7 @@ fn forward_sensitivities_with_a_controller_match_central_differences() {
     use bikedyn::runtime::linearize::parameter_vector;
     use bikedyn::runtime::parameters::ThesisParameters;
     use bikedyn::runtime::scalar::Dual;
-    use bikedyn::runtime::simulate::sensitivity::{response_with, Carried, Directions, Response};
+    use bikedyn::runtime::simulate::sensitivity::{response_with, Directions, Response};
     use bikedyn::runtime::simulate::{simulate, Inputs};
     use bikedyn::runtime::MultibodyModel;
     use nalgebra::Matrix2x4;
@@ -629,13 +617,7 @@ fn forward_sensitivities_with_a_controller_match_central_differences() {
             ("steer", &exact.steer, &a.steer, &b.steer),
             ("speed", &exact.speed, &a.speed, &b.speed),
         ] {
-            let fd: Vec<f64> = a.iter().zip(b).map(|(x, y)| (x - y) / (2.0 * h)).collect();
-            let scale = fd.iter().fold(1e-3f64, |m, x| m.max(x.abs()));
-            let worst = e
-                .iter()
-                .zip(&fd)
-                .map(|(x, f)| (x.derivative(d) - f).abs())
-                .fold(0.0f64, f64::max);
+            let (worst, scale) = misfit_against_central(e, a, b, h, d);
             assert!(
                 worst <= 1e-5 * scale,
                 "d {name} / d direction {d}: exact and central differences differ by {worst:.3e} (scale {scale:.3e})"
@@ -646,6 +628,27 @@ fn forward_sensitivities_with_a_controller_match_central_differences() {
 
 /// The state just after a kick at 5 m/s, and integration tolerances far
 /// below the differences' step, for the sensitivity checks.
+/// The largest difference between a sampled channel's exact derivative
+/// along direction `d` and the central difference of the channel moved by
+/// `+h` (`up`) and `-h` (`down`), and the scale it is judged against (the
+/// differences' largest size, at least 1e-3).
+fn misfit_against_central<T: bikedyn::runtime::simulate::sensitivity::Carried>(
+    exact: &[T],
+    up: &[f64],
+    down: &[f64],
+    h: f64,
+    d: usize,
+) -> (f64, f64) {
+    let fd: Vec<f64> = up.iter().zip(down).map(|(x, y)| (x - y) / (2.0 * h)).collect();
+    let scale = fd.iter().fold(1e-3f64, |m, x| m.max(x.abs()));
+    let worst = exact
+        .iter()
+        .zip(&fd)
+        .map(|(x, f)| (x.derivative(d) - f).abs())
+        .fold(0.0f64, f64::max);
+    (worst, scale)
+}
+
 /// Times at which the speed is asked for, as a wheel sensor gives them:
 /// off the output grid, from the start to past the end (held there).
 fn wheel_sensor_times(duration: f64) -> Vec<f64> {
