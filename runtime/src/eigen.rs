@@ -59,6 +59,7 @@ use nalgebra::{Complex, Matrix2};
 use crate::canonical::CanonicalMatrices;
 
 mod critical;
+mod float;
 mod general;
 mod quartic;
 mod states;
@@ -349,8 +350,8 @@ fn mixed(x: &Matrix2<f64>, y: &Matrix2<f64>) -> f64 {
 /// Accurate 2x2 determinant (Kahan's FMA algorithm).
 fn det2(m: &Matrix2<f64>) -> f64 {
     let w = m[(0, 1)] * m[(1, 0)];
-    let err = (-m[(0, 1)]).mul_add(m[(1, 0)], w);
-    m[(0, 0)].mul_add(m[(1, 1)], -w) + err
+    let err = float::mul_add(-m[(0, 1)], m[(1, 0)], w);
+    float::mul_add(m[(0, 0)], m[(1, 1)], -w) + err
 }
 
 impl CharPoly {

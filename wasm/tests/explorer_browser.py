@@ -582,6 +582,27 @@ def step_redraw_time(p):
        f"diagram painted on its canvas, before the browser's layout and paint) {spread(diagram)} [issue 34's target: < 5 ms]; "
        f"the whole update (also the tables, the critical speeds' text, the slider's mode shapes, the root locus "
        f"and the link) {spread(whole)}")
+    # Where the diagram's time goes, in the page: the module's answer to
+    # the same request alone (a new trail each time, as typed) and the
+    # diagram drawn again from the last answer alone, 21 times each.
+    answer, drawing = p.js("""
+        const app = window.Explorer, S = window.ExplorerState, answer = [], drawing = [];
+        const spec = app.bicycleSpec();
+        for (let k = 0; k < 21; k++) {
+          const set = (spec.set || []).filter(([s]) => s !== "c").concat([["c", 0.07 + 0.0001 * k]]);
+          const req = app.withModel({ job: "explore", bicycle: Object.assign({}, spec, { set }), speeds: S.speedRange(app.state),
+            speed_min: app.state.vmin, speed_max: app.state.vmax, speed: app.state.speed });
+          const t = performance.now();
+          app.call(req);
+          answer.push(performance.now() - t);
+        }
+        for (let k = 0; k < 21; k++) {
+          const t = performance.now();
+          app.drawDiagram();
+          drawing.push(performance.now() - t);
+        }
+        return [answer, drawing];""")
+    ok(f"of the diagram's redraw, in the page: the module's answer alone {spread(answer)}; the diagram drawn alone {spread(drawing)}")
 
 
 def map_rows_agree(p, rows):

@@ -23,6 +23,7 @@
 
 use nalgebra::{Complex, Matrix4};
 
+use super::float::{self, mul_add};
 use crate::linalg::solve_in_place;
 
 pub(crate) type C64 = Complex<f64>;
@@ -189,7 +190,7 @@ fn horner_complex(e: &[f64; 5], z: C64) -> (C64, C64, f64) {
     let (mut pr, mut pi) = (e[4], 0.0);
     let (mut dr, mut di) = (0.0, 0.0);
     let mut s = e[4].abs();
-    let az = z.re.abs().max(z.im.abs()) * std::f64::consts::SQRT_2; // >= |z|
+    let az = float::max(z.re.abs(), z.im.abs()) * std::f64::consts::SQRT_2; // >= |z|
     for i in (0..4).rev() {
         let ndr = dr * zr - di * zi + pr;
         let ndi = dr * zi + di * zr + pi;
@@ -211,11 +212,11 @@ fn largest_real_cubic_root(bb: f64, cc: f64, dd: f64) -> f64 {
     let q = dd - sh * cc + 2.0 * sh * sh * sh;
     // t^3 + p t + q = 0, y = t - sh.
     let t = if p == 0.0 {
-        (-q).cbrt()
+        float::cbrt(-q)
     } else {
         let h = (q / 2.0) * (q / 2.0) + (p / 3.0) * (p / 3.0) * (p / 3.0);
         if h > 0.0 {
-            let aa = -(q.signum()) * ((q / 2.0).abs() + h.sqrt()).cbrt();
+            let aa = -(q.signum()) * float::cbrt((q / 2.0).abs() + h.sqrt());
             if aa == 0.0 {
                 0.0
             } else {
@@ -252,13 +253,13 @@ fn largest_real_cubic_root(bb: f64, cc: f64, dd: f64) -> f64 {
 /// Ferrari factorisation + refinement + quadratic roots (unpolished).
 fn ferrari(a: f64, b: f64, c: f64, d: f64) -> Option<[C64; 4]> {
     // Resolvent: y^3 - b y^2 + (a c - 4 d) y - (a^2 d - 4 b d + c^2) = 0.
-    let y = largest_real_cubic_root(-b, a.mul_add(c, -4.0 * d), -(a * a * d - 4.0 * b * d + c * c));
+    let y = largest_real_cubic_root(-b, mul_add(a, c, -4.0 * d), -(a * a * d - 4.0 * b * d + c * c));
     if !y.is_finite() {
         return None;
     }
-    let alpha2 = (0.25 * a).mul_add(a, y - b).max(0.0);
-    let beta2 = (0.25 * y).mul_add(y, -d).max(0.0);
-    let ab2 = 0.5 * a.mul_add(0.5 * y, -c); // alpha * beta
+    let alpha2 = float::max(mul_add(0.25 * a, a, y - b), 0.0);
+    let beta2 = float::max(mul_add(0.25 * y, y, -d), 0.0);
+    let ab2 = 0.5 * mul_add(a, 0.5 * y, -c); // alpha * beta
     let (alpha, beta) = if alpha2 >= beta2 {
         let al = alpha2.sqrt();
         (al, if al > 0.0 { ab2 / al } else { 0.0 })
@@ -287,16 +288,16 @@ fn factor_residual(a: f64, b: f64, c: f64, d: f64, f: &[f64; 4]) -> [f64; 4] {
     let [p1, q1, p2, q2] = *f;
     [
         p1 + p2 - a,
-        p1.mul_add(p2, q1 + q2) - b,
-        p1.mul_add(q2, p2 * q1) - c,
-        q1.mul_add(q2, -d),
+        mul_add(p1, p2, q1 + q2) - b,
+        mul_add(p1, q2, p2 * q1) - c,
+        mul_add(q1, q2, -d),
     ]
 }
 
 /// Newton on `(z^2+p1 z+q1)(z^2+p2 z+q2) = z^4+a z^3+b z^2+c z+d`, accepting only
 /// residual-decreasing steps.
 fn refine_factors(a: f64, b: f64, c: f64, d: f64, mut f: [f64; 4]) -> [f64; 4] {
-    let nrm = |r: &[f64; 4]| r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let nrm = |r: &[f64; 4]| r.iter().fold(0.0f64, |m, x| float::max(m, x.abs()));
     let mut r = factor_residual(a, b, c, d, &f);
     let mut rn = nrm(&r);
     let tiny = 4.0 * EPS * (1.0 + a.abs() + b.abs() + c.abs() + d.abs());
@@ -332,7 +333,7 @@ fn refine_factors(a: f64, b: f64, c: f64, d: f64, mut f: [f64; 4]) -> [f64; 4] {
 /// Roots of `z^2 + p z + q` (real roots: larger first; complex: upper first).
 fn quadratic_roots(p: f64, q: f64) -> [C64; 2] {
     let h = -0.5 * p;
-    let disc = h.mul_add(h, -q);
+    let disc = mul_add(h, h, -q);
     if disc >= 0.0 {
         let sq = disc.sqrt();
         let big = if h >= 0.0 { h + sq } else { h - sq };
@@ -406,8 +407,8 @@ fn polish_all(e: &[f64; 5], z: [C64; 4]) -> Option<[C64; 4]> {
     for i in 0..4 {
         for j in i + 1..4 {
             let d = (z[i] - z[j]).norm_sqr();
-            gap[i] = gap[i].min(d);
-            gap[j] = gap[j].min(d);
+            gap[i] = float::min(gap[i], d);
+            gap[j] = float::min(gap[j], d);
         }
     }
     for g in gap.iter_mut() {
@@ -454,7 +455,7 @@ fn polish_real(e: &[f64; 5], x0: f64, gap: f64) -> Option<f64> {
         if !(sa < 0.5 * gap) {
             break;
         }
-        if sa <= 1e-9 * x.abs().max(gap.min(1.0)) && sa <= 1e-6 * gap {
+        if sa <= 1e-9 * float::max(x.abs(), float::min(gap, 1.0)) && sa <= 1e-6 * gap {
             // simple root, converged to within ~1e-18 after this step
             x -= step;
             return (p.abs() <= BACKWARD_TOL * sc).then_some(x);
@@ -475,7 +476,7 @@ fn polish_real(e: &[f64; 5], x0: f64, gap: f64) -> Option<f64> {
 /// Complex counterpart of [`polish_real`]; never crosses the real axis.
 fn polish_complex(e: &[f64; 5], z0: C64, gap: f64) -> Option<C64> {
     let mut z = z0;
-    let gap = gap.min(2.0 * z0.im.abs());
+    let gap = float::min(gap, 2.0 * z0.im.abs());
     let g2 = gap * gap;
     let (mut p, mut dp, mut sc) = horner_complex(e, z);
     let mut p2 = p.norm_sqr();
@@ -489,7 +490,7 @@ fn polish_complex(e: &[f64; 5], z0: C64, gap: f64) -> Option<C64> {
         if !(sn2 < 0.25 * g2) {
             break;
         }
-        if sn2 <= 1e-18 * z.norm_sqr().max(g2.min(1.0)) && sn2 <= 1e-12 * g2 {
+        if sn2 <= 1e-18 * float::max(z.norm_sqr(), float::min(g2, 1.0)) && sn2 <= 1e-12 * g2 {
             z -= step;
             return (p2 <= BACKWARD_TOL * BACKWARD_TOL * sc * sc).then_some(z);
         }

@@ -3,6 +3,7 @@
 //! the pattern of the roots names them (one complex pair and two real
 //! roots), matching the roots from one speed to the next.
 
+use super::float;
 use super::*;
 
 /// All 24 permutations of 0..4, identity first.
@@ -131,12 +132,18 @@ fn match_roots(prev: &Labelled, new: &[C64; 4]) -> ([C64; 4], bool) {
             d[i][j] = (prev.roots[i] - new[j]).norm_sqr();
         }
     }
+    // Each permutation's sum written out with constant indices (a loop
+    // over the table, with its index checks, was a tenth of the browser's
+    // stability map, 2026-12-01): the same sums in the same order, and the
+    // first least one chosen, as before.
+    macro_rules! sums {
+        ($($k:literal)*) => {
+            [$(d[0][PERMS[$k][0]] + d[1][PERMS[$k][1]] + d[2][PERMS[$k][2]] + d[3][PERMS[$k][3]]),*]
+        };
+    }
+    let costs: [f64; 24] = sums!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23);
     let mut best = (f64::INFINITY, 0usize);
-    for (pi, p) in PERMS.iter().enumerate() {
-        let mut cost = 0.0;
-        for i in 0..4 {
-            cost += d[i][p[i]];
-        }
+    for (pi, &cost) in costs.iter().enumerate() {
         if cost < best.0 {
             best = (cost, pi);
         }
@@ -226,8 +233,8 @@ fn pair_rule(z: &[C64; 4], mut l: [Mode; 4]) -> [Mode; 4] {
 /// threshold 1e-3 lies between.) The quartic's roots of a second-order model
 /// are continuous in speed and never jump.
 fn jumped(prev: &[C64; 4], new: &[C64; 4]) -> bool {
-    let size = prev.iter().chain(new).map(|z| z.norm()).fold(1.0, f64::max);
-    let moved = (0..4).map(|k| (prev[k] - new[k]).norm()).fold(0.0, f64::max);
+    let size = prev.iter().chain(new).map(|z| z.norm()).fold(1.0, float::max);
+    let moved = (0..4).map(|k| (prev[k] - new[k]).norm()).fold(0.0, float::max);
     moved > 1e-3 * size
 }
 
@@ -243,7 +250,7 @@ pub(super) fn continue_to<S: Spectrum + ?Sized>(
     if v0 == v1 {
         return Ok(cur);
     }
-    let hmin = 1e-12 * v0.abs().max(v1.abs()).max(1.0);
+    let hmin = 1e-12 * float::max(float::max(v0.abs(), v1.abs()), 1.0);
     let mut h = v1 - v0;
     let mut guard = 0usize;
     while v != v1 {
