@@ -151,26 +151,17 @@ fn match_roots(prev: &Labelled, new: &[C64; 4]) -> ([C64; 4], bool) {
     let p = PERMS[best.1];
     let out = [new[p[0]], new[p[1]], new[p[2]], new[p[3]]];
     // Squared distances (no square root or `hypot` in this inner loop of
-    // every continuation): `dmax <= 0.3 sep`. Comparisons, not `f64::max`
-    // and `min`: the same result here (a NaN distance is skipped by both),
-    // but WebAssembly has no instruction with their NaN rule, so each was
-    // a call (3 % of the browser's stability map, 2026-11-29).
+    // every continuation): `dmax <= 0.3 sep`. `float::max` and `min`, not
+    // `f64`'s, which are calls in WebAssembly (3 % of the browser's
+    // stability map, 2026-11-29); a NaN distance is skipped by both.
     let mut dmax2 = 0.0f64;
     let mut sep2 = f64::INFINITY;
-    let mut closer = |d: f64| {
-        if d < sep2 {
-            sep2 = d;
-        }
-    };
     for i in 0..4 {
-        let d = (prev.roots[i] - out[i]).norm_sqr();
-        if d > dmax2 {
-            dmax2 = d;
-        }
+        dmax2 = float::max(dmax2, (prev.roots[i] - out[i]).norm_sqr());
         for j in i + 1..4 {
             if prev.labels[i] != prev.labels[j] {
-                closer((prev.roots[i] - prev.roots[j]).norm_sqr());
-                closer((out[i] - out[j]).norm_sqr());
+                sep2 = float::min(sep2, (prev.roots[i] - prev.roots[j]).norm_sqr());
+                sep2 = float::min(sep2, (out[i] - out[j]).norm_sqr());
             }
         }
     }
