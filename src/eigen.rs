@@ -287,6 +287,16 @@ impl EigenJob {
         })
     }
 
+    /// The point at one more speed `v` (m/s) with this job's bicycle,
+    /// model and standard deviations: what a job of `v` alone gives, without
+    /// linearizing and labelling the first speed again (the explorer asks
+    /// for the slider's speed after every edit beside the diagram's).
+    pub fn point_at(&self, v: f64) -> Result<EigenAtSpeed, EigenSweepError> {
+        Speeds::List(vec![v]).check()?;
+        let mut s = eigen_sweep_of(&self.lin, &[v])?;
+        Ok(self.at_speed(s.points.remove(0)))
+    }
+
     /// Whether the points carry standard deviations.
     pub fn standard_deviations(&self) -> bool {
         self.spread.is_some()

@@ -103,6 +103,8 @@ def identify(
     progress: Optional[Callable[[str, int, Optional[int]], None]] = None,
     discover: bool = True,
     max_fits_per_step: Optional[int] = None,
+    family_wise_bar: bool = False,
+    own_scales: bool = False,
 ) -> _IdentifyResult: ...
 def identify_eigenvalues(
     table: str,

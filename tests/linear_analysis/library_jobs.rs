@@ -281,6 +281,49 @@ fn the_eig_job_streamed_equals_the_job_at_once_and_the_fast_path() {
     }
 }
 
+/// One more speed asked of a prepared job (the explorer's slider beside its
+/// diagram) is the point a job of that speed alone gives, standard
+/// deviations included (a file with uncertainties), through another model
+/// than the bicycle's, and with a rider's lean as extra states; a bad speed
+/// is the same typed error.
+#[test]
+fn a_point_asked_of_a_prepared_job_is_that_of_a_job_of_its_speed_alone() {
+    let with_uncertainties = fixture("BrowserBenchmark.txt").to_string_lossy().to_string();
+    let rider_lean = fixture("MooreRiderLean2012BrowserJason.txt")
+        .to_string_lossy()
+        .to_string();
+    for (file, model) in [
+        (with_uncertainties.as_str(), None),
+        ("benchmark", Some("extended")),
+        (rider_lean.as_str(), None),
+    ] {
+        let b = Bicycle::resolve(file).unwrap();
+        let opts = EigenOptions {
+            model: model.map(str::to_string),
+            speeds: Speeds::Range {
+                start: 0.5,
+                step: 0.5,
+                count: 20,
+            },
+            standard_deviations: true,
+            ..EigenOptions::default()
+        };
+        let job = EigenJob::new(&b, &opts).unwrap();
+        for v in [0.0, 2.3, 4.9, 7.25, 12.0] {
+            let alone = EigenOptions {
+                speeds: Speeds::List(vec![v]),
+                ..opts.clone()
+            };
+            let expected = eigen_sweep(&b, &alone).unwrap().points.remove(0);
+            assert_eq!(job.point_at(v).unwrap(), expected, "{file} {model:?} at {v} m/s");
+        }
+        assert!(matches!(
+            job.point_at(f64::NAN),
+            Err(EigenSweepError::Speed { index: 0, .. })
+        ));
+    }
+}
+
 /// Bad speeds are typed errors naming what is wrong, never a panic.
 #[test]
 fn the_eig_job_refuses_bad_speeds_with_a_typed_error() {

@@ -14,7 +14,7 @@
 use crate::arrays::{eig_arrays, EigArrays};
 use crate::bicycle_answer::{bicycle_answer, BicycleAnswer};
 use bikedyn::bicycle::{Bicycle, BicycleError};
-use bikedyn::eigen::{eigen_sweep, EigenAtSpeed, EigenJob, EigenOptions, EigenSweepError, Speeds};
+use bikedyn::eigen::{EigenAtSpeed, EigenJob, EigenOptions, EigenSweepError, Speeds};
 use bikedyn::runtime::eigen::critical_speeds_of;
 use serde::Serialize;
 
@@ -86,12 +86,10 @@ pub fn explore(
             .and_then(|lin| critical_speeds_of(&lin, lo, hi).ok())
             .map(|c| c.stable_intervals)
     };
-    let at = EigenOptions {
-        speeds: Speeds::List(vec![speed]),
-        critical_speeds: false,
-        ..opts
-    };
-    let at_speed = eigen_sweep(b, &at).ok().and_then(|r| r.points.into_iter().next());
+    // The slider's speed with the diagram's job: the numbers of `eig` at
+    // that speed alone, without a second linearization and labelling of
+    // the diagram's first speed.
+    let at_speed = job.point_at(speed).ok();
     Ok(ExploreAnswer {
         bicycle,
         eig,

@@ -48,11 +48,12 @@ pub use super::criterion::{bic, PLAUSIBLE_PRIOR_SDS};
 use super::criterion::{farthest_from_prior, with_priors_on_the_data_scale};
 pub use super::cross_validation::{folds_by_run, paired_gain};
 use super::fit::fit_trial;
+use super::fitted::channel_scales;
 use super::screen;
 use super::search_order::{added_of, first_passing, SearchOrder};
 use super::{
     fit_candidate, Candidate, CandidateFit, EffectParameter, Factory, IdentifyError, IdentifyOptions, ModelFactory,
-    RollChannel, Segment, SegmentError, Setup, Weights, NUISANCE,
+    RollChannel, Segment, Setup, Weights, NUISANCE,
 };
 use crate::model::MultibodyModel;
 pub(super) use bar::{entry_bar, trial_bar};
@@ -167,26 +168,7 @@ pub fn identify<M: MultibodyModel>(
     let setup0 = Setup::new::<M>(base, segments, &guesses, &[])?;
     // (No folds: this fit only sets the channel scales.)
     let first = fit_candidate(&setup0, vec![], &[], &x0, &[], opts, None)?;
-    let rms = |e: &SegmentError, c: usize| (e.channel_ss[c] / e.channel_n[c].max(1) as f64).sqrt();
-    let floor = |c: usize, min: f64| {
-        first
-            .errors
-            .iter()
-            .map(|e| rms(e, c))
-            .filter(|x| x.is_finite() && *x > 0.0)
-            .fold(f64::INFINITY, f64::min)
-            .max(min)
-    };
-    let floors = [floor(0, 1e-4), floor(1, 1e-4), floor(2, 1e-3)];
-    let weights: Vec<Weights> = first
-        .errors
-        .iter()
-        .map(|e| Weights {
-            roll: rms(e, 0).max(floors[0]),
-            steer: rms(e, 1).max(floors[1]),
-            speed: rms(e, 2).max(floors[2]),
-        })
-        .collect();
+    let weights = channel_scales(&first.errors);
     let setup0 = Setup::new::<M>(base, segments, &weights, &[])?;
     let mut before = fit_candidate(&setup0, vec![], &[], &first.nuisance, &fold_of, opts, None)?;
     before.bic = bic(&before, &before);
