@@ -2,6 +2,45 @@
 //! base model), the kicks are independent problems.
 
 use crate::common::*;
+use bikedyn::runtime::identify::{Candidate, EffectParameter, Segment};
+use bikedyn::runtime::simulate::Simulation;
+
+/// A measured-style segment of a simulated kick: roll and steer (rad) at
+/// every output sample, the speed (m/s) at every `speed_every`-th, as a
+/// wheel's magnet gives it sparsely.
+fn kick_segment(name: String, sim: &Simulation, roll: Vec<f64>, steer: Vec<f64>, speed_every: usize) -> Segment {
+    let speed_t: Vec<f64> = sim.t.iter().step_by(speed_every).copied().collect();
+    let speed_v: Vec<f64> = sim.speed.iter().step_by(speed_every).copied().collect();
+    Segment::new(name, 0.0, sim.t.clone(), roll, steer, speed_t, speed_v, None).unwrap()
+}
+
+/// A candidate of one parameter `symbol` (tied to `tied`), without prior
+/// or bounds, started at a tenth of `scale`.
+fn one_parameter_candidate(name: &str, symbol: &str, tied: &[&str], scale: f64, speed_decay: bool) -> Candidate {
+    Candidate {
+        name: name.into(),
+        effects: vec![name.into()],
+        parameters: vec![EffectParameter {
+            symbol: symbol.into(),
+            tied: tied.iter().map(|t| t.to_string()).collect(),
+            moves: Vec::new(),
+            scale,
+            dissipative: true,
+            unit: String::new(),
+            initial: None,
+            lower: None,
+            upper: None,
+            shape: false,
+            prior: None,
+            gross_beyond: 3.0,
+        }],
+        fixed: Vec::new(),
+        speed_decay,
+        reason: String::new(),
+        alternative_model: false,
+        nonsmooth: false,
+    }
+}
 
 /// A set's kicks below the weave speed fall within their window, and their
 /// fit is slow and far from the data while the others fit to their noise.
@@ -14,7 +53,7 @@ use crate::common::*;
 #[test]
 fn a_falling_kick_does_not_hold_back_the_base_fit_of_the_others() {
     use bikedyn::generated::ExtendedFree;
-    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Segment, Setup, Weights, NUISANCE};
+    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Setup, Weights, NUISANCE};
     use bikedyn::runtime::linearize::parameter_vector;
     use bikedyn::runtime::model::CoordinateRole as R;
     use bikedyn::runtime::parameters::ThesisParameters;
@@ -43,21 +82,7 @@ fn a_falling_kick_does_not_hold_back_the_base_fit_of_the_others() {
             let last = roll.last().unwrap().abs();
             assert!(last > 0.2, "the slow kick falls: roll {last} rad at the window's end");
         }
-        let speed_t: Vec<f64> = sim.t.iter().step_by(25).copied().collect();
-        let speed_v: Vec<f64> = sim.speed.iter().step_by(25).copied().collect();
-        segments.push(
-            Segment::new(
-                format!("kick{i}"),
-                0.0,
-                sim.t.clone(),
-                roll,
-                steer,
-                speed_t,
-                speed_v,
-                None,
-            )
-            .unwrap(),
-        );
+        segments.push(kick_segment(format!("kick{i}"), &sim, roll, steer, 25));
         truth.push(ic);
     }
     let weights = vec![
@@ -120,9 +145,7 @@ fn a_falling_kick_does_not_hold_back_the_base_fit_of_the_others() {
 #[test]
 fn a_fit_of_an_effect_parameter_ends_on_the_minimum_of_its_profile() {
     use bikedyn::generated::ExtendedFree;
-    use bikedyn::runtime::identify::{
-        fit_candidate, Candidate, EffectParameter, IdentifyOptions, Segment, Setup, Weights, NUISANCE,
-    };
+    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Setup, Weights, NUISANCE};
     use bikedyn::runtime::linearize::parameter_vector;
     use bikedyn::runtime::model::{CoordinateRole as R, MultibodyModel};
     use bikedyn::runtime::parameters::ThesisParameters;
@@ -155,21 +178,7 @@ fn a_fit_of_an_effect_parameter_ends_on_the_minimum_of_its_profile() {
         let sim = simulate::<M>(&truth, &ic, &Inputs::default(), window, &opts).unwrap();
         let roll = sim.require_coordinate(R::Roll, "test").unwrap();
         let steer = sim.require_coordinate(R::Steer, "test").unwrap();
-        let speed_t: Vec<f64> = sim.t.iter().step_by(25).copied().collect();
-        let speed_v: Vec<f64> = sim.speed.iter().step_by(25).copied().collect();
-        segments.push(
-            Segment::new(
-                format!("kick{i}"),
-                0.0,
-                sim.t.clone(),
-                roll,
-                steer,
-                speed_t,
-                speed_v,
-                None,
-            )
-            .unwrap(),
-        );
+        segments.push(kick_segment(format!("kick{i}"), &sim, roll, steer, 25));
     }
     let weights = vec![
         Weights {
@@ -180,29 +189,7 @@ fn a_fit_of_an_effect_parameter_ends_on_the_minimum_of_its_profile() {
         segments.len()
     ];
     let x0: Vec<[f64; NUISANCE]> = segments.iter().map(|s| s.initial).collect();
-    let rolling = Candidate {
-        name: "rolling_resistance".into(),
-        effects: vec!["rolling_resistance".into()],
-        parameters: vec![EffectParameter {
-            symbol: "Crr_rear".into(),
-            tied: vec!["Crr_front".into()],
-            moves: Vec::new(),
-            scale: 0.01,
-            dissipative: true,
-            unit: String::new(),
-            initial: None,
-            lower: None,
-            upper: None,
-            shape: false,
-            prior: None,
-            gross_beyond: 3.0,
-        }],
-        fixed: Vec::new(),
-        speed_decay: true,
-        reason: String::new(),
-        alternative_model: false,
-        nonsmooth: false,
-    };
+    let rolling = one_parameter_candidate("rolling_resistance", "Crr_rear", &["Crr_front"], 0.01, true);
     let opts = IdentifyOptions::default();
     let setup = Setup::new::<M>(&base, &segments, &weights, &[&rolling]).unwrap();
     let fit = fit_candidate(
@@ -253,7 +240,7 @@ fn a_fit_of_an_effect_parameter_ends_on_the_minimum_of_its_profile() {
 #[test]
 fn a_falling_kick_is_fitted_from_its_measured_speed_when_the_start_is_off() {
     use bikedyn::generated::ExtendedFree;
-    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Segment, Setup, Weights, NUISANCE};
+    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Setup, Weights, NUISANCE};
     use bikedyn::runtime::linearize::parameter_vector;
     use bikedyn::runtime::model::CoordinateRole as R;
     use bikedyn::runtime::parameters::ThesisParameters;
@@ -271,9 +258,7 @@ fn a_falling_kick_is_fitted_from_its_measured_speed_when_the_start_is_off() {
     let roll = sim.require_coordinate(R::Roll, "test").unwrap();
     let steer = sim.require_coordinate(R::Steer, "test").unwrap();
     assert!(roll.last().unwrap().abs() > 0.2, "the kick falls");
-    let speed_t: Vec<f64> = sim.t.iter().step_by(50).copied().collect();
-    let speed_v: Vec<f64> = sim.speed.iter().step_by(50).copied().collect();
-    let seg = Segment::new("fall".into(), 0.0, sim.t.clone(), roll, steer, speed_t, speed_v, None).unwrap();
+    let seg = kick_segment("fall".into(), &sim, roll, steer, 50);
     let weights = [Weights {
         roll: 0.005,
         steer: 0.01,
@@ -310,9 +295,7 @@ fn a_falling_kick_is_fitted_from_its_measured_speed_when_the_start_is_off() {
 #[test]
 fn a_candidate_fitted_again_at_its_own_scales_is_nearer_the_truth_when_one_kick_is_far_noisier() {
     use bikedyn::generated::ExtendedFree;
-    use bikedyn::runtime::identify::{
-        fit_candidate, Candidate, EffectParameter, IdentifyOptions, Segment, Setup, Weights, NUISANCE,
-    };
+    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Setup, Weights, NUISANCE};
     use bikedyn::runtime::linearize::parameter_vector;
     use bikedyn::runtime::model::{CoordinateRole as R, MultibodyModel};
     use bikedyn::runtime::parameters::ThesisParameters;
@@ -346,21 +329,7 @@ fn a_candidate_fitted_again_at_its_own_scales_is_nearer_the_truth_when_one_kick_
         let noisy = |x: Vec<f64>, gauss: &mut dyn FnMut() -> f64| x.into_iter().map(|v| v + sd * gauss()).collect();
         let roll = noisy(sim.require_coordinate(R::Roll, "test").unwrap(), &mut gauss);
         let steer = noisy(sim.require_coordinate(R::Steer, "test").unwrap(), &mut gauss);
-        let speed_t: Vec<f64> = sim.t.iter().step_by(25).copied().collect();
-        let speed_v: Vec<f64> = sim.speed.iter().step_by(25).copied().collect();
-        segments.push(
-            Segment::new(
-                format!("kick{i}"),
-                0.0,
-                sim.t.clone(),
-                roll,
-                steer,
-                speed_t,
-                speed_v,
-                None,
-            )
-            .unwrap(),
-        );
+        segments.push(kick_segment(format!("kick{i}"), &sim, roll, steer, 25));
     }
     // One scale per channel for every kick (as a base model that followed
     // every kick about equally badly would give).
@@ -371,29 +340,7 @@ fn a_candidate_fitted_again_at_its_own_scales_is_nearer_the_truth_when_one_kick_
     };
     let weights = vec![w; segments.len()];
     let x0: Vec<[f64; NUISANCE]> = segments.iter().map(|s| s.initial).collect();
-    let damping = Candidate {
-        name: "steer_damping".into(),
-        effects: vec!["steer_damping".into()],
-        parameters: vec![EffectParameter {
-            symbol: "c_steer".into(),
-            tied: Vec::new(),
-            moves: Vec::new(),
-            scale: 0.1,
-            dissipative: true,
-            unit: "N m s/rad".into(),
-            initial: None,
-            lower: None,
-            upper: None,
-            shape: false,
-            prior: None,
-            gross_beyond: 3.0,
-        }],
-        fixed: Vec::new(),
-        speed_decay: false,
-        reason: String::new(),
-        alternative_model: false,
-        nonsmooth: false,
-    };
+    let damping = one_parameter_candidate("steer_damping", "c_steer", &[], 0.1, false);
     let reference = {
         let setup = Setup::new::<M>(&base, &segments, &weights, &[]).unwrap();
         fit_candidate(&setup, vec![], &[], &x0, &[], &IdentifyOptions::default(), None).unwrap()
