@@ -2,8 +2,20 @@
 //! base model), the kicks are independent problems.
 
 use crate::common::*;
-use bikedyn::runtime::identify::{Candidate, EffectParameter, Segment};
-use bikedyn::runtime::simulate::Simulation;
+use bikedyn::generated::ExtendedFree;
+use bikedyn::runtime::identify::{
+    fit_candidate, Candidate, EffectParameter, IdentifyOptions, Segment, Setup, Weights, NUISANCE,
+};
+use bikedyn::runtime::linearize::parameter_vector;
+use bikedyn::runtime::model::{CoordinateRole as R, MultibodyModel};
+use bikedyn::runtime::parameters::ThesisParameters;
+use bikedyn::runtime::simulate::{simulate, Inputs, Simulation};
+
+/// The thesis bicycle's parameter vector for model `M` at `speed` (m/s).
+fn thesis_parameters<M: MultibodyModel>(speed: f64) -> Vec<f64> {
+    let thesis = ThesisParameters::thesis_bicycle();
+    parameter_vector::<M>(|s| thesis.get(s), speed).unwrap()
+}
 
 /// A measured-style segment of a simulated kick: roll and steer (rad) at
 /// every output sample, the speed (m/s) at every `speed_every`-th, as a
@@ -52,12 +64,6 @@ fn one_parameter_candidate(name: &str, symbol: &str, tied: &[&str], scale: f64, 
 /// from.
 #[test]
 fn a_falling_kick_does_not_hold_back_the_base_fit_of_the_others() {
-    use bikedyn::generated::ExtendedFree;
-    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Setup, Weights, NUISANCE};
-    use bikedyn::runtime::linearize::parameter_vector;
-    use bikedyn::runtime::model::CoordinateRole as R;
-    use bikedyn::runtime::parameters::ThesisParameters;
-    use bikedyn::runtime::simulate::{simulate, Inputs};
     type M = ExtendedFree;
 
     let thesis = ThesisParameters::thesis_bicycle();
@@ -144,18 +150,10 @@ fn a_falling_kick_does_not_hold_back_the_base_fit_of_the_others() {
 /// profile at its own value and 7 % short of the profile's minimum).
 #[test]
 fn a_fit_of_an_effect_parameter_ends_on_the_minimum_of_its_profile() {
-    use bikedyn::generated::ExtendedFree;
-    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Setup, Weights, NUISANCE};
-    use bikedyn::runtime::linearize::parameter_vector;
-    use bikedyn::runtime::model::{CoordinateRole as R, MultibodyModel};
-    use bikedyn::runtime::parameters::ThesisParameters;
-    use bikedyn::runtime::simulate::{simulate, Inputs};
     type M = ExtendedFree;
-
-    let thesis = ThesisParameters::thesis_bicycle();
     let (kick, opts) = kick_and_tight_options();
     let at = |s: &str| M::PARAMETERS.iter().position(|p| *p == s).unwrap();
-    let base = parameter_vector::<M>(|s| thesis.get(s), kick.speed).unwrap();
+    let base = thesis_parameters::<M>(kick.speed);
     let mut truth = base.clone();
     truth[at("c_steer")] = 0.3;
     truth[at("CdA")] = 0.4;
@@ -239,12 +237,6 @@ fn a_fit_of_an_effect_parameter_ends_on_the_minimum_of_its_profile() {
 /// state comes back from a start 0.8 m/s too fast.
 #[test]
 fn a_falling_kick_is_fitted_from_its_measured_speed_when_the_start_is_off() {
-    use bikedyn::generated::ExtendedFree;
-    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Setup, Weights, NUISANCE};
-    use bikedyn::runtime::linearize::parameter_vector;
-    use bikedyn::runtime::model::CoordinateRole as R;
-    use bikedyn::runtime::parameters::ThesisParameters;
-    use bikedyn::runtime::simulate::{simulate, Inputs};
     type M = ExtendedFree;
 
     let thesis = ThesisParameters::thesis_bicycle();
@@ -294,18 +286,10 @@ fn a_falling_kick_is_fitted_from_its_measured_speed_when_the_start_is_off() {
 /// and the second fit's simulations counted.
 #[test]
 fn a_candidate_fitted_again_at_its_own_scales_is_nearer_the_truth_when_one_kick_is_far_noisier() {
-    use bikedyn::generated::ExtendedFree;
-    use bikedyn::runtime::identify::{fit_candidate, IdentifyOptions, Setup, Weights, NUISANCE};
-    use bikedyn::runtime::linearize::parameter_vector;
-    use bikedyn::runtime::model::{CoordinateRole as R, MultibodyModel};
-    use bikedyn::runtime::parameters::ThesisParameters;
-    use bikedyn::runtime::simulate::{simulate, Inputs};
     type M = ExtendedFree;
-
-    let thesis = ThesisParameters::thesis_bicycle();
     let (kick, opts) = kick_and_tight_options();
     let at = |s: &str| M::PARAMETERS.iter().position(|p| *p == s).unwrap();
-    let base = parameter_vector::<M>(|s| thesis.get(s), kick.speed).unwrap();
+    let base = thesis_parameters::<M>(kick.speed);
     let true_damping = 0.2;
     let mut truth = base.clone();
     truth[at("c_steer")] = true_damping;
