@@ -97,7 +97,9 @@ pub(super) fn fit_trial(
     let errors = unweight(&res, fit_weights);
     let chi2_at_fit: f64 = res.iter().flatten().map(|x| x * x).sum();
     // The sum of squares at the setup's scales (the search's, whatever the
-    // fit's), so that fits compare by it and `cv` keeps one meaning.
+    // fit's), so that fits compare by it and `cv` keeps one meaning. A fit
+    // made at those scales keeps its own residuals' sum, the same number
+    // without the round trip through physical units (results as before).
     let chi2 = if own_scales.is_some() {
         weighted_ss(&errors, &setup.weights)
     } else {
