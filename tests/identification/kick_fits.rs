@@ -65,10 +65,8 @@ fn one_parameter_candidate(name: &str, symbol: &str, tied: &[&str], scale: f64, 
 #[test]
 fn a_falling_kick_does_not_hold_back_the_base_fit_of_the_others() {
     type M = ExtendedFree;
-
-    let thesis = ThesisParameters::thesis_bicycle();
     let (kick, opts) = kick_and_tight_options();
-    let param = parameter_vector::<M>(|s| thesis.get(s), kick.speed).unwrap();
+    let param = thesis_parameters::<M>(kick.speed);
     // A kick at 5.5 m/s (the weave decays) and one at 2.5 m/s, three times as
     // hard (below the weave speed: the weave grows and the bicycle falls
     // within the window).
@@ -238,10 +236,8 @@ fn a_fit_of_an_effect_parameter_ends_on_the_minimum_of_its_profile() {
 #[test]
 fn a_falling_kick_is_fitted_from_its_measured_speed_when_the_start_is_off() {
     type M = ExtendedFree;
-
-    let thesis = ThesisParameters::thesis_bicycle();
     let (kick, opts) = kick_and_tight_options();
-    let param = parameter_vector::<M>(|s| thesis.get(s), kick.speed).unwrap();
+    let param = thesis_parameters::<M>(kick.speed);
     let mut ic = kick;
     ic.speed = 2.5;
     ic.roll_rate *= 3.0;
