@@ -113,6 +113,68 @@
 
   const ALIGN = { start: "left", middle: "center", end: "right" };
 
+  // A canvas strokes a polyline's points as they are, and the browser's
+  // time goes to them: for the eigenvalue diagram's 1,001-speed lines,
+  // more than half of its drawing (Chromium, 2026-12-02). A canvas
+  // therefore strokes the fewest of a polyline's points that keep every
+  // other one within a tenth of a pixel of the line drawn (a smooth curve
+  // with a point per pixel or more needs a few in twenty); the SVG keeps
+  // every point.
+  const SIMPLIFY_TOLERANCE = 0.1; // pixels
+
+  /**
+   * The points of the polyline `p` (x, y in turn, pixels) to stroke on a
+   * canvas: its first and last, and in between the fewest, chosen from the
+   * start, such that every point left out lies within `tol` pixels (in y,
+   * so at most that far) of the segment between the kept ones on either
+   * side of it. Only points going right (x increasing, as over speed) are
+   * left out; a new array, or `p` itself when none can go. One pass: the
+   * slopes from the last kept point that pass within `tol` of every point
+   * since are an interval, narrowed by each point.
+   */
+  function simplified(p, tol = SIMPLIFY_TOLERANCE) {
+    const n = p.length >> 1;
+    if (n < 3) return p;
+    const out = new Float64Array(p.length);
+    out[0] = p[0];
+    out[1] = p[1];
+    let k = 2;
+    let ax = p[0];
+    let ay = p[1];
+    let lo = -Infinity;
+    let hi = Infinity;
+    let fresh = true; // the point is the first after the one kept
+    for (let b = 1; b < n; b++) {
+      let dx = p[2 * b] - ax;
+      let dy = p[2 * b + 1] - ay;
+      if (!fresh) {
+        const s = dy / dx;
+        if (!(dx > 0 && s >= lo && s <= hi)) {
+          // The segment to b would pass too far from a point left out: the
+          // point before b is kept.
+          ax = p[2 * b - 2];
+          ay = p[2 * b - 1];
+          out[k++] = ax;
+          out[k++] = ay;
+          lo = -Infinity;
+          hi = Infinity;
+          dx = p[2 * b] - ax;
+          dy = p[2 * b + 1] - ay;
+        }
+      }
+      fresh = false;
+      if (dx > 0) {
+        lo = Math.max(lo, (dy - tol) / dx);
+        hi = Math.min(hi, (dy + tol) / dx);
+      } else {
+        lo = Infinity; // going left or straight up: b is kept
+      }
+    }
+    out[k++] = p[2 * n - 2];
+    out[k++] = p[2 * n - 1];
+    return k === p.length ? p : out.subarray(0, k);
+  }
+
   /**
    * Paints a shape as the browser draws its SVG (the attributes the figures
    * use). `pass` is what the painting of one figure keeps between shapes:
@@ -150,10 +212,12 @@
           ctx.stroke();
         }
         return;
-      case "polyline":
-        ctx.moveTo(p[0], p[1]);
-        for (let i = 2; i < p.length; i += 2) ctx.lineTo(p[i], p[i + 1]);
+      case "polyline": {
+        const q = simplified(p);
+        ctx.moveTo(q[0], q[1]);
+        for (let i = 2; i < q.length; i += 2) ctx.lineTo(q[i], q[i + 1]);
         return paint();
+      }
       case "dots":
         // Strokes with round caps, discs as wide as the stroke: in
         // Chromium a quarter of the time of as many arcs (2026-11-30).
@@ -402,5 +466,5 @@
     return g;
   }
 
-  return { esc, n, niceTicks, niceLimits, tickLabel, shape, text, figure, line, legend, viridis, diverging, colorbar };
+  return { esc, n, niceTicks, niceLimits, tickLabel, shape, text, figure, line, simplified, legend, viridis, diverging, colorbar };
 });
