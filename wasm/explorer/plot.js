@@ -65,12 +65,13 @@
 
   // ---- shapes: one description, drawn as SVG text or on a canvas ----------
   //
-  // A figure is a list of shapes in pixels: `{tag, a, pts, text, rotate}`,
-  // with `tag` an SVG element's name, `a` its SVG attributes (numbers or
-  // strings), `pts` a polyline's or dots' coordinates (x, y in turn) and
-  // `text` a text's. The same list is written as SVG (a download, the
-  // figures of other panels) or painted on a canvas (the diagrams redrawn
-  // after every change: writing, parsing and laying out the SVG of a
+  // A figure is a list of shapes in pixels: `{tag, a, pts, text, rotate,
+  // title}`, with `tag` an SVG element's name, `a` its SVG attributes
+  // (numbers or strings), `pts` a polyline's or dots' coordinates (x, y in
+  // turn), `text` a text's and `title` an element's tooltip (SVG only).
+  // The same list is written as SVG (a download, the figures of other
+  // panels) or painted on a canvas (the figures redrawn after every change
+  // or as they come: writing, parsing and laying out the SVG of a
   // 1,000-speed diagram took the browser longer than the module took to
   // compute it, 2026-11-29). A figure may also take SVG text (`add` of a
   // string): such a figure is SVG only.
@@ -101,12 +102,16 @@
         for (let i = 0; i < p.length; i += 2) d += `M${n(p[i])} ${n(p[i + 1])}h0`;
         return `<path d="${d}" fill="none" stroke-linecap="round"${attrText(s.a)}/>`;
       }
+      case "raster":
+        throw new Error("plot.js: a raster is painted on a canvas only");
       case "text": {
         if (!s.rotate) return `<text${attrText(s.a)}>${esc(s.text)}</text>`;
         const { x, y, ...rest } = s.a;
         return `<text transform="translate(${n(x)} ${n(y)}) rotate(${s.rotate})"${attrText(rest)}>${esc(s.text)}</text>`;
       }
       default:
+        // A shape's `title` is its SVG tooltip (a canvas has none).
+        if (s.title !== undefined) return `<${s.tag}${attrText(s.a)}><title>${esc(s.title)}</title></${s.tag}>`;
         return `<${s.tag}${attrText(s.a)}/>`;
     }
   }
@@ -239,6 +244,20 @@
       case "circle":
         ctx.arc(a.cx, a.cy, a.r, 0, 2 * Math.PI);
         return paint();
+      case "raster": {
+        // A grid of `nx` x `ny` cells, `rgba` their colours (the top row
+        // first), stretched over the rectangle without smoothing: every
+        // cell a rectangle of one colour, as many SVG rectangles would be,
+        // in one drawing (canvas only).
+        const grid = document.createElement("canvas");
+        grid.width = s.nx;
+        grid.height = s.ny;
+        grid.getContext("2d").putImageData(new ImageData(s.rgba, s.nx, s.ny), 0, 0);
+        ctx.imageSmoothingEnabled = false;
+        ctx.drawImage(grid, a.x, a.y, a.width, a.height);
+        ctx.imageSmoothingEnabled = true;
+        return;
+      }
       case "text": {
         const font = `${a["font-weight"] || "normal"} ${a["font-size"] ?? 12}px ${FONT}`;
         if (pass.font !== font) ctx.font = pass.font = font;
@@ -429,18 +448,34 @@
   function hex(c) {
     return [1, 3, 5].map((i) => parseInt(c.slice(i, i + 2), 16));
   }
-  function colormap(stops, t) {
-    if (!Number.isFinite(t)) return "#bbbbbb";
-    t = Math.max(0, Math.min(1, t));
-    const f = t * (stops.length - 1);
-    const i = Math.min(stops.length - 2, Math.floor(f));
-    const a = hex(stops[i]);
-    const b = hex(stops[i + 1]);
-    const u = f - i;
-    return "#" + a.map((v, k) => Math.round(v + (b[k] - v) * u).toString(16).padStart(2, "0")).join("");
+  /**
+   * A colour map over [0, 1] from its stops: `map(t)` is a colour
+   * (`#rrggbb`; grey for a value that is not finite), `map.rgb(t, out)` the
+   * same colour's red, green and blue (0-255) written to `out` (a canvas's
+   * pixels, without writing and parsing the colour's text).
+   */
+  function colormap(stops) {
+    const rgb = stops.map(hex);
+    const into = (t, out) => {
+      if (!Number.isFinite(t)) {
+        out[0] = out[1] = out[2] = 0xbb;
+        return out;
+      }
+      t = Math.max(0, Math.min(1, t));
+      const f = t * (stops.length - 1);
+      const i = Math.min(stops.length - 2, Math.floor(f));
+      const a = rgb[i];
+      const b = rgb[i + 1];
+      const u = f - i;
+      for (let k = 0; k < 3; k++) out[k] = Math.round(a[k] + (b[k] - a[k]) * u);
+      return out;
+    };
+    const map = (t) => "#" + Array.from(into(t, [0, 0, 0]), (v) => v.toString(16).padStart(2, "0")).join("");
+    map.rgb = into;
+    return map;
   }
-  const viridis = (t) => colormap(VIRIDIS, t);
-  const diverging = (t) => colormap(DIVERGING, t);
+  const viridis = colormap(VIRIDIS);
+  const diverging = colormap(DIVERGING);
 
   /** A vertical colour bar (a list of shapes) at the right of `fig` for values [lo, hi]. */
   function colorbar(fig, lo, hi, map, label) {
