@@ -349,14 +349,29 @@ impl EigenJob {
     /// the mode shapes were a sixth of its time, 2026-11-29, and the
     /// eigenvectors they come from a tenth of what was left, 2026-11-30).
     pub fn eigenvalues_and_modes(&self) -> Result<Vec<EigenvaluesAtSpeed>, EigenSweepError> {
+        Ok(self
+            .labelled_eigenvalues()?
+            .iter()
+            .map(|p| EigenvaluesAtSpeed::of(p, &output_order(&p.modes, &p.eigenvalues)))
+            .collect())
+    }
+
+    /// Every speed's eigenvalues and mode labels as the eigen analysis
+    /// gives them (in its order: [`output_order`] gives the output order),
+    /// the numbers of [`EigenJob::eigenvalues_and_modes`] without a copy
+    /// of each speed's: the browser's diagram writes them straight into
+    /// its arrays (the copies, with their modes' names compared as text,
+    /// were a tenth of its request, 2026-12-02).
+    pub fn labelled_eigenvalues(&self) -> Result<Vec<LabelledEigenvalues>, EigenSweepError> {
         let n = self.speeds.len();
+        let speeds_of =
+            |start: usize| -> Vec<f64> { (start..(start + BLOCK).min(n)).map(|k| self.speeds.at(k)).collect() };
+        if n <= BLOCK {
+            return Ok(eigenvalue_sweep_of(&self.lin, &speeds_of(0))?);
+        }
         let mut out = Vec::with_capacity(n);
         for start in (0..n).step_by(BLOCK) {
-            let speeds: Vec<f64> = (start..(start + BLOCK).min(n)).map(|k| self.speeds.at(k)).collect();
-            for p in eigenvalue_sweep_of(&self.lin, &speeds)? {
-                let idx = output_order(&p.modes, &p.eigenvalues);
-                out.push(EigenvaluesAtSpeed::of(&p, &idx));
-            }
+            out.extend(eigenvalue_sweep_of(&self.lin, &speeds_of(start))?);
         }
         Ok(out)
     }

@@ -441,10 +441,31 @@ where
     let linear = |x: f64, y: Option<f64>| design(bike, opts, x, y).and_then(|b| b.linear_with(Some(&model)));
     match &opts.second {
         Some(p2) => {
+            // The designs of one value of the first parameter (a row of the
+            // map, the browser's request) share the bicycle with that value
+            // set: made once per value, not once per design; where it
+            // cannot be made, each design fails as `design` fails.
+            let firsts: Vec<Option<Bicycle<R>>> = p1
+                .values
+                .iter()
+                .map(|&x| bike.with_parameter(&p1.symbol, x).ok())
+                .collect();
             let map = stability_map(
                 ParamAxis::new(p1.symbol.clone(), p1.values.clone()),
                 ParamAxis::new(p2.symbol.clone(), p2.values.clone()),
-                |x, y| linear(x, Some(y)),
+                |x, y| {
+                    let first = p1
+                        .values
+                        .iter()
+                        .position(|v| v.to_bits() == x.to_bits())
+                        .and_then(|i| firsts[i].as_ref());
+                    match first {
+                        Some(b) => b
+                            .with_parameter(&p2.symbol, y)
+                            .and_then(|b| b.linear_with(Some(&model))),
+                        None => linear(x, Some(y)),
+                    }
+                },
                 &range,
                 on_cell_done,
             )?;

@@ -24,6 +24,7 @@ pub mod registry;
 pub mod scalar;
 pub mod sensitivity;
 pub mod simulate;
+pub mod small_sort;
 pub mod sweep;
 pub mod verify;
 

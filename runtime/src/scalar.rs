@@ -198,27 +198,53 @@ mod lanes {
 #[cfg(not(target_arch = "x86_64"))]
 use portable as lanes;
 
+// Written as loops over an array filled in place rather than with
+// `std::array::from_fn`: the browser's build compiles the crate that
+// instantiates them for size (`wasm/build.sh`), where `from_fn` stayed a
+// call per direction through its closure machinery (with the operations'
+// own calls, a fifth of the browser's stability map in a profile,
+// 2026-12-02). The same operations in the same order, so the same numbers.
 #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 mod portable {
     #[inline]
     pub(super) fn add<const N: usize>(a: &[f64; N], b: &[f64; N]) -> [f64; N] {
-        std::array::from_fn(|k| a[k] + b[k])
+        let mut out = [0.0; N];
+        for k in 0..N {
+            out[k] = a[k] + b[k];
+        }
+        out
     }
     #[inline]
     pub(super) fn sub<const N: usize>(a: &[f64; N], b: &[f64; N]) -> [f64; N] {
-        std::array::from_fn(|k| a[k] - b[k])
+        let mut out = [0.0; N];
+        for k in 0..N {
+            out[k] = a[k] - b[k];
+        }
+        out
     }
     #[inline]
     pub(super) fn scale<const N: usize>(a: &[f64; N], s: f64) -> [f64; N] {
-        std::array::from_fn(|k| a[k] * s)
+        let mut out = [0.0; N];
+        for k in 0..N {
+            out[k] = a[k] * s;
+        }
+        out
     }
     #[inline]
     pub(super) fn product<const N: usize>(a: &[f64; N], sb: f64, sa: f64, b: &[f64; N]) -> [f64; N] {
-        std::array::from_fn(|k| a[k] * sb + sa * b[k])
+        let mut out = [0.0; N];
+        for k in 0..N {
+            out[k] = a[k] * sb + sa * b[k];
+        }
+        out
     }
     #[inline]
     pub(super) fn quotient<const N: usize>(a: &[f64; N], q: f64, b: &[f64; N], inv: f64) -> [f64; N] {
-        std::array::from_fn(|k| (a[k] - q * b[k]) * inv)
+        let mut out = [0.0; N];
+        for k in 0..N {
+            out[k] = (a[k] - q * b[k]) * inv;
+        }
+        out
     }
 }
 

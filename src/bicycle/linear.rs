@@ -9,7 +9,7 @@ use bikedyn_runtime::eigen::LinearBicycle;
 use bikedyn_runtime::feedback::WithFeedback;
 use bikedyn_runtime::linearize::{canonical_matrices, LinearModel, LinearizeError};
 use bikedyn_runtime::parameters::{ParameterSet, ThesisParameters};
-use bikedyn_runtime::registry::{ModelRegistry, ModelVisitor};
+use bikedyn_runtime::registry::{ModelInfo, ModelRegistry, ModelVisitor};
 use bikedyn_runtime::MultibodyModel;
 use std::collections::BTreeMap;
 use std::marker::PhantomData;
@@ -42,8 +42,20 @@ impl<R: ModelRegistry> Bicycle<R> {
         }
         let nonzero = self.nonzero_parameters()?;
         let info = self.model_for(model, &nonzero)?;
+        self.plant_canonical_of(info, &nonzero)
+    }
+
+    /// [`Bicycle::plant_canonical_with`] past its choice of the model
+    /// `info` for the bicycle's non-zero parameters `nonzero` (the linear
+    /// equations have made that choice already: a stability map's design
+    /// made it twice, a twentieth of the browser's map, 2026-12-02).
+    fn plant_canonical_of(
+        &self,
+        info: &'static ModelInfo,
+        nonzero: &[(&'static str, f64)],
+    ) -> Result<CanonicalMatrices, BicycleError> {
         let active: Vec<String> = nonzero
-            .into_iter()
+            .iter()
             .filter(|(s, _)| info.parameter(s).is_some_and(|p| p.effect.is_some()))
             .map(|(s, v)| format!("{s} = {v}"))
             .collect();
@@ -58,7 +70,8 @@ impl<R: ModelRegistry> Bicycle<R> {
             // bicycle's, which the built-in models give for any registry.
             return canonical_zero_radius(&t);
         }
-        let lookup = self.lookup()?;
+        // `Bicycle::lookup`, with the thesis parameters converted above.
+        let lookup = |s: &str| t.get(s).or_else(|| self.effects.get(s).copied());
         R::with_model(info.name, Canonical(&lookup))
             .expect("registered model")
             .map_err(|source| BicycleError::Linearize {
@@ -104,7 +117,12 @@ impl<R: ModelRegistry> Bicycle<R> {
         // lean) has no canonical form (nor roll-steer M, C, K).
         let added = info.added_coordinates();
         let canonical = if info.states.is_empty() && added.is_empty() {
-            self.plant_canonical_with(model)
+            if model.is_none() && self.effects.is_empty() {
+                self.plant_canonical_with(model)
+            } else {
+                // What `plant_canonical_with` would choose again.
+                self.plant_canonical_of(info, &nonzero)
+            }
         } else {
             Err(BicycleError::NotCanonical {
                 effects: info.states.iter().chain(&added).copied().collect::<Vec<_>>().join(", "),

@@ -505,15 +505,16 @@ impl<R: ModelRegistry> Bicycle<R> {
             return Err(unknown_parameter::<R>(symbol));
         };
         let warnings = parameters.validate()?;
+        let name = format!("{} ({symbol} = {value})", self.name);
         // A value set here is checked as a file's would be (a wheelbase of
         // 1020 is millimetres, not metres).
-        refuse_millimetres(&warnings, &format!("{} ({symbol} = {value})", self.name))?;
+        refuse_millimetres(&warnings, &name)?;
         // A value set is set, not measured: the file's `+/-` of that symbol
         // no longer applies (the others do).
         let mut uncertainties = self.uncertainties.clone();
         uncertainties.remove(symbol);
         Ok(Bicycle {
-            name: format!("{} ({symbol} = {value})", self.name),
+            name,
             parameters,
             warnings,
             effects: self.effects.clone(),

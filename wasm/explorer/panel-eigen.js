@@ -30,21 +30,22 @@
   /** Eigenvalue k of speed i in the arrays of `eig` (its four, then its tyre states'): the index of its real part in `z` or `x`. */
   const at = (e, i, k) => (k < 4 ? 8 * i + 2 * k : 2 * (e * i + k - 4));
 
-  /** The mode of eigenvalue k at speed i ("extra": a tyre state's). */
-  const modeOf = (eig, i, k) => (k < 4 ? eig.mode_names[eig.arrays.modes[4 * i + k]] : "extra");
-
   /**
    * The series of the diagram: per mode and rank (by real part, the largest
    * first), the real and imaginary parts over speed as flat lists
    * (`[v, re, v, re, ...]`, the first `n` numbers of `re` and `im`; a NaN
    * pair breaks the line). A series has a point and at most one break per
-   * speed: its lists are made that long at once.
+   * speed: its lists are made that long at once. Modes are handled by their
+   * index in `mode_names` (a tyre state's is one past them, "extra"), not
+   * by name: the diagram is redrawn after every change.
    */
   function eigSeries(eig) {
-    const { v, eigenvalues: z, extra_eigenvalues: x } = eig.arrays;
+    const { v, eigenvalues: z, extra_eigenvalues: x, modes } = eig.arrays;
     const e = eig.extra_per_speed;
+    const names = eig.mode_names.concat(["extra"]);
+    const EXTRA = names.length - 1;
     const series = []; // in the order first met
-    const byMode = new Map(); // mode -> its series by rank
+    const byMode = names.map(() => null); // mode index -> its series by rank
     // One speed's eigenvalues in the upper half plane (a conjugate pair is drawn once).
     const re = [], im = [], mode = [], done = [], group = [];
     for (let i = 0; i < eig.count; i++) {
@@ -55,7 +56,7 @@
         if (w[j + 1] < 0) continue;
         re[n] = w[j];
         im[n] = w[j + 1];
-        mode[n] = modeOf(eig, i, k);
+        mode[n] = k < 4 ? modes[4 * i + k] : EXTRA;
         done[n] = false;
         n += 1;
       }
@@ -70,10 +71,9 @@
           for (; q > 0 && re[group[q - 1]] < re[l]; q--) group[q] = group[q - 1];
           group[q] = l;
         }
-        if (!byMode.has(mode[j])) byMode.set(mode[j], []);
-        const ranks = byMode.get(mode[j]);
+        const ranks = byMode[mode[j]] || (byMode[mode[j]] = []);
         for (let r = 0; r < g; r++) {
-          if (!ranks[r]) series.push((ranks[r] = { mode: mode[j], re: new Float64Array(4 * eig.count), im: new Float64Array(4 * eig.count), n: 0, last: -1 }));
+          if (!ranks[r]) series.push((ranks[r] = { mode: names[mode[j]], re: new Float64Array(4 * eig.count), im: new Float64Array(4 * eig.count), n: 0, last: -1 }));
           const s = ranks[r];
           // Pad the gap since the series' last point (a pair that merged or split).
           if (s.n && s.last !== i - 1) {

@@ -110,7 +110,7 @@
     const draw = () => {
       const s = performance.now();
       app.mapResult = { xs, ys, cells: rows.flat(), map: Object.assign({}, m), done: false };
-      $("map-plot").innerHTML = mapSvg(760, 460, false);
+      drawMap();
       drawnAt = performance.now();
       drawing = drawnAt - s;
     };
@@ -197,22 +197,53 @@
     return `${map.x} = ${sig(c.x)}, ${map.y} = ${sig(c.y)}: ${v === null || v === undefined ? (c.error || "none") : sig(v)}`;
   }
 
-  // The page's map tells the cell under the pointer in the plot's tooltip
-  // rather than with a title element in every cell (the downloaded SVG has
-  // them): 10,000 of them took Chromium longer to lay out than the cells.
+  // The page's map is painted on a canvas (plot.js): written as SVG, its
+  // 10,000 cells took Chromium 80-210 ms to write, parse and lay out at
+  // every drawing of a 100 x 100 map (2026-12-02), twice in a map of two
+  // seconds, on the cores the workers compute on. It tells the cell under
+  // the pointer in the plot's tooltip; the SVG download gives each cell
+  // its value as a title.
+  let mapShown = null; // the painted map: {fig, xs, ys, cellOf: (i * ny + j) -> index in cells}
   let hoverWired = false;
   function wireHover() {
     if (hoverWired) return;
     hoverWired = true;
-    $("map-plot").addEventListener("mouseover", (e) => {
-      const r = e.target.closest ? e.target.closest("rect[data-cell]") : null;
+    $("map-plot").addEventListener("mousemove", (e) => {
       const res = app.mapResult;
-      $("map-plot").title = r && res && res.cells[Number(r.dataset.cell)] ? cellText(res.cells[Number(r.dataset.cell)], res.map) : "";
+      const c = e.target.tagName === "CANVAS" ? e.target : null;
+      let text = "";
+      if (c && res && mapShown) {
+        const { fig, xs, ys, cellOf } = mapShown;
+        // The pointer in the figure's pixels (the canvas may be shown smaller).
+        const r = c.getBoundingClientRect();
+        const px = ((e.clientX - r.left) * fig.width) / (r.width || 1);
+        const py = ((e.clientY - r.top) * fig.height) / (r.height || 1);
+        const [x0, x1] = fig.xlim;
+        const [y0, y1] = fig.ylim;
+        const x = x0 + ((px - fig.margin.left) / fig.pw) * (x1 - x0);
+        const y = y0 + ((fig.margin.top + fig.ph - py) / fig.ph) * (y1 - y0);
+        const nearest = (v, t) => {
+          let best = 0;
+          for (let k = 1; k < v.length; k++) if (Math.abs(v[k] - t) < Math.abs(v[best] - t)) best = k;
+          return best;
+        };
+        if (x >= x0 && x <= x1 && y >= y0 && y <= y1) {
+          const k = cellOf.get(nearest(xs, x) * ys.length + nearest(ys, y));
+          if (k !== undefined && res.cells[k]) text = cellText(res.cells[k], res.map);
+        }
+      }
+      $("map-plot").title = text;
     });
   }
 
-  /** The map as SVG; `titles`: each cell's value as its tooltip (the download's). */
-  function mapSvg(width = 760, height = 460, titles = true) {
+  /**
+   * The map's figure (plot.js): written as SVG for its download, one
+   * rectangle per cell with its value as its title (`titles`), or painted
+   * on the page, where the cells are one raster (`raster`: 10,000
+   * rectangles painted one by one took Chromium longer than their SVG,
+   * the raster 10-20 ms, 2026-12-02; the same cells and colours).
+   */
+  function mapFigure(width = 760, height = 460, { titles = true, raster = false } = {}) {
     const { xs, ys, cells, map } = app.mapResult;
     const half = (v, k) => (v.length > 1 ? Math.abs(v[1] - v[0]) / 2 : 0.5) * (k || 1);
     const xlim = [Math.min(...xs) - half(xs), Math.max(...xs) + half(xs)];
@@ -230,18 +261,61 @@
     }
     if (!vals.length) [lo, hi] = [0, 1];
     if (hi === lo) hi = lo + 1;
-    cells.forEach((c, k) => {
-      const v = c[map.metric];
-      const x0 = fig.x(c.x - half(xs));
-      const x1 = fig.x(c.x + half(xs));
-      const y0 = fig.y(c.y + half(ys));
-      const y1 = fig.y(c.y - half(ys));
-      const fill = v === null || v === undefined || !Number.isFinite(v) ? "#cccccc" : cmap((v - lo) / (hi - lo));
-      const title = titles ? `<title>${P.esc(cellText(c, map))}</title>` : "";
-      fig.add(`<rect data-cell="${k}" x="${P.n(x0)}" y="${P.n(y0)}" width="${P.n(x1 - x0 + 0.5)}" height="${P.n(y1 - y0 + 0.5)}" fill="${fill}">${title}</rect>`);
-    });
+    const shown = (v) => v !== null && v !== undefined && Number.isFinite(v);
+    if (raster) {
+      // Cell (i, j) is pixel (i, ny - 1 - j) of the raster, which spans the
+      // plot (the axes' limits are the cells' outer edges); a cell not yet
+      // computed is left transparent (white), as the SVG leaves it out.
+      const nx = xs.length;
+      const ny = ys.length;
+      const rgba = new Uint8ClampedArray(4 * nx * ny);
+      const rgb = [0, 0, 0];
+      for (const c of cells) {
+        const v = c[map.metric];
+        if (shown(v)) cmap.rgb((v - lo) / (hi - lo), rgb);
+        else rgb[0] = rgb[1] = rgb[2] = 0xcc;
+        const k = 4 * ((ny - 1 - c.j) * nx + c.i);
+        rgba[k] = rgb[0];
+        rgba[k + 1] = rgb[1];
+        rgba[k + 2] = rgb[2];
+        rgba[k + 3] = 255;
+      }
+      fig.add(P.shape("raster", { x: fig.margin.left, y: fig.margin.top, width: fig.pw, height: fig.ph }, { nx, ny, rgba }));
+    } else {
+      cells.forEach((c, k) => {
+        const v = c[map.metric];
+        const x0 = fig.x(c.x - half(xs));
+        const x1 = fig.x(c.x + half(xs));
+        const y0 = fig.y(c.y + half(ys));
+        const y1 = fig.y(c.y - half(ys));
+        const fill = shown(v) ? cmap((v - lo) / (hi - lo)) : "#cccccc";
+        const cell = P.shape("rect", { "data-cell": k, x: x0, y: y0, width: x1 - x0 + 0.5, height: y1 - y0 + 0.5, fill });
+        if (titles) cell.title = cellText(c, map);
+        fig.add(cell);
+      });
+    }
     fig.over(P.colorbar(fig, lo, hi, cmap, METRIC_LABELS[map.metric] ? METRIC_LABELS[map.metric](map) : map.metric));
-    return fig.svg();
+    return fig;
+  }
+
+  /** The map as SVG, each cell's value as its title (the download). */
+  const mapSvg = () => mapFigure().svg();
+
+  /** Paints the map on its canvas; its number of cells is written on the canvas (for the tests: a canvas keeps no elements). */
+  function drawMap() {
+    const fig = mapFigure(760, 460, { titles: false, raster: true });
+    const host = $("map-plot");
+    let c = host.firstElementChild;
+    if (!c || c.tagName !== "CANVAS") {
+      host.textContent = "";
+      c = host.appendChild(document.createElement("canvas"));
+    }
+    fig.paint(c);
+    const { xs, ys, cells } = app.mapResult;
+    const cellOf = new Map();
+    cells.forEach((cell, k) => cellOf.set(cell.i * ys.length + cell.j, k));
+    mapShown = { fig, xs, ys, cellOf };
+    c.dataset.cells = String(cells.length);
   }
 
   // Used by the other files.

@@ -65,12 +65,13 @@
 
   // ---- shapes: one description, drawn as SVG text or on a canvas ----------
   //
-  // A figure is a list of shapes in pixels: `{tag, a, pts, text, rotate}`,
-  // with `tag` an SVG element's name, `a` its SVG attributes (numbers or
-  // strings), `pts` a polyline's or dots' coordinates (x, y in turn) and
-  // `text` a text's. The same list is written as SVG (a download, the
-  // figures of other panels) or painted on a canvas (the diagrams redrawn
-  // after every change: writing, parsing and laying out the SVG of a
+  // A figure is a list of shapes in pixels: `{tag, a, pts, text, rotate,
+  // title}`, with `tag` an SVG element's name, `a` its SVG attributes
+  // (numbers or strings), `pts` a polyline's or dots' coordinates (x, y in
+  // turn), `text` a text's and `title` an element's tooltip (SVG only).
+  // The same list is written as SVG (a download, the figures of other
+  // panels) or painted on a canvas (the figures redrawn after every change
+  // or as they come: writing, parsing and laying out the SVG of a
   // 1,000-speed diagram took the browser longer than the module took to
   // compute it, 2026-11-29). A figure may also take SVG text (`add` of a
   // string): such a figure is SVG only.
@@ -101,17 +102,83 @@
         for (let i = 0; i < p.length; i += 2) d += `M${n(p[i])} ${n(p[i + 1])}h0`;
         return `<path d="${d}" fill="none" stroke-linecap="round"${attrText(s.a)}/>`;
       }
+      case "raster":
+        throw new Error("plot.js: a raster is painted on a canvas only");
       case "text": {
         if (!s.rotate) return `<text${attrText(s.a)}>${esc(s.text)}</text>`;
         const { x, y, ...rest } = s.a;
         return `<text transform="translate(${n(x)} ${n(y)}) rotate(${s.rotate})"${attrText(rest)}>${esc(s.text)}</text>`;
       }
       default:
+        // A shape's `title` is its SVG tooltip (a canvas has none).
+        if (s.title !== undefined) return `<${s.tag}${attrText(s.a)}><title>${esc(s.title)}</title></${s.tag}>`;
         return `<${s.tag}${attrText(s.a)}/>`;
     }
   }
 
   const ALIGN = { start: "left", middle: "center", end: "right" };
+
+  // A canvas strokes a polyline's points as they are, and the browser's
+  // time goes to them: for the eigenvalue diagram's 1,001-speed lines,
+  // more than half of its drawing (Chromium, 2026-12-02). A canvas
+  // therefore strokes the fewest of a polyline's points that keep every
+  // other one within a tenth of a pixel of the line drawn (a smooth curve
+  // with a point per pixel or more needs a few in twenty); the SVG keeps
+  // every point.
+  const SIMPLIFY_TOLERANCE = 0.1; // pixels
+
+  /**
+   * The points of the polyline `p` (x, y in turn, pixels) to stroke on a
+   * canvas: its first and last, and in between the fewest, chosen from the
+   * start, such that every point left out lies within `tol` pixels (in y,
+   * so at most that far) of the segment between the kept ones on either
+   * side of it. Only points going right (x increasing, as over speed) are
+   * left out; a new array, or `p` itself when none can go. One pass: the
+   * slopes from the last kept point that pass within `tol` of every point
+   * since are an interval, narrowed by each point.
+   */
+  function simplified(p, tol = SIMPLIFY_TOLERANCE) {
+    const n = p.length >> 1;
+    if (n < 3) return p;
+    const out = new Float64Array(p.length);
+    out[0] = p[0];
+    out[1] = p[1];
+    let k = 2;
+    let ax = p[0];
+    let ay = p[1];
+    let lo = -Infinity;
+    let hi = Infinity;
+    let fresh = true; // the point is the first after the one kept
+    for (let b = 1; b < n; b++) {
+      let dx = p[2 * b] - ax;
+      let dy = p[2 * b + 1] - ay;
+      if (!fresh) {
+        const s = dy / dx;
+        if (!(dx > 0 && s >= lo && s <= hi)) {
+          // The segment to b would pass too far from a point left out: the
+          // point before b is kept.
+          ax = p[2 * b - 2];
+          ay = p[2 * b - 1];
+          out[k++] = ax;
+          out[k++] = ay;
+          lo = -Infinity;
+          hi = Infinity;
+          dx = p[2 * b] - ax;
+          dy = p[2 * b + 1] - ay;
+        }
+      }
+      fresh = false;
+      if (dx > 0) {
+        lo = Math.max(lo, (dy - tol) / dx);
+        hi = Math.min(hi, (dy + tol) / dx);
+      } else {
+        lo = Infinity; // going left or straight up: b is kept
+      }
+    }
+    out[k++] = p[2 * n - 2];
+    out[k++] = p[2 * n - 1];
+    return k === p.length ? p : out.subarray(0, k);
+  }
 
   /**
    * Paints a shape as the browser draws its SVG (the attributes the figures
@@ -150,10 +217,12 @@
           ctx.stroke();
         }
         return;
-      case "polyline":
-        ctx.moveTo(p[0], p[1]);
-        for (let i = 2; i < p.length; i += 2) ctx.lineTo(p[i], p[i + 1]);
+      case "polyline": {
+        const q = simplified(p);
+        ctx.moveTo(q[0], q[1]);
+        for (let i = 2; i < q.length; i += 2) ctx.lineTo(q[i], q[i + 1]);
         return paint();
+      }
       case "dots":
         // Strokes with round caps, discs as wide as the stroke: in
         // Chromium a quarter of the time of as many arcs (2026-11-30).
@@ -175,6 +244,20 @@
       case "circle":
         ctx.arc(a.cx, a.cy, a.r, 0, 2 * Math.PI);
         return paint();
+      case "raster": {
+        // A grid of `nx` x `ny` cells, `rgba` their colours (the top row
+        // first), stretched over the rectangle without smoothing: every
+        // cell a rectangle of one colour, as many SVG rectangles would be,
+        // in one drawing (canvas only).
+        const grid = document.createElement("canvas");
+        grid.width = s.nx;
+        grid.height = s.ny;
+        grid.getContext("2d").putImageData(new ImageData(s.rgba, s.nx, s.ny), 0, 0);
+        ctx.imageSmoothingEnabled = false;
+        ctx.drawImage(grid, a.x, a.y, a.width, a.height);
+        ctx.imageSmoothingEnabled = true;
+        return;
+      }
       case "text": {
         const font = `${a["font-weight"] || "normal"} ${a["font-size"] ?? 12}px ${FONT}`;
         if (pass.font !== font) ctx.font = pass.font = font;
@@ -365,18 +448,34 @@
   function hex(c) {
     return [1, 3, 5].map((i) => parseInt(c.slice(i, i + 2), 16));
   }
-  function colormap(stops, t) {
-    if (!Number.isFinite(t)) return "#bbbbbb";
-    t = Math.max(0, Math.min(1, t));
-    const f = t * (stops.length - 1);
-    const i = Math.min(stops.length - 2, Math.floor(f));
-    const a = hex(stops[i]);
-    const b = hex(stops[i + 1]);
-    const u = f - i;
-    return "#" + a.map((v, k) => Math.round(v + (b[k] - v) * u).toString(16).padStart(2, "0")).join("");
+  /**
+   * A colour map over [0, 1] from its stops: `map(t)` is a colour
+   * (`#rrggbb`; grey for a value that is not finite), `map.rgb(t, out)` the
+   * same colour's red, green and blue (0-255) written to `out` (a canvas's
+   * pixels, without writing and parsing the colour's text).
+   */
+  function colormap(stops) {
+    const rgb = stops.map(hex);
+    const into = (t, out) => {
+      if (!Number.isFinite(t)) {
+        out[0] = out[1] = out[2] = 0xbb;
+        return out;
+      }
+      t = Math.max(0, Math.min(1, t));
+      const f = t * (stops.length - 1);
+      const i = Math.min(stops.length - 2, Math.floor(f));
+      const a = rgb[i];
+      const b = rgb[i + 1];
+      const u = f - i;
+      for (let k = 0; k < 3; k++) out[k] = Math.round(a[k] + (b[k] - a[k]) * u);
+      return out;
+    };
+    const map = (t) => "#" + Array.from(into(t, [0, 0, 0]), (v) => v.toString(16).padStart(2, "0")).join("");
+    map.rgb = into;
+    return map;
   }
-  const viridis = (t) => colormap(VIRIDIS, t);
-  const diverging = (t) => colormap(DIVERGING, t);
+  const viridis = colormap(VIRIDIS);
+  const diverging = colormap(DIVERGING);
 
   /** A vertical colour bar (a list of shapes) at the right of `fig` for values [lo, hi]. */
   function colorbar(fig, lo, hi, map, label) {
@@ -402,5 +501,5 @@
     return g;
   }
 
-  return { esc, n, niceTicks, niceLimits, tickLabel, shape, text, figure, line, legend, viridis, diverging, colorbar };
+  return { esc, n, niceTicks, niceLimits, tickLabel, shape, text, figure, line, simplified, legend, viridis, diverging, colorbar };
 });

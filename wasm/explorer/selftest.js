@@ -125,7 +125,10 @@
       // (wasm/tests/explorer_browser.py, step 11).
       const cells = await app.runMap({ inPage: true });
       check(cells && cells.length === 9, `the map has ${cells ? cells.length : 0} cells, expected 9`);
-      check($("map-plot").querySelectorAll("rect[data-cell]").length === 9, "the map's cells are not drawn");
+      const mapCanvas = $("map-plot").querySelector("canvas");
+      check(mapCanvas && mapCanvas.dataset.cells === "9", "the map's cells are not drawn");
+      const mapDownload = new DOMParser().parseFromString(app.mapSvg(), "image/svg+xml");
+      check(mapDownload.querySelectorAll("rect[data-cell] > title").length === 9, "the map's SVG download lacks its 9 cells with their values");
       // 6. A kick simulation.
       const sim = app.runSim();
       check(sim && sim.summary.stop === "completed", `the simulation: ${sim ? sim.summary.stop : "failed"}`);

@@ -25,7 +25,8 @@ pub fn ordered_indices(p: &EigenPoint) -> [usize; 4] {
 /// [`ordered_indices`] of eigenvalues and their modes.
 pub fn output_order(modes: &[Mode; 4], eigenvalues: &[Complex<f64>; 4]) -> [usize; 4] {
     let mut idx = [0usize, 1, 2, 3];
-    idx.sort_by(|&a, &b| {
+    // Inline (it runs at every speed of a diagram), as `sort_by` sorts.
+    bikedyn_runtime::small_sort::sort4_by(&mut idx, |&a, &b| {
         mode_rank(modes[a])
             .cmp(&mode_rank(modes[b]))
             .then(eigenvalues[b].im.total_cmp(&eigenvalues[a].im))

@@ -161,7 +161,7 @@ fn monic_invariants([a, b, c, d]: [f64; 4]) -> Option<(f64, Option<u8>)> {
 
 /// Sort by descending real part, then descending imaginary part.
 pub(crate) fn sort_desc(z: &mut [C64; 4]) {
-    z.sort_by(|x, y| {
+    crate::small_sort::sort4_by(z, |x, y| {
         y.re.partial_cmp(&x.re)
             .unwrap_or(std::cmp::Ordering::Equal)
             .then(y.im.partial_cmp(&x.im).unwrap_or(std::cmp::Ordering::Equal))

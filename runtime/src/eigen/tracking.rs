@@ -45,7 +45,7 @@ impl Labelled {
     /// Canonical order: by label rank; within a label, descending imaginary then real part.
     pub(super) fn canonical(mut self) -> Self {
         let mut idx = [0usize, 1, 2, 3];
-        idx.sort_by(|&i, &j| {
+        crate::small_sort::sort4_by(&mut idx, |&i, &j| {
             rank(self.labels[i])
                 .cmp(&rank(self.labels[j]))
                 .then(
