@@ -457,9 +457,8 @@ def main():
     print(f"\nright cause: {s['right_causes']} of {s['sets_with_cause']} sets with a cause "
           f"({100 * s['right_causes'] / n:.0f} %; target 90 %: {mark(s['right_causes'] >= TARGET_RIGHT * s['sets_with_cause'])}"
           f"{'; of them ' + str(s['right_via_not_separable']) + ' reported as not separable from a selected candidate' if s.get('right_via_not_separable') else ''})")
-    misses = s["sets_with_cause"] - s["right_causes"]
     if s["missed_named_beside_a_correction_beyond_its_prior"]:
-        print(f"of the {misses} missed, {s['missed_named_beside_a_correction_beyond_its_prior']} named as not "
+        print(f"of the {s['sets_with_cause'] - s['right_causes']} missed, {s['missed_named_beside_a_correction_beyond_its_prior']} named as not "
               f"separable from a selected correction beyond its prior (the runs call for a gross correction "
               f"without telling which; counted as missed)")
     print(f"controls with nothing but speed decay: {s['clean_controls']} of {s['controls']} "
