@@ -784,7 +784,6 @@ def identify(
     discover: bool = True,
     max_fits_per_step: Optional[int] = None,
     family_wise_bar: bool = False,
-    own_scales: bool = False,
 ) -> IdentifyResult:
     """Close the loop (``bikedyn identify``): fit the base model to measured
     runs, diagnose the residual, select effects and parameter corrections
@@ -808,11 +807,7 @@ def identify(
     candidate predicted to gain). ``family_wise_bar``: raise each step's
     bar of a consistent held-out gain with the candidates it has fitted (a
     Bonferroni bar; the command line's ``--family-wise-bar``; default: two
-    standard errors for each). ``own_scales``: fit each candidate the
-    information criterion judges a second time at its own channel scales
-    (each kick's and channel's RMS residual under it), the likelihood the
-    criterion scores (the command line's ``--own-scales``; default: at the
-    base model's scales). Returns an
+    standard errors for each). Returns an
     :class:`IdentifyResult`: ``selected``, ``parameters`` (each an
     :class:`Estimate` with its 95 % interval), ``error_before`` and
     ``error_after`` (fitted and held out), ``discovery``; ``summary()``,
@@ -831,8 +826,6 @@ def identify(
             raise InvalidArgumentError("max_fits_per_step applies to runs and logs, not to an eigenvalue table")
         if family_wise_bar:
             raise InvalidArgumentError("family_wise_bar applies to runs and logs, not to an eigenvalue table")
-        if own_scales:
-            raise InvalidArgumentError("own_scales applies to runs and logs, not to an eigenvalue table")
         table = _paths(paths_or_eigen_table, "identify")[0]
         return IdentifyResult._from_json(
             _bikedyn.identify_eigenvalues(table, spec, list(effects), corrections, bool(discover))
@@ -850,7 +843,6 @@ def identify(
             bool(discover),
             max_fits_per_step,
             bool(family_wise_bar),
-            bool(own_scales),
         )
     )
 

@@ -104,7 +104,6 @@ def identify(
     discover: bool = True,
     max_fits_per_step: Optional[int] = None,
     family_wise_bar: bool = False,
-    own_scales: bool = False,
 ) -> _IdentifyResult: ...
 def identify_eigenvalues(
     table: str,

@@ -126,7 +126,7 @@ impl PyIdentifyResult {
 
 /// Run `bikedyn identify` on run folders, set folders or logs.
 #[pyfunction]
-#[pyo3(signature = (inputs, calibration=None, bike=None, effects=Vec::new(), folds=4, corrections=None, progress=None, discover=true, max_fits_per_step=None, family_wise_bar=false, own_scales=false))]
+#[pyo3(signature = (inputs, calibration=None, bike=None, effects=Vec::new(), folds=4, corrections=None, progress=None, discover=true, max_fits_per_step=None, family_wise_bar=false))]
 pub(crate) fn identify(
     py: Python<'_>,
     inputs: Vec<PathBuf>,
@@ -139,7 +139,6 @@ pub(crate) fn identify(
     discover: bool,
     max_fits_per_step: Option<usize>,
     family_wise_bar: bool,
-    own_scales: bool,
 ) -> PyResult<PyIdentifyResult> {
     if !(2..=1000).contains(&folds) {
         return Err(Failure::new("InvalidArgumentError", format!("folds = {folds}: expected 2 to 1000")).into_py(py));
@@ -154,7 +153,6 @@ pub(crate) fn identify(
         discover,
         max_fits_per_step,
         family_wise_bar,
-        own_scales,
     };
     let progress = PyProgress::new(progress);
     let outcome = detached(py, || {

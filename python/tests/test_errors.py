@@ -123,9 +123,6 @@ def test_identify_counts_are_checked_and_named():
     # So is the family-wise bar (the table's search has its own bars).
     with pytest.raises(bikedyn.InvalidArgumentError, match="family_wise_bar"):
         bikedyn.identify("table.csv", bike="thesis", family_wise_bar=True)
-    # And the refit at a candidate's own scales (the table has one channel).
-    with pytest.raises(bikedyn.InvalidArgumentError, match="own_scales"):
-        bikedyn.identify("table.csv", bike="thesis", own_scales=True)
 
 
 def test_a_rust_panic_is_an_exception_with_its_message():

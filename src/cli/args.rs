@@ -404,12 +404,6 @@ pub struct IdentifyArgs {
     /// among many tries. Default: two standard errors for every candidate.
     #[arg(long, conflicts_with = "eigenvalues")]
     pub family_wise_bar: bool,
-    /// Fit each candidate the information criterion judges a second time
-    /// at its own channel scales (each kick's and channel's RMS residual
-    /// under it), the likelihood the criterion scores. Default: every fit
-    /// at the base model's scales. Costs a second fit of each candidate.
-    #[arg(long, conflicts_with = "eigenvalues")]
-    pub own_scales: bool,
     /// Size and resolution of the report's plots; the limits apply to the
     /// continuation diagram.
     #[command(flatten)]

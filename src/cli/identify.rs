@@ -19,7 +19,6 @@ pub fn request(a: &IdentifyArgs) -> IdentifyRequest {
         discover: !a.no_discover,
         max_fits_per_step: a.max_fits_per_step,
         family_wise_bar: a.family_wise_bar,
-        own_scales: a.own_scales,
     }
 }
 

@@ -85,11 +85,6 @@ pub struct IdentifyRequest {
     /// standard errors for each: see
     /// [`bikedyn_runtime::identify::IdentifyOptions::family_wise_bar`]).
     pub family_wise_bar: bool,
-    /// Fit each candidate the criterion judges again at its own channel
-    /// scales, the likelihood the criterion scores (default false: at the
-    /// base model's; see
-    /// [`bikedyn_runtime::identify::IdentifyOptions::own_scales`]).
-    pub own_scales: bool,
 }
 
 impl Default for IdentifyRequest {
@@ -104,7 +99,6 @@ impl Default for IdentifyRequest {
             discover: true,
             max_fits_per_step: None,
             family_wise_bar: false,
-            own_scales: false,
         }
     }
 }
@@ -348,7 +342,6 @@ pub fn run_plan<R: ModelRegistry>(
         folds: request.folds,
         max_fits_per_step: request.max_fits_per_step,
         family_wise_bar: request.family_wise_bar,
-        own_scales: request.own_scales,
         ..FitSettings::default()
     };
     // The runtime reports each stage by name, from the fitting threads, with

@@ -339,21 +339,23 @@ fn in_the_time_series_a_steer_damper_the_library_lacks_is_found_and_halves_the_r
 /// identification model's dictionary parameter, eight runs at 5.5-7 m/s,
 /// sensor errors included) with every declared correction a candidate of
 /// the library. The library takes corrections beyond their priors for want
-/// of the force (on this seed, the front frame's product of inertia 9 and
-/// the rear frame's mass-centre height 3.5 prior standard deviations away,
-/// with the front frame's mass-centre x). The search in the time series
-/// must end with the force alone. Started from the library's whole
-/// selection it adds a steer stiffness growing with v^2, which drives the
-/// mass-centre height further (9 prior standard deviations), and the score
-/// test then sees no gain left for the force: the roll error stays at
-/// 0.43 deg. The second start, without the corrections beyond their
-/// plausible range, finds the force, and its model predicts the held-out
-/// runs better by more than one standard error, so it is kept. (Seed 11,
-/// the example's in `examples/discovered_force`, takes the other path: the
-/// force enters beside the stand-ins, and the backward check removes them.)
+/// of the force, so the search in the time series starts twice: from the
+/// library's whole selection, and from it without the corrections beyond
+/// their plausible range. Whichever start is kept, the search must end with
+/// the force alone, within 25 %, and halve the library's held-out roll
+/// error. Which start gets there depends on the criterion: with the
+/// criterion of a variance per kick and channel, the first start added a
+/// steer stiffness growing with v^2 and saw no gain left for the force
+/// (roll error 0.43 deg), and only the second found it; with the criterion
+/// on the fits' own weighted sum the first start already ends at the force
+/// and the second, equal to it, is not kept (the second start is kept only
+/// when it predicts the held-out runs better by more than one standard
+/// error). (Seed 11, the example's in `examples/discovered_force`, takes a
+/// third path: the force enters beside the stand-ins, and the backward
+/// check removes them.)
 #[test]
 #[ignore = "about 15 minutes: .ci/run runs it last when its time allows; `cargo test --release -- --ignored` runs it"]
-fn in_runs_a_second_start_without_the_implausible_corrections_finds_the_force_they_stood_in_for() {
+fn in_runs_the_search_ends_at_the_force_that_implausible_corrections_stood_in_for_from_either_start() {
     let dir = scratch("identify").join("steer_torque_roll_runs");
     let _ = std::fs::remove_dir_all(&dir);
     let out = bikedyn(&[
@@ -373,8 +375,21 @@ fn in_runs_a_second_start_without_the_implausible_corrections_finds_the_force_th
     ]);
     assert!(out.status.success(), "synth: {}", text(&out.stderr));
     let v = ok_json(&["identify", dir.to_str().unwrap(), "--bike", "thesis", "--json"]);
+    // The library's stand-ins were beyond their priors: a second start ran.
     let second = &v["time_series_discovery"]["second_start"];
-    assert_eq!(second["kept_second"], Value::from(true), "{second:#}");
+    assert!(
+        second["left_out"].as_array().is_some_and(|l| !l.is_empty()),
+        "no second start: {:#}",
+        v["time_series_discovery"]
+    );
+    // One not kept was no better on held-out runs by one standard error.
+    if second["kept_second"] == Value::from(false) {
+        let number = |k: &str| second[k].as_f64().unwrap_or(f64::NAN);
+        assert!(
+            !(number("cv_first") - number("cv_second") > number("standard_error")),
+            "{second:#}"
+        );
+    }
     let terms = time_series_terms(&v);
     assert_eq!(terms.len(), 1, "{:#}", v["time_series_discovery"]);
     let t = &terms[0]["term"];

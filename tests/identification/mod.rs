@@ -447,10 +447,9 @@ fn bad_inputs_are_clear_errors() {
         let e = String::from_utf8_lossy(&out.stderr);
         assert!(e.contains(named), "{args:?}: {e}");
     }
-    // The family-wise bar and the refit at a candidate's own scales are the
-    // library search's; a table's search has its own bars and one channel,
-    // so either flag there is refused by name.
-    for flag in ["--family-wise-bar", "--own-scales"] {
+    // The family-wise bar is the library search's; a table's search has its
+    // own bars, so the flag there is refused by name.
+    for flag in ["--family-wise-bar"] {
         let out = bikedyn(&["identify", flag, "--eigenvalues", "t.csv", "--bike", "thesis"]);
         assert_eq!(out.status.code(), Some(2));
         let e = String::from_utf8_lossy(&out.stderr);

@@ -8,7 +8,7 @@
 
 use super::criterion::bic;
 use super::cross_validation::cross_validate;
-use super::fitted::{channel_scales, weighted_ss, CandidateFit, IdentifyOptions, SegmentError};
+use super::fitted::{CandidateFit, IdentifyOptions, SegmentError};
 use super::levenberg_marquardt::lm_fit;
 use super::normal::Normal;
 use super::problem::{Free, Problem};
@@ -60,7 +60,7 @@ pub(super) fn fit_trial(
     problem.settled_on_floor = own
         .filter(|&j| setup.parameters.get(j).is_some_and(|q| q.dissipative))
         .collect();
-    let mut full = lm_fit(problem, opts.patience);
+    let full = lm_fit(problem, opts.patience);
     let unweight = |res: &[Vec<f64>], weights: &[Weights]| -> Vec<SegmentError> {
         res.iter()
             .zip(setup.segments)
@@ -68,43 +68,16 @@ pub(super) fn fit_trial(
             .map(|((r, s), w)| SegmentError::of(r, s, *w))
             .collect()
     };
-    // A candidate judged by the criterion, fitted again at its own channel
-    // scales (see `IdentifyOptions::own_scales`): from where the first fit
-    // ended, so that the second only moves as far as the weights do.
-    let own_scales: Option<Setup<'_>> = if opts.own_scales && reference.is_some() && setup.k() > 0 {
-        full.all_residuals()
-            .map(|res| setup.with_weights(channel_scales(&unweight(&res, &setup.weights))))
-    } else {
-        None
-    };
-    if let Some(own) = &own_scales {
-        let mut again = Problem::new(own, all.clone(), free, full.g.clone(), full.x0.clone());
-        again.from_measured_speed = true;
-        again.settled_on_floor = full.settled_on_floor.clone();
-        full = lm_fit(again, opts.patience);
-    }
-    // The scales the fit was made at: its Jacobian and residuals (the
-    // standard errors) are on them.
-    let fit_weights = own_scales.as_ref().map_or(&setup.weights, |s| &s.weights);
-    let simulations = || {
-        setup.simulations.load(Ordering::Relaxed) - sims_before
-            + own_scales.as_ref().map_or(0, |s| s.simulations.load(Ordering::Relaxed))
-    };
+    let simulations = || setup.simulations.load(Ordering::Relaxed) - sims_before;
     let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
         run: setup.segments[0].run.clone(),
         message: "the fitted model does not simulate every segment".into(),
     })?;
-    let errors = unweight(&res, fit_weights);
-    let chi2_at_fit: f64 = res.iter().flatten().map(|x| x * x).sum();
-    // The sum of squares at the setup's scales (the search's, whatever the
-    // fit's), so that fits compare by it and `cv` keeps one meaning. A fit
-    // made at those scales keeps its own residuals' sum, the same number
-    // without the round trip through physical units (results as before).
-    let chi2 = if own_scales.is_some() {
-        weighted_ss(&errors, &setup.weights)
-    } else {
-        chi2_at_fit
-    };
+    let errors = unweight(&res, &setup.weights);
+    // The weighted sum of squares at the search's scales: the fit's
+    // objective (prior rows aside), what fits compare by and the
+    // criterion weighs.
+    let chi2: f64 = res.iter().flatten().map(|x| x * x).sum();
     // Values beyond a parameter's floor or ceiling were simulated at it.
     let g: Vec<f64> = full
         .g
@@ -123,7 +96,7 @@ pub(super) fn fit_trial(
             let n: usize = res.iter().map(Vec::len).sum::<usize>() + full.prior_rows().len();
             let p = full.n_free() as f64;
             let rho = errors.iter().map(|e| e.rho).sum::<f64>() / errors.len() as f64;
-            let s2 = chi2_at_fit / (n as f64 - p).max(1.0) * (1.0 + rho) / (1.0 - rho);
+            let s2 = chi2 / (n as f64 - p).max(1.0) * (1.0 + rho) / (1.0 - rho);
             let prior: Vec<(usize, f64, f64)> = full
                 .prior_normal_rows()
                 .into_iter()

@@ -115,23 +115,6 @@ pub struct IdentifyOptions {
     /// corrections that clear two standard errors by a hair, and with them
     /// weak right ones.
     pub family_wise_bar: bool,
-    /// Whether each candidate of the search, once fitted at the base
-    /// model's channel scales, is fitted again at its own (each kick's
-    /// and channel's RMS residual under that candidate,
-    /// [`channel_scales`]) before its information criterion is taken.
-    /// The criterion counts every kick and channel by the log of its own
-    /// sum of squares (a variance per kick and channel, profiled out);
-    /// the fit at the base model's scales weighs a kick the base model
-    /// misses badly (a low-speed kick, 10 to 200 times its neighbours'
-    /// residual) as little as that miss, so it maximizes another
-    /// likelihood than the one the criterion scores. One refit (one step
-    /// of iteratively reweighted least squares) aligns the two. Costs a
-    /// second fit of every candidate. Default `false`: on the oracle's
-    /// seed base 7 it found the right cause on 7 of 9 sets against 9
-    /// without, as one step is not each model's maximum (a nested pair
-    /// scored below its member) and the score test still linearises at
-    /// the base scales (docs/identification.md, the own-scales refit).
-    pub own_scales: bool,
 }
 
 impl Default for IdentifyOptions {
@@ -142,7 +125,6 @@ impl Default for IdentifyOptions {
             patience: 4,
             max_fits_per_step: None,
             family_wise_bar: false,
-            own_scales: false,
         }
     }
 }
@@ -151,8 +133,7 @@ impl Default for IdentifyOptions {
 /// RMS per channel, but never below the best segment's (about the sensor
 /// noise) nor below 1e-4 rad (roll, steer) and 1e-3 m/s (speed), so that a
 /// segment the model follows almost exactly does not take all the weight.
-/// The search weighs every fit by the base model's scales; with
-/// [`IdentifyOptions::own_scales`] a candidate is refitted at its own.
+/// The search weighs every fit by the base model's scales.
 pub(super) fn channel_scales(errors: &[SegmentError]) -> Vec<Weights> {
     let rms = |e: &SegmentError, c: usize| (e.channel_ss[c] / e.channel_n[c].max(1) as f64).sqrt();
     let floor = |c: usize, min: f64| {

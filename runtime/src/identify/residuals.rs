@@ -277,25 +277,6 @@ fn segment_sensitivities<M: MultibodyModel>(
 }
 
 impl<'a> Setup<'a> {
-    /// The same model and segments at other channel scales (one per
-    /// segment), with a simulation count of its own.
-    pub(super) fn with_weights(&self, weights: Vec<Weights>) -> Setup<'a> {
-        Setup {
-            base: self.base.clone(),
-            segments: self.segments,
-            weights,
-            options: self.options.clone(),
-            slots: self.slots.clone(),
-            parameters: self.parameters.clone(),
-            simulate: self.simulate,
-            sensitivities: self.sensitivities,
-            extra_states: self.extra_states,
-            steer_bias: self.steer_bias,
-            model_parameters: self.model_parameters,
-            simulations: AtomicUsize::new(0),
-        }
-    }
-
     /// A setup for model `M` with the effect parameters of `candidates`
     /// active (their fixed values written into `base`).
     pub fn new<M: MultibodyModel>(

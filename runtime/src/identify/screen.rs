@@ -24,6 +24,7 @@
 //! finite one (on an independent set, a fitted gain 54 times the
 //! prediction), so it is always fitted.
 
+use super::fitted::weighted_ss;
 use super::normal::{Normal, SegmentJacobian};
 use super::problem::{Free, Problem};
 use super::Candidate;
@@ -114,9 +115,13 @@ fn predict(
             SegmentError::of(&r, &s.segments[m], s.weights[m])
         })
         .collect();
+    // The criterion weighs the weighted sum of squares at the search's
+    // scales, the sum the linearised step minimised.
+    let chi2 = weighted_ss(&errors, s.weights);
     let predicted = CandidateFit {
         errors,
         values: vec![0.0; k],
+        chi2,
         ..s.current.clone()
     };
     let bic = bic(&predicted, s.reference);
