@@ -180,29 +180,7 @@ mod tests {
         // The base model's weighted sum per sample (508 / 404) times 3.
         let s2 = 508.0 / 404.0 * 3.0;
         assert!((data_variance(&base) - s2).abs() < 1e-12);
-        let c = Candidate {
-            name: "correct I3z".into(),
-            effects: Vec::new(),
-            parameters: vec![crate::identify::EffectParameter {
-                symbol: "I3z".into(),
-                tied: Vec::new(),
-                moves: Vec::new(),
-                scale: 0.1,
-                dissipative: false,
-                unit: String::new(),
-                initial: None,
-                lower: None,
-                upper: None,
-                shape: false,
-                prior: Some((1.25, 0.125)),
-                gross_beyond: PLAUSIBLE_PRIOR_SDS,
-            }],
-            fixed: Vec::new(),
-            speed_decay: false,
-            reason: String::new(),
-            alternative_model: false,
-            nonsmooth: false,
-        };
+        let c = crate::identify::selection::tests::candidate("correct I3z", "I3z", Some((1.25, 0.125)));
         let scaled = with_priors_on_the_data_scale(&[c], &base);
         let (_, sd) = scaled[0].parameters[0].prior.unwrap();
         assert!((sd - 0.125 / s2.sqrt()).abs() < 1e-15);

@@ -691,4 +691,4 @@ impl<'s> Search<'s> {
 
 #[cfg(test)]
 #[path = "selection_tests.rs"]
-mod tests;
+pub(super) mod tests;

@@ -3,7 +3,7 @@
 
 use super::*;
 
-fn candidate(name: &str, symbol: &str, prior: Option<(f64, f64)>) -> Candidate {
+pub(crate) fn candidate(name: &str, symbol: &str, prior: Option<(f64, f64)>) -> Candidate {
     Candidate {
         name: name.into(),
         effects: Vec::new(),
