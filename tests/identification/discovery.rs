@@ -347,8 +347,8 @@ fn in_the_time_series_a_steer_damper_the_library_lacks_is_found_and_halves_the_r
 /// criterion of a variance per kick and channel, the first start added a
 /// steer stiffness growing with v^2 and saw no gain left for the force
 /// (roll error 0.43 deg), and only the second found it; with the criterion
-/// on the fits' own weighted sum the first start already ends at the force
-/// and the second, equal to it, is not kept (the second start is kept only
+/// on the fits' own weighted sum (on its branch, stop 72) the first start
+/// already ended at the force and the second, equal to it, was not kept (the second start is kept only
 /// when it predicts the held-out runs better by more than one standard
 /// error). (Seed 11, the example's in `examples/discovered_force`, takes a
 /// third path: the force enters beside the stand-ins, and the backward

@@ -12,7 +12,7 @@ use super::fitted::{CandidateFit, IdentifyOptions, SegmentError};
 use super::levenberg_marquardt::lm_fit;
 use super::normal::Normal;
 use super::problem::{Free, Problem};
-use super::{IdentifyError, Setup, Weights, NUISANCE};
+use super::{IdentifyError, Setup, NUISANCE};
 use std::sync::atomic::Ordering;
 
 /// Fit a model with the setup's effect parameters free, starting from `g0`
@@ -61,19 +61,17 @@ pub(super) fn fit_trial(
         .filter(|&j| setup.parameters.get(j).is_some_and(|q| q.dissipative))
         .collect();
     let full = lm_fit(problem, opts.patience);
-    let unweight = |res: &[Vec<f64>], weights: &[Weights]| -> Vec<SegmentError> {
-        res.iter()
-            .zip(setup.segments)
-            .zip(weights)
-            .map(|((r, s), w)| SegmentError::of(r, s, *w))
-            .collect()
-    };
     let simulations = || setup.simulations.load(Ordering::Relaxed) - sims_before;
     let res = full.all_residuals().ok_or_else(|| IdentifyError::Simulation {
         run: setup.segments[0].run.clone(),
         message: "the fitted model does not simulate every segment".into(),
     })?;
-    let errors = unweight(&res, &setup.weights);
+    let errors: Vec<SegmentError> = res
+        .iter()
+        .zip(setup.segments)
+        .zip(&setup.weights)
+        .map(|((r, s), w)| SegmentError::of(r, s, *w))
+        .collect();
     // The weighted sum of squares at the search's scales: the fit's
     // objective (prior rows aside), what fits compare by and the
     // criterion weighs.

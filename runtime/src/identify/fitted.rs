@@ -155,20 +155,6 @@ pub(super) fn channel_scales(errors: &[SegmentError]) -> Vec<Weights> {
         .collect()
 }
 
-/// The weighted sum of squares of `errors` at the channel scales
-/// `weights` (the objective of a fit at those scales, prior rows aside).
-pub(super) fn weighted_ss(errors: &[SegmentError], weights: &[Weights]) -> f64 {
-    errors
-        .iter()
-        .zip(weights)
-        .map(|(e, w)| {
-            e.channel_ss[0] / (w.roll * w.roll)
-                + e.channel_ss[1] / (w.steer * w.steer)
-                + e.channel_ss[2] / (w.speed * w.speed)
-        })
-        .sum()
-}
-
 /// Overall RMS of a channel over segments (rad or m/s).
 pub fn pooled_rms(errors: &[SegmentError], channel: usize) -> f64 {
     let (ss, n) = errors.iter().fold((0.0, 0usize), |(a, b), e| {
@@ -218,6 +204,10 @@ mod tests {
         // A channel without residual takes the best segment's level.
         assert!(close(w[0].speed, 0.1) && close(w[1].speed, 0.1));
         // At its own scales each segment's channel weighs its sample count.
-        assert!(close(weighted_ss(&errors[..1], &w[..1]), 204.0));
+        let e = &errors[0];
+        let at_own = e.channel_ss[0] / (w[0].roll * w[0].roll)
+            + e.channel_ss[1] / (w[0].steer * w[0].steer)
+            + e.channel_ss[2] / (w[0].speed * w[0].speed);
+        assert!(close(at_own, 204.0));
     }
 }

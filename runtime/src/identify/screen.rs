@@ -24,7 +24,6 @@
 //! finite one (on an independent set, a fitted gain 54 times the
 //! prediction), so it is always fitted.
 
-use super::fitted::weighted_ss;
 use super::normal::{Normal, SegmentJacobian};
 use super::problem::{Free, Problem};
 use super::Candidate;
@@ -103,6 +102,9 @@ fn predict(
         return None;
     }
     let dg = DVector::from_column_slice(&dx[..k]);
+    // The criterion weighs the weighted sum of squares at the search's
+    // scales, the sum the linearised step minimised.
+    let mut chi2 = 0.0;
     let errors: Vec<SegmentError> = sub
         .iter()
         .zip(res)
@@ -112,12 +114,10 @@ fn predict(
             let di = DVector::from_column_slice(&dx[k + m * nn..k + (m + 1) * nn]);
             let moved = &b.a * &dg + &b.b * di;
             let r: Vec<f64> = r.iter().zip(moved.iter()).map(|(a, d)| a + d).collect();
+            chi2 += r.iter().map(|x| x * x).sum::<f64>();
             SegmentError::of(&r, &s.segments[m], s.weights[m])
         })
         .collect();
-    // The criterion weighs the weighted sum of squares at the search's
-    // scales, the sum the linearised step minimised.
-    let chi2 = weighted_ss(&errors, s.weights);
     let predicted = CandidateFit {
         errors,
         values: vec![0.0; k],
